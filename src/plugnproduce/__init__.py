@@ -1,0 +1,5 @@
+"""plugnproduce: the Plug'n'Produce cell controller."""
+
+from __future__ import annotations
+
+__version__ = "0.1.0"

@@ -1,0 +1,338 @@
+"""Description files → :mod:`plugnproduce.description.model` objects.
+
+Every error names the file and line. The RDF graph each description came from is
+kept (:class:`Loaded`) so the SHACL shapes can check the same data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from urllib.parse import unquote, urlparse
+
+import rdflib
+import yaml
+from rdflib.namespace import RDF, RDFS, XSD
+
+from plugnproduce.description.charts import device_chart, process_regions
+from plugnproduce.description.model import (
+    Cell,
+    DeviceDescription,
+    Parameter,
+    ProcessDescription,
+    Role,
+    Step,
+    Task,
+    Where,
+)
+from plugnproduce.description.rdf import term_line
+from plugnproduce.errors import DescriptionError
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import PNP, local_name
+from plugnproduce.safeio import parse_turtle, parse_yaml_node
+
+PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """A parsed Turtle description: its graph, text and path."""
+
+    path: Path
+    graph: rdflib.Graph
+    text: str
+
+    def line(self, iri: str) -> int | None:
+        """The line where ``iri`` is described in the file."""
+        return term_line(self.text, self.graph, iri)
+
+    def where(self, iri: str) -> Where:
+        """The place where ``iri`` is described."""
+        return Where(str(self.path), self.line(iri))
+
+
+def read_description(path: str | Path) -> Loaded:
+    """Parse a Turtle description file."""
+    p = Path(path)
+    g, text = parse_turtle(p)
+    return Loaded(p, g, text)
+
+
+def _one(loaded: Loaded, subject: rdflib.term.Node, prop: rdflib.URIRef, what: str) -> rdflib.term.Node:
+    values = list(loaded.graph.objects(subject, prop))
+    if len(values) != 1:
+        found = "none" if not values else f"{len(values)} values"
+        raise DescriptionError(
+            f"{local_name(str(subject))} needs exactly one {what} ({local_name(str(prop))}); found {found}",
+            loaded.path,
+            loaded.line(str(subject)),
+        )
+    return values[0]
+
+
+def _opt(loaded: Loaded, subject: rdflib.term.Node, prop: rdflib.URIRef) -> rdflib.term.Node | None:
+    return next(iter(loaded.graph.objects(subject, prop)), None)
+
+
+def file_of(iri: rdflib.term.Node) -> Path:
+    """The local path a ``file:`` IRI (a relative reference in a description) names."""
+    return Path(unquote(urlparse(str(iri)).path))
+
+
+def device_subject(loaded: Loaded, taxonomy: Taxonomy) -> rdflib.URIRef:
+    """The one device a device description describes."""
+    devices = sorted(
+        {s for s, c in loaded.graph.subject_objects(RDF.type) if isinstance(s, rdflib.URIRef)
+         and taxonomy.is_kind(str(c), "Device")}
+    )
+    if len(devices) != 1:
+        raise DescriptionError(
+            f"a device description describes exactly one device (an individual of a pnp:Device class); "
+            f"found {len(devices)}",
+            loaded.path,
+            1,
+        )
+    return devices[0]
+
+
+def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
+    """Build the device of a parsed description, with its chart and reasoned skills."""
+    s = device_subject(loaded, taxonomy)
+    classes = tuple(sorted(str(c) for c in loaded.graph.objects(s, RDF.type) if taxonomy.is_kind(str(c), "Device")))
+    declared = tuple(sorted(str(k) for k in loaded.graph.objects(s, PNP.hasSkill)))
+    protocol = str(_one(loaded, s, PNP.protocol, "protocol"))
+    if protocol not in PROTOCOL_NAMES:
+        raise DescriptionError(
+            f"unknown protocol {local_name(protocol)}; expected pnp:XIRP or pnp:UPnP", loaded.path, loaded.line(str(s))
+        )
+    chart_file = file_of(_one(loaded, s, PNP.stateChart, "state chart"))
+    initial, states, transitions = device_chart(chart_file)
+    timeout = _opt(loaded, s, PNP.commandTimeout)
+    cost = _opt(loaded, s, PNP.cost)
+    label = _opt(loaded, s, RDFS.label)
+    return DeviceDescription(
+        id=local_name(str(s)),
+        iri=str(s),
+        label=str(label) if label is not None else local_name(str(s)),
+        classes=classes,
+        declared_skills=declared,
+        protocol=PROTOCOL_NAMES[protocol],
+        endpoint=str(_one(loaded, s, PNP.endpoint, "endpoint")),
+        chart_file=str(chart_file),
+        initial=initial,
+        states=states,
+        transitions=transitions,
+        where=loaded.where(str(s)),
+        command_timeout=float(timeout.toPython()) if isinstance(timeout, rdflib.Literal) else 10.0,
+        cost=float(cost.toPython()) if isinstance(cost, rdflib.Literal) else 0.0,
+        skills=tuple(sorted(taxonomy.device_skills(classes, declared))),
+    )
+
+
+def load_device(path: str | Path, taxonomy: Taxonomy) -> DeviceDescription:
+    """Read a device description (Turtle + its Device State Chart)."""
+    return device_from(read_description(path), taxonomy)
+
+
+def process_from(loaded: Loaded) -> ProcessDescription:
+    """Build the process of a parsed description, with its chart's regions."""
+    subjects = sorted({s for s in loaded.graph.subjects(PNP.generalChart) if isinstance(s, rdflib.URIRef)})
+    if len(subjects) != 1:
+        raise DescriptionError(
+            f"a process description describes exactly one process (with pnp:generalChart); found {len(subjects)}",
+            loaded.path,
+            1,
+        )
+    s = subjects[0]
+    chart_file = file_of(_one(loaded, s, PNP.generalChart, "general process state chart"))
+    regions = process_regions(chart_file)
+    roles: list[Role] = []
+    for r in sorted(loaded.graph.objects(s, PNP.hasRole)):
+        name = str(_one(loaded, r, PNP.roleName, "role name"))
+        if name not in regions:
+            raise DescriptionError(
+                f"role {name!r} has no region in {chart_file.name}; expected a region with pnp:role=\"{name}\"",
+                loaded.path,
+                loaded.line(str(r)),
+            )
+        skill = str(_one(loaded, r, PNP.requiresSkill, "required skill"))
+        roles.append(Role(name, str(r), skill, regions[name], loaded.where(str(r))))
+    missing = sorted(set(regions) - {r.name for r in roles})
+    if missing:
+        raise DescriptionError(
+            f"chart region(s) {', '.join(missing)} have no pnp:Role in the metadata", loaded.path, loaded.line(str(s))
+        )
+    params = tuple(sorted((_parameter(loaded, p) for p in loaded.graph.objects(s, PNP.hasParameter)), key=lambda p: p.name))
+    label = _opt(loaded, s, RDFS.label)
+    comment = _opt(loaded, s, RDFS.comment)
+    return ProcessDescription(
+        id=local_name(str(s)),
+        iri=str(s),
+        label=str(label) if label is not None else local_name(str(s)),
+        comment=str(comment) if comment is not None else "",
+        classes=tuple(sorted(str(c) for c in loaded.graph.objects(s, RDF.type))),
+        roles=tuple(sorted(roles, key=lambda r: r.name)),
+        parameters=params,
+        chart_file=str(chart_file),
+        where=loaded.where(str(s)),
+    )
+
+
+def _number(node: rdflib.term.Node | None) -> float | None:
+    return float(node.toPython()) if isinstance(node, rdflib.Literal) else None
+
+
+def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
+    role = _one(loaded, p, PNP.forRole, "role")
+    role_name = _opt(loaded, role, PNP.roleName)
+    default = _opt(loaded, p, PNP.defaultValue)
+    return Parameter(
+        name=str(_one(loaded, p, PNP.parameterName, "parameter name")),
+        iri=str(p),
+        role=str(role_name) if role_name is not None else local_name(str(role)),
+        quantity=str(_one(loaded, p, PNP.quantity, "quantity")),
+        datatype=str(_one(loaded, p, PNP.datatype, "datatype")),
+        unit=str(_opt(loaded, p, PNP.unit) or ""),
+        minimum=_number(_opt(loaded, p, PNP.minValue)),
+        maximum=_number(_opt(loaded, p, PNP.maxValue)),
+        default=default.toPython() if isinstance(default, rdflib.Literal) else None,
+        where=loaded.where(str(p)),
+    )
+
+
+def load_process(path: str | Path) -> ProcessDescription:
+    """Read a process description (Turtle + its General Process State Chart)."""
+    return process_from(read_description(path))
+
+
+# ------------------------------------------------------------------ YAML: tasks and cells
+
+
+def _mapping(node: yaml.Node, path: Path, what: str) -> dict[str, yaml.Node]:
+    if not isinstance(node, yaml.MappingNode):
+        raise DescriptionError(f"{what} must be a mapping", path, node.start_mark.line + 1)
+    out: dict[str, yaml.Node] = {}
+    for k, v in node.value:
+        if not isinstance(k, yaml.ScalarNode):
+            raise DescriptionError(f"{what}: keys must be plain names", path, k.start_mark.line + 1)
+        if k.value in out:
+            raise DescriptionError(f"{what}: key {k.value!r} appears twice", path, k.start_mark.line + 1)
+        out[k.value] = v
+    return out
+
+
+def _plain(node: yaml.Node) -> object:
+    return yaml.SafeLoader("").construct_document(node)  # type: ignore[no-untyped-call]
+
+
+def _unknown_keys(m: dict[str, yaml.Node], allowed: set[str], path: Path, what: str) -> None:
+    for k, v in m.items():
+        if k not in allowed:
+            raise DescriptionError(
+                f"{what}: unknown key {k!r}; expected one of {', '.join(sorted(allowed))}", path, v.start_mark.line
+            )
+
+
+def _str_map(node: yaml.Node | None, path: Path, what: str) -> dict[str, object]:
+    if node is None:
+        return {}
+    value = _plain(node)
+    if not isinstance(value, dict):
+        raise DescriptionError(f"{what} must be a mapping", path, node.start_mark.line + 1)
+    return {str(k): v for k, v in value.items()}
+
+
+def load_task(path: str | Path) -> Task:
+    """Read a task description (YAML)."""
+    p = Path(path)
+    top = _mapping(parse_yaml_node(p), p, "task")
+    _unknown_keys(top, {"task", "description", "repeat", "steps"}, p, "task")
+    if "task" not in top or "steps" not in top:
+        raise DescriptionError("a task needs 'task' (its name) and 'steps'", p, 1)
+    repeat = _plain(top["repeat"]) if "repeat" in top else 1
+    if not isinstance(repeat, int) or isinstance(repeat, bool) or not 1 <= repeat <= 1000:
+        raise DescriptionError(f"repeat must be a whole number from 1 to 1000; found {repeat!r}", p,
+                               top["repeat"].start_mark.line + 1)
+    steps_node = top["steps"]
+    if not isinstance(steps_node, yaml.SequenceNode) or not steps_node.value:
+        raise DescriptionError("steps must be a non-empty list", p, steps_node.start_mark.line + 1)
+    one_round: list[tuple[str, dict[str, str], dict[str, object], int]] = []
+    for node in steps_node.value:
+        line = node.start_mark.line + 1
+        m = _mapping(node, p, "step")
+        _unknown_keys(m, {"command", "bind", "params"}, p, "step")
+        if "command" not in m or not isinstance(_plain(m["command"]), str):
+            raise DescriptionError("a step needs 'command': the name of a process command", p, line)
+        bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
+        one_round.append((str(_plain(m["command"])), bind, _str_map(m.get("params"), p, "params"), line))
+    steps = [
+        Step(i * len(one_round) + j + 1, cmd, bind, params, line)
+        for i in range(repeat)
+        for j, (cmd, bind, params, line) in enumerate(one_round)
+    ]
+    description = _plain(top["description"]) if "description" in top else ""
+    return Task(str(_plain(top["task"])), tuple(steps), str(p), str(description or ""), repeat)
+
+
+def task_to_yaml(task: Task) -> str:
+    """Write a task back as YAML (one round of its steps when it repeats)."""
+    n = len(task.steps) // task.repeat
+    steps = []
+    for s in task.steps[:n]:
+        entry: dict[str, object] = {"command": s.command}
+        if s.bind:
+            entry["bind"] = dict(s.bind)
+        if s.params:
+            entry["params"] = dict(s.params)
+        steps.append(entry)
+    doc: dict[str, object] = {"task": task.name}
+    if task.description:
+        doc["description"] = task.description
+    if task.repeat != 1:
+        doc["repeat"] = task.repeat
+    doc["steps"] = steps
+    return yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
+
+
+def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
+    """A cell file's name and its device description files with the lines that list them."""
+    p = Path(path)
+    top = _mapping(parse_yaml_node(p), p, "cell")
+    _unknown_keys(top, {"cell", "devices"}, p, "cell")
+    if "cell" not in top or "devices" not in top or not isinstance(top["devices"], yaml.SequenceNode):
+        raise DescriptionError("a cell needs 'cell' (its name) and 'devices' (a list of files)", p, 1)
+    files = []
+    for node in top["devices"].value:
+        if not isinstance(node, yaml.ScalarNode):
+            raise DescriptionError("each device is a path to a device description", p, node.start_mark.line + 1)
+        files.append(((p.parent / node.value).resolve(), node.start_mark.line + 1))
+    return str(_plain(top["cell"])), files
+
+
+def load_cell(path: str | Path, taxonomy: Taxonomy) -> Cell:
+    """Read a cell (YAML) and all its device descriptions."""
+    name, files = cell_device_files(path)
+    devices = []
+    for f, line in files:
+        if not f.is_file():
+            raise DescriptionError(f"device description {f.name} not found", path, line)
+        devices.append(load_device(f, taxonomy))
+    ids = [d.id for d in devices]
+    for d in devices:
+        if ids.count(d.id) > 1:
+            raise DescriptionError(f"device id {d.id!r} appears twice in the cell", path)
+    return Cell(name, tuple(devices), str(path))
+
+
+def load_devices(folder: str | Path, taxonomy: Taxonomy) -> list[DeviceDescription]:
+    """Every device description in a folder (a catalogue), sorted by id."""
+    return sorted((load_device(f, taxonomy) for f in sorted(Path(folder).glob("*.ttl"))), key=lambda d: d.id)
+
+
+def load_processes(folder: str | Path) -> list[ProcessDescription]:
+    """Every process description in a folder, sorted by command name."""
+    return sorted((load_process(f) for f in sorted(Path(folder).glob("*.ttl"))), key=lambda p: p.id)
+
+
+POSE_DATATYPE = str(PNP.Pose)
+NUMERIC = {str(XSD.decimal), str(XSD.integer), str(XSD.double), str(XSD.float)}

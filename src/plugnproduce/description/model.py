@@ -1,0 +1,237 @@
+"""The descriptions as plain data: devices, processes, tasks and cells (paper section 5).
+
+Nothing here does I/O; :mod:`plugnproduce.description.loader` builds these objects
+from files, and every object remembers the file and line it came from so that a
+finding can say where it rests.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+Protocol = Literal["xirp", "upnp"]
+PROTOCOLS: tuple[Protocol, ...] = ("xirp", "upnp")
+
+
+@dataclass(frozen=True)
+class Where:
+    """A place in a description file."""
+
+    file: str
+    line: int | None = None
+
+    def __str__(self) -> str:
+        return self.file if self.line is None else f"{self.file}:{self.line}"
+
+
+@dataclass(frozen=True)
+class Command:
+    """A device command from the device's side: wait for a request, or send an event."""
+
+    protocol: str
+    kind: Literal["request", "event"]
+    name: str
+
+    @property
+    def event(self) -> str:
+        """The SCXML event name, e.g. ``xirp.request.Open``."""
+        return f"{self.protocol}.{self.kind}.{self.name}"
+
+    @classmethod
+    def parse(cls, event: str) -> Command | None:
+        """The command an event name stands for, or None for an internal event."""
+        parts = event.split(".", 2)
+        if len(parts) == 3 and parts[0] in PROTOCOLS and parts[1] in ("request", "event"):
+            return cls(parts[0], parts[1], parts[2])  # type: ignore[arg-type]
+        return None
+
+
+@dataclass(frozen=True)
+class ChartState:
+    """A state of a Device State Chart, with the ontology concept it is annotated with."""
+
+    id: str
+    concept: str | None
+    line: int | None
+
+
+@dataclass(frozen=True)
+class ChartTransition:
+    """A transition of a Device State Chart with the device commands on it."""
+
+    source: str
+    target: str
+    event: str | None
+    """Triggering event: a request (``xirp.request.Open``), an internal event, or None."""
+    sends: tuple[Command, ...]
+    """Protocol events the device sends while taking it (including the target's onentry)."""
+    accepts: tuple[str, ...]
+    """Quantity concept IRIs a request carries (``pnp:accepts``)."""
+    line: int | None
+
+    @property
+    def request(self) -> Command | None:
+        """The request this transition waits for, if any."""
+        cmd = Command.parse(self.event) if self.event else None
+        return cmd if cmd is not None and cmd.kind == "request" else None
+
+
+@dataclass(frozen=True)
+class DeviceDescription:
+    """A device: its metadata and its Device State Chart."""
+
+    id: str
+    iri: str
+    label: str
+    classes: tuple[str, ...]
+    declared_skills: tuple[str, ...]
+    protocol: str
+    endpoint: str
+    chart_file: str
+    initial: str
+    states: tuple[ChartState, ...]
+    transitions: tuple[ChartTransition, ...]
+    where: Where
+    command_timeout: float = 10.0
+    cost: float = 0.0
+    skills: tuple[str, ...] = ()
+    """Every skill of the device after reasoning (declared, implied by class, super-skills)."""
+
+    def state(self, state_id: str) -> ChartState:
+        """The chart state called ``state_id``."""
+        for s in self.states:
+            if s.id == state_id:
+                return s
+        raise KeyError(f"device {self.id} has no state {state_id!r}")
+
+
+@dataclass(frozen=True)
+class RegionState:
+    """A state of one role's region of a General Process State Chart."""
+
+    id: str
+    concept: str
+    line: int | None
+    params: tuple[str, ...] = ()
+    """Parameter names consumed on the way into this state (``pnp:params``)."""
+    waits_for: str | None = None
+    """State id of another region this state waits for (``In('...')``) before it is entered."""
+
+
+@dataclass(frozen=True)
+class Role:
+    """A role of a process: the skill it requires and the states its region visits."""
+
+    name: str
+    iri: str
+    required_skill: str
+    region: tuple[RegionState, ...]
+    where: Where
+
+    @property
+    def start_concept(self) -> str:
+        """The state concept the device must be in when the process starts."""
+        return self.region[0].concept
+
+    @property
+    def end_concept(self) -> str:
+        """The state concept the device is left in."""
+        return self.region[-1].concept
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A process parameter the user fills in on the HMI."""
+
+    name: str
+    iri: str
+    role: str
+    quantity: str
+    datatype: str
+    unit: str
+    minimum: float | None
+    maximum: float | None
+    default: object
+    where: Where
+
+
+@dataclass(frozen=True)
+class ProcessDescription:
+    """A process: roles, parameters and its General Process State Chart."""
+
+    id: str
+    iri: str
+    label: str
+    comment: str
+    classes: tuple[str, ...]
+    roles: tuple[Role, ...]
+    parameters: tuple[Parameter, ...]
+    chart_file: str
+    where: Where
+
+    def role(self, name: str) -> Role:
+        """The role called ``name``."""
+        for r in self.roles:
+            if r.name == name:
+                return r
+        raise KeyError(f"process {self.id} has no role {name!r}")
+
+    def parameter(self, name: str) -> Parameter:
+        """The parameter called ``name``."""
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(f"process {self.id} has no parameter {name!r}")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One process command of a task, with its role bindings and parameter values."""
+
+    index: int
+    """1-based position in the expanded task."""
+    command: str
+    bind: dict[str, str] = field(default_factory=dict)
+    params: dict[str, object] = field(default_factory=dict)
+    line: int | None = None
+
+
+@dataclass(frozen=True)
+class Task:
+    """A task description: an ordered list of process commands."""
+
+    name: str
+    steps: tuple[Step, ...]
+    file: str
+    description: str = ""
+    repeat: int = 1
+
+    def where(self, step: Step) -> Where:
+        """The place of a step in the task file."""
+        return Where(self.file, step.line)
+
+
+@dataclass(frozen=True)
+class Cell:
+    """A set of devices."""
+
+    name: str
+    devices: tuple[DeviceDescription, ...]
+    file: str | None = None
+
+    def device(self, device_id: str) -> DeviceDescription:
+        """The device called ``device_id``."""
+        for d in self.devices:
+            if d.id == device_id:
+                return d
+        raise KeyError(f"cell {self.name} has no device {device_id!r}")
+
+    def without(self, device_id: str) -> Cell:
+        """The same cell with one device unplugged."""
+        return Cell(self.name, tuple(d for d in self.devices if d.id != device_id), self.file)
+
+    def with_device(self, device: DeviceDescription) -> Cell:
+        """The same cell with one more device plugged in (replacing one of the same id)."""
+        rest = tuple(d for d in self.devices if d.id != device.id)
+        return Cell(self.name, rest + (device,), self.file)

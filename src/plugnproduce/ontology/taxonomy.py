@@ -1,0 +1,224 @@
+"""The taxonomy closure: what the DL reasoner (HermiT through owlready2) derives from the TBox.
+
+The closure is computed once per ontology content and cached on disk by its SHA-256,
+because HermiT costs a JVM start per call. Everything downstream (SHACL, ASP facts,
+code generation) asks this object, never the reasoner.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import tempfile
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import rdflib
+from rdflib.namespace import OWL, RDF, RDFS
+
+from plugnproduce.errors import OntologyError
+from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, local_name
+from plugnproduce.resources import ontology_path
+from plugnproduce.safeio import parse_turtle
+
+CACHE_VERSION = 1
+_CAPABILITY_PREFIX = PNP_IRI + "_HasSkill_"
+ROOTS = ("Device", "Skill", "StateConcept", "Process", "Quantity")
+
+
+@dataclass(frozen=True)
+class Taxonomy:
+    """Class subsumption, implied skills and mandatory states of the ontology."""
+
+    digest: str
+    superclasses: dict[str, frozenset[str]]
+    """Every named class → its named superclasses and equivalents, itself included."""
+    implied_skills: dict[str, frozenset[str]]
+    """Device class → every skill a device of that class has (super-skills included)."""
+    mandatory_states: dict[str, frozenset[str]]
+    """Skill → state concepts a device with that skill must have (own and inherited)."""
+    labels: dict[str, str] = field(default_factory=dict)
+
+    def is_a(self, sub: str, sup: str) -> bool:
+        """Whether class ``sub`` is subsumed by ``sup`` (reflexive)."""
+        return sup in self.superclasses.get(sub, frozenset((sub,)))
+
+    def knows(self, iri: str) -> bool:
+        """Whether ``iri`` is a named class of the ontology."""
+        return iri in self.superclasses
+
+    def is_kind(self, iri: str, root: str) -> bool:
+        """Whether ``iri`` is a class under one of :data:`ROOTS` (e.g. ``"Skill"``)."""
+        return self.is_a(iri, PNP_IRI + root) and iri != PNP_IRI + root
+
+    def classes_of_kind(self, root: str) -> list[str]:
+        """All named classes under ``root``, sorted."""
+        return sorted(c for c in self.superclasses if self.is_kind(c, root))
+
+    def skill_closure(self, skills: Iterable[str]) -> frozenset[str]:
+        """The given skills and every skill subsuming them."""
+        out: set[str] = set()
+        for s in skills:
+            out |= {c for c in self.superclasses.get(s, {s}) if self.is_kind(c, "Skill")}
+        return frozenset(out)
+
+    def device_skills(self, device_classes: Iterable[str], declared: Iterable[str]) -> frozenset[str]:
+        """Skills of a device: declared ones, those its classes imply, and their super-skills."""
+        implied: set[str] = set(declared)
+        for c in device_classes:
+            implied |= self.implied_skills.get(c, frozenset())
+        return self.skill_closure(implied)
+
+    def label(self, iri: str) -> str:
+        """The human label of a term, or its local name."""
+        return self.labels.get(iri, local_name(iri))
+
+    def to_json(self) -> str:
+        """Serialise for the on-disk cache."""
+        return json.dumps(
+            {
+                "version": CACHE_VERSION,
+                "digest": self.digest,
+                "superclasses": {k: sorted(v) for k, v in sorted(self.superclasses.items())},
+                "implied_skills": {k: sorted(v) for k, v in sorted(self.implied_skills.items())},
+                "mandatory_states": {k: sorted(v) for k, v in sorted(self.mandatory_states.items())},
+                "labels": dict(sorted(self.labels.items())),
+            },
+            indent=1,
+        )
+
+    @classmethod
+    def from_json(cls, text: str) -> Taxonomy:
+        """Read back what :meth:`to_json` wrote."""
+        d = json.loads(text)
+        if d.get("version") != CACHE_VERSION:
+            raise ValueError("cache version differs")
+
+        def sets(m: dict[str, list[str]]) -> dict[str, frozenset[str]]:
+            return {k: frozenset(v) for k, v in m.items()}
+
+        return cls(
+            d["digest"],
+            sets(d["superclasses"]),
+            sets(d["implied_skills"]),
+            sets(d["mandatory_states"]),
+            d["labels"],
+        )
+
+
+def ontology_files(folder: Path | None = None) -> list[Path]:
+    """The TBox files of an ontology folder: every ``.ttl`` except the SHACL shapes."""
+    folder = folder or ontology_path()
+    return sorted(p for p in folder.glob("*.ttl") if p.name != "shapes.ttl")
+
+
+def read_tbox(files: Iterable[Path]) -> rdflib.Graph:
+    """Parse the TBox files into one graph, with ``file: message`` errors."""
+    g = rdflib.Graph()
+    for p in files:
+        g += parse_turtle(p)[0]
+    return g
+
+
+def _digest(files: Iterable[Path]) -> str:
+    h = hashlib.sha256()
+    for p in files:
+        h.update(p.name.encode() + b"\0" + p.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def default_cache_dir() -> Path:
+    """Where closures are cached: the user's cache folder."""
+    return Path.home() / ".cache" / "plugnproduce"
+
+
+def load_taxonomy(
+    files: Iterable[Path] | None = None, cache_dir: Path | None = None, use_cache: bool = True
+) -> Taxonomy:
+    """The taxonomy closure of the ontology, from the cache or from HermiT."""
+    paths = list(files) if files is not None else ontology_files()
+    digest = _digest(paths)
+    cache = (cache_dir or default_cache_dir()) / f"taxonomy-{digest[:32]}.json"
+    if use_cache and cache.is_file():
+        try:
+            return Taxonomy.from_json(cache.read_text())
+        except (ValueError, KeyError):
+            pass  # stale or damaged cache: recompute
+    taxonomy = classify(read_tbox(paths), digest)
+    if use_cache:
+        try:
+            cache.parent.mkdir(parents=True, exist_ok=True)
+            tmp = cache.with_suffix(".tmp")
+            tmp.write_text(taxonomy.to_json())
+            tmp.replace(cache)
+        except OSError:
+            pass  # a read-only home only costs the next run a reasoner call
+    return taxonomy
+
+
+def _named_subclasses(g: rdflib.Graph, root: rdflib.URIRef) -> set[str]:
+    return {str(c) for c in g.transitive_subjects(RDFS.subClassOf, root) if isinstance(c, rdflib.URIRef)}
+
+
+def classify(g: rdflib.Graph, digest: str = "") -> Taxonomy:
+    """Run HermiT on the TBox ``g`` and read off the closure."""
+    import owlready2
+
+    skills = sorted(_named_subclasses(g, PNP.Skill) - {str(PNP.Skill)})
+    cap = rdflib.Graph()
+    for s in skills:  # _HasSkill_S ≡ Device ⊓ ∃hasSkill.S, so classification reveals implied skills
+        c, r, i = rdflib.URIRef(_CAPABILITY_PREFIX + local_name(s)), rdflib.BNode(), rdflib.BNode()
+        cap.add((c, RDF.type, OWL.Class))
+        cap.add((r, RDF.type, OWL.Restriction))
+        cap.add((r, OWL.onProperty, PNP.hasSkill))
+        cap.add((r, OWL.someValuesFrom, rdflib.URIRef(s)))
+        lst = rdflib.BNode()
+        rdflib.collection.Collection(cap, lst, [PNP.Device, r])
+        cap.add((i, RDF.type, OWL.Class))
+        cap.add((i, OWL.intersectionOf, lst))
+        cap.add((c, OWL.equivalentClass, i))
+    nt = (g + cap).serialize(format="nt", encoding="utf-8")
+    world = owlready2.World()
+    try:
+        onto = world.get_ontology(PNP_IRI.rstrip("#")).load(fileobj=io.BytesIO(nt), format="ntriples")
+        with tempfile.TemporaryDirectory(prefix="pnp-hermit-") as tmp:
+            saved, tempfile.tempdir = tempfile.tempdir, tmp
+            try:
+                with onto:
+                    owlready2.sync_reasoner_hermit(world, infer_property_values=False, debug=0)
+            finally:
+                tempfile.tempdir = saved
+    except owlready2.OwlReadyInconsistentOntologyError as exc:
+        raise OntologyError("the ontology is inconsistent (HermiT)") from exc
+    except owlready2.OwlReadyJavaError as exc:
+        raise OntologyError(f"HermiT failed: {str(exc).splitlines()[0]}") from exc
+    return _read_closure(world, g, skills, digest)
+
+
+def _read_closure(world: object, g: rdflib.Graph, skills: list[str], digest: str) -> Taxonomy:
+    import owlready2
+
+    superclasses: dict[str, frozenset[str]] = {}
+    implied: dict[str, frozenset[str]] = {}
+    for cls in world.classes():  # type: ignore[attr-defined]
+        iri = cls.iri
+        if iri.startswith(_CAPABILITY_PREFIX):
+            continue
+        named = {a.iri for a in cls.ancestors() if isinstance(a, owlready2.ThingClass)}
+        named |= {e.iri for e in cls.equivalent_to if isinstance(e, owlready2.ThingClass)}
+        named.discard(str(OWL.Thing))
+        caps = {PNP_IRI + a[len(_CAPABILITY_PREFIX):] for a in named if a.startswith(_CAPABILITY_PREFIX)}
+        superclasses[iri] = frozenset(a for a in named if not a.startswith(_CAPABILITY_PREFIX))
+        if caps and iri != str(PNP.Device):
+            implied[iri] = frozenset(caps)
+    mandatory: dict[str, frozenset[str]] = {}
+    for s in skills:
+        states = {
+            str(m) for sup in superclasses.get(s, {s}) for m in g.objects(rdflib.URIRef(sup), PNP.mandatoryState)
+        }
+        if states:
+            mandatory[s] = frozenset(states)
+    labels = {str(s): str(o) for s, o in g.subject_objects(RDFS.label) if isinstance(s, rdflib.URIRef)}
+    return Taxonomy(digest, superclasses, implied, mandatory, labels)

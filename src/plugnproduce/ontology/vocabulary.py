@@ -1,0 +1,75 @@
+"""The ontology's vocabulary as rdflib namespaces; a misspelt term is an error."""
+
+from __future__ import annotations
+
+from rdflib import Namespace, URIRef
+from rdflib.namespace import DefinedNamespace
+
+PNP_IRI = "http://plugnproduce.org/ontology#"
+DEV = Namespace("http://plugnproduce.org/devices/")
+PROC = Namespace("http://plugnproduce.org/processes/")
+
+
+class PNP(DefinedNamespace):
+    """Terms of the Plug'n'Produce ontology that the code refers to by name."""
+
+    _NS = Namespace(PNP_IRI)
+    _fail = True
+
+    Device: URIRef
+    Skill: URIRef
+    StateConcept: URIRef
+    Process: URIRef
+    Role: URIRef
+    Parameter: URIRef
+    Quantity: URIRef
+    Protocol: URIRef
+    Task: URIRef
+    Step: URIRef
+    Pose: URIRef
+    XIRP: URIRef
+    UPnP: URIRef
+    hasSkill: URIRef
+    protocol: URIRef
+    endpoint: URIRef
+    stateChart: URIRef
+    generalChart: URIRef
+    commandTimeout: URIRef
+    cost: URIRef
+    hasRole: URIRef
+    roleName: URIRef
+    requiresSkill: URIRef
+    hasParameter: URIRef
+    parameterName: URIRef
+    forRole: URIRef
+    quantity: URIRef
+    datatype: URIRef
+    unit: URIRef
+    minValue: URIRef
+    maxValue: URIRef
+    defaultValue: URIRef
+    startState: URIRef
+    endState: URIRef
+    hasState: URIRef
+    stateId: URIRef
+    concept: URIRef
+    sourceLine: URIRef
+    mandatoryState: URIRef
+    # task description lifted to RDF (for the task shapes)
+    hasStep: URIRef
+    stepIndex: URIRef
+    command: URIRef
+    hasValue: URIRef
+    parameter: URIRef
+    value: URIRef
+
+
+def local_name(iri: str) -> str:
+    """The part of an IRI after its last ``#`` or ``/``."""
+    cut = max(iri.rfind("#"), iri.rfind("/"))
+    return iri[cut + 1 :]
+
+
+def concept_iri(value: str) -> str:
+    """The IRI of a state or quantity concept written as a local name or a full IRI."""
+    return value if ":" in value else PNP_IRI + value

@@ -1,0 +1,46 @@
+"""Where the project's data files are: shipped in the wheel, or in the checkout.
+
+``ontology/``, ``rules/`` and ``descriptions/`` live at the top of the repository and
+are mapped into the wheel as ``plugnproduce/data/<name>``. An editable install has
+no such copy, so the checkout's folder is used instead.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+DATA_FOLDERS = ("ontology", "rules", "descriptions")
+
+
+def data_path(name: str) -> Path:
+    """The folder of shipped data called ``name`` (one of :data:`DATA_FOLDERS`)."""
+    if name not in DATA_FOLDERS:
+        raise ValueError(f"unknown data folder {name!r}; expected one of {DATA_FOLDERS}")
+    shipped = Path(str(resources.files("plugnproduce"))) / "data" / name
+    if shipped.is_dir():
+        return shipped
+    checkout = Path(__file__).resolve().parents[2] / name
+    if checkout.is_dir():
+        return checkout
+    raise FileNotFoundError(f"data folder {name!r} is neither in the package nor in a checkout")
+
+
+def ontology_path() -> Path:
+    """The ontology folder (OWL TBox and SHACL shapes)."""
+    return data_path("ontology")
+
+
+def rules_path() -> Path:
+    """The folder of ASP encodings."""
+    return data_path("rules")
+
+
+def descriptions_path() -> Path:
+    """The folder of built-in descriptions: devices, processes, tasks, cells."""
+    return data_path("descriptions")
+
+
+def package_file(*parts: str) -> Path:
+    """A data file that lives inside the package itself (e.g. the W3C SCXML schema)."""
+    return Path(str(resources.files("plugnproduce").joinpath(*parts)))

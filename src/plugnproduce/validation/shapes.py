@@ -1,0 +1,46 @@
+"""The SHACL shapes run by pySHACL over the knowledge graph."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+
+import rdflib
+from pyshacl import validate as shacl_validate
+from rdflib.namespace import SH
+
+from plugnproduce.description.knowledge import KnowledgeGraph
+from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.resources import ontology_path
+from plugnproduce.safeio import parse_turtle
+from plugnproduce.validation.findings import Problem
+
+
+@lru_cache(maxsize=4)
+def shapes_graph(path: Path | None = None) -> rdflib.Graph:
+    """The shapes file, parsed once."""
+    return parse_turtle(path or ontology_path() / "shapes.ttl")[0]
+
+
+def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> list[Problem]:
+    """Run the shapes over the knowledge graph; one problem per violation, at its node's place."""
+    conforms, results, _ = shacl_validate(
+        kg.graph,
+        shacl_graph=shapes if shapes is not None else shapes_graph(),
+        inference="none",
+        advanced=True,
+        allow_warnings=True,
+    )
+    if conforms:
+        return []
+    problems = []
+    for result in results.subjects(rdflib.RDF.type, SH.ValidationResult):
+        focus = results.value(result, SH.focusNode)
+        message = str(results.value(result, SH.resultMessage) or "does not conform")
+        where = kg.places.get(str(focus))
+        if not message.startswith("step ") and local_name(str(focus)) not in message:
+            message = f"{local_name(str(focus))}: {message}"
+        problems.append(
+            Problem(where.file if where else "<knowledge graph>", (where.line or 0) if where else 0, message)
+        )
+    return sorted(problems)
