@@ -87,7 +87,8 @@ class KnowledgeGraph:
             for name, value in sorted(step.params.items()):
                 if name not in params:
                     continue
-                pv = rdflib.BNode()
+                pv = rdflib.URIRef(f"{base}step{step.index}-{name}")
+                self.places[str(pv)] = task.where(step, name)
                 self.graph.add((node, PNP.hasValue, pv))
                 self.graph.add((pv, PNP.parameter, rdflib.URIRef(params[name].iri)))
                 self.graph.add((pv, PNP.value, value_literal(value)))

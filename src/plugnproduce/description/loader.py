@@ -229,7 +229,7 @@ def _unknown_keys(m: dict[str, yaml.Node], allowed: set[str], path: Path, what: 
     for k, v in m.items():
         if k not in allowed:
             raise DescriptionError(
-                f"{what}: unknown key {k!r}; expected one of {', '.join(sorted(allowed))}", path, v.start_mark.line
+                f"{what}: unknown key {k!r}; expected one of {', '.join(sorted(allowed))}", path, v.start_mark.line + 1
             )
 
 
@@ -256,7 +256,7 @@ def load_task(path: str | Path) -> Task:
     steps_node = top["steps"]
     if not isinstance(steps_node, yaml.SequenceNode) or not steps_node.value:
         raise DescriptionError("steps must be a non-empty list", p, steps_node.start_mark.line + 1)
-    one_round: list[tuple[str, dict[str, str], dict[str, object], int]] = []
+    one_round: list[tuple[str, dict[str, str], dict[str, object], int, dict[str, int]]] = []
     for node in steps_node.value:
         line = node.start_mark.line + 1
         m = _mapping(node, p, "step")
@@ -264,11 +264,13 @@ def load_task(path: str | Path) -> Task:
         if "command" not in m or not isinstance(_plain(m["command"]), str):
             raise DescriptionError("a step needs 'command': the name of a process command", p, line)
         bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
-        one_round.append((str(_plain(m["command"])), bind, _str_map(m.get("params"), p, "params"), line))
+        params = m.get("params")
+        lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value} if isinstance(params, yaml.MappingNode) else {}
+        one_round.append((str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
     steps = [
-        Step(i * len(one_round) + j + 1, cmd, bind, params, line)
+        Step(i * len(one_round) + j + 1, cmd, bind, params, line, lines)
         for i in range(repeat)
-        for j, (cmd, bind, params, line) in enumerate(one_round)
+        for j, (cmd, bind, params, line, lines) in enumerate(one_round)
     ]
     description = _plain(top["description"]) if "description" in top else ""
     return Task(str(_plain(top["task"])), tuple(steps), str(p), str(description or ""), repeat)

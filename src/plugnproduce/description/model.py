@@ -195,6 +195,8 @@ class Step:
     bind: dict[str, str] = field(default_factory=dict)
     params: dict[str, object] = field(default_factory=dict)
     line: int | None = None
+    param_lines: dict[str, int] = field(default_factory=dict, compare=False)
+    """Line of each parameter value in the task file."""
 
 
 @dataclass(frozen=True)
@@ -207,9 +209,9 @@ class Task:
     description: str = ""
     repeat: int = 1
 
-    def where(self, step: Step) -> Where:
-        """The place of a step in the task file."""
-        return Where(self.file, step.line)
+    def where(self, step: Step, parameter: str | None = None) -> Where:
+        """The place of a step (or of one of its parameter values) in the task file."""
+        return Where(self.file, step.param_lines.get(parameter, step.line) if parameter else step.line)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,15 @@
+"""The ``pnp`` command line: a thin layer over :mod:`plugnproduce.service`.
+
+Exit codes: 0 done/ok; 1 a finding (invalid, infeasible, implausible, failed run);
+2 bad input or usage, reported as one ``file:line: message`` line, never a traceback.
+Each command module registers its commands on :data:`app`.
+"""
+
+from __future__ import annotations
+
+from plugnproduce.cli.app import app, main
+
+# Command modules register themselves on import.
+from plugnproduce.cli import validate  # noqa: E402,F401  isort: skip
+
+__all__ = ["app", "main"]

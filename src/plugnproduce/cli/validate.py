@@ -1,0 +1,35 @@
+"""``pnp validate``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from plugnproduce import service
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+
+
+@app.command()
+@boundary
+def validate(
+    paths: list[Path] = typer.Argument(..., help="Description files or folders."),
+    json_out: bool = JSON_OPTION,
+) -> None:
+    """Check descriptions: hardened parsing, W3C SCXML schema, SHACL shapes, structure.
+
+    Exit 0 valid, 1 invalid, 2 unreadable or hostile input.
+    """
+    report = service.validate(list(paths))
+    problems = report.sorted()
+    if json_out:
+        emit_json({"valid": report.valid, "files": len(report.files), "problems": [p.to_json() for p in problems]})
+    else:
+        for p in problems:
+            typer.echo(str(p))
+        if report.valid:
+            typer.echo(f"{len(report.files)} files valid")
+    if report.unreadable:
+        raise typer.Exit(2)
+    if not report.valid:
+        raise typer.Exit(1)

@@ -1,0 +1,50 @@
+"""Shared fixtures: the built-in descriptions and the taxonomy closure."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy
+from plugnproduce.resources import descriptions_path
+
+DESCRIPTIONS = descriptions_path()
+
+
+@pytest.fixture(scope="session")
+def taxonomy() -> Taxonomy:
+    """The taxonomy closure of the built-in ontology (HermiT once, then cached)."""
+    return load_taxonomy()
+
+
+@pytest.fixture()
+def device_copy(tmp_path: Path):
+    """Copy a built-in device description (Turtle + chart) into a temporary folder."""
+
+    def copy(name: str) -> tuple[Path, Path]:
+        ttl = shutil.copy(DESCRIPTIONS / "devices" / f"{name}.ttl", tmp_path)
+        scxml = shutil.copy(DESCRIPTIONS / "devices" / f"{name}.scxml", tmp_path)
+        return Path(ttl), Path(scxml)
+
+    return copy
+
+
+@pytest.fixture()
+def process_copy(tmp_path: Path):
+    """Copy a built-in process description (Turtle + chart) into a temporary folder."""
+
+    def copy(name: str) -> tuple[Path, Path]:
+        ttl = shutil.copy(DESCRIPTIONS / "processes" / f"{name}.ttl", tmp_path)
+        scxml = shutil.copy(DESCRIPTIONS / "processes" / f"{name}.scxml", tmp_path)
+        return Path(ttl), Path(scxml)
+
+    return copy
+
+
+def edit(path: Path, old: str, new: str) -> None:
+    """Replace text in a file, failing loudly if the text is not there."""
+    text = path.read_text()
+    assert old in text, f"{old!r} not in {path.name}"
+    path.write_text(text.replace(old, new))

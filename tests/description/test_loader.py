@@ -1,0 +1,108 @@
+"""Reading every built-in description into the model, and the task format's round trip."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from plugnproduce.description.loader import (
+    load_cell,
+    load_device,
+    load_process,
+    load_task,
+    task_to_yaml,
+)
+from plugnproduce.description.model import Command
+from plugnproduce.errors import DescriptionError
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.resources import descriptions_path
+
+D = descriptions_path()
+P = "http://plugnproduce.org/ontology#"
+
+
+@pytest.mark.parametrize("ttl", sorted((D / "devices").glob("*.ttl")), ids=lambda p: p.stem)
+def test_every_device_loads_with_reasoned_skills(ttl: Path, taxonomy: Taxonomy) -> None:
+    device = load_device(ttl, taxonomy)
+    assert device.id == ttl.stem
+    assert device.skills, "every catalogue device can do something"
+    assert device.initial in {s.id for s in device.states}
+    assert all(t.request is None or t.request.protocol == device.protocol for t in device.transitions)
+
+
+@pytest.mark.parametrize("ttl", sorted((D / "processes").glob("*.ttl")), ids=lambda p: p.stem)
+def test_every_process_loads_with_its_regions(ttl: Path, taxonomy: Taxonomy) -> None:
+    process = load_process(ttl)
+    assert process.id == ttl.stem
+    for role in process.roles:
+        assert taxonomy.is_kind(role.required_skill, "Skill")
+        assert len(role.region) >= 2
+    for p in process.parameters:
+        assert p.role in {r.name for r in process.roles}
+
+
+def test_gripper_is_the_papers_figure_2(taxonomy: Taxonomy) -> None:
+    gripper = load_device(D / "devices" / "gripper.ttl", taxonomy)
+    assert {s.id for s in gripper.states} == {"open", "closed", "opening", "closing", "configuring"}
+    assert P + "CanGrip" in gripper.skills and P + "CanParallelGrip" in gripper.skills
+    close = next(t for t in gripper.transitions if t.event == "xirp.request.Close")
+    assert close.request == Command("xirp", "request", "Close")
+    to_closed = next(t for t in gripper.transitions if t.target == "closed")
+    assert to_closed.sends == (Command("xirp", "event", "gripper_closed"),)
+    set_angle = next(t for t in gripper.transitions if t.event == "xirp.request.SetAngle")
+    assert set_angle.target == "configuring" and set_angle.accepts == (P + "OpeningAngle",)
+
+
+def test_bin_picking_cell_has_the_papers_four_devices(taxonomy: Taxonomy) -> None:
+    cell = load_cell(D / "cells" / "bin-picking.yaml", taxonomy)
+    assert sorted(d.id for d in cell.devices) == ["binpicking-pc", "gripper", "robot", "sensor3d"]
+    assert {d.protocol for d in cell.devices} == {"xirp", "upnp"}
+    assert sorted(d.id for d in cell.without("gripper").devices) == ["binpicking-pc", "robot", "sensor3d"]
+
+
+def test_task_repeat_expands_and_keeps_lines() -> None:
+    task = load_task(D / "tasks" / "bin-picking.yaml")
+    assert task.repeat == 3
+    assert [s.command for s in task.steps] == ["bin-pick", "place"] * 3
+    assert [s.index for s in task.steps] == [1, 2, 3, 4, 5, 6]
+    assert task.steps[0].line == task.steps[2].line == 6
+    assert task.steps[0].params["grip_force"] == 45
+    assert task.steps[1].params["place_pose"] == [0.6, -0.2, 0.1, 0, 180, 0]
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in (D / "tasks").glob("*.yaml")))
+def test_task_yaml_round_trip(tmp_path: Path, name: str) -> None:
+    task = load_task(D / "tasks" / name)
+    again = tmp_path / name
+    again.write_text(task_to_yaml(task))
+    back = load_task(again)
+    assert [(s.command, s.bind, s.params) for s in back.steps] == [(s.command, s.bind, s.params) for s in task.steps]
+    assert (back.name, back.description, back.repeat) == (task.name, task.description, task.repeat)
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "needle"),
+    [
+        ("task: t\n", 1, "needs 'task'"),
+        ("task: t\nsteps:\n  - params: {a: 1}\n", 3, "needs 'command'"),
+        ("task: t\nrepeat: 0\nsteps:\n  - command: pick\n", 2, "repeat must be"),
+        ("task: t\nsteps:\n  - command: pick\n    colour: red\n", 4, "unknown key 'colour'"),
+        ("task: t\ntask: u\nsteps: []\n", 2, "appears twice"),
+    ],
+)
+def test_bad_task_names_file_and_line(tmp_path: Path, text: str, line: int, needle: str) -> None:
+    f = tmp_path / "t.yaml"
+    f.write_text(text)
+    with pytest.raises(DescriptionError) as err:
+        load_task(f)
+    assert (err.value.file, err.value.line) == (str(f), line)
+    assert needle in err.value.message
+
+
+def test_cell_with_missing_device_file(tmp_path: Path, taxonomy: Taxonomy) -> None:
+    f = tmp_path / "c.yaml"
+    f.write_text("cell: c\ndevices:\n  - nowhere.ttl\n")
+    with pytest.raises(DescriptionError, match="nowhere.ttl not found") as err:
+        load_cell(f, taxonomy)
+    assert err.value.line == 3

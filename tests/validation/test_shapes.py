@@ -1,0 +1,79 @@
+"""Every SHACL shape, with a conforming and a violating description.
+
+Each case copies a built-in description, applies one edit and expects exactly the
+shape's message at the right line; the unedited copy is the conforming example.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from plugnproduce.resources import descriptions_path
+from plugnproduce.validation import validate_paths
+from tests.conftest import edit
+
+DESCRIPTIONS = descriptions_path()
+
+# (shape, kind, name, old text, new text, line of the problem in the Turtle file, part of the message)
+CASES = [
+    ("DeviceShape/skill", "devices", "cnc", "a pnp:CNCMachine", "a pnp:Machine", 6,
+     "no skill, declared or implied by its class"),
+    ("DeviceShape/protocol", "devices", "gripper", "pnp:protocol pnp:XIRP", "pnp:protocol pnp:Modbus", 6,
+     "exactly one pnp:protocol, pnp:XIRP or pnp:UPnP"),
+    ("DeviceShape/endpoint", "devices", "robot", '"xirp://127.0.0.1:0"', '"127.0.0.1"', 6, "pnp:endpoint"),
+    ("DeviceShape/chart", "devices", "gripper", "pnp:stateChart <gripper.scxml> ;", "", 6, "pnp:stateChart"),
+    ("DeviceShape/cost", "devices", "gripper", "pnp:cost 1800", "pnp:cost -5", 6, "pnp:cost"),
+    ("DeviceShape/mandatory", "devices", "vacuum-gripper", 'pnp:concept="ClosedWithPart"', 'pnp:concept="Running"',
+     6, "lacks the mandatory state 'Closed'"),
+    ("ChartStateShape", "devices", "gripper", 'pnp:concept="Configuring"', 'pnp:concept="GripForce"', 0,
+     "not a state concept of the ontology"),
+    ("ProcessShape/label", "processes", "pick", 'rdfs:label "pick" ;', "", 6, "rdfs:label"),
+    ("ProcessShape/role", "processes", "open-gripper", "pnp:hasRole proc:open-gripper-gripper",
+     "pnp:hasRole proc:nothing", 6, "pnp:hasRole"),
+    ("RoleShape/skill", "processes", "pick", 'pnp:requiresSkill pnp:CanGrip', 'pnp:requiresSkill pnp:Open', 14,
+     "pnp:requiresSkill, a skill"),
+    ("RoleShape/start", "processes", "pick", 'id="gripper_open" pnp:concept="Open"', 'id="gripper_open" pnp:concept="Speed"',
+     14, "start state"),
+    ("ParameterShape/datatype", "processes", "pick", "pnp:datatype xsd:decimal ;\n    pnp:unit \"N\"",
+     "pnp:datatype xsd:float ;\n    pnp:unit \"N\"", 41, "pnp:datatype"),
+    ("ParameterShape/range", "processes", "pick", "pnp:minValue 10 ; pnp:maxValue 140", "pnp:minValue 150 ; pnp:maxValue 140",
+     41, "must not exceed"),
+    ("ParameterShape/default", "processes", "pick", "pnp:defaultValue 40", "pnp:defaultValue 400", 41,
+     "default 400 of parameter 'grip_force' lies outside its range [10, 140]"),
+    ("ParameterShape/quantity", "processes", "pick", "pnp:quantity pnp:GripForce", "pnp:quantity pnp:Open", 41,
+     "pnp:quantity"),
+]
+
+
+def _copy(tmp_path: Path, kind: str, name: str) -> tuple[Path, Path]:
+    ttl = Path(shutil.copy(DESCRIPTIONS / kind / f"{name}.ttl", tmp_path))
+    scxml = Path(shutil.copy(DESCRIPTIONS / kind / f"{name}.scxml", tmp_path))
+    return ttl, scxml
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_conforming_example(tmp_path: Path, case: tuple) -> None:
+    _, kind, name, *_ = case
+    _copy(tmp_path, kind, name)
+    assert validate_paths([tmp_path]).problems == []
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_violating_example(tmp_path: Path, case: tuple) -> None:
+    _, kind, name, old, new, line, needle = case
+    ttl, scxml = _copy(tmp_path, kind, name)
+    edit(scxml if old in scxml.read_text() else ttl, old, new)
+    problems = validate_paths([tmp_path]).sorted()
+    assert any(needle in p.message for p in problems), [str(p) for p in problems]
+    hit = next(p for p in problems if needle in p.message)
+    if line:
+        assert (hit.file, hit.line) == (str(ttl), line)
+    else:
+        assert hit.file == str(scxml) and hit.line > 0
+
+
+def test_task_value_shapes_conform_for_builtin_tasks() -> None:
+    assert validate_paths([DESCRIPTIONS / "tasks"]).problems == []
