@@ -10,6 +10,6 @@ from __future__ import annotations
 from plugnproduce.cli.app import app, main
 
 # Command modules register themselves on import.
-from plugnproduce.cli import validate  # noqa: E402,F401  isort: skip
+from plugnproduce.cli import draw, validate  # noqa: E402,F401  isort: skip
 
 __all__ = ["app", "main"]

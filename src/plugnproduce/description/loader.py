@@ -147,7 +147,7 @@ def process_from(loaded: Loaded) -> ProcessDescription:
     chart_file = file_of(_one(loaded, s, PNP.generalChart, "general process state chart"))
     regions = process_regions(chart_file)
     roles: list[Role] = []
-    for r in sorted(loaded.graph.objects(s, PNP.hasRole)):
+    for r in sorted(loaded.graph.objects(s, PNP.hasRole), key=str):
         name = str(_one(loaded, r, PNP.roleName, "role name"))
         if name not in regions:
             raise DescriptionError(
@@ -162,7 +162,9 @@ def process_from(loaded: Loaded) -> ProcessDescription:
         raise DescriptionError(
             f"chart region(s) {', '.join(missing)} have no pnp:Role in the metadata", loaded.path, loaded.line(str(s))
         )
-    params = tuple(sorted((_parameter(loaded, p) for p in loaded.graph.objects(s, PNP.hasParameter)), key=lambda p: p.name))
+    params = tuple(
+        sorted((_parameter(loaded, p) for p in loaded.graph.objects(s, PNP.hasParameter)), key=lambda p: p.name)
+    )
     label = _opt(loaded, s, RDFS.label)
     comment = _opt(loaded, s, RDFS.comment)
     return ProcessDescription(
@@ -265,7 +267,9 @@ def load_task(path: str | Path) -> Task:
             raise DescriptionError("a step needs 'command': the name of a process command", p, line)
         bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
         params = m.get("params")
-        lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value} if isinstance(params, yaml.MappingNode) else {}
+        lines = {}
+        if isinstance(params, yaml.MappingNode):
+            lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value}
         one_round.append((str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
     steps = [
         Step(i * len(one_round) + j + 1, cmd, bind, params, line, lines)

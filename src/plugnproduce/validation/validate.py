@@ -7,6 +7,7 @@ from pathlib import Path
 
 from rdflib.namespace import OWL, RDF
 
+from plugnproduce.description.charts import device_chart
 from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.description.loader import (
     Loaded,
@@ -19,7 +20,6 @@ from plugnproduce.description.loader import (
     read_description,
 )
 from plugnproduce.description.model import ProcessDescription
-from plugnproduce.description.charts import device_chart
 from plugnproduce.errors import DescriptionError, UnreadableError
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
 from plugnproduce.ontology.vocabulary import PNP
