@@ -1,0 +1,169 @@
+"""Specific Process State Charts (paper section 6.1, figure 5).
+
+For one step of a task: each role's region of the General Process State Chart is
+bound to a device; for each of the region's transitions a path is searched in the
+device's chart and inserted with its device commands *mirrored* to the controller's
+side. The device's "wait for request Open" becomes the controller's "send request
+Open"; the device's "send event gripper_closed" becomes the controller's "wait for
+event gripper_closed". Synchronisation between regions (``In('...')``) is kept,
+pointing at the controller states the general states became.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from lxml import etree
+
+from plugnproduce.codegen.emit import el, pnp_attr
+from plugnproduce.codegen.paths import find_path
+from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import local_name
+
+
+@dataclass
+class RegionResult:
+    """One role's region of a Specific Process State Chart, bound to its device."""
+
+    role: str
+    device: DeviceDescription
+    element: etree._Element
+    start_state: str
+    end_state: str
+    commands: list[tuple[str, Command]] = field(default_factory=list)
+    """(controller state id, command) in order: what the controller sends and waits for."""
+    path: list[ChartTransition] = field(default_factory=list)
+    """The transitions the device takes in its own chart, in order."""
+
+
+def state_id(step: int, device: str, general_id: str, role: str) -> str:
+    """Controller state id: step, device and the general state's name (``s2_gripper_open``)."""
+    name = general_id[len(role) + 1 :] if general_id.startswith(role + "_") else general_id
+    return f"s{step}_{device}_{name}".replace("-", "_")
+
+
+def controller_ids(step: int, process: ProcessDescription, binding: dict[str, str]) -> dict[str, str]:
+    """Every general state id of the process → the controller state it becomes in this step."""
+    return {g.id: state_id(step, binding[r.name], g.id, r.name) for r in process.roles for g in r.region}
+
+
+def specific_region(
+    step: int,
+    process: ProcessDescription,
+    role: Role,
+    device: DeviceDescription,
+    start_state: str,
+    params: dict[str, object],
+    ids: dict[str, str],
+    taxonomy: Taxonomy,
+) -> RegionResult:
+    """Build the controller's region for ``role`` played by ``device``, from the device state ``start_state``."""
+    region = el("state", id=f"s{step}_{device.id}".replace("-", "_"), initial=ids[role.region[0].id])
+    region.set(pnp_attr("role"), role.name)
+    region.set(pnp_attr("device"), device.id)
+    result = RegionResult(role.name, device, region, start_state, start_state)
+    current = start_state
+    head = el("state", id=ids[role.region[0].id])
+    _annotate(head, role.region[0].concept, current)
+    states = [head]
+    for general in role.region[1:]:
+        wanted = frozenset(process.parameter(p).quantity for p in general.params)
+        path = find_path(device, current, general.concept, taxonomy, wanted)
+        cond = f"In('{ids[general.waits_for]}')" if general.waits_for else None
+        values = {p: params[p] for p in general.params if p in params}
+        _insert_path(states, path.steps, ids[general.id], device, values, process, cond, result)
+        result.path.extend(path.steps)
+        current = path.target
+        target = el("final" if general is role.region[-1] else "state", id=ids[general.id])
+        _annotate(target, general.concept, current)
+        states.append(target)
+    for s in states:
+        region.append(s)
+    result.end_state = current
+    return result
+
+
+def _annotate(state: etree._Element, concept: str, device_state: str) -> None:
+    state.set(pnp_attr("concept"), local_name(concept))
+    state.set(pnp_attr("deviceState"), device_state)
+
+
+def _insert_path(
+    states: list[etree._Element],
+    steps: tuple[ChartTransition, ...],
+    target_id: str,
+    device: DeviceDescription,
+    values: dict[str, object],
+    process: ProcessDescription,
+    cond: str | None,
+    result: RegionResult,
+) -> None:
+    """Append the mirrored transitions of a path, with the intermediate states it passes."""
+    source = states[-1]
+    if not steps:
+        t = el("transition", target=target_id)
+        if cond:
+            t.set("cond", cond)
+        source.append(t)
+        return
+    for i, edge in enumerate(steps):
+        last = i == len(steps) - 1
+        moves: list[tuple[str, Command | None]] = []
+        if edge.request:
+            moves.append(("send", edge.request))
+        moves += [("wait", c) for c in edge.sends]
+        if not moves:
+            moves.append(("pass", None))
+        for j, (kind, command) in enumerate(moves):
+            final_move = last and j == len(moves) - 1
+            nxt = target_id if final_move else f"{target_id}_{i + 1}{'abcdefghij'[j]}"
+            t = el("transition", target=nxt)
+            if cond and i == 0 and j == 0:
+                t.set("cond", cond)
+            if kind == "send" and command is not None:
+                t.append(_request(device, command, edge.accepts, values, process))
+                result.commands.append((source.get("id", ""), command))
+            elif kind == "wait" and command is not None:
+                t.set("event", f"{device.id}.{command.event}")
+                result.commands.append((source.get("id", ""), command))
+            source.append(t)
+            if not final_move:
+                source = el("state", id=nxt)
+                source.set(pnp_attr("deviceState"), edge.target)
+                states.append(source)
+
+
+def _request(
+    device: DeviceDescription,
+    command: Command,
+    accepts: tuple[str, ...],
+    values: dict[str, object],
+    process: ProcessDescription,
+) -> etree._Element:
+    send = el("send", type=command.protocol, target=device.id, event=command.event)
+    for name, value in sorted(values.items()):
+        quantity = process.parameter(name).quantity
+        if quantity in accepts:
+            send.append(el("param", name=local_name(quantity), expr=_literal(value)))
+    return send
+
+
+def _literal(value: object) -> str:
+    """A Python-datamodel expression for a parameter value."""
+    if isinstance(value, str) and not _is_pose(value):
+        return repr(value)
+    if isinstance(value, str):
+        return "[" + ", ".join(value.split()) + "]"
+    if isinstance(value, list):
+        return "[" + ", ".join(format(float(v), "g") for v in value) + "]"
+    return repr(value)
+
+
+def _is_pose(value: str) -> bool:
+    parts = value.split()
+    try:
+        return len(parts) == 6 and all(float(p) == float(p) for p in parts)
+    except ValueError:
+        return False
+
