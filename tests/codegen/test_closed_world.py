@@ -1,0 +1,48 @@
+"""Closed-world simulation charts run in an independent SCXML interpreter (python-statemachine)."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from statemachine.io.scxml.processor import SCXMLProcessor
+
+from plugnproduce import service
+from plugnproduce.codegen.closed_world import closed_world_chart
+from plugnproduce.description.loader import load_device
+from plugnproduce.resources import descriptions_path
+from tests.codegen.conftest import generate
+from tests.conftest import edit
+
+VALID_TASKS = ["bin-picking", "pick-and-place"]
+
+
+def run(chart: bytes) -> set[str]:
+    processor = SCXMLProcessor()
+    processor.parse_scxml("closed_world", chart.decode())
+    machine = processor.start()
+    return set(machine.configuration_values)
+
+
+@pytest.mark.parametrize("task", VALID_TASKS)
+def test_closed_world_chart_reaches_done(task, bin_picking_cell, processes) -> None:
+    generated = generate(task, bin_picking_cell, processes)
+    assert run(closed_world_chart(generated, bin_picking_cell)) == {"done"}
+
+
+def test_every_builtin_valid_task_is_covered() -> None:
+    names = {p.stem for p in (descriptions_path() / "tasks").glob("*.yaml")}
+    assert names - {"bin-picking-invalid"} == set(VALID_TASKS)
+
+
+def test_broken_device_model_does_not_reach_done(tmp_path: Path, bin_picking_cell, processes) -> None:
+    for f in ("gripper.ttl", "gripper.scxml"):
+        shutil.copy(descriptions_path() / "devices" / f, tmp_path)
+    # The program is generated for the real gripper, but the model it runs against never
+    # reports that it closed: the controller waits until the gripper's command timeout fires.
+    edit(tmp_path / "gripper.scxml", '<send event="xirp.event.gripper_closed" type="xirp"/>', "")
+    broken = load_device(tmp_path / "gripper.ttl", service.knowledge().taxonomy)
+    generated = generate("bin-picking", bin_picking_cell, processes)
+    configuration = run(closed_world_chart(generated, bin_picking_cell.with_device(broken)))
+    assert configuration == {"failed"}

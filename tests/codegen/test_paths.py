@@ -1,0 +1,49 @@
+"""Path search in Device State Charts."""
+
+from __future__ import annotations
+
+import pytest
+
+from plugnproduce import service
+from plugnproduce.codegen.paths import NoPath, find_path
+from plugnproduce.description.model import Command
+
+P = "http://plugnproduce.org/ontology#"
+
+
+@pytest.fixture(scope="module")
+def catalogue():
+    return {d.id: d for d in service.catalogue()}
+
+
+def test_gripper_open_to_closed_is_the_papers_figure_5(catalogue, taxonomy) -> None:
+    path = find_path(catalogue["gripper"], "open", P + "Closed", taxonomy)
+    assert [(t.source, t.target) for t in path.steps] == [("open", "closing"), ("closing", "closed")]
+    assert path.steps[0].request == Command("xirp", "request", "Close")
+    assert path.steps[1].sends == (Command("xirp", "event", "gripper_closed"),)
+
+
+def test_subsumption_counts(catalogue, taxonomy) -> None:
+    vacuum = catalogue["vacuum-gripper"]
+    # 'holding' is annotated ClosedWithPart, which satisfies Closed; 'released' is Released ≡ Open.
+    assert find_path(vacuum, "released", P + "Closed", taxonomy).target == "holding"
+    assert find_path(vacuum, "holding", P + "Open", taxonomy).target == "released"
+    assert find_path(vacuum, "released", P + "Open", taxonomy).steps == ()
+
+
+def test_equal_paths_prefer_the_one_that_takes_the_parameters(catalogue, taxonomy) -> None:
+    robot = catalogue["robot"]
+    plain = find_path(robot, "at_pose", P + "Moving", taxonomy)
+    with_pose = find_path(robot, "at_pose", P + "Moving", taxonomy, frozenset({P + "TargetPose"}))
+    assert plain.target == "homing"  # first by state id when nothing is handed over
+    assert with_pose.target == "moving" and with_pose.steps[0].request.name == "MoveTo"
+
+
+def test_no_path_names_device_state_and_concept(catalogue, taxonomy) -> None:
+    with pytest.raises(NoPath, match="device conveyor: no path .* from state 'stopped' to a state of concept Open"):
+        find_path(catalogue["conveyor"], "stopped", P + "Open", taxonomy)
+
+
+def test_path_search_is_deterministic(catalogue, taxonomy) -> None:
+    paths = {find_path(catalogue["cnc"], "door_closed", P + "MachineIdle", taxonomy) for _ in range(5)}
+    assert len(paths) == 1
