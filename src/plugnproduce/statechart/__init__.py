@@ -1,0 +1,1 @@
+"""The project's one SCXML layer: schema validation, model, reader, writer and runtime."""

@@ -1,0 +1,50 @@
+"""Validation against the W3C SCXML 1.0 schema (vendored in ``w3c/``, licence in scxml-copyright.xsd).
+
+``xmlschema`` is used because it also reports dangling ``target``/``initial`` IDREFs
+and duplicate ids, which libxml2 does not.
+"""
+
+from __future__ import annotations
+
+import re
+from functools import lru_cache
+from pathlib import Path
+
+import xmlschema
+from lxml import etree
+
+from plugnproduce.errors import DescriptionError
+from plugnproduce.resources import package_file
+from plugnproduce.safeio import parse_xml_bytes
+
+
+@lru_cache(maxsize=1)
+def scxml_schema() -> xmlschema.XMLSchema:
+    """The W3C SCXML schema, loaded once (from package data; nothing is fetched)."""
+    return xmlschema.XMLSchema(str(package_file("statechart", "w3c", "scxml.xsd")))
+
+
+def schema_problems(data: bytes, source: str | Path) -> list[DescriptionError]:
+    """Every way the document breaks the W3C SCXML schema, each with its line."""
+    tree = parse_xml_bytes(data, source)  # hardened: refuses DOCTYPE, entities, oversize
+    problems = []
+    for error in scxml_schema().iter_errors(tree):
+        reason = (error.reason or str(error.message)).rstrip(".")
+        line = _line(tree, error, reason)
+        problems.append(DescriptionError(f"not valid W3C SCXML: {reason}", source, line))
+    return problems
+
+
+_IDREF = re.compile(r"IDREF '([^']+)' not found")
+
+
+def _line(tree: etree._ElementTree, error: xmlschema.XMLSchemaValidationError, reason: str) -> int | None:
+    """The line of the element an error is about; for a dangling IDREF, the element that uses it."""
+    dangling = _IDREF.search(reason)
+    if dangling:
+        token = dangling.group(1)
+        for el in tree.getroot().iter():
+            if any(token in (el.get(a) or "").split() for a in ("target", "initial")):
+                return el.sourceline  # type: ignore[no-any-return]
+    element = error.elem
+    return element.sourceline if isinstance(element, etree._Element) else None  # type: ignore[no-any-return]
