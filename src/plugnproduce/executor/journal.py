@@ -1,0 +1,126 @@
+"""The run journal: an append-only, fsynced JSON-lines file per run.
+
+Every run writes one record per line: ``start`` (task, cell, chart digest), then
+``command`` (sent to a device), ``event`` (from a device or the chart), ``state``
+(a device region entered a state), ``step`` (a step began), ``fault`` and finally
+``end`` (outcome). A line is flushed and fsynced before the run goes on, so after a
+crash the journal holds everything up to the crash, and a run without ``end`` is
+told apart from a finished one. Nothing is ever rewritten.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+from plugnproduce.errors import DescriptionError
+
+KINDS = ("start", "step", "command", "event", "state", "fault", "end")
+
+
+class Journal:
+    """Appends records to a run's journal file, durably."""
+
+    def __init__(self, path: str | Path, clock: Any = time.time):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._clock = clock
+        self._file: TextIO | None = self.path.open("a", encoding="utf-8")
+        self._seq = 0
+
+    def write(self, kind: str, **data: Any) -> None:
+        """Append one record and make it durable before returning."""
+        if kind not in KINDS:
+            raise ValueError(f"unknown journal record kind {kind!r}")
+        if self._file is None:
+            raise ValueError(f"journal {self.path} is closed")
+        self._seq += 1
+        record = {"seq": self._seq, "t": round(self._clock(), 6), "kind": kind, **data}
+        self._file.write(json.dumps(record, sort_keys=True, default=str) + "\n")
+        self._file.flush()
+        os.fsync(self._file.fileno())
+
+    def close(self) -> None:
+        """Close the file (records already written stay)."""
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> Journal:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self.close()
+
+
+@dataclass
+class RunRecord:
+    """A run as its journal tells it."""
+
+    path: Path
+    records: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def start(self) -> dict[str, Any]:
+        """The start record (empty if the journal has none)."""
+        return next((r for r in self.records if r["kind"] == "start"), {})
+
+    @property
+    def end(self) -> dict[str, Any] | None:
+        """The end record, or None if the run never finished (crashed or still running)."""
+        return next((r for r in self.records if r["kind"] == "end"), None)
+
+    @property
+    def status(self) -> str:
+        """``succeeded``, ``failed``, or ``crashed`` when the journal has no end."""
+        if self.end is None:
+            return "crashed"
+        return str(self.end.get("outcome", "failed"))
+
+    def of_kind(self, kind: str) -> Iterator[dict[str, Any]]:
+        """The records of one kind, in order."""
+        return (r for r in self.records if r["kind"] == kind)
+
+
+def read_journal(path: str | Path) -> RunRecord:
+    """Read a journal; a torn last line (a crash mid-write) is ignored, any other bad line is an error."""
+    p = Path(path)
+    try:
+        lines = p.read_text(encoding="utf-8").splitlines()
+    except OSError as exc:
+        raise DescriptionError(f"cannot read journal: {exc.strerror or exc}", p) from exc
+    run = RunRecord(p)
+    for number, line in enumerate(lines, start=1):
+        try:
+            record = json.loads(line)
+        except json.JSONDecodeError as exc:
+            if number == len(lines):
+                break  # the write the crash interrupted
+            raise DescriptionError(f"damaged journal line: {exc.msg}", p, number) from exc
+        if not isinstance(record, dict) or record.get("kind") not in KINDS:
+            raise DescriptionError("not a journal record", p, number)
+        run.records.append(record)
+    return run
+
+
+def describe(record: dict[str, Any]) -> str:
+    """One human line for a journal record."""
+    kind = record["kind"]
+    if kind == "start":
+        return f"start task {record.get('task')} on cell {record.get('cell')}"
+    if kind == "step":
+        return f"step {record.get('step')}: {record.get('command')}"
+    if kind == "command":
+        return f"→ {record.get('device')}: {record.get('command')} {record.get('params') or ''}".rstrip()
+    if kind == "event":
+        return f"← {record.get('device') or 'chart'}: {record.get('event')}"
+    if kind == "state":
+        return f"  {record.get('device')} is {record.get('state')}"
+    if kind == "fault":
+        return f"FAULT {record.get('fault')}: {record.get('message')}"
+    return f"end: {record.get('outcome')}" + (f" ({record.get('reason')})" if record.get("reason") else "")

@@ -1,0 +1,56 @@
+"""The run journal: durable, append-only, and a crash is told apart from a finished run."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from plugnproduce.errors import DescriptionError
+from plugnproduce.executor.journal import Journal, describe, read_journal
+
+
+def test_records_are_on_disk_as_soon_as_written(tmp_path: Path) -> None:
+    path = tmp_path / "run.jsonl"
+    journal = Journal(path)
+    journal.write("start", task="t", cell="c")
+    journal.write("command", device="gripper", command="xirp.request.Close", params={"GripForce": 40})
+    # Not closed: a reader (or a crash) sees both records already.
+    run = read_journal(path)
+    assert [r["kind"] for r in run.records] == ["start", "command"]
+    assert run.status == "crashed"
+    journal.close()
+
+
+def test_finished_run_has_its_outcome(tmp_path: Path) -> None:
+    path = tmp_path / "run.jsonl"
+    with Journal(path) as journal:
+        journal.write("start", task="t", cell="c")
+        journal.write("end", outcome="succeeded")
+    run = read_journal(path)
+    assert run.status == "succeeded"
+    assert [r["seq"] for r in run.records] == [1, 2]
+
+
+def test_torn_last_line_is_ignored_but_damage_elsewhere_is_an_error(tmp_path: Path) -> None:
+    path = tmp_path / "run.jsonl"
+    good = json.dumps({"seq": 1, "t": 0, "kind": "start"})
+    path.write_text(good + "\n" + '{"seq": 2, "t": 0, "ki')
+    assert read_journal(path).status == "crashed"
+    path.write_text('{"seq": 1, "t"\n' + good + "\n")
+    with pytest.raises(DescriptionError) as err:
+        read_journal(path)
+    assert err.value.line == 1
+
+
+def test_unknown_kind_is_refused(tmp_path: Path) -> None:
+    with Journal(tmp_path / "run.jsonl") as journal, pytest.raises(ValueError, match="unknown journal record kind"):
+        journal.write("gossip")
+
+
+def test_describe_reads_like_a_log() -> None:
+    assert describe({"kind": "command", "device": "gripper", "command": "xirp.request.Close", "params": None}) == (
+        "→ gripper: xirp.request.Close"
+    )
+    assert describe({"kind": "end", "outcome": "failed", "reason": "timeout"}) == "end: failed (timeout)"
