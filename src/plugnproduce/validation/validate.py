@@ -44,13 +44,20 @@ def expand(paths: Iterable[str | Path]) -> list[Path]:
     return sorted(out)
 
 
-def validate_paths(paths: Iterable[str | Path], taxonomy: Taxonomy | None = None) -> Report:
-    """Validate every description under ``paths`` against the schema, shapes and structure rules."""
+def validate_paths(
+    paths: Iterable[str | Path], taxonomy: Taxonomy | None = None, ontology: list[Path] | None = None
+) -> Report:
+    """Validate every description under ``paths`` against the schema, shapes and structure rules.
+
+    ``ontology`` names the TBox files (default: the built-in ontology); ``taxonomy`` is their
+    closure if the caller has it already.
+    """
     files = expand(paths)
     report = Report(files=[str(f) for f in files])
-    taxonomy = taxonomy or load_taxonomy()
+    tbox_files = ontology or ontology_files()
+    taxonomy = taxonomy or load_taxonomy(tbox_files)
     kg = KnowledgeGraph()
-    kg.add_tbox(read_tbox(ontology_files()), taxonomy)
+    kg.add_tbox(read_tbox(tbox_files), taxonomy)
     processes: dict[str, ProcessDescription] = {}
     tasks = []
     known: dict[str, ProcessDescription] = {}
