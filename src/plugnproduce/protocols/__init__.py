@@ -1,0 +1,1 @@
+"""Device protocols: how the controller talks to devices (UPnP, XIRP)."""

@@ -1,0 +1,75 @@
+"""UPnP for Plug'n'Produce devices, on async-upnp-client.
+
+* Device side: :class:`UpnpDeviceServer` publishes a device (description, one
+  service with actions and evented variables, its own Turtle and SCXML files).
+* Controller side: :func:`discover`, :class:`DeviceSearch`,
+  :class:`AdvertisementListener`, :func:`describe` and :class:`UpnpDeviceClient`.
+* :func:`service_spec_from_chart_events` turns a device chart's ``upnp.request.*``
+  and ``upnp.event.*`` events into the service the device publishes.
+
+See ``docs/upnp.md``.
+"""
+
+from __future__ import annotations
+
+from plugnproduce.protocols.upnp.boundary import LOOPBACK, SsdpNetwork, UntrustedUrlError
+from plugnproduce.protocols.upnp.client import UpnpDeviceClient, VariableChange
+from plugnproduce.protocols.upnp.device import NOT_ACCEPTED_NOW, ActionFailed, ActionHandler, UpnpDeviceServer
+from plugnproduce.protocols.upnp.discovery import (
+    Advertisement,
+    AdvertisementListener,
+    DeviceSearch,
+    Discovery,
+    FoundDevice,
+    Refusal,
+    SearchHit,
+    describe,
+    discover,
+)
+from plugnproduce.protocols.upnp.spec import (
+    EVENT_PREFIX,
+    REQUEST_PREFIX,
+    SERVICE_TYPE,
+    ActionSpec,
+    ArgumentSpec,
+    DeviceFiles,
+    RemoteFiles,
+    ServiceSpec,
+    VariableSpec,
+    device_type_for,
+    service_spec_from_chart_events,
+    udn_for,
+)
+
+__all__ = [
+    "EVENT_PREFIX",
+    "LOOPBACK",
+    "NOT_ACCEPTED_NOW",
+    "REQUEST_PREFIX",
+    "SERVICE_TYPE",
+    "ActionFailed",
+    "ActionHandler",
+    "ActionSpec",
+    "Advertisement",
+    "AdvertisementListener",
+    "ArgumentSpec",
+    "DeviceFiles",
+    "DeviceSearch",
+    "Discovery",
+    "FoundDevice",
+    "Refusal",
+    "RemoteFiles",
+    "SearchHit",
+    "ServiceSpec",
+    "SsdpNetwork",
+    "UntrustedUrlError",
+    "UpnpDeviceClient",
+    "UpnpDeviceServer",
+    "VariableChange",
+    "VariableSpec",
+    "describe",
+    "device_type_for",
+    "discover",
+    "service_spec_from_chart_events",
+    "udn_for",
+]

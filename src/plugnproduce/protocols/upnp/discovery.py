@@ -1,0 +1,302 @@
+"""The controller side of SSDP: search for devices, listen for alive/byebye, describe what was found.
+
+async-upnp-client calls plain functions (a coroutine callback would never be
+awaited); those put what arrived into asyncio queues and wake waiters.
+Everything found carries ``source_host``, the address the SSDP message came
+from: the only host the device is trusted for (see
+:mod:`plugnproduce.protocols.upnp.boundary`).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from dataclasses import dataclass
+
+from async_upnp_client.advertisement import SsdpAdvertisementListener
+from async_upnp_client.exceptions import UpnpError
+from async_upnp_client.search import SsdpSearchListener
+from async_upnp_client.utils import CaseInsensitiveDict
+
+from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
+from plugnproduce.protocols.upnp.boundary import (
+    LOOPBACK,
+    ChangeSignal,
+    NoRedirectRequester,
+    SsdpNetwork,
+    TrustedRequester,
+    reason,
+)
+from plugnproduce.protocols.upnp.client import load_device
+from plugnproduce.protocols.upnp.spec import SERVICE_TYPE
+from plugnproduce.safeio import MAX_BYTES
+
+_LOGGER = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class SearchHit:
+    """A device that answered an SSDP search: its UDN, description URL and the address it answered from."""
+
+    udn: str
+    location: str
+    source_host: str
+
+
+@dataclass(frozen=True)
+class Advertisement:
+    """A device announced itself (``alive``) or its leaving (``byebye``)."""
+
+    udn: str
+    alive: bool
+    location: str | None
+    source_host: str
+
+
+@dataclass(frozen=True)
+class FoundDevice:
+    """A discovered device whose description was read from the address it was discovered at."""
+
+    udn: str
+    location: str
+    device_type: str
+    friendly_name: str
+    source_host: str
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """A device that answered but was not accepted, and why (e.g. its description is on another host)."""
+
+    udn: str
+    location: str
+    source_host: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class Discovery:
+    """What a search found: the devices accepted and those refused."""
+
+    devices: tuple[FoundDevice, ...]
+    refused: tuple[Refusal, ...]
+
+
+def _headers_udn(headers: CaseInsensitiveDict) -> tuple[str, str | None, str] | None:
+    udn, location, host = headers.get_lower("_udn"), headers.get_lower("location"), headers.get_lower("_host")
+    if not udn or not host:
+        _LOGGER.debug("ignoring SSDP message without USN or source: %s", headers.as_dict())
+        return None
+    return str(udn), str(location) if location else None, str(host)
+
+
+class DeviceSearch:
+    """An SSDP search (M-SEARCH) and the answers to it, one per device.
+
+    ``async with DeviceSearch() as search: hit = await search.wait_for(udn, 2.0)``.
+    Devices wait a random time up to ``mx`` seconds (minus 0.25 s) before they answer.
+    """
+
+    def __init__(self, network: SsdpNetwork = LOOPBACK, search_target: str = SERVICE_TYPE, mx: int = 1) -> None:
+        self.network = network
+        self.search_target = search_target
+        self.mx = mx
+        self.hits: dict[str, SearchHit] = {}
+        """The first answer of each device, by UDN."""
+        self._queue: asyncio.Queue[SearchHit] = asyncio.Queue()
+        self._changed = ChangeSignal()
+        self._listener: SsdpSearchListener | None = None
+
+    async def __aenter__(self) -> DeviceSearch:
+        await self.start()
+        return self
+
+    async def __aexit__(self, *exc_info: object) -> None:
+        self.stop()
+
+    async def start(self) -> None:
+        """Open the socket and send the search."""
+        listener = SsdpSearchListener(
+            callback=self._on_response,
+            loop=asyncio.get_running_loop(),
+            source=self.network.source,
+            target=self.network.target,
+            timeout=self.mx,
+            search_target=self.search_target,
+        )
+        try:
+            await listener.async_start()
+        except (OSError, UpnpError) as exc:
+            raise ProtocolConnectionError(
+                f"SSDP search on {self.network.interface} for {self.network.group}:{self.network.port}: "
+                f"cannot open the socket ({reason(exc)}); multicast must be possible on that interface"
+            ) from exc
+        self._listener = listener
+        self.search_again()
+
+    def search_again(self) -> None:
+        """Send the M-SEARCH once more (UDP may lose a datagram); answers already seen are not repeated."""
+        if self._listener is None:
+            raise ProtocolError("the SSDP search is not started")
+        self._listener.async_search()
+
+    def stop(self) -> None:
+        """Close the socket; later answers are not received."""
+        listener, self._listener = self._listener, None
+        if listener is not None:
+            listener.async_stop()
+
+    def _on_response(self, headers: CaseInsensitiveDict) -> None:
+        found = _headers_udn(headers)
+        if found is None or found[1] is None or found[0] in self.hits:
+            return
+        hit = SearchHit(found[0], found[1], found[2])
+        self.hits[hit.udn] = hit
+        self._queue.put_nowait(hit)
+        self._changed.notify()
+
+    async def next_hit(self, timeout: float) -> SearchHit:
+        """The next device that answers; :class:`~plugnproduce.errors.ProtocolTimeout` if none does in time."""
+        try:
+            async with asyncio.timeout(timeout):
+                return await self._queue.get()
+        except TimeoutError as exc:
+            raise ProtocolTimeout(f"SSDP search for {self.search_target}: no new answer within {timeout:g} s") from exc
+
+    async def wait_for(self, udn: str, timeout: float) -> SearchHit:
+        """The answer of the device ``udn``, as soon as it arrives."""
+        return await self._changed.wait_for(lambda: self.hits.get(udn), timeout, f"SSDP search for {udn}")
+
+
+async def describe(found: SearchHit | Advertisement, *, timeout: float = 5.0) -> FoundDevice:
+    """Read the description of a device seen by SSDP, from the address it was seen at only.
+
+    A description URL on another host than ``found.source_host`` is refused with
+    :class:`~plugnproduce.protocols.upnp.boundary.UntrustedUrlError` before any
+    connection is made; a description naming another UDN is a
+    :class:`~plugnproduce.errors.RemoteError`.
+    """
+    if found.location is None:
+        raise RemoteError(f"device {found.udn} from {found.source_host} gave no description URL")
+    what = f"device {found.udn} at {found.location}"
+    requester = TrustedRequester(NoRedirectRequester(timeout, MAX_BYTES), found.source_host, what)
+    device = await load_device(found.location, requester, what, timeout)
+    if device.udn.lower() != found.udn.lower():
+        raise RemoteError(f"{what}: its description names UDN {device.udn}; it was discovered as {found.udn}")
+    return FoundDevice(found.udn, found.location, device.device_type, device.friendly_name, found.source_host)
+
+
+async def _describe_or_refuse(hit: SearchHit, timeout: float) -> FoundDevice | Refusal:
+    try:
+        return await describe(hit, timeout=timeout)
+    except ProtocolError as exc:
+        _LOGGER.warning("refused %s: %s", hit.udn, exc)
+        return Refusal(hit.udn, hit.location, hit.source_host, str(exc))
+
+
+async def discover(
+    timeout: float = 2.0,
+    *,
+    network: SsdpNetwork = LOOPBACK,
+    search_target: str = SERVICE_TYPE,
+    describe_timeout: float = 5.0,
+) -> Discovery:
+    """Search for devices for ``timeout`` seconds, then read each one's description.
+
+    SSDP gives no end to the answers, so the whole ``timeout`` is waited; devices
+    answer within ``MX`` seconds, here ``timeout`` rounded down and clamped to 1..5,
+    so ``timeout`` should be at least 1 s. By default only Plug'n'Produce devices
+    (those with :data:`~plugnproduce.protocols.upnp.spec.SERVICE_TYPE`) answer.
+    """
+    mx = max(1, min(5, int(timeout)))
+    async with DeviceSearch(network, search_target, mx) as search:
+        await asyncio.sleep(timeout)  # the search window: answers arrive through the callback meanwhile
+    hits = sorted(search.hits.values(), key=lambda h: h.udn)
+    results = await asyncio.gather(*(_describe_or_refuse(hit, describe_timeout) for hit in hits))
+    return Discovery(
+        tuple(r for r in results if isinstance(r, FoundDevice)),
+        tuple(r for r in results if isinstance(r, Refusal)),
+    )
+
+
+class AdvertisementListener:
+    """Listen for SSDP ``alive`` and ``byebye`` announcements, one report per change of a device's presence.
+
+    A device sends several announcements (one per device and service type); only
+    the first that changes what is known of the device is reported: a device is
+    reported alive once, and gone once. Reports go to a queue (:meth:`next`) and
+    to :attr:`seen`, which :meth:`wait_for` looks at.
+    """
+
+    def __init__(self, network: SsdpNetwork = LOOPBACK) -> None:
+        self.network = network
+        self.seen: list[Advertisement] = []
+        """Every report so far, oldest first."""
+        self._alive: dict[str, bool] = {}
+        self._queue: asyncio.Queue[Advertisement] = asyncio.Queue()
+        self._changed = ChangeSignal()
+        self._listener: SsdpAdvertisementListener | None = None
+
+    async def __aenter__(self) -> AdvertisementListener:
+        await self.start()
+        return self
+
+    async def __aexit__(self, *exc_info: object) -> None:
+        await self.stop()
+
+    async def start(self) -> None:
+        """Open the socket on the SSDP port and join the multicast group."""
+        listener = SsdpAdvertisementListener(
+            on_alive=self._on_alive,
+            on_byebye=self._on_byebye,
+            source=self.network.source,
+            target=self.network.target,
+            loop=asyncio.get_running_loop(),
+        )
+        try:
+            await listener.async_start()
+        except (OSError, UpnpError) as exc:
+            raise ProtocolConnectionError(
+                f"SSDP listener on {self.network.interface} for {self.network.group}:{self.network.port}: "
+                f"cannot open the socket ({reason(exc)}); multicast must be possible on that interface"
+            ) from exc
+        self._listener = listener
+
+    async def stop(self) -> None:
+        """Close the socket."""
+        listener, self._listener = self._listener, None
+        if listener is not None:
+            await listener.async_stop()
+
+    def _on_alive(self, headers: CaseInsensitiveDict) -> None:
+        self._report(headers, alive=True)
+
+    def _on_byebye(self, headers: CaseInsensitiveDict) -> None:
+        self._report(headers, alive=False)
+
+    def _report(self, headers: CaseInsensitiveDict, alive: bool) -> None:
+        found = _headers_udn(headers)
+        if found is None or self._alive.get(found[0]) is alive:
+            return
+        self._alive[found[0]] = alive
+        advertisement = Advertisement(found[0], alive, found[1], found[2])
+        self.seen.append(advertisement)
+        self._queue.put_nowait(advertisement)
+        self._changed.notify()
+
+    async def next(self, timeout: float) -> Advertisement:
+        """The next report; :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time."""
+        try:
+            async with asyncio.timeout(timeout):
+                return await self._queue.get()
+        except TimeoutError as exc:
+            raise ProtocolTimeout(f"SSDP advertisements: none within {timeout:g} s") from exc
+
+    async def wait_for(self, udn: str, alive: bool, timeout: float) -> Advertisement:
+        """The report that device ``udn`` is alive (or gone), as soon as it has been seen."""
+
+        def probe() -> Advertisement | None:
+            return next((a for a in reversed(self.seen) if a.udn == udn and a.alive is alive), None)
+
+        state = "alive" if alive else "byebye"
+        return await self._changed.wait_for(probe, timeout, f"SSDP {state} of {udn}")

@@ -1,0 +1,95 @@
+"""The pure parts of the UPnP side: chart events to service, spec checks, the trust rule."""
+
+from __future__ import annotations
+
+import pytest
+
+from plugnproduce.errors import DescriptionError, ProtocolError
+from plugnproduce.protocols.upnp import (
+    ActionSpec,
+    ArgumentSpec,
+    DeviceFiles,
+    ServiceSpec,
+    UntrustedUrlError,
+    VariableSpec,
+    device_type_for,
+    service_spec_from_chart_events,
+    udn_for,
+)
+from plugnproduce.protocols.upnp.boundary import check_trusted, resolve_trusted
+
+
+def test_chart_requests_become_actions_with_their_parameters() -> None:
+    spec = service_spec_from_chart_events({"MoveTo": ["Pose", "Speed"], "Home": []}, [])
+    assert [a.name for a in spec.actions] == ["Home", "MoveTo"]
+    assert spec.action("MoveTo").input_names == ("Pose", "Speed")
+    assert spec.action("MoveTo").inputs[0].data_type == "string"
+    assert [a.name for a in spec.action("Home").outputs] == ["Result"]
+
+
+def test_chart_events_become_counting_evented_variables() -> None:
+    spec = service_spec_from_chart_events({}, ["arrived", "homed", "arrived"])
+    assert spec.variables == (
+        VariableSpec("arrived", "ui4", default="0"),
+        VariableSpec("homed", "ui4", default="0"),
+    )
+
+
+def test_repeated_request_parameters_appear_once() -> None:
+    spec = service_spec_from_chart_events({"Close": ["GripForce", "GripForce"]}, [])
+    assert spec.action("Close").input_names == ("GripForce",)
+
+
+def test_argument_types_override_the_string_default() -> None:
+    spec = service_spec_from_chart_events({"Close": ["GripForce"]}, [], argument_types={"GripForce": "r8"})
+    assert spec.action("Close").inputs[0].data_type == "r8"
+
+
+@pytest.mark.parametrize(
+    ("build", "expected"),
+    [
+        (lambda: service_spec_from_chart_events({}, ["gripper-closed"]), "'gripper-closed' cannot be a UPnP name"),
+        (lambda: ArgumentSpec("x", "float64"), "expected one of the UPnP types"),
+        (lambda: VariableSpec("Mode", allowed_values=("a", "b"), default="c"), "default 'c' is not one of"),
+        (lambda: VariableSpec("A_ARG_TYPE_x"), "prefix A_ARG_TYPE_ is reserved"),
+        (lambda: ArgumentSpec("n", "i4", allowed_values=("one",)), "allowed value 'one' is not a i4"),
+        (lambda: ActionSpec("Go", (ArgumentSpec("Result"),)), "names argument(s) Result more than once"),
+        (lambda: ServiceSpec((ActionSpec("Go"), ActionSpec("Go"))), "action name(s) Go given more than once"),
+        (lambda: DeviceFiles("../x.ttl", "", "x.scxml", ""), "'../x.ttl' cannot be served"),
+    ],
+)
+def test_unusable_specs_are_refused_with_the_reason(build, expected: str) -> None:
+    with pytest.raises(DescriptionError) as info:
+        build()
+    assert expected in str(info.value)
+
+
+def test_device_type_and_udn() -> None:
+    assert device_type_for("ParallelGripper") == "urn:plugnproduce-org:device:ParallelGripper:1"
+    assert udn_for("gripper") == udn_for("gripper")
+    assert udn_for("gripper") != udn_for("robot")
+    assert udn_for("gripper").startswith("uuid:")
+
+
+def test_url_on_the_discovered_host_is_trusted() -> None:
+    url = "http://127.0.0.1:4711/pnp/gripper.scxml"
+    assert check_trusted(url, "127.0.0.1", "chart") == url
+    assert resolve_trusted("http://127.0.0.1:4711/device.xml", "/pnp/gripper.scxml", "127.0.0.1", "chart") == url
+
+
+@pytest.mark.parametrize(
+    "reference",
+    [
+        "http://127.0.0.2:4711/pnp/gripper.scxml",
+        "http://localhost:4711/pnp/gripper.scxml",
+        "//10.0.0.1/pnp/gripper.scxml",
+        "file:///etc/passwd",
+        "https://127.0.0.1/pnp/gripper.scxml",
+    ],
+)
+def test_file_url_elsewhere_is_refused(reference: str) -> None:
+    with pytest.raises(UntrustedUrlError) as info:
+        resolve_trusted("http://127.0.0.1:4711/device.xml", reference, "127.0.0.1", "pnp:chartURL of gripper")
+    assert isinstance(info.value, ProtocolError)
+    assert "pnp:chartURL of gripper" in str(info.value)
+    assert "refused" in str(info.value)
