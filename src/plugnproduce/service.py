@@ -63,3 +63,88 @@ def task(path: str | Path) -> Task:
 def builtin(*parts: str) -> Path:
     """A path inside the built-in descriptions, e.g. ``builtin("cells", "bin-picking.yaml")``."""
     return descriptions_path().joinpath(*parts)
+
+
+# ------------------------------------------------------------------ reasoning: capabilities, check, repair, explain
+
+from collections.abc import Callable, Iterator  # noqa: E402  (kept with the use cases it serves)
+
+from plugnproduce import reasoning  # noqa: E402
+
+
+def _as_cell(cell_or_path: Cell | str | Path) -> Cell:
+    return cell_or_path if isinstance(cell_or_path, Cell) else cell(cell_or_path)
+
+
+def _as_task(task_or_path: Task | str | Path) -> Task:
+    return task_or_path if isinstance(task_or_path, Task) else task(task_or_path)
+
+
+def capabilities(cell_or_path: Cell | str | Path) -> reasoning.Capabilities:
+    """The process commands a cell offers, with every valid role binding; the others with reasons."""
+    k = knowledge()
+    return reasoning.capabilities(_as_cell(cell_or_path), k.taxonomy, k.processes)
+
+
+def check(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path) -> reasoning.CheckResult:
+    """Whether a task is plausible in a cell: per step its bindings, device states and problems."""
+    k = knowledge()
+    return reasoning.check(_as_task(task_or_path), _as_cell(cell_or_path), k.taxonomy, k.processes)
+
+
+def repair(
+    task_or_path: Task | str | Path,
+    cell_or_path: Cell | str | Path,
+    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+    top: int = 3,
+    costs: reasoning.RepairCosts | None = None,
+) -> list[reasoning.Repair]:
+    """The ``top`` cheapest distinct repairs of an implausible task (none if it is plausible).
+
+    With a catalogue (device descriptions, or a folder of them) a repair may add a device.
+    """
+    k = knowledge()
+    devices = catalogue(catalogue_or_folder) if isinstance(catalogue_or_folder, str | Path) else catalogue_or_folder
+    return reasoning.repair(_as_task(task_or_path), _as_cell(cell_or_path), k.taxonomy, k.processes,
+                            catalogue=devices, top=top, costs=costs)
+
+
+def explain_process(cell_or_path: Cell | str | Path, command: str) -> reasoning.ProcessExplanation:
+    """Why a process command is (not) offered in a cell."""
+    k = knowledge()
+    return reasoning.explain_process(_as_cell(cell_or_path), command, k.taxonomy, k.processes)
+
+
+def explain_step(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path,
+                 n: int) -> reasoning.StepExplanation:
+    """Why step ``n`` (1-based) of a task is (not) plausible in a cell."""
+    k = knowledge()
+    return reasoning.explain_step(_as_task(task_or_path), _as_cell(cell_or_path), n, k.taxonomy, k.processes)
+
+
+def batch(
+    configurations: list[reasoning.Configuration] | str | Path,
+    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+    tasks: list[Task | str | Path] | None = None,
+    workers: int = 2,
+    progress: Callable[[int], None] | None = None,
+) -> Iterator[reasoning.BatchRow]:
+    """Feasibility of many configurations (a list, or a JSONL/CSV file of device lists) of catalogue devices:
+    per configuration the offered processes, the plausible tasks, and for the others the cheapest device to add."""
+    k = knowledge()
+    devices = catalogue_or_folder if isinstance(catalogue_or_folder, list) else catalogue(catalogue_or_folder)
+    configs = (configurations if isinstance(configurations, list)
+               else reasoning.read_configurations(configurations))
+    return reasoning.batch(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+                           workers=workers, progress=progress)
+
+
+def generate_configurations(
+    count: int,
+    sizes: tuple[int, int],
+    seed: int,
+    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+) -> list[reasoning.Configuration]:
+    """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices."""
+    devices = catalogue_or_folder if isinstance(catalogue_or_folder, list) else catalogue(catalogue_or_folder)
+    return reasoning.generate(devices, count, sizes, seed)

@@ -36,6 +36,7 @@ def schema_problems(data: bytes, source: str | Path) -> list[DescriptionError]:
 
 
 _IDREF = re.compile(r"IDREF '([^']+)' not found")
+_CHILD = re.compile(r"Unexpected child with tag '[^']+' at position (\d+)")
 
 
 def _line(tree: etree._ElementTree, error: xmlschema.XMLSchemaValidationError, reason: str) -> int | None:
@@ -47,4 +48,12 @@ def _line(tree: etree._ElementTree, error: xmlschema.XMLSchemaValidationError, r
             if any(token in (el.get(a) or "").split() for a in ("target", "initial")):
                 return el.sourceline  # type: ignore[no-any-return]
     element = error.elem
-    return element.sourceline if isinstance(element, etree._Element) else None  # type: ignore[no-any-return]
+    if not isinstance(element, etree._Element):
+        return None
+    child = _CHILD.search(reason)
+    if child:  # xmlschema names the parent; point at the unexpected child itself
+        children = [c for c in element if isinstance(c.tag, str)]
+        position = int(child.group(1))
+        if 0 < position <= len(children):
+            return children[position - 1].sourceline  # type: ignore[no-any-return]
+    return element.sourceline  # type: ignore[no-any-return]

@@ -1,0 +1,142 @@
+"""Benchmark: XIRP command round trip against a raw asyncio TCP echo, on loopback.
+
+Run ``python bench/bench_xirp.py [--iterations N] [--rounds R]``. One process, one
+event loop, two connections kept open side by side:
+
+* raw echo: the client writes a payload the size of an XIRP request frame, an
+  ``asyncio.start_server`` echo writes it back, the client reads it whole;
+* XIRP: ``XirpClient.request("MoveTo", {Target: pose, Speed: decimal})`` to an
+  ``XirpServer`` whose handler answers at once (encode, frame, hardened parse and
+  XSD validation of the request, request matching, handler dispatch, the response
+  back). Measured twice: with a plain-function handler (answered within the
+  callback that received the request) and with an ``async def`` handler (answered
+  from the connection's task, one event-loop turn later).
+
+They run in alternating blocks (``R`` rounds of ``N / R`` round trips each), so a
+change of machine load hits all alike. Prints the median and the 99th percentile
+of each and the ratios to the raw echo (target ≤ 3).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import statistics
+import time
+from collections.abc import Awaitable, Callable, Mapping
+
+from plugnproduce.protocols.xirp import Pose, Request, Value, XirpClient, XirpServer, encode_frame
+
+HOST = "127.0.0.1"
+PARAMS: dict[str, Value] = {"Target": Pose(0.4, 0.1, 0.2, 0.0, 180.0, 0.0), "Speed": 0.25}
+WARM_UP = 200
+
+
+async def _echo(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+    try:
+        while data := await reader.read(65536):
+            writer.write(data)
+    finally:
+        writer.close()
+
+
+class RawEcho:
+    """A raw asyncio TCP echo on loopback: one connection, a payload written and read back whole."""
+
+    def __init__(self, payload: bytes) -> None:
+        self.payload = payload
+        self._server: asyncio.Server | None = None
+        self._streams: tuple[asyncio.StreamReader, asyncio.StreamWriter] | None = None
+
+    async def __aenter__(self) -> RawEcho:
+        self._server = await asyncio.start_server(_echo, HOST, 0)
+        self._streams = await asyncio.open_connection(HOST, self._server.sockets[0].getsockname()[1])
+        return self
+
+    async def __aexit__(self, *exc_info: object) -> None:
+        if self._streams is not None:
+            self._streams[1].close()
+            await self._streams[1].wait_closed()
+        if self._server is not None:
+            self._server.close()
+            await self._server.wait_closed()
+
+    async def round_trip(self) -> None:
+        """Write the payload, read it back."""
+        if self._streams is None:
+            raise RuntimeError("echo not started")
+        reader, writer = self._streams
+        writer.write(self.payload)
+        await reader.readexactly(len(self.payload))
+
+
+def _plain_handler(request: Request) -> Mapping[str, Value]:
+    return {}
+
+
+async def _async_handler(request: Request) -> Mapping[str, Value]:
+    return {}
+
+
+async def _block(call: Callable[[], Awaitable[object]], count: int, into: list[float]) -> None:
+    clock = time.perf_counter_ns
+    for _ in range(count):
+        start = clock()
+        await call()
+        into.append((clock() - start) / 1000)
+
+
+async def measure(iterations: int, rounds: int) -> dict[str, list[float]]:
+    """Round-trip times (µs) of the raw echo and of XIRP requests, in alternating blocks."""
+    payload = encode_frame(Request("1", "MoveTo", PARAMS))
+    times: dict[str, list[float]] = {"raw TCP echo": [], "XIRP, plain handler": [], "XIRP, async handler": []}
+    robot = "http://plugnproduce.org/ontology#Robot"
+    async with (
+        RawEcho(payload) as echo,
+        XirpServer("robot", robot, _plain_handler, host=HOST) as plain,
+        XirpServer("robot", robot, _async_handler, host=HOST) as awaited,
+        await XirpClient.connect(HOST, plain.port) as plain_client,
+        await XirpClient.connect(HOST, awaited.port) as async_client,
+    ):
+        calls: dict[str, Callable[[], Awaitable[object]]] = {
+            "raw TCP echo": echo.round_trip,
+            "XIRP, plain handler": lambda: plain_client.request("MoveTo", PARAMS),
+            "XIRP, async handler": lambda: async_client.request("MoveTo", PARAMS),
+        }
+        for call in calls.values():
+            await _block(call, WARM_UP, [])
+        for _ in range(rounds):
+            for name, call in calls.items():
+                await _block(call, iterations // rounds, times[name])
+    return times
+
+
+def _summary(times: list[float]) -> tuple[float, float]:
+    ordered = sorted(times)
+    return statistics.median(ordered), ordered[min(len(ordered) - 1, round(0.99 * len(ordered)))]
+
+
+async def main(iterations: int, rounds: int) -> float:
+    """Run the measurements, print them, return the ratio of the medians (plain handler / raw)."""
+    times = await measure(iterations, rounds)
+    raw_median, raw_p99 = _summary(times["raw TCP echo"])
+    size = len(encode_frame(Request("1", "MoveTo", PARAMS)))
+    print(f"request frame {size} bytes; {iterations // rounds * rounds} round trips each, {rounds} alternating blocks")
+    ratios = {}
+    for name, samples in times.items():
+        median, p99 = _summary(samples)
+        ratios[name] = median / raw_median
+        line = f"{name:20} median {median:6.1f} µs   p99 {p99:6.1f} µs"
+        if name != "raw TCP echo":
+            line += f"   ratio to raw: median {median / raw_median:4.2f}, p99 {p99 / raw_p99:4.2f}"
+        print(line)
+    print("target: median ratio ≤ 3")
+    return ratios["XIRP, plain handler"]
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    parser.add_argument("--iterations", type=int, default=2000, help="round trips of each kind (default 2000)")
+    parser.add_argument("--rounds", type=int, default=10, help="alternating blocks (default 10)")
+    arguments = parser.parse_args()
+    asyncio.run(main(arguments.iterations, arguments.rounds))

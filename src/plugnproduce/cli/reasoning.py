@@ -1,0 +1,200 @@
+"""``pnp capabilities``, ``pnp check``, ``pnp repair``, ``pnp explain`` and ``pnp batch``.
+
+Exit codes: 0 ok (offered, plausible, repaired, batch done); 1 a finding (implausible
+task, process not offered, no repair found); 2 bad input, one ``file:line: message`` line.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import sys
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+from plugnproduce import reasoning, service
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
+from plugnproduce.description.loader import task_to_yaml
+
+CELL_OPTION = typer.Option(..., "--cell", help="The cell file (YAML).")
+
+
+def _bindings(bindings: tuple[dict[str, str], ...]) -> str:
+    return " | ".join(" ".join(f"{r}={d}" for r, d in b.items()) for b in bindings)
+
+
+def _reasons(reasons: tuple[reasoning.Reason, ...], indent: str = "    ") -> None:
+    for r in reasons:
+        typer.echo(f"{indent}- {r.text}")
+        if r.where:
+            typer.echo(f"{indent}  rests on: {', '.join(str(w) for w in r.where)}")
+
+
+@app.command()
+@boundary
+def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION) -> None:
+    """Show the process commands a cell offers (with every role binding) and why the others are not offered."""
+    caps = service.capabilities(cell)
+    if json_out:
+        emit_json(caps.to_json())
+        return
+    total = len(caps.offered) + len(caps.not_offered)
+    typer.echo(f"cell {caps.cell}: {len(caps.offered)} of {total} process commands offered")
+    for o in caps.offered:
+        typer.echo(f"  {o.command:<16} {_bindings(o.bindings)}")
+    if caps.not_offered:
+        typer.echo("not offered:")
+    for n in caps.not_offered:
+        typer.echo(f"  {n.command}")
+        _reasons(n.reasons)
+
+
+def _print_problems(result: reasoning.CheckResult) -> None:
+    for p in result.problems:
+        typer.echo(str(p))
+        if p.reason.where:
+            typer.echo(f"    rests on: {', '.join(str(w) for w in p.reason.where)}")
+
+
+@app.command()
+@boundary
+def check(task: Path = typer.Argument(..., help="The task file (YAML)."), cell: Path = CELL_OPTION,
+          json_out: bool = JSON_OPTION) -> None:
+    """Check that a task is plausible: each step finds its devices in the states it starts from.
+
+    Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
+    """
+    result = service.check(task, cell)
+    if json_out:
+        emit_json(result.to_json())
+    else:
+        verdict = "plausible" if result.plausible else f"implausible ({len(result.problems)} problem(s))"
+        typer.echo(f"task {result.task} in cell {result.cell}: {verdict}")
+        _print_problems(result)
+    if not result.plausible:
+        raise typer.Exit(1)
+
+
+@app.command()
+@boundary
+def repair(
+    task: Path = typer.Argument(..., help="The task file (YAML)."),
+    cell: Path = CELL_OPTION,
+    catalogue: Path | None = typer.Option(None, "--catalogue", help="Devices a repair may add (a folder)."),
+    top: int = typer.Option(3, "--top", min=1, max=20, help="How many distinct repairs, cheapest first."),
+    json_out: bool = JSON_OPTION,
+) -> None:
+    """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
+
+    Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
+    """
+    result = service.check(task, cell)
+    repairs = [] if result.plausible else service.repair(task, cell, catalogue, top)
+    if json_out:
+        emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
+                   "repairs": [r.to_json() for r in repairs]})
+    elif result.plausible:
+        typer.echo(f"task {result.task} in cell {result.cell}: plausible; nothing to repair")
+    else:
+        typer.echo(f"task {result.task} in cell {result.cell}: implausible; {len(repairs)} repair(s)")
+        _print_problems(result)
+        for r in repairs:
+            typer.echo(f"\nrepair {r.rank} (cost {r.cost:g}):")
+            for e in r.edits:
+                typer.echo(f"  - {e.text} [cost {e.cost:g}]")
+            typer.echo("  resulting task:")
+            typer.echo("".join(f"    {line}\n" for line in task_to_yaml(r.task).splitlines()), nl=False)
+    if not result.plausible and not repairs:
+        raise typer.Exit(1)
+
+
+@app.command()
+@boundary
+def explain(
+    target: str = typer.Argument(..., help="A process command, or with --step a task file."),
+    cell: Path = CELL_OPTION,
+    step: int | None = typer.Option(None, "--step", help="Explain this step (1-based) of the task TARGET."),
+    json_out: bool = JSON_OPTION,
+) -> None:
+    """Why a process command is (not) offered, or why a task's step is (not) plausible. Exit 1 when it is not."""
+    if step is None:
+        ex = service.explain_process(cell, target)
+        if json_out:
+            emit_json(ex.to_json())
+        elif ex.offered:
+            typer.echo(f"{ex.command} is offered in cell {service.cell(cell).name}: {_bindings(ex.bindings)}")
+        else:
+            typer.echo(f"{ex.command} is not offered in cell {service.cell(cell).name}:")
+            _reasons(ex.reasons, "  ")
+        ok = ex.offered
+    else:
+        st = service.explain_step(Path(target), cell, step)
+        if json_out:
+            emit_json(st.to_json())
+        else:
+            typer.echo(f"step {st.step} ({st.command}): {'plausible' if st.plausible else 'not plausible'}")
+            _reasons(st.states, "  ")
+            for p in st.problems:
+                typer.echo(f"  problem: {p}")
+        ok = st.plausible
+    if not ok:
+        raise typer.Exit(1)
+
+
+def _sizes(text: str) -> tuple[int, int]:
+    low, _, high = text.partition("-")
+    try:
+        return int(low), int(high or low)
+    except ValueError:
+        fail(f"--sizes: expected MIN-MAX such as 2-6; found {text!r}")
+
+
+@app.command()
+@boundary
+def batch(
+    configs: Path | None = typer.Argument(None, help="Configurations: JSONL ({\"config\", \"devices\"}) or CSV."),
+    generate: int | None = typer.Option(None, "--generate", help="Generate this many random configurations."),
+    sizes: str = typer.Option("2-6", "--sizes", help="Devices per generated configuration, MIN-MAX."),
+    seed: int = typer.Option(1, "--seed", help="Seed of the generator."),
+    catalogue: Path | None = typer.Option(None, "--catalogue", help="Device folder (default: built-in devices)."),
+    tasks: list[Path] = typer.Option([], "--task", help="A task to check in every configuration (repeatable)."),
+    output: Path | None = typer.Option(None, "-o", "--output", help="Report file: .jsonl or .csv (default: stdout)."),
+    workers: int = typer.Option(2, "--workers", min=1, help="Worker processes."),
+) -> None:
+    """Feasibility of many cell configurations: offered processes, plausible tasks, cheapest device to add."""
+    if (configs is None) == (generate is None):
+        fail("give either CONFIGS (a JSONL or CSV file) or --generate N")
+    devices = service.catalogue(catalogue)
+    if generate is not None:
+        try:
+            configurations = service.generate_configurations(generate, _sizes(sizes), seed, devices)
+        except ValueError as exc:
+            fail(f"--sizes: {exc}")
+    else:
+        configurations = reasoning.read_configurations(configs)  # type: ignore[arg-type]
+    err = Console(stderr=True)
+    columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=err, transient=True) as bar:
+        job = bar.add_task("batch", total=len(configurations))
+        rows = list(service.batch(configurations, devices, list(tasks), workers,
+                                  progress=lambda n: bar.advance(job, n)))
+    text = _report(rows, output.suffix.lower() == ".csv" if output else False)
+    if output is None:
+        sys.stdout.write(text)
+    else:
+        output.write_text(text, encoding="utf-8")
+        typer.echo(f"wrote {len(rows)} configurations to {output}", err=True)
+
+
+def _report(rows: list[reasoning.BatchRow], as_csv: bool) -> str:
+    if not as_csv:
+        return "".join(json.dumps(r.to_json()) + "\n" for r in rows)
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(reasoning.BATCH_CSV_HEADER)
+    writer.writerows(r.to_csv() for r in rows)
+    return buf.getvalue()

@@ -1,0 +1,80 @@
+"""The FastAPI application: the HTTP API (OpenAPI at ``/openapi.json``) and the page, in one process."""
+
+from __future__ import annotations
+
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from importlib import resources
+from pathlib import Path
+
+from fastapi import FastAPI
+from fastapi.responses import FileResponse
+from fastapi.staticfiles import StaticFiles
+from starlette.middleware.trustedhost import TrustedHostMiddleware
+
+from plugnproduce import service
+from plugnproduce.description.model import DeviceDescription
+from plugnproduce.hmi import errors
+from plugnproduce.hmi.hub import Hub
+from plugnproduce.hmi.interfaces import CellSource, Runner
+from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
+from plugnproduce.hmi.routes import cell, charts, runs, task
+from plugnproduce.hmi.security import SecurityHeaders
+
+DESCRIPTION = """\
+The Generic HMI of a Plug'n'Produce cell: the live cell, the process commands it offers,
+tasks checked, repaired, explained and turned into SCXML, and runs watched live.
+
+Requests that change the cell or a run need `Authorization: Bearer TOKEN` (the token
+`pnp serve` prints); the others are open to clients on this machine. Errors are
+`{"detail": "one line"}` with the messages the `pnp` command line gives.
+"""
+
+
+def static_folder() -> Path:
+    """The page's files, shipped inside the package."""
+    return Path(str(resources.files("plugnproduce.hmi") / "static"))
+
+
+def create_app(
+    source: CellSource,
+    runner: Runner,
+    token: str,
+    catalogue: list[DeviceDescription] | None = None,
+    allowed_hosts: list[str] | None = None,
+) -> FastAPI:
+    """The HMI application over a cell source and a runner.
+
+    ``token`` guards every request that changes something; ``catalogue`` is what repairs may add
+    (default: the built-in devices); ``allowed_hosts`` (e.g. ``["127.0.0.1", "localhost"]``) refuses
+    requests for any other ``Host``, which stops DNS-rebinding pages from reading the API.
+    """
+    hub = Hub(source, runner, catalogue if catalogue is not None else service.catalogue())
+
+    @asynccontextmanager
+    async def lifespan(_: FastAPI) -> AsyncIterator[None]:
+        await hub.start()
+        try:
+            yield
+        finally:
+            await hub.stop()
+
+    app = FastAPI(title="Plug'n'Produce HMI", description=DESCRIPTION, version="1", lifespan=lifespan)
+    app.state.hub = hub
+    app.state.token = token
+    app.state.pictures = Pictures()
+    app.state.generated = GeneratedCharts()
+    errors.install(app)
+    for router in (cell.router, task.router, charts.router, runs.router):
+        app.include_router(router)
+    folder = static_folder()
+    app.mount("/static", StaticFiles(directory=folder), name="static")
+
+    @app.get("/", include_in_schema=False)
+    def page() -> FileResponse:
+        return FileResponse(folder / "index.html", headers={"Cache-Control": "no-cache"})
+
+    app.add_middleware(SecurityHeaders)
+    if allowed_hosts:
+        app.add_middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts)
+    return app

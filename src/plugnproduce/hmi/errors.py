@@ -1,0 +1,82 @@
+"""The HTTP error boundary: the same one-line messages the CLI gives, with a 4xx status.
+
+Every error response is ``{"detail": "ONE LINE"}``; a request that does not match its
+schema also lists each bad field: ``{"detail": "steps[0].command: field required",
+"errors": [{"field": "steps[0].command", "reason": "field required"}]}``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, cast
+
+from fastapi import FastAPI, Request, status
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+
+from plugnproduce.errors import DescriptionError, PlugNProduceError
+from plugnproduce.hmi.interfaces import CellChangeRefused, RunRefused
+
+
+def field_name(loc: Sequence[int | str]) -> str:
+    """``("body", "steps", 0, "params", "speed")`` → ``steps[0].params.speed``."""
+    parts = list(loc[1:] if loc and loc[0] in ("body", "query", "path") else loc)
+    out = ""
+    for p in parts:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out or (str(loc[0]) if loc else "request")
+
+
+def _reason(error: dict[str, Any]) -> str:
+    msg = str(error.get("msg", "invalid"))
+    for prefix in ("Value error, ", "Assertion failed, "):
+        msg = msg.removeprefix(prefix)
+    if error.get("type") == "missing":
+        return "field required"
+    if error.get("type") == "json_invalid":
+        loc = error.get("loc", ())
+        at = f" at character {loc[-1]}" if loc and isinstance(loc[-1], int) else ""
+        return f"not valid JSON{at}: {error.get('ctx', {}).get('error', msg)}"
+    return msg[:1].lower() + msg[1:]
+
+
+def _one(status_code: int, detail: str, **extra: Any) -> JSONResponse:
+    return JSONResponse({"detail": detail, **extra}, status_code=status_code)
+
+
+async def _invalid_request(_: Request, exc: Exception) -> JSONResponse:
+    raw = cast(RequestValidationError, exc).errors()  # registered for this class only
+    errors = [{"field": "body" if e.get("type") == "json_invalid" else field_name(e.get("loc", ())),
+               "reason": _reason(e)} for e in raw]
+    unique = list({(e["field"], e["reason"]): e for e in errors}.values())
+    code = status.HTTP_400_BAD_REQUEST if any(e.get("type") == "json_invalid" for e in raw) \
+        else status.HTTP_422_UNPROCESSABLE_CONTENT
+    first = unique[0] if unique else {"field": "request", "reason": "invalid"}
+    return _one(code, f"{first['field']}: {first['reason']}", errors=unique)
+
+
+async def _description(_: Request, exc: Exception) -> JSONResponse:
+    return _one(status.HTTP_400_BAD_REQUEST, cast(DescriptionError, exc).location_message())
+
+
+async def _unknown(_: Request, exc: Exception) -> JSONResponse:
+    name = exc.args[0] if exc.args else "name"
+    return _one(status.HTTP_404_NOT_FOUND, f"error: unknown {name}")
+
+
+async def _conflict(_: Request, exc: Exception) -> JSONResponse:
+    return _one(status.HTTP_409_CONFLICT, f"error: {exc}")
+
+
+async def _other(_: Request, exc: Exception) -> JSONResponse:
+    return _one(status.HTTP_400_BAD_REQUEST, f"error: {exc}")
+
+
+def install(app: FastAPI) -> None:
+    """Register the error boundary on ``app`` (the most specific class wins)."""
+    app.add_exception_handler(RequestValidationError, _invalid_request)
+    app.add_exception_handler(DescriptionError, _description)
+    app.add_exception_handler(KeyError, _unknown)
+    app.add_exception_handler(RunRefused, _conflict)
+    app.add_exception_handler(CellChangeRefused, _conflict)
+    app.add_exception_handler(PlugNProduceError, _other)

@@ -1,0 +1,93 @@
+"""Pictures of charts for the page (SVG drawn by :func:`plugnproduce.drawing.draw_chart`), and the
+charts generated for recent tasks, kept in memory so the page can fetch them by id."""
+
+from __future__ import annotations
+
+import hashlib
+import tempfile
+import threading
+from collections import OrderedDict
+from collections.abc import Callable
+from pathlib import Path
+
+from plugnproduce.codegen.outputs import Chart
+from plugnproduce.drawing import draw_chart
+
+
+class _Bounded(OrderedDict[str, object]):
+    def __init__(self, limit: int) -> None:
+        super().__init__()
+        self.limit = limit
+
+    def keep(self, key: str, value: object) -> None:
+        self[key] = value
+        self.move_to_end(key)
+        while len(self) > self.limit:
+            self.popitem(last=False)
+
+
+class Pictures:
+    """SVG pictures of chart files and of generated charts, drawn once and cached."""
+
+    def __init__(self, limit: int = 64) -> None:
+        self._cache = _Bounded(limit)
+        self._lock = threading.Lock()
+
+    def of_file(self, path: str | Path) -> bytes:
+        """The picture of a chart file (redrawn when the file changes)."""
+        p = Path(path)
+        key = f"file:{p}:{p.stat().st_mtime_ns}"
+        return self._cached(key, lambda: self._draw(p))
+
+    def of_chart(self, chart: Chart) -> bytes:
+        """The picture of a generated chart."""
+        key = "chart:" + hashlib.sha256(chart.data).hexdigest()
+
+        def draw() -> bytes:
+            with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
+                src = Path(folder) / "chart.scxml"
+                src.write_bytes(chart.data)
+                return self._draw(src)
+
+        return self._cached(key, draw)
+
+    def _cached(self, key: str, draw: Callable[[], bytes]) -> bytes:
+        with self._lock:
+            hit = self._cache.get(key)
+        if isinstance(hit, bytes):
+            return hit
+        data = draw()
+        with self._lock:
+            self._cache.keep(key, data)
+        return data
+
+    @staticmethod
+    def _draw(src: Path) -> bytes:
+        with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
+            return draw_chart(src, Path(folder) / "chart.svg").read_bytes()
+
+
+class GeneratedCharts:
+    """The charts generated for the last few tasks, by generation id."""
+
+    def __init__(self, limit: int = 16) -> None:
+        self._store = _Bounded(limit)
+        self._lock = threading.Lock()
+
+    def add(self, charts: tuple[Chart, ...]) -> str:
+        """Keep a generation's charts; its id is a digest of their content."""
+        digest = hashlib.sha256(b"".join(c.name.encode() + b"\0" + c.data for c in charts)).hexdigest()[:16]
+        with self._lock:
+            self._store.keep(digest, {c.name: c for c in charts})
+        return digest
+
+    def chart(self, generation: str, name: str) -> Chart:
+        """One chart of a generation (KeyError if either is unknown)."""
+        with self._lock:
+            charts = self._store.get(generation)
+        if not isinstance(charts, dict):
+            raise KeyError(f"generation {generation!r} (generate the task again)")
+        if name not in charts:
+            raise KeyError(f"chart {name!r} of generation {generation} (it has: {', '.join(charts)})")
+        chart: Chart = charts[name]
+        return chart

@@ -1,0 +1,150 @@
+// The cell (devices with class, skills, protocol, state; plug and unplug) and the process commands.
+
+import { ApiError, del, get, post } from "./api.js";
+import { $, announce, fill, h } from "./dom.js";
+import { changed, state } from "./state.js";
+
+let addCommand = () => {};
+let showChart = () => {};
+
+/** Wire the panel: `onAdd(command)` opens the step dialog, `onChart(url, caption)` shows a picture. */
+export function initCell({ onAdd, onChart }) {
+  addCommand = onAdd;
+  showChart = onChart;
+  $("#plug-form").addEventListener("submit", async (e) => {
+    e.preventDefault();
+    const device = $("#plug-device").value;
+    if (!device) return;
+    try {
+      await post("/api/cell/devices", { device }, { auth: true });
+    } catch (err) {
+      announce(err.message);
+      alertError(err);
+    }
+  });
+}
+
+function alertError(err) {
+  const box = $("#verdict");
+  fill(box, h("p", { class: "error" }, err instanceof ApiError ? err.message : String(err)));
+}
+
+async function unplug(device) {
+  try {
+    await del(`/api/cell/devices/${encodeURIComponent(device.id)}`, { auth: true });
+  } catch (err) {
+    alertError(err);
+  }
+}
+
+function stateCell(device) {
+  const concept = device.state_concept && device.state_concept !== device.state ? ` (${device.state_concept})` : "";
+  return h("td", { class: "state", dataset: { device: device.id } }, h("span", { class: "badge" }, device.state || "?"), concept);
+}
+
+function deviceRow(device) {
+  const actions = h("td", { class: "actions" },
+    h("button", { type: "button", class: "quiet", "aria-label": `Show the state chart of ${device.id}`,
+      onclick: () => showChart(device.chart, `Device State Chart of ${device.id}`) }, "Chart"),
+    state.pluggable ? h("button", { type: "button", class: "quiet danger", "aria-label": `Unplug ${device.id}`,
+      onclick: () => unplug(device) }, "Unplug") : null);
+  return h("tr", { dataset: { device: device.id } },
+    h("th", { scope: "row" }, h("span", { class: "device-id" }, device.id), h("span", { class: "device-label" }, device.label)),
+    h("td", {}, device.classes.join(", ")),
+    h("td", { class: "skills" }, device.skills.join(", ")),
+    h("td", {}, h("span", { class: `proto proto-${device.protocol}` }, device.protocol.toUpperCase())),
+    stateCell(device),
+    actions);
+}
+
+/** Show the cell as it is now. */
+export function renderCell() {
+  const cell = state.cell;
+  $("#cell-name").textContent = cell ? cell.name : "…";
+  const devices = cell ? cell.devices : [];
+  fill($("#devices tbody"), devices.map(deviceRow));
+  $("#devices").hidden = devices.length === 0;
+  $("#devices-empty").hidden = devices.length > 0;
+  const present = new Set(devices.map((d) => d.id));
+  const pluggable = state.catalogue.filter((d) => !present.has(d.id));
+  $("#plug-form").hidden = !state.pluggable || pluggable.length === 0;
+  fill($("#plug-device"), pluggable.map((d) => h("option", { value: d.id }, `${d.id} (${d.classes.join(", ")})`)));
+}
+
+/** Update one device's state cell (from a run or the live cell). */
+export function renderDeviceState(device, stateName, concept) {
+  const d = state.cell && state.cell.devices.find((x) => x.id === device);
+  if (d) {
+    d.state = stateName;
+    d.state_concept = concept;
+  }
+  const cell = document.querySelector(`#devices td.state[data-device="${CSS.escape(device)}"]`);
+  if (cell && d) cell.replaceWith(stateCell(d));
+}
+
+function bindingsText(offer) {
+  if (offer.bindings.length !== 1) return `${offer.bindings.length} ways to bind its roles`;
+  return Object.entries(offer.bindings[0]).map(([role, dev]) => `${role}: ${dev}`).join(", ");
+}
+
+async function toggleWhy(button, box, command) {
+  const open = button.getAttribute("aria-expanded") === "true";
+  button.setAttribute("aria-expanded", String(!open));
+  box.hidden = open;
+  if (open || box.dataset.loaded) return;
+  fill(box, h("p", { class: "hint" }, "asking the reasoner…"));
+  try {
+    const ex = await get(`/api/commands/${encodeURIComponent(command)}/explanation`);
+    box.dataset.loaded = "1";
+    fill(box, h("ul", { class: "reasons" }, ex.reasons.map((r) => h("li", {}, r.text,
+      r.where.length ? h("span", { class: "where" }, ` (rests on ${r.where.map(shortWhere).join(", ")})`) : null))));
+  } catch (err) {
+    fill(box, h("p", { class: "error" }, err.message));
+  }
+}
+
+/** A description file and line, without its folder. */
+export function shortWhere(where) {
+  return String(where).split(/[\\/]/).pop();
+}
+
+/** Show the offered process commands and, behind "Why not?", the others. */
+export function renderCommands() {
+  const commands = state.commands;
+  $("#no-reasoner").hidden = commands !== null;
+  const offered = commands ? commands.offered : [];
+  fill($("#offered"), offered.map((o) => h("li", { dataset: { command: o.command } },
+    h("div", { class: "cmd" }, h("span", { class: "cmd-label" }, o.label), h("code", {}, o.command)),
+    h("span", { class: "cmd-binding" }, bindingsText(o)),
+    h("button", { type: "button", class: "add", "aria-label": `Add ${o.label} to the task`,
+      onclick: () => addCommand(o.command) }, "Add"))));
+  const notOffered = commands ? commands.not_offered : [];
+  fill($("#not-offered"), notOffered.map((n) => {
+    const id = `why-${n.command}`;
+    const box = h("div", { id, class: "why", hidden: true });
+    const button = h("button", { type: "button", class: "quiet", "aria-expanded": "false", "aria-controls": id,
+      "aria-label": `Why is ${n.label} not offered?`, onclick: () => toggleWhy(button, box, n.command) }, "Why not?");
+    return h("li", { dataset: { command: n.command } },
+      h("div", { class: "cmd" }, h("span", { class: "cmd-label" }, n.label), h("code", {}, n.command)), button, box);
+  }));
+}
+
+/** Take in a "cell" event (or the first load): the cell, its commands, and what changed. */
+export function takeCell(data) {
+  const before = new Set((state.commands ? state.commands.offered : []).map((o) => o.command));
+  state.cell = data.cell;
+  state.commands = data.commands;
+  renderCell();
+  renderCommands();
+  if (data.change) {
+    const after = new Set((state.commands ? state.commands.offered : []).map((o) => o.command));
+    const gone = [...before].filter((c) => !after.has(c));
+    const come = [...after].filter((c) => !before.has(c));
+    const verb = data.change.kind === "plug" ? "plugged in" : data.change.kind === "unplug" ? "unplugged" : data.change.kind;
+    const parts = [`${data.change.device} ${verb}.`];
+    if (come.length) parts.push(`Now offered: ${come.join(", ")}.`);
+    if (gone.length) parts.push(`No longer offered: ${gone.join(", ")}.`);
+    announce(parts.join(" "));
+  }
+  changed("cell", data);
+}

@@ -1,0 +1,142 @@
+// Runs: start and stop, each device's state and the current step live, the journal, the fault report.
+
+import { get, post } from "./api.js";
+import { renderDeviceState } from "./cell.js";
+import { $, announce, fill, h } from "./dom.js";
+import { state, taskBody } from "./state.js";
+
+function statusText(run) {
+  const step = run.step ? `step ${run.step.step} of ${run.steps}: ${run.step.command}` : "starting";
+  switch (run.status) {
+    case "running": return `Run ${run.run} of task ${run.task} is running (${step}).`;
+    case "succeeded": return `Run ${run.run} of task ${run.task} succeeded.`;
+    case "stopped": return `Run ${run.run} of task ${run.task} was stopped.`;
+    default: return `Run ${run.run} of task ${run.task} ${run.status}.`;
+  }
+}
+
+function markCurrentStep(run) {
+  const n = state.task.steps.length;
+  document.querySelectorAll("#steps .step").forEach((li) => {
+    li.classList.remove("running");
+    li.removeAttribute("aria-current");
+  });
+  if (!run || run.status !== "running" || !run.step || n === 0) return;
+  const li = $(`#steps li[data-row="${(run.step.step - 1) % n}"]`);
+  if (li) {
+    li.classList.add("running");
+    li.setAttribute("aria-current", "step");
+  }
+}
+
+function faultReport(run) {
+  if (run.status !== "failed") return null;
+  const fault = run.faults[run.faults.length - 1];
+  const where = fault && fault.step ? `step ${fault.step}` : "";
+  return [
+    h("h3", {}, "Fault report"),
+    h("p", { class: "fault-message" }, fault ? `${fault.fault}: ${fault.message}` : (run.end && run.end.reason) || "the run failed"),
+    h("dl", { class: "facts" },
+      fault && fault.device ? [h("dt", {}, "Device"), h("dd", {}, fault.device)] : null,
+      where ? [h("dt", {}, "Step"), h("dd", {}, `${where}${run.step ? ` (${run.step.command})` : ""}`)] : null,
+      h("dt", {}, "Run"), h("dd", {}, run.run)),
+    h("p", {}, "Every device was left in the state it had reached:"),
+    h("ul", { class: "fault-states" }, Object.entries(run.states).map(([d, s]) => h("li", {}, `${d}: ${s}`))),
+  ];
+}
+
+/** Show a run as its journal tells it. */
+export function renderRun() {
+  const run = state.run;
+  const running = Boolean(run && run.status === "running");
+  $("#run-start").disabled = running;
+  $("#run-stop").disabled = !running;
+  if (!run) return;
+  const status = $("#run-status");
+  status.textContent = statusText(run);
+  status.dataset.status = run.status;
+  $("#run-step").textContent = run.step ? `Current step: ${run.step.step} of ${run.steps}, ${run.step.command}` : "";
+  const table = $("#run-states");
+  table.hidden = Object.keys(run.states).length === 0;
+  const used = new Set(Object.values((run.step && run.step.bindings) || {}));
+  fill(table.querySelector("tbody"), Object.entries(run.states).map(([d, s]) =>
+    h("tr", { class: used.has(d) && running ? "busy" : "", dataset: { device: d } },
+      h("th", { scope: "row" }, d), h("td", {}, h("span", { class: "badge" }, s)))));
+  fill($("#journal"), run.lines.map((line) => h("li", {}, line)));
+  const link = $("#journal-link");
+  link.href = `/api/runs/${encodeURIComponent(run.run)}/journal?format=jsonl`;
+  link.hidden = false;
+  const fault = $("#fault");
+  const report = faultReport(run);
+  fault.hidden = !report;
+  fill(fault, report);
+  markCurrentStep(run);
+}
+
+/** Take in one journal record of a run (from the event stream). */
+export function takeRecord({ run: id, record, text }) {
+  if (!state.run || state.run.run !== id) {
+    state.run = { run: id, task: null, status: "running", steps: null, step: null, states: {}, faults: [], end: null,
+      lines: [], seq: 0 };
+  }
+  const run = state.run;
+  if (record.seq <= run.seq) return; // already in the run's view
+  run.seq = record.seq;
+  run.lines.push(text);
+  switch (record.kind) {
+    case "start":
+      Object.assign(run, { task: record.task, steps: record.steps, states: { ...(record.states || {}) } });
+      break;
+    case "step": run.step = record; break;
+    case "state":
+      run.states[record.device] = record.state;
+      break;
+    case "fault": run.faults.push(record); break;
+    case "end":
+      run.end = record;
+      run.status = record.outcome;
+      announce(statusText(run));
+      break;
+    default: break;
+  }
+  renderRun();
+}
+
+/** Take in a device's new state (runs and the live cell both report them). */
+export function takeDeviceState({ device, state: s, state_concept: concept }) {
+  renderDeviceState(device, s, concept);
+}
+
+async function start() {
+  const status = $("#run-status");
+  try {
+    state.run = await post("/api/runs", { task: taskBody() }, { auth: true });
+    announce(statusText(state.run));
+    renderRun();
+  } catch (err) {
+    status.textContent = err.message;
+    status.dataset.status = "refused";
+  }
+}
+
+async function stop() {
+  if (!state.run) return;
+  try {
+    state.run = await post(`/api/runs/${encodeURIComponent(state.run.run)}/stop`, undefined, { auth: true });
+    renderRun();
+  } catch (err) {
+    $("#run-status").textContent = err.message;
+  }
+}
+
+/** Wire the run panel and show the last run, if any. */
+export async function initRun() {
+  $("#run-start").addEventListener("click", start);
+  $("#run-stop").addEventListener("click", stop);
+  const runs = await get("/api/runs");
+  const last = runs.active || (runs.runs.length ? runs.runs[runs.runs.length - 1].run : null);
+  if (last) {
+    state.run = await get(`/api/runs/${encodeURIComponent(last)}`);
+    renderRun();
+  }
+}

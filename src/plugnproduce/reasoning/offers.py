@@ -1,0 +1,81 @@
+"""Offered process commands of a cell, every valid role binding, and why-not answers (offered.lp, explain.lp)."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Sequence
+
+from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.reasoning import render, solver
+from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning.facts import FactBook, config_facts, fact_book
+from plugnproduce.reasoning.results import Capabilities, NotOffered, Offer, ProcessExplanation, Reason
+from plugnproduce.reasoning.terms import Model, program, strings
+
+CELL = "cell"
+"""The configuration name a single cell gets in ASP."""
+
+
+def cell_program(book: FactBook, cell: Cell, extra: Sequence[DeviceDescription] = ()) -> str:
+    """Facts of the processes, the cell's devices (and ``extra`` devices not in the cell) and its membership."""
+    return (book.process_text() + book.devices_text([*cell.devices, *extra])
+            + program(config_facts(CELL, [d.id for d in cell.devices])))
+
+
+def context(book: FactBook, cell: Cell, extra: Sequence[DeviceDescription] = (),
+            task: Task | None = None) -> render.Context:
+    """The rendering context of a cell (and a task)."""
+    devices = {d.id: d for d in [*extra, *cell.devices]}
+    return render.Context(book.taxonomy, {p.id: p for p in book.processes}, devices, cell.name, task)
+
+
+def _bindings(model: Model, processes: dict[str, ProcessDescription]) -> dict[str, list[dict[str, str]]]:
+    out: dict[str, list[dict[str, str]]] = defaultdict(list)
+    for b in model[s.Binding]:
+        roles = [r.name for r in processes[b.p].roles]
+        devices = list(reversed(strings(b.devices)))
+        out[b.p].append(dict(zip(roles, devices, strict=True)))
+    for v in out.values():
+        v.sort(key=lambda b: sorted(b.items()))
+    return out
+
+
+def _reasons(model: Model, ctx: render.Context) -> dict[str, list[Reason]]:
+    out: dict[str, list[Reason]] = defaultdict(list)
+    for a in sorted(model[s.NoSkill], key=lambda a: (a.p, a.r)):
+        out[a.p].append(render.no_skill(ctx, a))
+    for b in sorted(model[s.LacksState], key=lambda a: (a.p, a.r, a.d, a.i)):
+        out[b.p].append(render.lacks_state(ctx, b))
+    for c in sorted(model[s.Unreachable], key=lambda a: (a.p, a.r, a.d, a.i, a.x)):
+        out[c.p].append(render.unreachable(ctx, c))
+    return out
+
+
+def capabilities(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> Capabilities:
+    """What ``cell`` can do: offered commands with all valid role bindings; the others with reasons."""
+    book = fact_book(taxonomy, processes)
+    model = solver.solve(solver.CAPABILITIES, cell_program(book, cell))
+    ctx = context(book, cell)
+    bindings, reasons = _bindings(model, ctx.processes), _reasons(model, ctx)
+    offered = {a.p for a in model[s.Offered] if a.c == CELL}
+    procs = sorted(book.processes, key=lambda p: p.id)
+    return Capabilities(
+        cell.name,
+        tuple(Offer(p.id, p.label, tuple(bindings[p.id])) for p in procs if p.id in offered),
+        tuple(NotOffered(p.id, p.label, tuple(reasons[p.id])) for p in procs if p.id not in offered),
+    )
+
+
+def explain_process(cell: Cell, command: str, taxonomy: Taxonomy,
+                    processes: Sequence[ProcessDescription]) -> ProcessExplanation:
+    """Why ``command`` is (not) offered in ``cell``: its bindings, or every reason with provenance."""
+    caps = capabilities(cell, taxonomy, processes)
+    for o in caps.offered:
+        if o.command == command:
+            return ProcessExplanation(o.command, o.label, True, o.bindings, ())
+    for n in caps.not_offered:
+        if n.command == command:
+            return ProcessExplanation(n.command, n.label, False, (), n.reasons)
+    known = ", ".join(sorted(p.id for p in processes))
+    raise KeyError(f"process command {command!r} (known: {known})")

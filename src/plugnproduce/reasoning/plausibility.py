@@ -1,0 +1,79 @@
+"""The plausibility check of a task in a cell, and why a step is (not) plausible (resolve.lp, chain.lp, params.lp)."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Sequence
+
+from plugnproduce.description.model import Cell, ProcessDescription, Task
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.reasoning import render, solver
+from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning.facts import fact_book, task_facts
+from plugnproduce.reasoning.offers import CELL, cell_program, context
+from plugnproduce.reasoning.results import CheckResult, Problem, StepCheck, StepExplanation
+from plugnproduce.reasoning.terms import Model, program
+
+TASK = "task"
+"""The name a single task gets in ASP."""
+
+
+def _problems(model: Model, ctx: render.Context) -> list[Problem]:
+    left = {(a.i, a.d): a.j for a in model[s.LeftBy]}
+    out = [render.wrong_state(ctx, a, left.get((a.i, a.d))) for a in model[s.WrongState]]
+    out += [render.stuck(ctx, a) for a in model[s.Stuck]]
+    out += [render.unknown_command(ctx, a) for a in model[s.UnknownCommand]]
+    out += [render.binding_problem(ctx, "no_device", a.i, a.r, []) for a in model[s.NoDevice]]
+    ambiguous: dict[tuple[int, str], list[str]] = defaultdict(list)
+    for b in model[s.Ambiguous]:
+        ambiguous[(b.i, b.r)].append(b.d)
+    out += [render.binding_problem(ctx, "ambiguous", i, r, ds) for (i, r), ds in ambiguous.items()]
+    out += [render.binding_problem(ctx, "absent", a.i, a.r, [a.d]) for a in model[s.Absent]]
+    out += [render.binding_problem(ctx, "cannot_play", a.i, a.r, [a.d]) for a in model[s.CannotPlay]]
+    out += [render.binding_problem(ctx, "unknown_role", a.i, a.r, []) for a in model[s.UnknownRole]]
+    values: list[s.BadType | s.TooLow | s.TooHigh | s.UnknownParam] = [
+        *model[s.BadType], *model[s.TooLow], *model[s.TooHigh], *model[s.UnknownParam]]
+    out += [render.parameter_problem(ctx, a) for a in values]
+    return sorted(out, key=lambda p: (p.step, p.kind, p.role or "", p.parameter or "", p.device or ""))
+
+
+def _steps(model: Model, task: Task) -> tuple[tuple[StepCheck, ...], dict[str, str]]:
+    bound: dict[int, dict[str, str]] = defaultdict(dict)
+    for b in model[s.Bound]:
+        bound[b.i][b.r] = b.d
+    states: dict[int, dict[str, str]] = defaultdict(dict)
+    for a in model[s.At]:
+        states[a.i][a.d] = a.x
+    steps = tuple(StepCheck(st.index, st.command, dict(sorted(bound[st.index].items())),
+                            dict(sorted(states[st.index].items()))) for st in task.steps)
+    return steps, dict(sorted(states[len(task.steps) + 1].items()))
+
+
+def run_check(task: Task, cell: Cell, taxonomy: Taxonomy,
+              processes: Sequence[ProcessDescription]) -> tuple[Model, render.Context]:
+    """The check's model and the context to render it."""
+    book = fact_book(taxonomy, processes)
+    facts = cell_program(book, cell) + program(task_facts(task, TASK)) + program([s.Check(CELL, TASK)])
+    return solver.solve(solver.CHECK, facts), context(book, cell, task=task)
+
+
+def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> CheckResult:
+    """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems."""
+    model, ctx = run_check(task, cell, taxonomy, processes)
+    steps, final = _steps(model, task)
+    plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible])
+    return CheckResult(task.name, cell.name, plausible, tuple(_problems(model, ctx)), steps, final)
+
+
+def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,
+                 processes: Sequence[ProcessDescription]) -> StepExplanation:
+    """Why step ``n`` (1-based) is (not) plausible: each device it uses, its state and what the step needs."""
+    if not 1 <= n <= len(task.steps):
+        raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+    model, ctx = run_check(task, cell, taxonomy, processes)
+    left = {(a.i, a.d): a.j for a in model[s.LeftBy]}
+    at = {(a.i, a.d): a.x for a in model[s.At]}
+    bound = sorted((b.r, b.d) for b in model[s.Bound] if b.i == n)
+    states = tuple(render.device_state(ctx, n, r, d, at[(n, d)], left.get((n, d))) for r, d in bound if (n, d) in at)
+    problems = tuple(p for p in _problems(model, ctx) if p.step == n)
+    return StepExplanation(n, task.steps[n - 1].command, not problems, states, problems)

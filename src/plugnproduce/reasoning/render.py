@@ -1,0 +1,194 @@
+"""Reason atoms → sentences an operator understands, naming the ontology terms and file:line they rest on."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task, Where
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import PNP_IRI
+from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning.facts import SCALE
+from plugnproduce.reasoning.results import Problem, Reason
+
+
+@dataclass(frozen=True)
+class Context:
+    """Everything a sentence may name: labels from the taxonomy, and where each thing is described."""
+
+    taxonomy: Taxonomy
+    processes: dict[str, ProcessDescription]
+    devices: dict[str, DeviceDescription]
+    cell: str
+    task: Task | None = None
+
+    def term(self, iri: str) -> str:
+        """A term as ``label (pnp:Local)``."""
+        curie = "pnp:" + iri[len(PNP_IRI):] if iri.startswith(PNP_IRI) else iri
+        return f"{self.taxonomy.label(iri)} ({curie})"
+
+    def state_where(self, d: str, x: str) -> Where:
+        """Where a device's chart state is written."""
+        dev = self.devices.get(d)
+        if dev is None:
+            return Where(self.cell)
+        line = next((st.line for st in dev.states if st.id == x), None)
+        return Where(dev.chart_file, line)
+
+    def state_concept(self, d: str, x: str) -> str | None:
+        """The concept a device's chart state is annotated with."""
+        dev = self.devices.get(d)
+        return next((st.concept for st in dev.states if st.id == x), None) if dev else None
+
+    def role_where(self, p: str, r: str) -> Where:
+        """Where a process's role is described."""
+        return self.processes[p].role(r).where
+
+    def region_where(self, p: str, r: str, i: int) -> Where:
+        """Where the ``i``-th state (1-based) of a role's region is written."""
+        proc = self.processes[p]
+        return Where(proc.chart_file, proc.role(r).region[i - 1].line)
+
+    def step_where(self, i: int, parameter: str | None = None) -> Where:
+        """Where a step (or one of its parameter values) is written in the task file."""
+        if self.task is None or not 1 <= i <= len(self.task.steps):
+            return Where(self.task.file if self.task else "task")
+        return self.task.where(self.task.steps[i - 1], parameter)
+
+    def step_command(self, i: int) -> str:
+        """The command of step ``i``."""
+        return self.task.steps[i - 1].command if self.task and 1 <= i <= len(self.task.steps) else "?"
+
+
+# ------------------------------------------------------------------ why a process is not offered
+
+
+def no_skill(ctx: Context, a: s.NoSkill) -> Reason:
+    """No device of the cell has the skill a role requires."""
+    proc = ctx.processes[a.p]
+    text = (f"role '{a.r}' of {a.p} needs a device that {ctx.term(a.s)}; "
+            f"no device in cell '{ctx.cell}' has that skill")
+    return Reason("no_skill", text, (a.s, proc.role(a.r).iri), (ctx.role_where(a.p, a.r),))
+
+
+def lacks_state(ctx: Context, a: s.LacksState) -> Reason:
+    """A device with the skill has no state of a concept the role's region visits."""
+    proc, dev = ctx.processes[a.p], ctx.devices[a.d]
+    text = (f"device '{a.d}' has the skill role '{a.r}' of {a.p} requires "
+            f"({ctx.term(proc.role(a.r).required_skill)}), but its state chart has no state of concept "
+            f"{ctx.term(a.con)}, which the role's region visits")
+    where = (ctx.region_where(a.p, a.r, a.i), Where(dev.chart_file), dev.where)
+    return Reason("lacks_state", text, (a.con, proc.role(a.r).required_skill, dev.iri), where)
+
+
+def unreachable(ctx: Context, a: s.Unreachable) -> Reason:
+    """A device has the states but cannot reach them in the order the region visits them."""
+    proc, dev = ctx.processes[a.p], ctx.devices[a.d]
+    prev = proc.role(a.r).region[a.i - 1].concept
+    text = (f"device '{a.d}' cannot play role '{a.r}' of {a.p}: in its state chart no state of "
+            f"concept {ctx.term(a.con)} is reachable from state '{a.x}' ({ctx.term(prev)}), "
+            f"but the role's region goes there next")
+    where = (ctx.region_where(a.p, a.r, a.i + 1), ctx.state_where(a.d, a.x), dev.where)
+    return Reason("unreachable", text, (a.con, prev, dev.iri), where)
+
+
+# ------------------------------------------------------------------ why a step is not plausible
+
+
+def since(ctx: Context, j: int | None) -> str:
+    """Where a device's state came from: a step, or power-up."""
+    if j is None:
+        return ""
+    return " (its initial state)" if j == 0 else f", left there by step {j} ({ctx.step_command(j)})"
+
+
+def wrong_state(ctx: Context, a: s.WrongState, left_by: int | None) -> Problem:
+    """A device is not in a state the step's role may start from."""
+    concept = ctx.state_concept(a.d, a.x)
+    now = f"{ctx.term(concept)}" if concept else "no concept"
+    text = (f"step {a.i} ({ctx.step_command(a.i)}): device '{a.d}' (role '{a.r}') is in state "
+            f"'{a.x}' [{now}]{since(ctx, left_by)}; the step needs it {ctx.term(a.need)}")
+    p = ctx.step_command(a.i)
+    rests = (ctx.state_where(a.d, a.x), ctx.region_where(p, a.r, 1)) if p in ctx.processes else ()
+    reason = Reason("wrong_state", text, tuple(x for x in (concept, a.need) if x), rests)
+    return Problem(a.i, p, "wrong_state", reason, ctx.step_where(a.i), a.r, a.d, a.x, concept, a.need)
+
+
+def stuck(ctx: Context, a: s.Stuck) -> Problem:
+    """From its state the device's chart has no path through the role's region."""
+    p = ctx.step_command(a.i)
+    text = (f"step {a.i} ({p}): device '{a.d}' (role '{a.r}') starts in state '{a.x}', but its state "
+            f"chart has no path from there through the states the role's region visits")
+    reason = Reason("stuck", text, (), (ctx.state_where(a.d, a.x), ctx.role_where(p, a.r)))
+    return Problem(a.i, p, "stuck", reason, ctx.step_where(a.i), a.r, a.d, a.x, ctx.state_concept(a.d, a.x))
+
+
+def binding_problem(ctx: Context, kind: str, i: int, r: str, devices: list[str]) -> Problem:
+    """A role of a step that cannot be bound: none fits, several fit, or the named device cannot play it."""
+    p = ctx.step_command(i)
+    proc = ctx.processes.get(p)
+    role = next((x for x in proc.roles if x.name == r), None) if proc else None
+    needs = f", which needs a device that {ctx.term(role.required_skill)}" if role else ""
+    head = f"step {i} ({p}): role '{r}'"
+    named = devices[0] if devices else "?"
+    if kind == "no_device":
+        text = f"step {i} ({p}): no device in cell '{ctx.cell}' can play role '{r}'{needs}"
+    elif kind == "ambiguous":
+        text = f"{head} is not bound and several devices fit: {', '.join(sorted(devices))}; bind one in the task"
+    elif kind == "absent":
+        text = f"{head} is bound to device '{named}', which is not in cell '{ctx.cell}'"
+    elif kind == "cannot_play":
+        text = f"{head}{needs}, is bound to device '{named}', which cannot play it"
+    else:
+        roles = ", ".join(x.name for x in proc.roles) if proc else "-"
+        text = f"{head} is bound, but {p} has no such role (its roles: {roles})"
+    rests = (role.where,) if role else ()
+    iris = (role.required_skill,) if role else ()
+    reason = Reason(kind, text, iris, rests)
+    device = devices[0] if len(devices) == 1 else None
+    return Problem(i, p, kind, reason, ctx.step_where(i), r, device)
+
+
+def unknown_command(ctx: Context, a: s.UnknownCommand) -> Problem:
+    """A step names no known process command."""
+    known = ", ".join(sorted(ctx.processes))
+    reason = Reason("unknown_command", f"step {a.i}: unknown process command '{a.p}'; known: {known}")
+    return Problem(a.i, a.p, "unknown_command", reason, ctx.step_where(a.i))
+
+
+def _num(v: int) -> str:
+    return format(v / SCALE, "g")
+
+
+def parameter_problem(ctx: Context, a: s.BadType | s.TooLow | s.TooHigh | s.UnknownParam) -> Problem:
+    """A parameter value that does not fit its process's declaration."""
+    p = ctx.step_command(a.i)
+    proc = ctx.processes.get(p)
+    par = next((x for x in proc.parameters if x.name == a.n), None) if proc else None
+    unit = f" {par.unit}" if par and par.unit else ""
+    head = f"step {a.i} ({p}): parameter {a.n}"
+    if isinstance(a, s.BadType):
+        kind, text = "bad_type", f"{head} is not a {a.ty} value"
+    elif isinstance(a, s.TooLow):
+        kind, text = "too_low", f"{head} = {_num(a.v)}{unit} is below its minimum {_num(a.bound)}{unit}"
+    elif isinstance(a, s.TooHigh):
+        kind, text = "too_high", f"{head} = {_num(a.v)}{unit} is above its maximum {_num(a.bound)}{unit}"
+    else:
+        names = ", ".join(x.name for x in proc.parameters) if proc else "-"
+        kind, text = "unknown_param", f"{head} is not declared by {p} (its parameters: {names})"
+    iris = (par.quantity,) if par else ()
+    reason = Reason(kind, text, iris, (par.where,) if par else ())
+    return Problem(a.i, p, kind, reason, ctx.step_where(a.i, a.n), parameter=a.n)
+
+
+def device_state(ctx: Context, i: int, r: str, d: str, x: str, left_by: int | None) -> Reason:
+    """One sentence on a device a step uses: its state, where it came from, what the role needs."""
+    p = ctx.step_command(i)
+    concept = ctx.state_concept(d, x)
+    now = ctx.term(concept) if concept else "no concept"
+    need = ctx.processes[p].role(r).start_concept if p in ctx.processes else None
+    ok = need is not None and concept is not None and ctx.taxonomy.is_a(concept, need)
+    needs = f"; role '{r}' needs it {ctx.term(need)}: {'satisfied' if ok else 'not satisfied'}" if need else ""
+    text = f"device '{d}' is in state '{x}' [{now}]{since(ctx, left_by)}{needs}"
+    rests = (ctx.state_where(d, x),) + ((ctx.region_where(p, r, 1),) if need else ())
+    return Reason("device_state", text, tuple(c for c in (concept, need) if c), rests)

@@ -1,0 +1,135 @@
+"""The one typed boundary between Python and ASP: every predicate the encodings read or write.
+
+Each predicate is a frozen dataclass whose fields are ``str`` (an ASP string: an IRI, an
+id, a name), ``int`` (an ASP number) or :class:`clingo.Symbol` (a nested term, e.g. a
+binding list). Facts become ASP text through :func:`program`; a model's symbols become
+typed atoms through :func:`decode`. Nothing else in the package builds or reads ASP
+atoms, so a misspelt predicate or a wrong argument type fails here, loudly.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import defaultdict
+from collections.abc import Callable, Iterable, Sequence
+from typing import Any, ClassVar, TypeVar, dataclass_transform
+
+import clingo
+
+from plugnproduce.errors import EncodingError
+
+A = TypeVar("A", bound="Atom")
+
+_REGISTRY: dict[tuple[str, int], type[Atom]] = {}
+
+
+class Atom:
+    """Base class of the typed predicates; subclasses are made by :func:`predicate`."""
+
+    __slots__ = ()
+    asp: ClassVar[str]
+    _fields: ClassVar[tuple[str, ...]]
+    _encoders: ClassVar[tuple[Callable[[Any], str], ...]]
+    _decoders: ClassVar[tuple[Callable[[clingo.Symbol], Any], ...]]
+
+    def text(self) -> str:
+        """The atom in ASP syntax, e.g. ``has_skill("gripper","http://...#CanGrip")``."""
+        if not self._fields:
+            return self.asp
+        args = ",".join(enc(getattr(self, f)) for enc, f in zip(self._encoders, self._fields, strict=True))
+        return f"{self.asp}({args})"
+
+    @classmethod
+    def from_symbol(cls: type[A], symbol: clingo.Symbol) -> A:
+        """The typed atom a clingo symbol stands for."""
+        args = symbol.arguments
+        if symbol.name != cls.asp or len(args) != len(cls._decoders):
+            raise EncodingError(f"expected {cls.asp}/{len(cls._decoders)}; found {symbol}")
+        try:
+            return cls(*(dec(a) for dec, a in zip(cls._decoders, args, strict=True)))
+        except (RuntimeError, TypeError) as exc:
+            raise EncodingError(f"{symbol} does not fit {cls.__name__}") from exc
+
+
+def quote(value: str) -> str:
+    """An ASP string literal."""
+    return '"' + value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+
+
+def _number(value: int) -> str:
+    if not isinstance(value, int) or isinstance(value, bool):
+        raise EncodingError(f"expected a whole number for an ASP number; found {value!r}")
+    return str(value)
+
+
+def _symbol_text(value: clingo.Symbol) -> str:
+    return str(value)
+
+
+_CODECS: dict[object, tuple[Callable[[Any], str], Callable[[clingo.Symbol], Any]]] = {
+    "str": (quote, lambda s: s.string),
+    "int": (_number, lambda s: s.number),
+    "clingo.Symbol": (_symbol_text, lambda s: s),
+}
+_CODECS.update({str: _CODECS["str"], int: _CODECS["int"], clingo.Symbol: _CODECS["clingo.Symbol"]})
+
+
+@dataclass_transform(frozen_default=True)
+def predicate(name: str) -> Callable[[type[A]], type[A]]:
+    """Class decorator: make a frozen dataclass a typed ASP predicate called ``name``."""
+
+    def wrap(cls: type[A]) -> type[A]:
+        data = dataclasses.dataclass(frozen=True, slots=True)(cls)
+        declared = dataclasses.fields(data)  # type: ignore[arg-type]
+        fields = [f.type for f in declared]
+        data._fields = tuple(f.name for f in declared)
+        try:
+            codecs = [_CODECS[t] for t in fields]
+        except KeyError as exc:
+            raise EncodingError(f"predicate {name}: unsupported field type {exc.args[0]!r}") from exc
+        data.asp = name
+        data._encoders = tuple(c[0] for c in codecs)
+        data._decoders = tuple(c[1] for c in codecs)
+        key = (name, len(fields))
+        if key in _REGISTRY:
+            raise EncodingError(f"predicate {name}/{len(fields)} declared twice")
+        _REGISTRY[key] = data
+        return data
+
+    return wrap
+
+
+def program(atoms: Iterable[Atom]) -> str:
+    """ASP text stating every atom as a fact."""
+    return "".join(a.text() + ".\n" for a in atoms)
+
+
+class Model:
+    """The typed atoms of one answer set, by predicate class."""
+
+    def __init__(self, atoms: dict[type[Atom], list[Atom]], cost: Sequence[int] = ()):
+        self._atoms = atoms
+        self.cost = tuple(cost)
+
+    def __getitem__(self, cls: type[A]) -> list[A]:
+        return self._atoms.get(cls, [])  # type: ignore[return-value]
+
+
+def decode(symbols: Iterable[clingo.Symbol], cost: Sequence[int] = ()) -> Model:
+    """Sort a model's symbols into typed atoms; a shown atom of no known predicate is an error."""
+    out: dict[type[Atom], list[Atom]] = defaultdict(list)
+    for s in symbols:
+        cls = _REGISTRY.get((s.name, len(s.arguments)))
+        if cls is None:
+            raise EncodingError(f"the encodings show {s.name}/{len(s.arguments)}, which no typed predicate declares")
+        out[cls].append(cls.from_symbol(s))
+    return Model(dict(out), cost)
+
+
+def strings(term: clingo.Symbol) -> list[str]:
+    """The strings of a cons list ``("a",("b",nil))``, first element first."""
+    out: list[str] = []
+    while term.type == clingo.SymbolType.Function and len(term.arguments) == 2:
+        out.append(term.arguments[0].string)
+        term = term.arguments[1]
+    return out

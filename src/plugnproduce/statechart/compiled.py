@@ -1,0 +1,237 @@
+"""The chart prepared for running: states and transitions with everything the algorithm asks
+for precomputed once (document order, ancestors, descendants, default entries, static
+transition domains and event matchers), executable content compiled to actions.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+from plugnproduce.statechart.actions import Action, Block, compile_block, compile_donedata, compile_invoke
+from plugnproduce.statechart.evaluator import Evaluator, Expr
+from plugnproduce.statechart.model import (
+    Chart,
+    Data,
+    Final,
+    History,
+    Parallel,
+    State,
+    StateNode,
+    Transition,
+)
+
+log = logging.getLogger(__name__)
+
+ROOT, ATOMIC, COMPOUND, PARALLEL, FINAL, HISTORY = range(6)
+
+
+class CState:
+    """A state (or the ``<scxml>`` root, or a history pseudo-state) ready to run."""
+
+    __slots__ = ("idx", "id", "kind", "node", "parent", "ancestors", "lineage", "substates", "histories",
+                 "descendants", "initial", "transitions", "evented", "eventless", "onentry", "onexit",
+                 "invokes", "data", "donedata", "deep", "is_atomic", "is_final", "is_parallel", "is_compound",
+                 "is_history", "data_ready")
+
+    def __init__(self, idx: int, state_id: str, kind: int, node: Any, parent: CState | None):
+        self.idx = idx
+        self.id = state_id
+        self.kind = kind
+        self.node = node
+        self.parent = parent
+        self.ancestors: tuple[CState, ...] = (parent,) + parent.ancestors if parent is not None else ()
+        self.lineage: tuple[CState, ...] = ()
+        self.substates: list[CState] = []
+        self.histories: list[CState] = []
+        self.descendants: frozenset[CState] = frozenset()
+        self.initial: CTransition | None = None
+        self.transitions: list[CTransition] = []
+        self.evented: list[CTransition] = []
+        self.eventless: list[CTransition] = []
+        self.onentry: list[Block] = []
+        self.onexit: list[Block] = []
+        self.invokes: list[Any] = []
+        self.data: list[Data] = []
+        self.donedata: Any = None
+        self.deep = False
+        self.is_atomic = kind in (ATOMIC, FINAL)
+        self.is_final = kind == FINAL
+        self.is_parallel = kind == PARALLEL
+        self.is_compound = kind in (COMPOUND, ROOT)
+        self.is_history = kind == HISTORY
+        self.data_ready = False
+
+    def __repr__(self) -> str:
+        return f"<CState {self.id}>"
+
+
+class CTransition:
+    """A transition ready to run, with a fast event matcher and (when static) its domain."""
+
+    __slots__ = ("idx", "source", "node", "events", "exact", "prefixes", "wildcard", "cond", "targets", "internal",
+                 "actions", "has_history", "domain", "entry_cache")
+
+    def __init__(self, idx: int, source: CState, node: Transition, evaluator: Evaluator, actions: Block):
+        self.idx = idx
+        self.source = source
+        self.node = node
+        descriptors = [_descriptor(d) for d in node.events]
+        self.events = node.event
+        self.wildcard = "*" in descriptors
+        self.exact = frozenset(descriptors)
+        self.prefixes = tuple(d + "." for d in descriptors)
+        blank = node.cond is None or not node.cond.strip()  # an empty cond is read as no cond
+        self.cond: Expr | None = None if blank else evaluator.expr(node.cond)  # type: ignore[arg-type]
+        self.targets: list[CState] = []
+        self.internal = node.type == "internal"
+        self.actions = actions
+        self.has_history = False
+        self.domain: CState | None = None
+        self.entry_cache: Any = None
+
+    def matches(self, name: str) -> bool:
+        """True when the event ``name`` matches one of the transition's descriptors."""
+        return self.wildcard or name in self.exact or name.startswith(self.prefixes)
+
+    def __repr__(self) -> str:
+        return f"<CTransition {self.source.id} -> {[t.id for t in self.targets]}>"
+
+
+def _descriptor(text: str) -> str:
+    if text == "*":
+        return text
+    if text.endswith(".*"):
+        text = text[:-2]
+    return text.rstrip(".")
+
+
+class CompiledChart:
+    """All states of a chart in document order, with look-ups by id."""
+
+    def __init__(self, chart: Chart, evaluator: Evaluator, where: str):
+        self.chart = chart
+        self.evaluator = evaluator
+        self.where = where
+        self.states: list[CState] = []
+        self.by_id: dict[str, CState] = {}
+        self.transitions: list[CTransition] = []
+        self.root = self._state(chart, None, ROOT)
+        self._link(self.root)
+        self.scripts = [compile_block(evaluator, [s], where) for s in chart.scripts]
+        self.all_data: list[tuple[CState, Data]] = [(s, d) for s in self.states for d in s.data]
+
+    # --- building --------------------------------------------------------------------
+
+    def _state(self, node: Any, parent: CState | None, kind: int) -> CState:
+        idx = len(self.states)
+        state_id = getattr(node, "id", None) or f"_state{idx}"
+        cs = CState(idx, state_id, kind, node, parent)
+        self.states.append(cs)
+        self.by_id.setdefault(state_id, cs)
+        if isinstance(node, History):
+            cs.deep = node.type == "deep"
+            return cs
+        if not isinstance(node, Chart):
+            cs.onentry = [compile_block(self.evaluator, b.actions, self.where) for b in node.onentry]
+            cs.onexit = [compile_block(self.evaluator, b.actions, self.where) for b in node.onexit]
+        cs.data = list(node.data) if not isinstance(node, Final) else []
+        if isinstance(node, Final):
+            cs.donedata = compile_donedata(self.evaluator, node.donedata, self.where)
+            return cs
+        if isinstance(node, State | Parallel):
+            cs.invokes = [compile_invoke(self.evaluator, inv, self.where) for inv in node.invokes]
+        for child in node.children:
+            cs_child = self._state(child, cs, _kind(child))
+            (cs.histories if cs_child.is_history else cs.substates).append(cs_child)
+        return cs
+
+    def _link(self, root: CState) -> None:
+        """Second pass, once every state exists: descendants, transitions, initial entries."""
+        for cs in reversed(self.states):
+            below: set[CState] = set()
+            for child in cs.substates + cs.histories:
+                below.add(child)
+                below |= child.descendants
+            cs.descendants = frozenset(below)
+            cs.lineage = (cs,) + tuple(a for a in cs.ancestors if a.kind != ROOT)
+        for cs in self.states:
+            node = cs.node
+            if isinstance(node, State | Parallel):
+                cs.transitions = [self._transition(cs, t) for t in node.transitions]
+                cs.evented = [t for t in cs.transitions if t.exact]
+                cs.eventless = [t for t in cs.transitions if not t.exact]
+            if isinstance(node, History) and node.transition is not None:
+                cs.initial = self._transition(cs, node.transition)
+            elif cs.is_compound:
+                cs.initial = self._initial(cs)
+        for t in self.transitions:
+            self._domain(t)
+
+    def _transition(self, source: CState, node: Transition) -> CTransition:
+        t = CTransition(len(self.transitions), source, node, self.evaluator,
+                        compile_block(self.evaluator, node.actions, self.where))
+        for target in node.targets:
+            cs = self.by_id.get(target)
+            if cs is None:  # only in inline child charts; the reader refuses these at the top
+                log.warning("%s: transition target %r does not exist; the transition is dropped", self.where, target)
+                t.targets = []
+                t.exact = frozenset()
+                t.prefixes = ()
+                t.wildcard = False
+                t.cond = self.evaluator.expr("False")
+                break
+            t.targets.append(cs)
+        t.has_history = any(s.is_history for s in t.targets)
+        self.transitions.append(t)
+        return t
+
+    def _initial(self, cs: CState) -> CTransition | None:
+        node = cs.node
+        element = getattr(node, "initial_element", None)
+        if element is not None:
+            return self._transition(cs, element.transition)
+        names = node.initial if isinstance(node, State | Chart) else []
+        if not names:
+            if not cs.substates:
+                return None
+            names = [cs.substates[0].id]
+        return self._transition(cs, Transition(targets=list(names), line=node.line))
+
+    def _domain(self, t: CTransition) -> None:
+        """The transition domain, when it does not depend on history (else computed when taken)."""
+        if t.has_history or not t.targets:
+            return
+        t.domain = transition_domain(t, t.targets)
+
+
+def _kind(node: StateNode) -> int:
+    if isinstance(node, Parallel):
+        return PARALLEL
+    if isinstance(node, Final):
+        return FINAL
+    if isinstance(node, History):
+        return HISTORY
+    return ATOMIC if node.is_atomic else COMPOUND
+
+
+def transition_domain(t: CTransition, targets: list[CState]) -> CState:
+    """The compound state (or root) whose descendants the transition exits and enters."""
+    source = t.source
+    if t.internal and source.is_compound and all(s in source.descendants for s in targets):
+        return source
+    return lcca([source, *targets])
+
+
+def lcca(states: list[CState]) -> CState:
+    """The least common compound ancestor of ``states`` (the root at worst)."""
+    head, rest = states[0], states[1:]
+    if head.kind == ROOT:
+        return head
+    for anc in head.ancestors:
+        if anc.is_compound and all(s in anc.descendants for s in rest):
+            return anc
+    return head.ancestors[-1]
+
+
+__all__ = ["Action", "CState", "CTransition", "CompiledChart", "lcca", "transition_domain"]

@@ -1,0 +1,236 @@
+"""The HMI's HTTP API in process: the cell, processes, tasks, charts, errors and authentication."""
+
+from __future__ import annotations
+
+import httpx
+import pytest
+import yaml
+
+from plugnproduce import service
+from tests.hmi.conftest import AUTH, Hmi, needs_reasoner
+
+BIN_PICK = {"command": "bin-pick", "params": {"grip_force": 45, "exposure": 25}}
+PLACE = {"command": "place", "params": {"place_pose": [0.6, -0.2, 0.1, 0, 180, 0], "speed": 80}}
+TASK = {"name": "bin-picking", "repeat": 3, "steps": [BIN_PICK, PLACE]}
+INVALID = {"name": "bin-picking-invalid", "steps": [BIN_PICK, BIN_PICK, {"command": "place"}]}
+
+
+async def test_openapi_describes_every_endpoint(client: httpx.AsyncClient) -> None:
+    paths = (await client.get("/openapi.json")).json()["paths"]
+    for path in ("/api/cell", "/api/commands", "/api/commands/{command}/explanation", "/api/catalogue",
+                 "/api/processes", "/api/task/validate", "/api/task/check", "/api/task/repair", "/api/task/explain",
+                 "/api/task/generate", "/api/task/export", "/api/task/import", "/api/charts/device/{device_id}.svg",
+                 "/api/runs", "/api/runs/{run_id}/stop", "/api/runs/{run_id}/journal", "/events"):
+        assert path in paths
+
+
+async def test_cell_shows_each_device_with_class_skills_protocol_and_state(client: httpx.AsyncClient) -> None:
+    cell = (await client.get("/api/cell")).json()
+    gripper = next(d for d in cell["devices"] if d["id"] == "gripper")
+    assert cell["name"] == "bin-picking" and cell["pluggable"] is True
+    assert gripper["classes"] == ["parallel gripper"]
+    assert "can grip" in gripper["skills"]
+    assert (gripper["protocol"], gripper["state"]) == ("xirp", "open")
+    assert [d["id"] for d in cell["devices"]] == ["robot", "gripper", "sensor3d", "binpicking-pc"]
+
+
+async def test_processes_carry_what_the_dialogs_need(client: httpx.AsyncClient) -> None:
+    pick = (await client.get("/api/processes/pick")).json()
+    force = next(p for p in pick["parameters"] if p["name"] == "grip_force")
+    assert {k: force[k] for k in ("datatype", "unit", "min", "max", "default", "role")} == {
+        "datatype": "decimal", "unit": "N", "min": 10, "max": 140, "default": 40, "role": "gripper"}
+    pose = next(p for p in pick["parameters"] if p["name"] == "pick_pose")
+    assert pose["datatype"] == "pose" and len(pose["default"]) == 6
+    assert {r["name"] for r in pick["roles"]} == {"robot", "gripper"}
+
+
+async def test_catalogue_marks_the_devices_in_the_cell(client: httpx.AsyncClient) -> None:
+    catalogue = {d["id"]: d["in_cell"] for d in (await client.get("/api/catalogue")).json()}
+    assert catalogue["gripper"] is True and catalogue["vacuum-gripper"] is False
+
+
+@pytest.mark.parametrize(("method", "path", "body"), [
+    ("POST", "/api/cell/devices", {"device": "camera"}),
+    ("DELETE", "/api/cell/devices/gripper", None),
+    ("POST", "/api/runs", {"task": TASK}),
+    ("POST", "/api/runs/any/stop", None),
+])
+async def test_a_change_without_the_token_is_refused(client: httpx.AsyncClient, hmi: Hmi, method: str, path: str,
+                                                     body: dict[str, object] | None) -> None:
+    res = await client.request(method, path, json=body)
+    assert res.status_code == 401
+    assert res.headers["www-authenticate"].startswith("Bearer")
+    assert "bearer token" in res.json()["detail"]
+    assert [d.id for d in hmi.source.cell.devices] == ["robot", "gripper", "sensor3d", "binpicking-pc"]
+
+
+async def test_a_wrong_token_is_refused(client: httpx.AsyncClient) -> None:
+    res = await client.delete("/api/cell/devices/gripper", headers={"Authorization": "Bearer not-the-token"})
+    assert res.status_code == 401 and res.json()["detail"].startswith("wrong bearer token")
+
+
+async def test_reads_from_another_host_need_the_token(hmi: Hmi) -> None:
+    transport = httpx.ASGITransport(app=hmi.app, client=("192.0.2.7", 40000))
+    async with hmi.app.router.lifespan_context(hmi.app), httpx.AsyncClient(
+            transport=transport, base_url="http://controller") as remote:
+        assert (await remote.get("/api/cell")).status_code == 401
+        assert (await remote.get("/api/cell", headers=AUTH)).status_code == 200
+
+
+@pytest.mark.parametrize(("body", "status", "detail"), [
+    ({"name": "t", "steps": [{"params": {}}]}, 422, "steps[0].command: field required"),
+    ({"name": "t", "steps": []}, 422, "steps: list should have at least 1 item"),
+    ({"steps": [{"command": "pick"}]}, 422, "name: field required"),
+    ({"name": "t", "repeat": 0, "steps": [{"command": "pick"}]}, 422, "repeat: input should be greater than or equal to 1"),
+    ({"name": "t", "steps": [{"command": "pick", "speed": 3}]}, 422, "steps[0].speed: extra inputs are not permitted"),
+    ({"name": "t", "steps": [{"command": "pick", "params": {"grip_force": {"n": 1}}}]}, 422,
+     "steps[0].params.grip_force: a parameter value is a number, text, true or false, or a pose"),
+    ({"name": "t", "steps": [{"command": "pick", "bind": {"robot": 3}}]}, 422,
+     "steps[0].bind.robot: input should be a valid string"),
+])
+async def test_a_malformed_task_names_the_field_and_the_reason(client: httpx.AsyncClient, body: dict[str, object],
+                                                               status: int, detail: str) -> None:
+    res = await client.post("/api/task/validate", json=body)
+    assert res.status_code == status
+    assert res.json()["detail"].startswith(detail)
+    assert "\n" not in res.json()["detail"]
+
+
+async def test_a_body_that_is_not_json_is_a_bad_request(client: httpx.AsyncClient) -> None:
+    res = await client.post("/api/task/check", content=b"{steps: [", headers={"content-type": "application/json"})
+    assert res.status_code == 400
+    assert res.json()["detail"].startswith("body: not valid JSON at character 1")
+
+
+async def test_validate_gives_the_shape_message_at_the_parameter(client: httpx.AsyncClient) -> None:
+    task = {"name": "t", "steps": [{"command": "pick", "params": {"grip_force": 500, "speed": "fast"}}]}
+    result = (await client.post("/api/task/validate", json=task)).json()
+    assert result["valid"] is False
+    by_field = {p["field"]: p["message"] for p in result["problems"]}
+    assert by_field["steps[0].params.grip_force"] == \
+        "step 1: parameter 'grip_force' is 500 N; expected a value from 10 to 140 N"
+    assert by_field["steps[0].params.speed"] == "step 1: parameter 'speed' takes a number; found fast"
+
+
+async def test_validate_accepts_the_bin_picking_task(client: httpx.AsyncClient) -> None:
+    assert (await client.post("/api/task/validate", json=TASK)).json() == {"valid": True, "problems": []}
+
+
+async def test_yaml_export_and_import_round_trip(client: httpx.AsyncClient) -> None:
+    res = await client.post("/api/task/export", json=TASK)
+    assert res.headers["content-type"].startswith("application/yaml")
+    assert yaml.safe_load(res.text)["repeat"] == 3
+    back = await client.post("/api/task/import", content=res.text.encode(), headers={"content-type": "application/yaml"})
+    assert back.json() == {"description": "", **TASK, "steps": [{**s, "bind": {}} for s in TASK["steps"]]}
+
+
+async def test_yaml_import_errors_name_the_file_and_line(client: httpx.AsyncClient) -> None:
+    text = b"task: t\nsteps:\n  - command: pick\n    speed: 3\n"
+    res = await client.post("/api/task/import?filename=mine.yaml", content=text)
+    assert res.status_code == 400
+    assert res.json()["detail"] == "mine.yaml:4: step: unknown key 'speed'; expected one of bind, command, params"
+
+
+async def test_yaml_import_refuses_aliases(client: httpx.AsyncClient) -> None:
+    text = b"task: t\nsteps:\n  - &s {command: pick}\n  - *s\n"
+    res = await client.post("/api/task/import", content=text)
+    assert res.status_code == 400 and res.json()["detail"].startswith("task.yaml:")
+
+
+async def test_device_and_process_pictures_are_svg(client: httpx.AsyncClient) -> None:
+    for path in ("/api/charts/device/gripper.svg", "/api/charts/process/pick.svg"):
+        res = await client.get(path)
+        assert res.status_code == 200 and res.headers["content-type"] == "image/svg+xml"
+        assert b"<svg" in res.content
+
+
+async def test_unknown_names_get_the_cli_message(client: httpx.AsyncClient) -> None:
+    res = await client.get("/api/charts/process/nope.svg")
+    assert res.status_code == 404
+    assert res.json()["detail"].startswith("error: unknown process command 'nope' (known: bin-pick,")
+
+
+# ------------------------------------------------------------------ with the reasoner
+
+
+@needs_reasoner
+async def test_the_bin_picking_cell_offers_pick_place_pick_and_place_and_bin_pick(client: httpx.AsyncClient) -> None:
+    offered = {o["command"] for o in (await client.get("/api/commands")).json()["offered"]}
+    assert {"pick", "place", "pick-and-place", "bin-pick"} <= offered
+
+
+@needs_reasoner
+async def test_a_command_not_offered_is_explained(client: httpx.AsyncClient) -> None:
+    ex = (await client.get("/api/commands/screw/explanation")).json()
+    assert ex["offered"] is False
+    assert any("pnp:CanScrew" in r["text"] for r in ex["reasons"])
+
+
+@needs_reasoner
+async def test_unplugging_the_gripper_withdraws_pick(client: httpx.AsyncClient) -> None:
+    res = await client.delete("/api/cell/devices/gripper", headers=AUTH)
+    assert res.status_code == 200
+    assert "pick" not in {o["command"] for o in res.json()["commands"]["offered"]}
+    res = await client.post("/api/cell/devices", json={"device": "gripper"}, headers=AUTH)
+    assert "pick" in {o["command"] for o in res.json()["commands"]["offered"]}
+
+
+async def test_plugging_a_device_twice_is_a_conflict(client: httpx.AsyncClient) -> None:
+    res = await client.post("/api/cell/devices", json={"device": "gripper"}, headers=AUTH)
+    assert res.status_code == 409 and res.json()["detail"] == "error: device 'gripper' is in cell 'bin-picking' already"
+
+
+@needs_reasoner
+async def test_check_puts_the_problem_at_its_step(client: httpx.AsyncClient) -> None:
+    result = (await client.post("/api/task/check", json=INVALID)).json()
+    assert result["plausible"] is False
+    (problem,) = result["problems"]
+    assert (problem["step"], problem["row"], problem["kind"], problem["device"]) == (2, 1, "wrong_state", "gripper")
+
+
+@needs_reasoner
+async def test_repairs_are_ranked_tasks_ready_to_apply(client: httpx.AsyncClient) -> None:
+    result = (await client.post("/api/task/repair?top=2", json=INVALID)).json()
+    first = result["repairs"][0]
+    assert first["rank"] == 1 and first["edits"][0]["text"] == "insert open-gripper before step 2 (bin-pick)"
+    assert [s["command"] for s in first["task"]["steps"]] == ["bin-pick", "open-gripper", "bin-pick", "place"]
+    fixed = (await client.post("/api/task/check", json=first["task"])).json()
+    assert fixed["plausible"] is True
+
+
+@needs_reasoner
+async def test_explain_a_step(client: httpx.AsyncClient) -> None:
+    ex = (await client.post("/api/task/explain?step=2", json=INVALID)).json()
+    assert ex["plausible"] is False and any("left there by step 1" in s["text"] for s in ex["states"])
+    res = await client.post("/api/task/explain?step=9", json=INVALID)
+    assert res.status_code == 404 and res.json()["detail"] == "error: unknown step 9; the task has steps 1 to 3"
+
+
+@needs_reasoner
+async def test_generate_gives_scxml_and_pictures(client: httpx.AsyncClient) -> None:
+    result = (await client.post("/api/task/generate", json=TASK)).json()
+    names = [c["name"] for c in result["charts"]]
+    assert "bin-picking.task.scxml" in names and "step01-bin-pick.scxml" in names
+    task_chart = next(c for c in result["charts"] if c["kind"] == "task")
+    scxml = await client.get(task_chart["scxml"])
+    assert scxml.content.startswith(b"<?xml") and b"http://www.w3.org/2005/07/scxml" in scxml.content
+    svg = await client.get(task_chart["svg"])
+    assert svg.headers["content-type"] == "image/svg+xml"
+
+
+@needs_reasoner
+async def test_generating_an_implausible_task_is_a_result(client: httpx.AsyncClient) -> None:
+    result = (await client.post("/api/task/generate", json=INVALID)).json()
+    assert result["plausible"] is False and result["charts"] == [] and result["problems"][0]["step"] == 2
+
+
+def test_the_reasoner_check_matches_the_service() -> None:
+    """The API converts the JSON task to the same model task the YAML file gives (one round per repeat)."""
+    from plugnproduce.hmi.schemas import TaskIn
+
+    from_file = service.task(service.builtin("tasks", "bin-picking.yaml"))
+    from_json = TaskIn.model_validate({**TASK, "steps": [
+        {**BIN_PICK, "bind": from_file.steps[0].bind, "params": from_file.steps[0].params},
+        {**PLACE, "params": from_file.steps[1].params}]}).to_task()
+    assert [(s.index, s.command, s.bind, s.params) for s in from_json.steps] == \
+        [(s.index, s.command, s.bind, s.params) for s in from_file.steps]

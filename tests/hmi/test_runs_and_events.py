@@ -1,0 +1,136 @@
+"""Runs through the Runner interface (the model runner), and the server-sent event stream on a real server."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from collections.abc import AsyncIterator
+
+import httpx
+import pytest
+
+from tests.hmi.conftest import AUTH, Hmi, Served, needs_reasoner
+
+TASK = {"name": "pick-and-place", "steps": [{"command": "pick-and-place"}, {"command": "move-to"}]}
+
+
+async def _until_end(client: httpx.AsyncClient, hmi: Hmi, run_id: str) -> dict[str, object]:
+    """Wait for the run to end (no polling: the runner says when)."""
+    await asyncio.wait_for(hmi.runner.finished(run_id), 10)
+    return dict((await client.get(f"/api/runs/{run_id}")).json())
+
+
+@needs_reasoner
+async def test_a_run_walks_every_step_and_journals_it(client: httpx.AsyncClient, hmi: Hmi) -> None:
+    res = await client.post("/api/runs", json={"task": TASK}, headers=AUTH)
+    assert res.status_code == 202 and res.json()["status"] == "running"
+    run = await _until_end(client, hmi, res.json()["run"])
+    assert run["status"] == "succeeded"
+    assert run["states"] == {"robot": "at_pose", "gripper": "open", "sensor3d": "ready", "binpicking-pc": "ready"}
+    journal = (await client.get(f"/api/runs/{run['run']}/journal")).json()
+    kinds = [r["kind"] for r in journal]
+    assert kinds[0] == "start" and kinds[-1] == "end" and kinds.count("step") == 2
+    assert {"device": "gripper", "command": "Close"}.items() <= next(r for r in journal if r["kind"] == "command"
+                                                                       and r["device"] == "gripper").items()
+    listed = (await client.get("/api/runs")).json()
+    assert listed["active"] is None and listed["runs"][0]["status"] == "succeeded"
+
+
+@needs_reasoner
+async def test_a_device_lost_during_a_run_is_a_fault(client: httpx.AsyncClient, hmi: Hmi) -> None:
+    run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
+    await client.delete("/api/cell/devices/gripper", headers=AUTH)
+    run = await _until_end(client, hmi, run_id)
+    assert run["status"] == "failed"
+    (fault,) = run["faults"]  # type: ignore[misc]
+    assert (fault["fault"], fault["device"], fault["step"]) == ("connection", "gripper", 1)
+    assert "left the cell during step 1" in fault["message"]
+
+
+@needs_reasoner
+async def test_a_run_can_be_stopped(client: httpx.AsyncClient) -> None:
+    run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
+    run = (await client.post(f"/api/runs/{run_id}/stop", headers=AUTH)).json()
+    assert run["status"] == "stopped" and run["end"]["reason"] == "stopped by the operator"
+
+
+@needs_reasoner
+async def test_a_second_run_waits_for_the_first(client: httpx.AsyncClient) -> None:
+    first = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
+    res = await client.post("/api/runs", json={"task": TASK}, headers=AUTH)
+    assert res.status_code == 409 and res.json()["detail"] == f"error: run {first} is still running; stop it first"
+
+
+@needs_reasoner
+async def test_an_implausible_task_does_not_start(client: httpx.AsyncClient) -> None:
+    task = {"name": "t", "steps": [{"command": "pick"}, {"command": "pick"}]}
+    res = await client.post("/api/runs", json={"task": task}, headers=AUTH)
+    assert res.status_code == 409
+    assert res.json()["detail"].startswith("error: task 't' cannot run in cell 'bin-picking': step 2 (pick):")
+
+
+async def test_an_unknown_run_is_404(client: httpx.AsyncClient) -> None:
+    res = await client.get("/api/runs/nope")
+    assert res.status_code == 404 and res.json()["detail"] == "error: unknown run 'nope'"
+
+
+async def _events(response: httpx.Response) -> AsyncIterator[tuple[str, dict[str, object]]]:
+    event = ""
+    async for line in response.aiter_lines():
+        if line.startswith("event: "):
+            event = line[7:]
+        elif line.startswith("data: "):
+            yield event, json.loads(line[6:])
+
+
+async def _next(events: AsyncIterator[tuple[str, dict[str, object]]], name: str) -> dict[str, object]:
+    async for event, data in events:
+        if event == name:
+            return data
+    raise AssertionError(f"the stream ended before a {name!r} event")
+
+
+@needs_reasoner
+async def test_unplug_reaches_the_event_stream_within_a_second(served: Served) -> None:
+    async with httpx.AsyncClient(base_url=served.url, timeout=5) as client:
+        async with client.stream("GET", "/events") as response:
+            assert response.headers["content-type"].startswith("text/event-stream")
+            events = _events(response)
+            first = await _next(events, "cell")
+            assert "pick" in {o["command"] for o in first["commands"]["offered"]}  # type: ignore[index]
+            started = time.monotonic()
+            assert (await client.delete("/api/cell/devices/gripper", headers=AUTH)).status_code == 200
+            change = await asyncio.wait_for(_next(events, "cell"), 1.0)
+            assert time.monotonic() - started < 1.0
+            assert change["change"] == {"kind": "unplug", "device": "gripper", "reason": ""}
+            assert "pick" not in {o["command"] for o in change["commands"]["offered"]}  # type: ignore[index]
+            assert "gripper" not in {d["id"] for d in change["cell"]["devices"]}  # type: ignore[index]
+            await events.aclose()
+
+
+@needs_reasoner
+async def test_run_progress_reaches_the_event_stream(served: Served) -> None:
+    async with httpx.AsyncClient(base_url=served.url, timeout=5) as client:
+        async with client.stream("GET", "/events") as response:
+            events = _events(response)
+            await _next(events, "cell")
+            run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
+            seen: list[str] = []
+            async for event, data in events:
+                if event == "run":
+                    assert data["run"] == run_id
+                    record = data["record"]
+                    seen.append(record["kind"])  # type: ignore[index]
+                    if record["kind"] == "end":  # type: ignore[index]
+                        assert record["outcome"] == "succeeded"  # type: ignore[index]
+                        break
+            assert seen[0] == "start" and "step" in seen and "state" in seen
+            await events.aclose()
+
+
+@pytest.mark.parametrize("path", ["/", "/static/js/main.js", "/static/style.css"])
+def test_the_page_is_served_with_a_strict_policy(served: Served, path: str) -> None:
+    res = httpx.get(served.url + path)
+    assert res.status_code == 200
+    assert "script-src 'self'" in res.headers["content-security-policy"]

@@ -1,0 +1,69 @@
+"""``pnp serve`` as a user starts it: it prints the URL and the token, serves, and stops on Ctrl-C."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import httpx
+from typer.testing import CliRunner
+
+from plugnproduce.cli import app
+from tests.hmi.conftest import TOKEN
+
+SERVE = [sys.executable, "-m", "plugnproduce", "serve", "--port", "0"]
+
+
+def _start(*args: str) -> tuple[subprocess.Popen[str], list[str]]:
+    proc = subprocess.Popen([*SERVE, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout is not None
+    lines = [proc.stdout.readline().strip()]  # blocks until the server listens and says where
+    return proc, lines
+
+
+def _stop(proc: subprocess.Popen[str]) -> str:
+    proc.send_signal(signal.SIGINT)  # Ctrl-C
+    out, err = proc.communicate(timeout=20)
+    assert proc.returncode == 0, err
+    return out
+
+
+def test_serve_prints_the_url_and_a_new_token() -> None:
+    proc, lines = _start()
+    try:
+        assert proc.stdout is not None
+        lines += [proc.stdout.readline().strip(), proc.stdout.readline().strip()]
+        url = lines[0].rsplit(" ", 1)[1]
+        token = lines[2].removeprefix("token: ")
+        assert url.startswith("http://127.0.0.1:") and lines[1] == f"open {url}#token={token}"
+        assert httpx.get(url + "api/cell").json()["name"] == "bin-picking"
+        assert httpx.delete(url + "api/cell/devices/gripper").status_code == 401
+        assert httpx.delete(url + "api/cell/devices/gripper",
+                            headers={"Authorization": f"Bearer {token}"}).status_code == 200
+        assert httpx.get(url, headers={"Host": "attacker.example"}).status_code == 400
+    finally:
+        out = _stop(proc)
+    assert out.strip().endswith("stopped")
+
+
+def test_serve_takes_the_token_from_a_file_and_the_cell_given(tmp_path: Path) -> None:
+    token_file = tmp_path / "token"
+    token_file.write_text(TOKEN + "\n")
+    cell = Path(__file__).resolve().parents[2] / "descriptions" / "cells" / "assembly.yaml"
+    proc, lines = _start("--token-file", str(token_file), "--cell", str(cell))
+    try:
+        url = lines[0].rsplit(" ", 1)[1]
+        assert httpx.get(url + "api/cell").json()["name"] == "assembly"
+        res = httpx.post(url + "api/cell/devices", json={"device": "gripper"}, headers={"Authorization": f"Bearer {TOKEN}"})
+        assert res.status_code == 200
+    finally:
+        out = _stop(proc)
+    assert TOKEN not in out
+
+
+def test_a_missing_token_file_is_one_line_and_exit_2(tmp_path: Path) -> None:
+    result = CliRunner().invoke(app, ["serve", "--token-file", str(tmp_path / "none")])
+    assert result.exit_code == 2
+    assert result.output.strip() == f"{tmp_path / 'none'}: cannot read the token file: No such file or directory"

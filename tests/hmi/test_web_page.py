@@ -1,0 +1,194 @@
+"""The web page in real headless Chromium: dialogs, refusals, check and repair, plug/unplug, runs.
+
+Every test waits for what it expects to see (selectors, responses), never for a fixed time,
+and saves a screenshot of its main view under ``artifacts/screenshots/``.
+"""
+
+from __future__ import annotations
+
+import yaml
+from playwright.sync_api import Page, expect
+
+from plugnproduce import service
+from tests.hmi.conftest import AUTH, Served, needs_reasoner, screenshot
+
+CHART_SHOWN = "() => { const i = document.querySelector('#chart-img'); return i.complete && i.naturalWidth > 0; }"
+"""The chart picture has loaded (a function, not an expression: the page's policy forbids eval)."""
+
+
+def add_step(page: Page, command: str, values: dict[str, str | list[str]] | None = None) -> None:
+    """Add a process command through its dialog, filling the given fields."""
+    page.get_by_role("button", name=f"Add {_label(command)} to the task", exact=True).click()
+    dialog = page.locator("#step-dialog")
+    expect(dialog).to_be_visible()
+    for name, value in (values or {}).items():
+        if isinstance(value, list):
+            for axis, v in zip(("x", "y", "z", "rx", "ry", "rz"), value, strict=True):
+                dialog.locator(f"#param-{name}-{axis}").fill(v)
+        else:
+            dialog.locator(f"#param-{name}").fill(value)
+    with page.expect_response("**/api/task/validate"):
+        dialog.get_by_role("button", name="Add step").click()
+    expect(dialog).to_be_hidden()
+
+
+def _label(command: str) -> str:
+    return service.knowledge().process(command).label
+
+
+def steps(page: Page) -> list[str]:
+    return page.locator("#steps li.step").evaluate_all("els => els.map(e => e.dataset.command)")
+
+
+@needs_reasoner
+def test_build_the_bin_picking_task_through_the_dialogs(page: Page) -> None:
+    page.locator("#task-name").fill("bin-picking")
+    page.locator("#task-name").press("Tab")
+    add_step(page, "bin-pick", {"grip_force": "45", "exposure": "25"})
+    add_step(page, "place", {"place_pose": ["0.55", "-0.25", "0.08", "0", "180", "0"], "speed": "80"})
+    page.locator("#task-repeat").fill("3")
+    page.locator("#task-repeat").press("Tab")
+    assert steps(page) == ["bin-pick", "place"]
+    expect(page.locator("#steps li.step").first).to_contain_text("grip force 45 N")
+    page.get_by_role("button", name="Check", exact=True).click()
+    expect(page.locator("#verdict .ok")).to_contain_text("Plausible")
+    screenshot(page, "task-editor-bin-picking")
+    with page.expect_download() as download:
+        page.get_by_role("button", name="Export YAML").click()
+    task = yaml.safe_load(download.value.path().read_text(encoding="utf-8"))
+    assert task == {"task": "bin-picking", "repeat": 3, "steps": [  # values equal to the defaults are left out
+        {"command": "bin-pick", "params": {"grip_force": 45, "exposure": 25}},
+        {"command": "place", "params": {"place_pose": [0.55, -0.25, 0.08, 0, 180, 0], "speed": 80}}]}
+
+
+def test_an_out_of_range_value_is_refused_with_the_shape_message(page: Page) -> None:
+    page.get_by_role("button", name="Add pick to the task", exact=True).click()
+    field = page.locator("#param-grip_force")
+    expect(field).to_have_attribute("min", "10")
+    expect(field).to_have_attribute("max", "140")
+    field.fill("500")
+    with page.expect_response("**/api/task/validate"):
+        page.get_by_role("button", name="Add step").click()
+    error = page.locator("[data-param='grip_force'] .field-error")
+    expect(error).to_have_text("step 1: parameter 'grip_force' is 500 N; expected a value from 10 to 140 N")
+    expect(field).to_have_attribute("aria-invalid", "true")
+    expect(field).to_be_focused()
+    expect(page.locator("#step-dialog")).to_be_visible()
+    screenshot(page, "dialog-out-of-range")
+    page.keyboard.press("Escape")
+    expect(page.locator("#step-dialog")).to_be_hidden()
+    assert steps(page) == []
+
+
+@needs_reasoner
+def test_an_invalid_task_shows_its_problem_at_its_step_and_a_repair_fixes_it(page: Page) -> None:
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "bin-picking-invalid.yaml")))
+    second = page.locator("#steps li.step[data-row='1']")
+    expect(second.locator(".problem")).to_contain_text("device 'gripper' (role 'gripper') is in state 'closed'")
+    expect(page.locator("#steps li.step[data-row='0'] .problem")).to_have_count(0)
+    first_repair = page.locator("#repair-list li.repair").first
+    expect(first_repair).to_contain_text("insert open-gripper before step 2 (bin-pick)")
+    second.get_by_role("button", name="Why?").click()
+    expect(second.locator(".why")).to_contain_text("left there by step 1")
+    screenshot(page, "check-problem-and-repairs")
+    first_repair.get_by_role("button", name="Apply").click()
+    expect(page.locator("#verdict .ok")).to_contain_text("Plausible")
+    assert steps(page) == ["bin-pick", "open-gripper", "bin-pick", "place"]
+
+
+@needs_reasoner
+def test_unplugging_the_gripper_takes_pick_away(page: Page, served: Served) -> None:
+    pick = page.locator("#offered li[data-command='pick']")
+    expect(pick).to_be_visible()
+    page.get_by_role("button", name="Unplug gripper").click()
+    expect(pick).to_have_count(0)
+    expect(page.locator("#devices tr[data-device='gripper']")).to_have_count(0)
+    expect(page.locator("#not-offered li[data-command='pick']")).to_be_visible()
+    expect(page.locator("#announce")).to_contain_text("gripper unplugged")
+    screenshot(page, "cell-gripper-unplugged")
+    page.get_by_role("button", name="Why is pick not offered?").click()
+    expect(page.locator("#why-pick")).to_contain_text("pnp:CanGrip")
+
+
+@needs_reasoner
+def test_a_device_plugged_in_elsewhere_shows_up_live(page: Page, served: Served) -> None:
+    import httpx
+
+    httpx.post(f"{served.url}/api/cell/devices", json={"device": "conveyor"}, headers=AUTH).raise_for_status()
+    expect(page.locator("#devices tr[data-device='conveyor']")).to_be_visible()
+    expect(page.locator("#offered li[data-command='transport']")).to_be_visible()
+
+
+def test_steps_are_reordered_and_removed_from_the_keyboard(page: Page) -> None:
+    add_step(page, "scan-bin")
+    add_step(page, "move-to")
+    add_step(page, "localize-part")
+    page.get_by_role("button", name="Move step 3 (localize part) up").focus()
+    page.keyboard.press("Enter")
+    assert steps(page) == ["scan-bin", "localize-part", "move-to"]
+    expect(page.get_by_role("button", name="Move step 2 (localize part) up")).to_be_focused()
+    page.keyboard.press("Alt+ArrowUp")
+    assert steps(page) == ["localize-part", "scan-bin", "move-to"]
+    page.get_by_role("button", name="Remove step 3 (move to)").click()
+    assert steps(page) == ["localize-part", "scan-bin"]
+    screenshot(page, "task-editor-reordered")
+
+
+@needs_reasoner
+def test_a_run_shows_the_current_step_and_each_device_state(page: Page) -> None:
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "pick-and-place.yaml")))
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    page.get_by_role("button", name="Start run").click()
+    expect(page.locator("#run-status")).to_contain_text("is running")
+    expect(page.get_by_role("button", name="Stop")).to_be_enabled()
+    expect(page.locator("#run-step")).to_contain_text("Current step: 2 of 2, move-to")
+    running = page.locator("#steps li.step.running")
+    expect(running).to_have_attribute("data-row", "1")
+    expect(running).to_have_attribute("aria-current", "step")
+    expect(page.locator("#run-states tr[data-device='robot']")).to_have_class("busy")
+    screenshot(page, "run-in-progress")
+    expect(page.locator("#run-status")).to_contain_text("succeeded")
+    expect(page.locator("#run-states tr[data-device='robot'] .badge")).to_have_text("at_pose")
+    expect(page.locator("#devices td.state[data-device='robot'] .badge")).to_have_text("at_pose")
+    page.locator("#journal-box summary").click()
+    expect(page.locator("#journal")).to_contain_text("gripper is closed")
+    expect(page.locator("#fault")).to_be_hidden()
+    expect(page.locator("#steps li.step.running")).to_have_count(0)
+
+
+@needs_reasoner
+def test_a_failed_run_shows_the_fault_report(page: Page, served: Served) -> None:
+    import httpx
+
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "pick-and-place.yaml")))
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    page.get_by_role("button", name="Start run").click()
+    expect(page.locator("#run-states tr[data-device='gripper'] .badge")).to_have_text("closing")
+    httpx.delete(f"{served.url}/api/cell/devices/gripper", headers=AUTH).raise_for_status()
+    fault = page.locator("#fault")
+    expect(fault).to_be_visible()
+    expect(fault).to_contain_text("connection: device 'gripper' left the cell during step 1")
+    expect(page.locator("#run-status")).to_contain_text("failed")
+    screenshot(page, "run-fault-report")
+
+
+def test_charts_of_devices_and_processes_are_shown(page: Page) -> None:
+    page.get_by_role("button", name="Show the state chart of gripper").click()
+    image = page.locator("#chart-img")
+    expect(image).to_have_attribute("alt", "Device State Chart of gripper")
+    page.wait_for_function(CHART_SHOWN)
+    page.locator("#chart-pick").select_option(label="pick (pick)")
+    expect(image).to_have_attribute("src", "/api/charts/process/pick.svg")
+    page.wait_for_function(CHART_SHOWN)
+    screenshot(page, "charts-process")
+
+
+@needs_reasoner
+def test_generated_task_chart_is_shown(page: Page) -> None:
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "pick-and-place.yaml")))
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    page.get_by_role("button", name="Generate code").click()
+    expect(page.locator("#chart-caption")).to_have_text("Task State Chart pick-and-place.task.scxml")
+    expect(page.locator("#chart-links")).to_contain_text("pick-and-place.closed-world.scxml")
+    page.wait_for_function(CHART_SHOWN)
+    screenshot(page, "charts-generated-task")

@@ -1,0 +1,71 @@
+"""Offered process commands of the bin-picking cell; unplugging and plugging grippers; why-not answers."""
+
+from __future__ import annotations
+
+from plugnproduce import service
+from plugnproduce.description.model import Cell, DeviceDescription
+
+GRIPPING = {"pick", "place", "pick-and-place", "bin-pick", "open-gripper", "close-gripper"}
+
+
+def test_the_paper_cell_offers_pick_place_pick_and_place_and_bin_pick(cell: Cell) -> None:
+    assert {"pick", "place", "pick-and-place", "bin-pick"} <= set(service.capabilities(cell).commands())
+
+
+def test_every_valid_binding_is_listed(cell: Cell) -> None:
+    caps = service.capabilities(cell)
+    bin_pick = next(o for o in caps.offered if o.command == "bin-pick")
+    assert bin_pick.bindings == ({"gripper": "gripper", "localizer": "binpicking-pc", "robot": "robot",
+                                  "sensor": "sensor3d"},)
+
+
+def test_a_second_gripper_doubles_the_bindings_of_pick(cell: Cell, device) -> None:
+    caps = service.capabilities(cell.with_device(device("vacuum-gripper")))
+    pick = next(o for o in caps.offered if o.command == "pick")
+    assert sorted(b["gripper"] for b in pick.bindings) == ["gripper", "vacuum-gripper"]
+
+
+def test_unplugging_the_gripper_removes_every_process_with_a_gripping_role(cell: Cell) -> None:
+    before = set(service.capabilities(cell).commands())
+    after = set(service.capabilities(cell.without("gripper")).commands())
+    assert before - after == GRIPPING
+
+
+def test_the_reason_is_the_missing_can_grip(cell: Cell) -> None:
+    ex = service.explain_process(cell.without("gripper"), "pick")
+    assert not ex.offered
+    (reason,) = ex.reasons
+    assert reason.code == "no_skill"
+    assert "pnp:CanGrip" in reason.text and "gripper" in reason.text
+    assert "http://plugnproduce.org/ontology#CanGrip" in reason.iris
+    assert reason.where[0].file.endswith("pick.ttl") and reason.where[0].line is not None
+
+
+def test_a_vacuum_gripper_brings_back_what_its_gripping_role_can_do(cell: Cell, device) -> None:
+    swapped = cell.without("gripper").with_device(device("vacuum-gripper"))
+    assert GRIPPING <= set(service.capabilities(swapped).commands())
+
+
+def test_a_device_lacking_a_state_is_explained_with_its_chart(cell: Cell, device) -> None:
+    gripper = device("gripper")
+    broken = DeviceDescription(**{**gripper.__dict__, "states": tuple(s for s in gripper.states if s.id != "closed"),
+                                  "transitions": tuple(t for t in gripper.transitions if "closed" not in
+                                                       (t.source, t.target))})
+    ex = service.explain_process(Cell("broken", (broken, device("robot"))), "pick")
+    assert [r.code for r in ex.reasons] == ["lacks_state"]
+    assert "closed (pnp:Closed)" in ex.reasons[0].text
+    assert ex.reasons[0].where[0].file.endswith("pick.scxml")
+
+
+def test_a_state_out_of_order_is_explained_as_unreachable(cell: Cell, device) -> None:
+    gripper = device("gripper")
+    one_way = DeviceDescription(**{**gripper.__dict__,
+                                   "transitions": tuple(t for t in gripper.transitions if t.target != "closing")})
+    ex = service.explain_process(Cell("one-way", (one_way, device("robot"))), "pick")
+    assert [r.code for r in ex.reasons] == ["unreachable"]
+    assert "from state 'open'" in ex.reasons[0].text
+
+
+def test_capabilities_of_an_empty_cell_are_a_result() -> None:
+    caps = service.capabilities(Cell("empty", ()))
+    assert caps.offered == () and all(n.reasons for n in caps.not_offered)

@@ -1,0 +1,127 @@
+"""``pnp capabilities``, ``check``, ``repair``, ``explain`` and ``batch`` through the command line."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import yaml
+from typer.testing import CliRunner
+
+from plugnproduce.cli import app
+from tests.reasoning.conftest import BIN_PICKING, DESCRIPTIONS, TASKS, write
+
+runner = CliRunner()
+INVALID = str(TASKS / "bin-picking-invalid.yaml")
+VALID = str(TASKS / "bin-picking.yaml")
+CELL = str(BIN_PICKING)
+
+
+def pnp(*args: str):
+    return runner.invoke(app, list(args))
+
+
+def cell_file(tmp_path: Path, *devices: str) -> str:
+    lines = "".join(f"  - {DESCRIPTIONS / 'devices' / d}.ttl\n" for d in devices)
+    return str(write(tmp_path, "cell.yaml", f"cell: test\ndevices:\n{lines}"))
+
+
+def test_capabilities_lists_offered_commands_and_reasons() -> None:
+    result = pnp("capabilities", "--cell", CELL)
+    assert result.exit_code == 0, result.output
+    assert "9 of 12 process commands offered" in result.stdout
+    assert "pick-and-place   gripper=gripper robot=robot" in result.stdout
+    assert "pnp:CanScrew" in result.stdout and "screw.ttl:" in result.stdout
+
+
+def test_capabilities_json() -> None:
+    doc = json.loads(pnp("capabilities", "--cell", CELL, "--json").stdout)
+    assert {"pick", "place", "pick-and-place", "bin-pick"} <= {o["command"] for o in doc["offered"]}
+
+
+def test_explain_says_the_missing_skill_is_can_grip(tmp_path: Path) -> None:
+    cell = cell_file(tmp_path, "robot", "sensor3d", "binpicking-pc")
+    result = pnp("explain", "--cell", cell, "pick-and-place")
+    assert result.exit_code == 1
+    assert "pick-and-place is not offered" in result.stdout and "pnp:CanGrip" in result.stdout
+    assert "pick-and-place.ttl:" in result.stdout
+
+
+def test_explain_an_offered_process() -> None:
+    result = pnp("explain", "--cell", CELL, "pick")
+    assert result.exit_code == 0 and "gripper=gripper robot=robot" in result.stdout
+
+
+def test_check_exits_1_naming_step_gripper_state_and_need() -> None:
+    result = pnp("check", INVALID, "--cell", CELL)
+    assert result.exit_code == 1
+    line = next(x for x in result.stdout.splitlines() if "step 2" in x)
+    assert "bin-picking-invalid.yaml:8:" in line
+    assert "'gripper'" in line and "'closed'" in line and "needs it open (pnp:Open)" in line
+
+
+def test_check_of_the_bin_picking_task_exits_0() -> None:
+    result = pnp("check", VALID, "--cell", CELL)
+    assert result.exit_code == 0 and "plausible" in result.stdout
+
+
+def test_check_json() -> None:
+    doc = json.loads(pnp("check", INVALID, "--cell", CELL, "--json").stdout)
+    assert doc["plausible"] is False
+    p = doc["problems"][0]
+    assert (p["step"], p["device"], p["state"], p["needed"]) == (2, "gripper", "closed",
+                                                                 "http://plugnproduce.org/ontology#Open")
+
+
+def test_repair_proposes_inserting_open_gripper_first() -> None:
+    result = pnp("repair", INVALID, "--cell", CELL, "--top", "2")
+    assert result.exit_code == 0, result.output
+    first = result.stdout.split("repair 1 (cost 2):")[1].split("repair 2")[0]
+    assert "insert open-gripper before step 2 (bin-pick)" in first
+    body = "\n".join(line[4:] for line in first.split("resulting task:\n")[1].splitlines())
+    assert [s["command"] for s in yaml.safe_load(body)["steps"]] == ["bin-pick", "open-gripper", "bin-pick", "place"]
+
+
+def test_repair_json_with_a_catalogue(tmp_path: Path) -> None:
+    cell = cell_file(tmp_path, "robot", "sensor3d", "binpicking-pc")
+    doc = json.loads(pnp("repair", VALID, "--cell", cell, "--catalogue", str(DESCRIPTIONS / "devices"),
+                         "--json").stdout)
+    assert doc["repairs"][0]["added_devices"] == ["gripper"]
+
+
+def test_explain_a_step() -> None:
+    result = pnp("explain", INVALID, "--cell", CELL, "--step", "2")
+    assert result.exit_code == 1
+    assert "device 'gripper' is in state 'closed'" in result.stdout and "not satisfied" in result.stdout
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path: Path) -> None:
+    for args in (("check", str(tmp_path / "missing.yaml"), "--cell", CELL),
+                 ("explain", "--cell", CELL, "teleport"),
+                 ("explain", INVALID, "--cell", CELL, "--step", "9"),
+                 ("batch",),
+                 ("batch", "--generate", "3", "--sizes", "20-30")):
+        result = pnp(*args)
+        assert result.exit_code == 2, args
+        assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output
+
+
+def test_batch_generates_and_writes_jsonl_and_csv(tmp_path: Path) -> None:
+    out = tmp_path / "out.jsonl"
+    result = pnp("batch", "--generate", "40", "--sizes", "2-6", "--seed", "1", "--catalogue",
+                 str(DESCRIPTIONS / "devices"), "-o", str(out), "--task", VALID, "--workers", "1")
+    assert result.exit_code == 0, result.output
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    assert len(rows) == 40 and set(rows[0]) == {"config", "devices", "offered", "plausible", "cheapest_device"}
+    configs = write(tmp_path, "c.jsonl", json.dumps({"config": "paper", "devices": ["robot", "gripper"]}) + "\n")
+    table = tmp_path / "out.csv"
+    assert pnp("batch", str(configs), "-o", str(table), "--workers", "1").exit_code == 0
+    assert table.read_text().splitlines()[1].startswith("paper,robot gripper,close-gripper")
+
+
+def test_the_real_command_line_exits_1_on_the_invalid_task() -> None:
+    result = subprocess.run([sys.executable, "-m", "plugnproduce", "check", INVALID, "--cell", CELL],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1 and "'closed'" in result.stdout

@@ -1,0 +1,254 @@
+"""Table-driven tests of the encodings in rules/: a named case is facts + the expected answer sets.
+
+A toy world: gripper ``g`` (states o: Open, c: Closed; o <-> c), robot ``r`` (h: AtPose and
+Idle, m: Moving; h <-> m), process ``pick`` (gripper: Open, Closed; robot: Idle, Moving,
+AtPose), one-role processes ``close``, ``open`` and ``move``.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.reasoning.conftest import answer_sets
+
+GRIPPER = """
+device("g"). has_skill("g","Grip"). has_skill("g","Release"). initial("g","o"). cost("g",1000).
+chart_state("g","o"). chart_state("g","c"). state_is("g","o","Open"). state_is("g","c","Closed").
+edge("g","o","c"). edge("g","c","o").
+"""
+ROBOT = """
+device("r"). has_skill("r","Move"). initial("r","h"). cost("r",30000).
+chart_state("r","h"). chart_state("r","m").
+state_is("r","h","AtPose"). state_is("r","h","Idle"). state_is("r","m","Moving").
+edge("r","h","m"). edge("r","m","h").
+"""
+PROCESSES = """
+process("pick"). role("pick","gripper"). role("pick","robot"). nroles("pick",2).
+role_order("pick",1,"gripper"). role_order("pick",2,"robot").
+requires("pick","gripper","Grip"). requires("pick","robot","Move").
+region_state("pick","gripper",1,"Open"). region_state("pick","gripper",2,"Closed").
+region_state("pick","robot",1,"Idle"). region_state("pick","robot",2,"Moving"). region_state("pick","robot",3,"AtPose").
+process("close"). role("close","gripper"). nroles("close",1). role_order("close",1,"gripper").
+requires("close","gripper","Grip").
+region_state("close","gripper",1,"Open"). region_state("close","gripper",2,"Closed").
+process("open"). role("open","gripper"). nroles("open",1). role_order("open",1,"gripper").
+requires("open","gripper","Release").
+region_state("open","gripper",1,"Closed"). region_state("open","gripper",2,"Open").
+process("move"). role("move","robot"). nroles("move",1). role_order("move",1,"robot").
+requires("move","robot","Move").
+region_state("move","robot",1,"Idle"). region_state("move","robot",2,"Moving"). region_state("move","robot",3,"AtPose").
+param("close","force","decimal"). param_min("close","force",10000). param_max("close","force",140000).
+param("move","speed","integer").
+"""
+LEAVES = """
+leaves(P,"gripper",D,"o","c") :- P = ("pick";"close"), device(D), state_is(D,"o","Open").
+leaves("open","gripper",D,"c","o") :- device(D), state_is(D,"c","Closed").
+leaves(P,"robot","r","h","h") :- P = ("pick";"move").
+recovers(P,R,D,Y) :- leaves(P,R,D,_,Y).
+"""
+WORLD = GRIPPER + ROBOT + PROCESSES + LEAVES
+SECOND_GRIPPER = GRIPPER.replace('"g"', '"h"').replace("1000", "500")
+
+OFFERED = ["roles.lp", "offered.lp", "bindings.lp", "explain.lp"]
+CHECK = ["roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"]
+
+
+def cell(*devices: str) -> str:
+    return 'config("c").' + "".join(f'member("c","{d}").' for d in devices)
+
+
+def task(*steps: str, binds: str = "") -> str:
+    return "".join(f'step("t",{i},"{p}").' for i, p in enumerate(steps, start=1)) + binds + 'check("c","t").'
+
+
+OFFERED_CASES = {
+    "every role has a device": (
+        WORLD + cell("g", "r"), ["offered/2"],
+        {'offered("c","pick")', 'offered("c","close")', 'offered("c","open")', 'offered("c","move")'}),
+    "no gripper: only the robot's process": (
+        WORLD + cell("r"), ["offered/2"], {'offered("c","move")'}),
+    "a super-skill fills the role (has_skill is closed)": (
+        WORLD.replace('has_skill("g","Grip").', 'has_skill("g","ParallelGrip"). has_skill("g","Grip").')
+        + cell("g"), ["can_play/3"],
+        {'can_play("close","gripper","g")', 'can_play("open","gripper","g")', 'can_play("pick","gripper","g")',
+         'can_play("pick","robot","r")', 'can_play("move","robot","r")'}),
+    "a device lacking the Closed state plays no gripping role": (
+        WORLD.replace('chart_state("g","c"). ', "").replace('state_is("g","c","Closed").', "")
+        .replace('edge("g","o","c"). edge("g","c","o").', "") + cell("g"), ["can_play/3", "offered/2"],
+        {'can_play("pick","robot","r")', 'can_play("move","robot","r")'}),
+    "states reachable only in the wrong order": (
+        WORLD.replace('edge("g","o","c").', "") + cell("g"), ["can_play/3"],
+        {'can_play("open","gripper","g")', 'can_play("pick","robot","r")', 'can_play("move","robot","r")'}),
+    "one device may fill two roles it can play": (
+        WORLD.replace('has_skill("g","Release").', 'has_skill("g","Release"). has_skill("g","Move").')
+        .replace('state_is("g","o","Open").', 'state_is("g","o","Open"). state_is("g","o","Idle"). '
+                 'state_is("g","o","AtPose"). state_is("g","c","Moving").') + cell("g"),
+        ["binding/3"],
+        {'binding("c","pick",("g",("g",nil)))', 'binding("c","move",("g",nil))', 'binding("c","close",("g",nil))',
+         'binding("c","open",("g",nil))'}),
+    "every valid binding, not just one": (
+        WORLD + SECOND_GRIPPER + cell("g", "h", "r"), ["binding/3"],
+        {'binding("c","pick",("r",("g",nil)))', 'binding("c","pick",("r",("h",nil)))',
+         'binding("c","close",("g",nil))', 'binding("c","close",("h",nil))',
+         'binding("c","open",("g",nil))', 'binding("c","open",("h",nil))', 'binding("c","move",("r",nil))'}),
+}
+
+EXPLAIN_CASES = {
+    "no device with the skill": (
+        WORLD + cell("r"), {'no_skill("c","pick","gripper","Grip")', 'no_skill("c","close","gripper","Grip")',
+                            'no_skill("c","open","gripper","Release")'}),
+    "device lacks a state the region visits": (
+        WORLD.replace('chart_state("g","c"). ', "").replace('state_is("g","c","Closed").', "")
+        .replace('edge("g","o","c"). edge("g","c","o").', "") + cell("g", "r"),
+        {'lacks_state("c","pick","gripper","g",2,"Closed")', 'lacks_state("c","close","gripper","g",2,"Closed")',
+         'lacks_state("c","open","gripper","g",1,"Closed")'}),
+    "state unreachable from where the device is": (
+        WORLD.replace('edge("g","o","c").', "") + cell("g", "r"),
+        {'unreachable("c","pick","gripper","g",1,"o","Closed")', 'unreachable("c","close","gripper","g",1,"o","Closed")'}),
+}
+
+
+@pytest.mark.parametrize("facts, show, expected", OFFERED_CASES.values(), ids=OFFERED_CASES.keys())
+def test_offered(facts: str, show: list[str], expected: set[str]) -> None:
+    assert answer_sets(OFFERED, facts, show) == [expected]
+
+
+@pytest.mark.parametrize("facts, expected", EXPLAIN_CASES.values(), ids=EXPLAIN_CASES.keys())
+def test_explain(facts: str, expected: set[str]) -> None:
+    assert answer_sets(OFFERED, facts, ["no_skill/4", "lacks_state/6", "unreachable/7"]) == [expected]
+
+
+PROBLEMS = ["wrong_state/7", "stuck/6", "no_device/4", "ambiguous/5", "absent/5", "cannot_play/5", "unknown_role/4",
+            "unknown_command/4", "bad_type/4", "too_low/5", "too_high/5", "unknown_param/3", "plausible/2"]
+
+CHAIN_CASES = {
+    "close then open is plausible": (WORLD + cell("g") + task("close", "open"), {'plausible("c","t")'}),
+    "close twice: the gripper is closed, step 2 needs Open": (
+        WORLD + cell("g") + task("close", "close"), {'wrong_state("c","t",2,"gripper","g","c","Open")'}),
+    "after a wrong start the chain goes on from where the role leaves it": (
+        WORLD + cell("g") + task("close", "close", "open"), {'wrong_state("c","t",2,"gripper","g","c","Open")'}),
+    "the first use is checked against the initial state": (
+        WORLD + cell("g") + task("open"), {'wrong_state("c","t",1,"gripper","g","o","Closed")'}),
+    "an unbound role with two fitting devices is ambiguous": (
+        WORLD + SECOND_GRIPPER + cell("g", "h") + task("close"),
+        {'ambiguous("c","t",1,"gripper","g")', 'ambiguous("c","t",1,"gripper","h")'}),
+    "an explicit binding settles it": (
+        WORLD + SECOND_GRIPPER + cell("g", "h") + task("close", "close", binds='bind("t",2,"gripper","h").'),
+        {'ambiguous("c","t",1,"gripper","g")', 'ambiguous("c","t",1,"gripper","h")'}),
+    "explicit bindings on every step: plausible with two grippers": (
+        WORLD + SECOND_GRIPPER + cell("g", "h")
+        + task("close", "close", binds='bind("t",1,"gripper","g"). bind("t",2,"gripper","h").'),
+        {'plausible("c","t")'}),
+    "no device can play the role": (WORLD + cell("r") + task("close"), {'no_device("c","t",1,"gripper")'}),
+    "bound to a device not in the cell": (
+        WORLD + cell("r") + task("close", binds='bind("t",1,"gripper","g").'), {'absent("c","t",1,"gripper","g")'}),
+    "bound to a device that cannot play the role": (
+        WORLD + cell("g", "r") + task("close", binds='bind("t",1,"gripper","r").'),
+        {'cannot_play("c","t",1,"gripper","r")'}),
+    "a binding of no role of the process": (
+        WORLD + cell("g") + task("close", binds='bind("t",1,"hand","g").'), {'unknown_role("c","t",1,"hand")'}),
+    "an unknown command": (WORLD + cell("g") + task("fly"), {'unknown_command("c","t",1,"fly")'}),
+    "a value above the maximum": (
+        WORLD + cell("g") + task("close") + 'given("t",1,"force"). value_kind("t",1,"force","integer"). '
+        'value_num("t",1,"force",200000).', {'too_high("t",1,"force",200000,140000)'}),
+    "a value below the minimum": (
+        WORLD + cell("g") + task("close") + 'given("t",1,"force"). value_kind("t",1,"force","decimal"). '
+        'value_num("t",1,"force",5500).', {'too_low("t",1,"force",5500,10000)'}),
+    "an integer is a decimal": (
+        WORLD + cell("g") + task("close") + 'given("t",1,"force"). value_kind("t",1,"force","integer"). '
+        'value_num("t",1,"force",40000).', {'plausible("c","t")'}),
+    "a decimal is not an integer": (
+        WORLD + cell("r") + task("move") + 'given("t",1,"speed"). value_kind("t",1,"speed","decimal"). '
+        'value_num("t",1,"speed",2500).', {'bad_type("t",1,"speed","integer")'}),
+    "an undeclared parameter": (
+        WORLD + cell("g") + task("close") + 'given("t",1,"angle"). value_kind("t",1,"angle","integer").',
+        {'unknown_param("t",1,"angle")'}),
+}
+
+
+@pytest.mark.parametrize("facts, expected", CHAIN_CASES.values(), ids=CHAIN_CASES.keys())
+def test_chain(facts: str, expected: set[str]) -> None:
+    assert answer_sets(CHECK, facts, PROBLEMS) == [expected]
+
+
+def test_devices_a_step_does_not_use_keep_their_state() -> None:
+    (model,) = answer_sets(CHECK, WORLD + cell("g", "r") + task("close", "move", "open"), ["at/5"])
+    assert {a for a in model if ',"g",' in a} == {
+        'at("c","t",1,"g","o")', 'at("c","t",2,"g","c")', 'at("c","t",3,"g","c")', 'at("c","t",4,"g","o")'}
+
+
+def test_left_by_names_the_step_that_left_the_state() -> None:
+    (model,) = answer_sets(CHECK, WORLD + cell("g", "r") + task("close", "move", "open"), ["left_by/5"])
+    assert {'left_by("c","t",3,"g",1)', 'left_by("c","t",1,"r",0)', 'left_by("c","t",4,"r",2)'} <= model
+
+
+def test_a_shared_device_plays_its_roles_in_role_order() -> None:
+    # "g" fills both roles of pick: first the gripper region (o -> c), then the robot region from c
+    # (Idle at c, Moving at o, AtPose at c). In the other order the robot region would start at o: not Idle.
+    world = (WORLD.replace('has_skill("g","Release").', 'has_skill("g","Release"). has_skill("g","Move").')
+             .replace('state_is("g","o","Open").', 'state_is("g","o","Open"). state_is("g","c","Idle"). '
+                      'state_is("g","o","Moving"). state_is("g","c","AtPose").')
+             + 'leaves("pick","robot","g","c","c").')
+    (model,) = answer_sets(CHECK, world + cell("g") + task("pick") + 'bind("t",1,"robot","g").',
+                           PROBLEMS + ["at/5"])
+    assert model == {'at("c","t",1,"g","o")', 'at("c","t",2,"g","c")', 'plausible("c","t")'}
+
+
+REPAIR = ["roles.lp", "chain.lp", "params.lp", "repair.lp"]
+COSTS = ('edit_cost("insert",P,100+100*N) :- nroles(P,N). edit_cost("remove","",400). edit_cost("swap","",300). '
+         'edit_cost("rebind","",200). edit_cost("reset","",100).')
+
+
+def horizon(steps: int) -> str:
+    out = 'repair("c","t").'
+    for i in range(1, steps + 1):
+        out += f"slot({2 * i - 1}). gap({2 * i - 1},{i},1). slot({2 * i}). home({2 * i},{i})."
+    return out
+
+
+def repair_case(steps: tuple[str, ...], devices: tuple[str, ...], extra: str = "", costs: str = COSTS) -> str:
+    body = "".join(f'step("t",{i},"{p}").' for i, p in enumerate(steps, start=1))
+    return WORLD + SECOND_GRIPPER + cell(*devices) + body + horizon(len(steps)) + costs + extra
+
+
+REPAIR_CASES = {
+    "insert the missing open": (repair_case(("close", "close"), ("g",)), [{'edit(insert(2,1,"open"))'}]),
+    "swap when inserting costs more": (
+        repair_case(("open", "close"), ("g",), costs=COSTS.replace("100+100*N", "900")), [{"edit(swap(1))"}]),
+    "remove when nothing cheaper": (
+        repair_case(("close", "close"), ("g",), costs=COSTS.replace("100+100*N", "900")),
+        [{"edit(remove(1))"}, {"edit(remove(2))"}]),
+    "rebind to the other gripper": (
+        repair_case(("close", "close"), ("g", "h"), 'bind("t",1,"gripper","g"). bind("t",2,"gripper","g").',
+                    COSTS.replace("100+100*N", "900")),
+        [{'edit(rebind(2,"gripper","h"))'}, {'edit(rebind(1,"gripper","h"))'}]),
+    "add a device from the catalogue": (
+        repair_case(("close",), ("r",), 'catalogue("g"). catalogue("h"). edit_cost("add","g",510). '
+                    'edit_cost("add","h",505).', COSTS.replace("400", "900")), [{'edit(add("h"))'}]),
+    "reset a value that does not fit": (
+        repair_case(("close",), ("g",), 'given("t",1,"force"). value_kind("t",1,"force","string").'),
+        [{'edit(reset(1,"force"))'}]),
+}
+
+
+@pytest.mark.parametrize("facts, expected", REPAIR_CASES.values(), ids=REPAIR_CASES.keys())
+def test_repair(facts: str, expected: list[set[str]]) -> None:
+    found = answer_sets(REPAIR, facts, ["edit/1"], ["--opt-mode=optN"])
+    assert sorted(map(sorted, found)) == sorted(map(sorted, expected))
+
+
+BATCH = ["roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"]
+
+
+def test_batch_stage1_proposes_devices_that_fill_every_missing_role() -> None:
+    facts = WORLD + SECOND_GRIPPER + cell("r") + task("pick")
+    (model,) = answer_sets(BATCH, facts, ["addable/3", "plausible/2"])
+    assert model == {'addable("c","t","g")', 'addable("c","t","h")'}
+
+
+def test_batch_stage2_keeps_the_cheapest_device_that_works() -> None:
+    facts = (WORLD + SECOND_GRIPPER + task("pick").replace('check("c","t").', "")
+             + 'config("v1"). member("v1","r"). member("v1","g"). variant("v1","c","g"). check("v1","t").'
+             + 'config("v2"). member("v2","r"). member("v2","h"). variant("v2","c","h"). check("v2","t").')
+    (model,) = answer_sets(BATCH, facts, ["cheapest/3"])
+    assert model == {'cheapest("c","t","h")'}

@@ -1,0 +1,85 @@
+"""The plausibility check: the paper's implausible task, the valid ones, and its agreement with code generation."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from plugnproduce import service
+from plugnproduce.codegen import generate_task
+from plugnproduce.description.model import Cell, Step
+from tests.reasoning.conftest import task
+
+OPEN, CLOSED = "http://plugnproduce.org/ontology#Open", "http://plugnproduce.org/ontology#Closed"
+
+
+def test_the_bin_picking_task_is_plausible(cell: Cell) -> None:
+    result = service.check(task("bin-picking"), cell)
+    assert result.plausible and result.problems == ()
+
+
+def test_the_pick_and_place_task_is_plausible(cell: Cell) -> None:
+    assert service.check(task("pick-and-place"), cell).plausible
+
+
+def test_the_invalid_task_names_step_device_state_and_need(cell: Cell) -> None:
+    result = service.check(task("bin-picking-invalid"), cell)
+    assert not result.plausible
+    (p,) = result.problems
+    assert (p.step, p.kind, p.device, p.state, p.state_concept, p.needed) == (2, "wrong_state", "gripper", "closed",
+                                                                               CLOSED, OPEN)
+    assert p.where.file.endswith("bin-picking-invalid.yaml") and p.where.line == 8
+    assert "left there by step 1" in p.text
+
+
+def test_omitted_bindings_are_resolved_when_one_device_fits(cell: Cell) -> None:
+    result = service.check(task("bin-picking"), cell)
+    assert result.steps[1].bindings == {"gripper": "gripper", "robot": "robot"}
+
+
+def test_two_fitting_devices_make_an_omitted_binding_ambiguous(cell: Cell, device) -> None:
+    result = service.check(task("bin-picking"), cell.with_device(device("vacuum-gripper")))
+    kinds = {(p.step, p.kind, p.role) for p in result.problems}
+    assert (2, "ambiguous", "gripper") in kinds
+    assert "gripper, vacuum-gripper" in next(p.text for p in result.problems if p.kind == "ambiguous")
+
+
+def test_parameter_values_must_fit_type_and_range(cell: Cell) -> None:
+    t = task("bin-picking-invalid")
+    bad = replace(t, steps=(replace(t.steps[0], params={"grip_force": 200, "exposure": "long", "colour": 1}),))
+    kinds = {(p.kind, p.parameter) for p in service.check(bad, cell).problems}
+    assert kinds == {("too_high", "grip_force"), ("bad_type", "exposure"), ("unknown_param", "colour")}
+
+
+def test_a_pose_is_six_numbers(cell: Cell) -> None:
+    t = task("pick-and-place")
+    short = replace(t, steps=(replace(t.steps[0], params={"pick_pose": [1, 2, 3]}),))
+    (p,) = service.check(short, cell).problems
+    assert (p.kind, p.parameter) == ("bad_type", "pick_pose")
+
+
+def test_an_unknown_command_is_a_problem_not_an_error(cell: Cell) -> None:
+    t = task("pick-and-place")
+    odd = replace(t, steps=(Step(1, "fly", line=3),))
+    (p,) = service.check(odd, cell).problems
+    assert p.kind == "unknown_command"
+
+
+def test_check_and_code_generation_agree_on_where_devices_are_left(cell: Cell) -> None:
+    k = service.knowledge()
+    t = task("bin-picking")
+    result = service.check(t, cell)
+    generated = generate_task(t, cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
+    assert result.final_states == generated.final_states
+
+
+def test_explain_step_gives_every_device_its_state_and_need(cell: Cell) -> None:
+    ex = service.explain_step(task("bin-picking-invalid"), cell, 2)
+    assert not ex.plausible
+    gripper = next(r for r in ex.states if "'gripper'" in r.text)
+    assert "'closed'" in gripper.text and "open (pnp:Open)" in gripper.text and "not satisfied" in gripper.text
+    assert gripper.where[0].file.endswith("gripper.scxml")
+
+
+def test_explain_step_of_a_plausible_step(cell: Cell) -> None:
+    ex = service.explain_step(task("bin-picking"), cell, 3)
+    assert ex.plausible and len(ex.states) == 4
