@@ -6,12 +6,17 @@ generation, execution) and return typed results; they never print.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from plugnproduce import reasoning
+from plugnproduce.codegen import GeneratedTask, generate_task
+from plugnproduce.codegen.outputs import Chart, all_charts
 from plugnproduce.description.loader import load_cell, load_devices, load_processes, load_task
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy
 from plugnproduce.resources import descriptions_path
 from plugnproduce.validation import Report, validate_paths
@@ -64,12 +69,6 @@ def builtin(*parts: str) -> Path:
     """A path inside the built-in descriptions, e.g. ``builtin("cells", "bin-picking.yaml")``."""
     return descriptions_path().joinpath(*parts)
 
-
-# ------------------------------------------------------------------ reasoning: capabilities, check, repair, explain
-
-from collections.abc import Callable, Iterator  # noqa: E402  (kept with the use cases it serves)
-
-from plugnproduce import reasoning  # noqa: E402
 
 
 def _as_cell(cell_or_path: Cell | str | Path) -> Cell:
@@ -148,3 +147,35 @@ def generate_configurations(
     """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices."""
     devices = catalogue_or_folder if isinstance(catalogue_or_folder, list) else catalogue(catalogue_or_folder)
     return reasoning.generate(devices, count, sizes, seed)
+
+
+# ------------------------------------------------------------------ code generation
+
+
+class ImplausibleTask(PlugNProduceError):
+    """A task the plausibility check refuses; ``result`` holds the problems per step."""
+
+    def __init__(self, result: reasoning.CheckResult):
+        self.result = result
+        super().__init__(f"task {result.task} is not plausible in cell {result.cell}: "
+                         + "; ".join(str(p) for p in result.problems))
+
+
+@dataclass(frozen=True)
+class Generated:
+    """A task's generated program: the task chart model and every chart written for it."""
+
+    task: GeneratedTask
+    charts: list[Chart]
+
+
+def generate(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path, per_device: bool = False) -> Generated:
+    """Check a task, then generate its specific process charts, task chart, closed-world chart and,
+    with ``per_device``, each device's program. Raises :class:`ImplausibleTask` for an implausible task."""
+    the_task, the_cell = _as_task(task_or_path), _as_cell(cell_or_path)
+    result = check(the_task, the_cell)
+    if not result.plausible:
+        raise ImplausibleTask(result)
+    k = knowledge()
+    generated = generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
+    return Generated(generated, all_charts(generated, the_cell, per_device))
