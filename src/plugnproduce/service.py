@@ -6,10 +6,16 @@ generation, execution) and return typed results; they never print.
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
+import os
+import secrets
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from plugnproduce import reasoning
 from plugnproduce.codegen import GeneratedTask, generate_task
@@ -20,6 +26,11 @@ from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy
 from plugnproduce.resources import descriptions_path
 from plugnproduce.validation import Report, validate_paths
+
+if TYPE_CHECKING:  # execution pulls in the network stack: imported when a run needs it
+    from plugnproduce.discovery import LiveCell
+    from plugnproduce.executor.journal import RunRecord
+    from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
 
 
 @dataclass(frozen=True)
@@ -179,3 +190,91 @@ def generate(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path, p
     k = knowledge()
     generated = generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
     return Generated(generated, all_charts(generated, the_cell, per_device))
+
+
+# ------------------------------------------------------------------ execution
+
+
+class DevicesMissing(PlugNProduceError):
+    """Devices of the cell that discovery did not find."""
+
+
+def runs_folder() -> Path:
+    """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``~/.local/state/plugnproduce/runs``."""
+    return Path(os.environ.get("PNP_RUNS") or Path.home() / ".local" / "state" / "plugnproduce" / "runs")
+
+
+def new_run_id(task_name: str) -> str:
+    """A run id that sorts by start time: ``20261123-101500-bin-picking-1a2b``."""
+    return f"{time.strftime('%Y%m%d-%H%M%S')}-{task_name}-{secrets.token_hex(2)}"
+
+
+async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cell:
+    """Wait until discovery has found every wanted device; the live cell's devices with their real endpoints."""
+    deadline = asyncio.get_running_loop().time() + timeout
+    while missing := [d for d in wanted if d not in {x.id for x in live.cell.devices}]:
+        left = deadline - asyncio.get_running_loop().time()
+        if left <= 0:
+            raise DevicesMissing(f"device(s) {', '.join(missing)} of the cell not found on the network "
+                                 f"within {timeout:g} s")
+        with contextlib.suppress(TimeoutError):
+            await live.next_change(left)
+    return Cell(live.cell.name, tuple(live.cell.device(d) for d in wanted))
+
+
+async def run_task(
+    task_or_path: Task | str | Path,
+    cell_or_path: Cell | str | Path,
+    *,
+    simulate: bool = False,
+    faults: str = "",
+    journal: Path | None = None,
+    observer: RecordObserver | None = None,
+    started: Callable[[TaskRun], None] | None = None,
+    discovery_timeout: float = 10.0,
+) -> RunReport:
+    """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
+
+    With ``simulate`` the cell's devices are simulated for the run, on a private SSDP network,
+    with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`). ``started`` is
+    given the run once it exists (to stop it). Raises :class:`ImplausibleTask` before anything runs.
+    """
+    from plugnproduce.discovery import LiveCell
+    from plugnproduce.executor.run import TaskRun
+    from plugnproduce.protocols.upnp import network_from_env, private_network
+    from plugnproduce.sim.cell import SimulatedCell, parse_faults
+
+    the_task, the_cell = _as_task(task_or_path), _as_cell(cell_or_path)
+    generated = generate(the_task, the_cell).task
+    journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
+    network = private_network() if simulate else network_from_env()
+    async with contextlib.AsyncExitStack() as stack:
+        if simulate:
+            sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices))
+            await stack.enter_async_context(sim)
+        live = await stack.enter_async_context(LiveCell(knowledge().taxonomy, network=network, name=the_cell.name))
+        devices = await find_devices(live, [d.id for d in the_cell.devices], discovery_timeout)
+        run = TaskRun(generated, devices, journal, observer)
+        if started is not None:
+            started(run)
+        follow = asyncio.create_task(_follow_unplugs(live, run))
+        try:
+            return await run.run()
+        finally:
+            follow.cancel()
+
+
+async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:
+    async for change in live.changes():
+        if change.kind == "unplug":
+            run.device_lost(change.device, "the device left the network (SSDP byebye)")
+
+
+def report(run: str | Path) -> RunRecord:
+    """A run's journal, by path or by run id (in :func:`runs_folder`)."""
+    from plugnproduce.executor.journal import read_journal
+
+    path = Path(run)
+    if not path.exists() and not path.suffix:
+        path = runs_folder() / f"{run}.jsonl"
+    return read_journal(path)

@@ -12,6 +12,6 @@ from plugnproduce.cli.app import app, main
 # Command modules register themselves on import.
 from plugnproduce.cli import draw, validate  # noqa: E402,F401  isort: skip
 from plugnproduce.cli import generate, reasoning  # noqa: E402,F401  isort: skip
-from plugnproduce.cli import serve  # noqa: E402,F401  isort: skip
+from plugnproduce.cli import devices, run, serve  # noqa: E402,F401  isort: skip
 
 __all__ = ["app", "main"]

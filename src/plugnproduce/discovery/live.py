@@ -16,7 +16,7 @@ import re
 import shutil
 import tempfile
 from collections.abc import AsyncIterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 from urllib.parse import urlparse
@@ -31,10 +31,12 @@ from plugnproduce.protocols.upnp import (
     AdvertisementListener,
     FoundDevice,
     SsdpNetwork,
+    UntrustedUrlError,
     UpnpDeviceClient,
     describe,
     discover,
 )
+from plugnproduce.protocols.xirp import parse_endpoint
 
 
 @dataclass(frozen=True)
@@ -138,4 +140,11 @@ class LiveCell:
         ttl = folder / Path(urlparse(files.description_url).path).name
         ttl.write_text(files.description, encoding="utf-8")
         (folder / Path(urlparse(files.chart_url).path).name).write_text(files.chart, encoding="utf-8")
-        return load_device(ttl, self.taxonomy)
+        device = load_device(ttl, self.taxonomy)
+        if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
+            return replace(device, endpoint=found.location)
+        host = urlparse(found.location).hostname
+        if parse_endpoint(device.endpoint)[0] != host:
+            raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {device.endpoint} "
+                                    "on another host; refused")
+        return device

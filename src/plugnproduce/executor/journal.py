@@ -33,8 +33,8 @@ class Journal:
         self._file: TextIO | None = self.path.open("a", encoding="utf-8")
         self._seq = 0
 
-    def write(self, kind: str, **data: Any) -> None:
-        """Append one record and make it durable before returning."""
+    def write(self, kind: str, **data: Any) -> dict[str, Any]:
+        """Append one record, make it durable, and return it."""
         if kind not in KINDS:
             raise ValueError(f"unknown journal record kind {kind!r}")
         if self._file is None:
@@ -44,6 +44,7 @@ class Journal:
         self._file.write(json.dumps(record, sort_keys=True, default=str) + "\n")
         self._file.flush()
         os.fsync(self._file.fileno())
+        return record
 
     def close(self) -> None:
         """Close the file (records already written stay)."""

@@ -12,7 +12,13 @@ See ``docs/upnp.md``.
 
 from __future__ import annotations
 
-from plugnproduce.protocols.upnp.boundary import LOOPBACK, SsdpNetwork, UntrustedUrlError
+from plugnproduce.protocols.upnp.boundary import (
+    LOOPBACK,
+    SsdpNetwork,
+    UntrustedUrlError,
+    network_from_env,
+    private_network,
+)
 from plugnproduce.protocols.upnp.client import UpnpDeviceClient, VariableChange
 from plugnproduce.protocols.upnp.device import NOT_ACCEPTED_NOW, ActionFailed, ActionHandler, UpnpDeviceServer
 from plugnproduce.protocols.upnp.discovery import (
@@ -70,6 +76,8 @@ __all__ = [
     "describe",
     "device_type_for",
     "discover",
+    "network_from_env",
+    "private_network",
     "service_spec_from_chart_events",
     "udn_for",
 ]

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import asyncio
 import ipaddress
+import os
+import socket
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -64,6 +66,27 @@ class SsdpNetwork:
 
 LOOPBACK = SsdpNetwork()
 """SSDP on the loopback interface, standard group and port."""
+
+SSDP_PORT_VARIABLE = "PNP_SSDP_PORT"
+"""Environment variable naming another SSDP port, for a private simulated cell (see :func:`network_from_env`)."""
+
+
+def private_network() -> SsdpNetwork:
+    """Loopback SSDP on a free port: a network only the devices and controller told about it share."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind((LOOPBACK.interface, 0))
+        return SsdpNetwork(port=int(sock.getsockname()[1]))
+
+
+def network_from_env() -> SsdpNetwork:
+    """:data:`LOOPBACK`, or loopback on the port ``PNP_SSDP_PORT`` names, so that ``pnp sim up`` and
+    ``pnp discover`` started with the same value see each other and nobody else."""
+    value = os.environ.get(SSDP_PORT_VARIABLE, "")
+    if not value:
+        return LOOPBACK
+    if not value.isdigit() or not 0 < int(value) < 65536:
+        raise ProtocolError(f"{SSDP_PORT_VARIABLE}={value!r}: expected a UDP port number (1-65535)")
+    return SsdpNetwork(port=int(value))
 
 
 class UntrustedUrlError(ProtocolError):

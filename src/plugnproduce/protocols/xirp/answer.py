@@ -70,7 +70,8 @@ class Responder:
         self.device = device
         self.faults = faults
         self._handler = handler
-        self._files = files
+        self.files = files
+        """What ``describe`` answers with (may be replaced while the server runs)."""
         self._max_frame = max_frame
 
     def react(self, link: FrameLink, data: bytes) -> Finish | None:
@@ -137,11 +138,11 @@ class Responder:
         return _failed(request, FAILED, f"device {self.device!r} failed on {request.name}: {exc}")
 
     def _describe(self, request: Request) -> Response:
-        if self._files is None:
+        if self.files is None:
             return _failed(request, UNKNOWN_REQUEST, f"device {self.device!r} serves no description")
         if request.params:
             return _failed(request, BAD_PARAMETER, f"describe takes no parameters; got {', '.join(request.params)}")
-        return Response(request.id, documents=self._files.documents())
+        return Response(request.id, documents=self.files.documents())
 
     def _send(self, link: FrameLink, response: Response, fault: Fault | None) -> None:
         """Send the response, unless a fault drops it or sends garbage instead."""

@@ -351,6 +351,7 @@ class XirpClient:
         except MessageError as exc:
             self.stats.malformed += 1
             _LOGGER.warning("%s", exc)
+            self.stats.tell(str(exc))
             self._link.send(encode_frame(ErrorMessage(exc.code, str(exc), exc.ref)))
             return None
         if isinstance(message, Response):
@@ -378,6 +379,7 @@ class XirpClient:
             return
         self.stats.errors.append(error)
         _LOGGER.warning("%s reports %s: %s", self._what, error.code, error.text)
+        self.stats.tell(f"{self._what} reports {error.code}: {error.text}")
 
     async def close(self) -> None:
         """Say ``bye`` and close; waiting requests fail with ProtocolConnectionError. Safe to call twice."""

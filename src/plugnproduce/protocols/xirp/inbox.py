@@ -38,6 +38,13 @@ class LinkStats:
     """Events dropped because the event buffer was full (oldest first)."""
     errors: list[ErrorMessage] = field(default_factory=list)
     """Protocol errors the device reported that named no waiting request."""
+    on_anomaly: Callable[[str], None] | None = field(default=None, repr=False, compare=False)
+    """Told, in a sentence, about each of the above as it happens (e.g. so an executor can stop)."""
+
+    def tell(self, what: str) -> None:
+        """Pass an anomaly on to :attr:`on_anomaly`, if anyone listens."""
+        if self.on_anomaly is not None:
+            self.on_anomaly(what)
 
 
 class EventInbox:
@@ -59,6 +66,7 @@ class EventInbox:
         if event.seq in self._seen:
             self._stats.duplicates += 1
             _LOGGER.info("%s: event %s #%d received twice; dropped", self.what, event.name, event.seq)
+            self._stats.tell(f"{self.what} sent event {event.name} #{event.seq} twice")
             return
         self._seen.add(event.seq)
         self._seen_order.append(event.seq)

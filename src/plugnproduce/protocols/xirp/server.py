@@ -61,7 +61,6 @@ class XirpServer:
     ) -> None:
         self.hello = Hello(device, device_class, label, DESCRIBE if files is not None else None)
         """What every connection is greeted with."""
-        self.files = files
         self.max_frame = max_frame
         self._responder = Responder(device, handler, files, faults if faults is not None else Faults(), max_frame)
         self._host, self._port = host, port
@@ -77,6 +76,15 @@ class XirpServer:
 
     async def __aexit__(self, *exc_info: object) -> None:
         await self.stop()
+
+    @property
+    def files(self) -> DeviceFiles | None:
+        """What ``describe`` answers with; may be replaced while the server runs (e.g. to name its port)."""
+        return self._responder.files
+
+    @files.setter
+    def files(self, files: DeviceFiles) -> None:
+        self._responder.files = files
 
     @property
     def faults(self) -> Faults:

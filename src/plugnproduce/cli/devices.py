@@ -1,0 +1,148 @@
+"""``pnp discover`` and ``pnp sim``: the live cell and the simulated one."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from plugnproduce import service
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
+from plugnproduce.description.model import Cell
+from plugnproduce.errors import ProtocolError
+from plugnproduce.sim import control
+
+if TYPE_CHECKING:  # the network stack is imported by the commands that use it
+    from plugnproduce.discovery import CellChange
+
+sim_app = typer.Typer(no_args_is_help=True, help="Run simulated devices: the paper's bin-picking cell and more.")
+app.add_typer(sim_app, name="sim")
+
+
+def _device_json(cell: Cell) -> list[dict[str, object]]:
+    taxonomy = service.knowledge().taxonomy
+    return [
+        {
+            "id": d.id,
+            "label": d.label,
+            "class": [taxonomy.label(c) for c in d.classes],
+            "skills": [taxonomy.label(s) for s in d.skills],
+            "protocol": d.protocol,
+            "endpoint": d.endpoint,
+        }
+        for d in cell.devices
+    ]
+
+
+def _offered(cell: Cell) -> list[str]:
+    return service.capabilities(cell).commands() if cell.devices else []
+
+
+def _change_json(change: CellChange) -> dict[str, object]:
+    return {"change": change.kind, "device": change.device, "reason": change.reason or None,
+            "devices": [d.id for d in change.cell.devices], "offered": _offered(change.cell)}
+
+
+@app.command()
+@boundary
+def discover(
+    json_out: bool = JSON_OPTION,
+    watch: bool = typer.Option(False, "--watch", help="Keep watching: stream plug and unplug events."),
+    timeout: float = typer.Option(2.0, help="Seconds to search for devices."),
+) -> None:
+    """List the devices found on the network (SSDP on loopback), with class and skills."""
+    try:
+        asyncio.run(_discover(json_out, watch, timeout))
+    except KeyboardInterrupt:
+        pass
+
+
+async def _discover(json_out: bool, watch: bool, timeout: float) -> None:
+    from plugnproduce.discovery import LiveCell
+    from plugnproduce.protocols.upnp import network_from_env
+
+    async with LiveCell(service.knowledge().taxonomy, network=network_from_env(), search_timeout=timeout) as live:
+        cell = live.cell
+        if json_out and watch:  # one JSON object per line from the first on
+            typer.echo(json.dumps({"devices": _device_json(cell), "offered": _offered(cell)}))
+        elif json_out:
+            emit_json({"devices": _device_json(cell), "offered": _offered(cell)})
+        else:
+            for d in _device_json(cell):
+                typer.echo(f"{d['id']:16} {', '.join(d['class']):22} {d['protocol']:5} {', '.join(d['skills'])}")
+            typer.echo(f"offered: {', '.join(_offered(cell)) or 'nothing'}")
+        shown = {d.id for d in cell.devices}
+        while watch:
+            change = await live.next_change()
+            if change.kind != "refused" and (change.device in shown) == (change.kind == "plug"):
+                continue  # already shown (the devices found at start are also queued as plugs)
+            shown = {d.id for d in change.cell.devices}
+            line = _change_json(change)
+            if json_out:
+                typer.echo(json.dumps(line))
+            else:
+                typer.echo(f"{change.kind} {change.device}" + (f": {change.reason}" if change.reason else ""))
+                typer.echo(f"offered: {', '.join(line['offered']) or 'nothing'}")  # type: ignore[arg-type]
+
+
+def _address(control_address: str | None) -> tuple[str, int]:
+    if control_address:
+        host, _, port = control_address.rpartition(":")
+        if not host or not port.isdigit():
+            fail(f"--control: expected HOST:PORT; found {control_address!r}")
+        return host, int(port)
+    return control.read_state()
+
+
+CONTROL = typer.Option(None, "--control", help="HOST:PORT of the running simulated cell (default: the last started).")
+
+
+@sim_app.command("plug")
+@boundary
+def sim_plug(device: str = typer.Argument(..., help="A catalogue device id or a device description file."),
+             control_address: str | None = CONTROL) -> None:
+    """Plug a simulated device into the running cell."""
+    _control("plug", device, control_address)
+
+
+@sim_app.command("unplug")
+@boundary
+def sim_unplug(device: str = typer.Argument(..., help="The id of a running device."),
+               control_address: str | None = CONTROL) -> None:
+    """Unplug a simulated device from the running cell."""
+    _control("unplug", device, control_address)
+
+
+def _control(op: str, device: str, control_address: str | None) -> None:
+    try:
+        devices = asyncio.run(control.request(_address(control_address), op, device))
+    except ProtocolError as exc:
+        fail(f"error: {exc}")
+    typer.echo(f"{op}ged {device}; running: {', '.join(devices)}")
+
+
+@sim_app.command("up")
+@boundary
+def sim_up(
+    cell: Path = typer.Argument(..., help="A cell file, e.g. descriptions/cells/bin-picking.yaml."),
+    faults: str = typer.Option("", "--faults", help="Faults to inject: DEVICE:KIND[:NAME[:SECONDS]],... "
+                                "e.g. 'gripper:drop-response:Close'."),
+    state_file: Path | None = typer.Option(None, help="Where to record the control address."),
+) -> None:
+    """Start the cell's simulated devices; Ctrl-C stops them cleanly.
+
+    Plug in more with 'pnp sim plug DEVICE' (any built-in device). PNP_SSDP_PORT chooses a private SSDP port.
+    """
+    from plugnproduce.protocols.upnp import network_from_env
+    from plugnproduce.sim.cell import SimulatedCell, parse_faults, run_simulated_cell
+
+    the_cell = service.cell(cell)
+    sim = SimulatedCell(the_cell, catalogue=service.catalogue(), network=network_from_env(),
+                        faults=parse_faults(faults, the_cell.devices))
+    try:
+        asyncio.run(run_simulated_cell(sim, state_file or control.default_state_file(), echo=typer.echo))
+    except KeyboardInterrupt:
+        typer.echo("stopped")

@@ -1,0 +1,79 @@
+"""``pnp run`` and ``pnp report``: run a task on the cell's devices, and read a run's journal."""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from plugnproduce import service
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.executor.journal import describe
+
+if TYPE_CHECKING:
+    from plugnproduce.executor.run import TaskRun
+
+
+@app.command()
+@boundary
+def run(
+    task: Path = typer.Argument(..., help="The task file (YAML)."),
+    cell: Path | None = typer.Option(None, "--cell", help="The cell file (default with --sim: the bin-picking cell)."),
+    sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices for this run (on loopback)."),
+    faults: str = typer.Option("", "--faults", help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
+    journal: Path | None = typer.Option(None, "--journal", help="Journal file (default: a new file in PNP_RUNS)."),
+    json_out: bool = JSON_OPTION,
+) -> None:
+    """Check and generate the task, find the devices, run it, and journal every command and event.
+
+    Exit 0 the task succeeded, 1 it failed or is implausible (with the report), 2 bad input.
+    Ctrl-C stops the run safely.
+    """
+    if cell is None:
+        if not sim:
+            raise typer.BadParameter("give --cell CELL, or --sim to run on the simulated bin-picking cell")
+        cell = service.builtin("cells", "bin-picking.yaml")
+
+    def show(record: dict[str, object]) -> None:
+        if not json_out:
+            typer.echo(describe(record))
+
+    def started(the_run: TaskRun) -> None:
+        asyncio.get_running_loop().add_signal_handler(signal.SIGINT, the_run.stop)
+
+    try:
+        report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
+                                              observer=show, started=started))
+    except service.ImplausibleTask as exc:
+        if json_out:
+            emit_json(exc.result.to_json())
+        else:
+            typer.echo(f"task {exc.result.task} is not plausible in cell {exc.result.cell}; not run", err=True)
+            for p in exc.result.problems:
+                typer.echo(str(p), err=True)
+        raise typer.Exit(1) from None
+    if json_out:
+        emit_json(report.to_json())
+    else:
+        typer.echo(f"{report.outcome}; journal {report.journal}")
+        if report.fault is not None:
+            typer.echo(f"fault: {report.fault}")
+    if report.outcome != "succeeded":
+        raise typer.Exit(1)
+
+
+@app.command()
+@boundary
+def report(run_id: str = typer.Argument(..., metavar="RUN", help="A run id or a journal file."),
+           json_out: bool = JSON_OPTION) -> None:
+    """Print a run from its journal: every step, command, event and state, and how it ended (or that it crashed)."""
+    record = service.report(run_id)
+    if json_out:
+        emit_json({"journal": str(record.path), "status": record.status, "records": record.records})
+        return
+    for r in record.records:
+        typer.echo(describe(r))
+    typer.echo(f"status: {record.status}")

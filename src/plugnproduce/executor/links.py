@@ -1,0 +1,107 @@
+"""The controller's connections to the devices of a cell, one per device, over its protocol.
+
+A link sends a device command (a request with parameters) and reports what comes back
+through three callbacks: ``on_event(device, name, params)`` for a device event,
+``on_lost(device, reason)`` when the connection ends, ``on_anomaly(device, what)``
+for a message that should not have come (malformed, duplicated, an unsolicited error).
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable, Mapping
+from typing import Any, Protocol
+from urllib.parse import urlparse
+
+from plugnproduce.description.model import DeviceDescription
+from plugnproduce.errors import ProtocolError
+from plugnproduce.protocols import upnp, xirp
+
+EventCallback = Callable[[str, str, Mapping[str, Any]], None]
+ProblemCallback = Callable[[str, str], None]
+
+
+class DeviceLink(Protocol):
+    """A connection to one device."""
+
+    device: str
+
+    async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:
+        """Send a request and wait for the device to accept it (ProtocolError if it does not)."""
+        ...
+
+    async def close(self) -> None:
+        """End the connection politely."""
+        ...
+
+
+class XirpLink:
+    """A device driven over XIRP."""
+
+    def __init__(self, device: str, client: xirp.XirpClient, on_lost: ProblemCallback) -> None:
+        self.device = device
+        self._client = client
+        self._watch = asyncio.create_task(self._watch_connection(on_lost))
+
+    @classmethod
+    async def open(cls, device: DeviceDescription, on_event: EventCallback, on_lost: ProblemCallback,
+                   on_anomaly: ProblemCallback) -> XirpLink:
+        """Connect to the device's endpoint."""
+        client = await xirp.XirpClient.connect_endpoint(
+            device.endpoint, timeout=device.command_timeout,
+            on_event=lambda e: on_event(device.id, e.name, dict(e.params)))
+        client.stats.on_anomaly = lambda what: on_anomaly(device.id, what)
+        return cls(device.id, client, on_lost)
+
+    async def _watch_connection(self, on_lost: ProblemCallback) -> None:
+        await self._client.wait_closed()
+        if self._client.lost is not None:
+            on_lost(self.device, str(self._client.lost))
+
+    async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:
+        await self._client.request(name, dict(params), timeout=timeout)
+
+    async def close(self) -> None:
+        self._watch.cancel()
+        await self._client.close()
+
+
+class UpnpLink:
+    """A device driven over UPnP: requests are SOAP actions, events are changes of evented counters."""
+
+    def __init__(self, device: str, client: upnp.UpnpDeviceClient) -> None:
+        self.device = device
+        self._client = client
+
+    @classmethod
+    async def open(cls, device: DeviceDescription, on_event: EventCallback, on_lost: ProblemCallback,
+                   on_anomaly: ProblemCallback) -> UpnpLink:
+        """Read the device's UPnP description (where it was discovered) and subscribe to its events."""
+        host = urlparse(device.endpoint).hostname or ""
+        client = await upnp.UpnpDeviceClient.connect(device.endpoint, host, timeout=device.command_timeout)
+        await client.subscribe(lambda variable, _value: on_event(device.id, variable, {}))
+        return cls(device.id, client)
+
+    async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:
+        await self._client.invoke(name, {k: _lexical(v) for k, v in params.items()}, timeout=timeout)
+
+    async def close(self) -> None:
+        await self._client.close()
+
+
+def _lexical(value: Any) -> str:
+    """A parameter value in its lexical form, as the chart-derived actions take it (``"x y z rx ry rz"``)."""
+    if isinstance(value, list | tuple):
+        return " ".join(str(v) for v in value)
+    return str(value)
+
+
+async def open_link(device: DeviceDescription, on_event: EventCallback, on_lost: ProblemCallback,
+                    on_anomaly: ProblemCallback) -> DeviceLink:
+    """Connect to a device over its protocol."""
+    kinds: dict[str, Any] = {"xirp": XirpLink, "upnp": UpnpLink}
+    if device.protocol not in kinds:
+        raise ProtocolError(f"device {device.id}: protocol {device.protocol!r} is not supported; "
+                            "expected xirp or upnp")
+    link: DeviceLink = await kinds[device.protocol].open(device, on_event, on_lost, on_anomaly)
+    return link

@@ -1,0 +1,271 @@
+"""Running a Task State Chart against the devices of a cell (paper section 6.3).
+
+The task chart runs in the project's SCXML runtime. Its ``<send type="xirp|upnp">``
+commands go out over the device links; device events come back as
+``DEVICE.PROTOCOL.event.NAME``. Every command, event, device state and step is written
+to the run's journal before the run goes on.
+
+A fault stops the run: a device that does not answer or does not report in time
+(the chart's own ``timeout.DEVICE`` timers), refuses a command, loses its connection,
+sends a malformed or duplicated message, or sends an event the task does not wait
+for. The chart is then sent ``error.fault`` and leaves every state for ``failed``;
+no further command goes out, and the report names the step, device, the state the
+controller last saw it in, and the message.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hashlib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from plugnproduce.codegen import DONE, GeneratedTask
+from plugnproduce.description.model import Cell, Command
+from plugnproduce.errors import PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
+from plugnproduce.executor.journal import Journal
+from plugnproduce.executor.links import DeviceLink, open_link
+from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
+from plugnproduce.statechart.events import STATE_ENTERED, Event, MacroStep, MetaEvent
+from plugnproduce.statechart.interpreter import Interpreter
+from plugnproduce.statechart.loop import ChartLoop
+from plugnproduce.statechart.model import StateNode
+
+RecordObserver = Callable[[dict[str, Any]], None]
+"""Called with each journal record as soon as it is written."""
+
+FAULT_EVENT = "error.fault"
+
+_STEP, _COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("step", "command", "device", "deviceState"))
+
+
+@dataclass(frozen=True)
+class Fault:
+    """What stopped a run.
+
+    ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected`` or ``stopped``.
+    """
+
+    kind: str
+    message: str
+    step: int | None = None
+    command: str | None = None
+    device: str | None = None
+    state: str | None = None
+    """The device's chart state as the controller last saw it."""
+
+    def __str__(self) -> str:
+        where = f"step {self.step} ({self.command})" if self.step is not None else "before the first step"
+        device = f", device {self.device} in state {self.state}" if self.device else ""
+        return f"{self.kind} at {where}{device}: {self.message}"
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict."""
+        return {"fault": self.kind, "message": self.message, "step": self.step, "command": self.command,
+                "device": self.device, "state": self.state}
+
+
+@dataclass
+class RunReport:
+    """How a run ended: ``succeeded``, ``failed`` or ``stopped``, and where each device was left."""
+
+    outcome: str
+    journal: Path
+    fault: Fault | None = None
+    device_states: dict[str, str] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict."""
+        return {"outcome": self.outcome, "journal": str(self.journal),
+                "fault": self.fault.to_json() if self.fault else None, "device_states": dict(self.device_states)}
+
+
+@dataclass(frozen=True)
+class _StateInfo:
+    device: str | None
+    device_state: str | None
+    step: int | None
+    command: str | None
+
+
+def _chart_map(chart: Chart) -> dict[str, _StateInfo]:
+    """Per controller state: the device region it belongs to, the device state it stands for, its step."""
+    out: dict[str, _StateInfo] = {}
+
+    def walk(node: StateNode, device: str | None, step: int | None, command: str | None) -> None:
+        attrs = node.extra_attrs
+        if isinstance(node, Parallel) and _STEP in attrs:
+            step, command = int(attrs[_STEP]), attrs.get(_COMMAND)
+        device = attrs.get(_DEVICE, device)
+        if node.id:
+            out[node.id] = _StateInfo(device, attrs.get(_DEVICE_STATE), step, command)
+        for child in getattr(node, "children", ()):
+            walk(child, device, step, command)
+
+    for top in chart.children:
+        walk(top, None, None, None)
+    return out
+
+
+class TaskRun:
+    """One run of a generated task in a cell whose devices carry their real endpoints."""
+
+    def __init__(self, generated: GeneratedTask, cell: Cell, journal_path: Path,
+                 observer: RecordObserver | None = None) -> None:
+        self.generated = generated
+        self.cell = cell
+        self.journal_path = journal_path
+        self._observer = observer
+        data = generated.task_chart()
+        self._digest = hashlib.sha256(data).hexdigest()
+        chart = parse_chart(data, f"{generated.task.name}.task.scxml")
+        self._states = _chart_map(chart)
+        self.interpreter = Interpreter(chart, io_processors={"xirp": self, "upnp": self})
+        self.interpreter.attach(self._on_meta)
+        self._loop = ChartLoop(self.interpreter, self._on_step)
+        self._journal: Journal | None = None
+        self._links: dict[str, DeviceLink] = {}
+        self._commands: set[asyncio.Task[None]] = set()
+        self.fault: Fault | None = None
+        self.step: int | None = None
+        self.command: str | None = None
+        self.device_states: dict[str, str] = {}
+
+    # --- public -----------------------------------------------------------------------
+
+    async def run(self) -> RunReport:
+        """Connect to the devices, run the chart to its end, close everything; the report says how it went."""
+        with Journal(self.journal_path) as self._journal:
+            self._record("start", task=self.generated.task.name, cell=self.cell.name, chart_sha256=self._digest,
+                         devices={d.id: d.endpoint for d in self.cell.devices})
+            try:
+                await self._connect()
+                if self.fault is None:
+                    await self._loop.run()
+            finally:
+                for task in self._commands:
+                    task.cancel()
+                await asyncio.gather(*self._commands, return_exceptions=True)
+                await asyncio.gather(*(link.close() for link in self._links.values()), return_exceptions=True)
+            outcome = self._outcome()
+            end: dict[str, Any] = {"outcome": outcome, "device_states": dict(self.device_states)}
+            if self.fault is not None:
+                end["reason"] = str(self.fault)
+            self._record("end", **end)
+        return RunReport(outcome, self.journal_path, self.fault, dict(self.device_states))
+
+    def stop(self, reason: str = "stopped by the operator") -> None:
+        """Stop the run as a fault of kind ``stopped``: no further command goes out."""
+        self._fail(Fault("stopped", reason, self.step, self.command))
+
+    def device_lost(self, device: str, reason: str) -> None:
+        """A device left the cell (e.g. its byebye was seen) while the run goes on."""
+        if device in self._links:
+            self._fail(self._fault("lost", device, reason))
+
+    # --- devices --------------------------------------------------------------------------
+
+    async def _connect(self) -> None:
+        for device in self.cell.devices:
+            try:
+                self._links[device.id] = await open_link(device, self._on_event, self._on_lost, self._on_anomaly)
+            except PlugNProduceError as exc:
+                self._fail(self._fault("lost", device.id, f"cannot connect: {exc}"))
+                return
+
+    def send(self, event: Event, target: str | None, type: str) -> None:  # noqa: A002 - the SCXML name
+        """The chart's I/O processor: send a device command (it goes out after the macrostep).
+
+        After a fault nothing goes out: the chart is on its way to ``failed``.
+        """
+        if self.fault is not None:
+            return
+        command = Command.parse(event.name)
+        if command is None or command.kind != "request" or target not in self._links:
+            raise PlugNProduceError(f"cannot send {event.name!r} to {target!r}: not a request to a device of the cell")
+        params = dict(event.data or {})
+        self._record("command", step=self.step, device=target, command=command.name, params=params)
+        task = asyncio.get_running_loop().create_task(self._request(target, command.name, params))
+        self._commands.add(task)
+        task.add_done_callback(self._commands.discard)
+
+    async def _request(self, device: str, name: str, params: Mapping[str, Any]) -> None:
+        timeout = self.cell.device(device).command_timeout
+        try:
+            await self._links[device].request(name, params, timeout)
+        except ProtocolTimeout:
+            self._fail(self._fault("timeout", device, f"command {name}: no answer within {timeout:g} s"))
+        except ProtocolConnectionError as exc:
+            self._fail(self._fault("lost", device, f"command {name}: {exc}"))
+        except PlugNProduceError as exc:
+            self._fail(self._fault("refused", device, f"command {name}: {exc}"))
+
+    def _on_event(self, device: str, name: str, params: Mapping[str, Any]) -> None:
+        if self.fault is not None:
+            return
+        protocol = self.cell.device(device).protocol
+        event = f"{device}.{protocol}.event.{name}"
+        self._record("event", step=self.step, device=device, event=name, params=dict(params))
+        self._loop.queue(event, dict(params))
+
+    def _on_lost(self, device: str, reason: str) -> None:
+        self._fail(self._fault("lost", device, reason))
+
+    def _on_anomaly(self, device: str, what: str) -> None:
+        self._fail(self._fault("anomaly", device, what))
+
+    # --- the chart ----------------------------------------------------------------------
+
+    def _on_meta(self, meta: MetaEvent) -> None:
+        """A state entered: journal a new step, and a device's new state, in the order they happen."""
+        if meta.name != STATE_ENTERED:
+            return
+        info = self._states.get(meta.data["state"])
+        if info is None:
+            return
+        if info.step is not None and info.step != self.step:
+            self.step, self.command = info.step, info.command
+            self._record("step", step=info.step, command=info.command)
+        if info.device is not None and info.device_state is not None:
+            if self.device_states.get(info.device) != info.device_state:
+                self.device_states[info.device] = info.device_state
+                self._record("state", step=self.step, device=info.device, state=info.device_state)
+
+    def _on_step(self, step: MacroStep) -> None:
+        """A macrostep done: a timer that fired, or a device event nothing waited for, is a fault."""
+        event = step.event
+        if event is None:
+            return
+        if event.name.startswith("timeout."):
+            device = event.name.removeprefix("timeout.")
+            self._fail(self._fault("timeout", device, f"no event from {device} within "
+                                                      f"{self.cell.device(device).command_timeout:g} s"))
+        elif not step.transitions and event.name != FAULT_EVENT and self.fault is None:
+            device = event.name.split(".", 1)[0]
+            self._fail(self._fault("unexpected", device, f"event {event.name.split('.', 3)[-1]} is not what the "
+                                                         "task waits for now"))
+
+    def _fault(self, kind: str, device: str, message: str) -> Fault:
+        return Fault(kind, message, self.step, self.command, device, self.device_states.get(device))
+
+    def _fail(self, fault: Fault) -> None:
+        """Record the first fault and send the chart to ``failed``; later faults are journalled only."""
+        first = self.fault is None
+        if first:
+            self.fault = fault
+        self._record("fault", **fault.to_json(), first=first)
+        if first and self.interpreter.running:
+            self._loop.queue(FAULT_EVENT)
+
+    def _outcome(self) -> str:
+        if self.fault is None and self.interpreter.final_state == DONE:
+            return "succeeded"
+        return "stopped" if self.fault is not None and self.fault.kind == "stopped" else "failed"
+
+    def _record(self, kind: str, **data: Any) -> None:
+        assert self._journal is not None
+        record = self._journal.write(kind, **data)
+        if self._observer is not None:
+            self._observer(record)

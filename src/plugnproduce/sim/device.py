@@ -1,0 +1,170 @@
+"""A simulated device: its own Device State Chart is its program.
+
+A request the chart waits for moves it; an event the chart sends goes out over the
+device's protocol. The device is driven over XIRP (an :class:`XirpServer`) or UPnP
+(an :class:`UpnpDeviceServer` whose actions and evented variables come from the
+chart) and, whatever its protocol, announces itself by SSDP and serves its own
+Turtle and chart, the Turtle naming the endpoint it really listens on. A request the
+chart does not wait for in its current state is refused (XIRP ``not-accepted``, UPnP
+701) and does not move the chart.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import re
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from plugnproduce.description.model import Command, DeviceDescription
+from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.protocols import upnp, xirp
+from plugnproduce.statechart import read_chart
+from plugnproduce.statechart.events import Event
+from plugnproduce.statechart.interpreter import Interpreter
+from plugnproduce.statechart.loop import ChartLoop
+
+_ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
+
+
+def served_description(device: DeviceDescription, endpoint: str) -> tuple[str, str]:
+    """The device's Turtle with its real endpoint, and its chart, as text."""
+    turtle = Path(device.where.file).read_text(encoding="utf-8")
+    turtle, found = _ENDPOINT.subn(lambda m: f'{m.group(1)}"{endpoint}"', turtle, count=1)
+    if not found:
+        raise ValueError(f"{device.where.file}: no pnp:endpoint literal to fill in")
+    return turtle, Path(device.chart_file).read_text(encoding="utf-8")
+
+
+def requests_and_events(device: DeviceDescription) -> tuple[dict[str, list[str]], list[str]]:
+    """The requests the chart waits for (with the quantities they carry) and the events it sends."""
+    requests: dict[str, list[str]] = {}
+    events: list[str] = []
+    for t in device.transitions:
+        if t.request is not None:
+            names = requests.setdefault(t.request.name, [])
+            names.extend(local_name(q) for q in t.accepts if local_name(q) not in names)
+        events.extend(c.name for c in t.sends if c.kind == "event" and c.name not in events)
+    return requests, events
+
+
+class SimulatedDevice:
+    """One device running its chart behind its protocol; ``async with`` starts and stops it."""
+
+    def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
+                 faults: xirp.Faults | None = None) -> None:
+        self.description = device
+        self.network = network
+        self.faults = faults if faults is not None else xirp.Faults()
+        chart = read_chart(device.chart_file)
+        self.interpreter = Interpreter(chart, io_processors={device.protocol: self},
+                                       base_dir=Path(device.chart_file).parent)
+        self._loop = ChartLoop(self.interpreter)
+        self._task: asyncio.Task[None] | None = None
+        self._xirp: xirp.XirpServer | None = None
+        self._upnp: upnp.UpnpDeviceServer | None = None
+        self._pending: set[asyncio.Task[Any]] = set()
+
+    @property
+    def id(self) -> str:
+        """The device id."""
+        return self.description.id
+
+    @property
+    def state(self) -> str:
+        """The chart state the device is in."""
+        return self.interpreter.configuration[-1] if self.interpreter.configuration else self.description.initial
+
+    @property
+    def endpoint(self) -> str:
+        """Where a controller reaches the device: ``xirp://host:port`` or the UPnP description URL."""
+        if self._xirp is not None:
+            return self._xirp.endpoint
+        if self._upnp is not None and self._upnp.location is not None:
+            return self._upnp.location
+        raise RuntimeError(f"device {self.id} is not started")
+
+    async def __aenter__(self) -> SimulatedDevice:
+        await self.start()
+        return self
+
+    async def __aexit__(self, *exc_info: object) -> None:
+        await self.stop()
+
+    async def start(self) -> None:
+        """Start the chart, listen on the protocol, then announce the device."""
+        d = self.description
+        self._task = asyncio.create_task(self._loop.run(), name=f"device {d.id}")
+        device_class = local_name(d.classes[0])
+        requests, events = requests_and_events(d)
+        if d.protocol == "xirp":
+            self._xirp = xirp.XirpServer(d.id, device_class, self._on_xirp_request, label=d.label,
+                                         files=self._files(xirp.DeviceFiles, d.endpoint), faults=self.faults)
+            await self._xirp.start()
+            spec = upnp.service_spec_from_chart_events({}, [])
+            files = self._files(upnp.DeviceFiles, self._xirp.endpoint)
+            self._xirp.files = self._files(xirp.DeviceFiles, self._xirp.endpoint)
+        else:
+            spec = upnp.service_spec_from_chart_events(requests, events)
+            files = self._files(upnp.DeviceFiles, d.endpoint)
+        self._upnp = upnp.UpnpDeviceServer(d.id, d.label, upnp.device_type_for(device_class), spec,
+                                           self._on_upnp_action, files=files, network=self.network)
+        await self._upnp.start()
+
+    async def stop(self) -> None:
+        """Say goodbye (SSDP byebye, XIRP bye) and stop the chart."""
+        if self._upnp is not None:
+            await self._upnp.stop()
+        if self._xirp is not None:
+            await self._xirp.stop()
+        if self._task is not None:
+            self._task.cancel()
+            await asyncio.gather(self._task, *self._pending, return_exceptions=True)
+        self._upnp = self._xirp = self._task = None
+
+    async def drop_connections(self) -> int:
+        """Abort every XIRP connection (a cable pulled); the device stays announced."""
+        return await self._xirp.disconnect_all() if self._xirp is not None else 0
+
+    def _files(self, kind: type, endpoint: str) -> Any:
+        d = self.description
+        turtle, chart = served_description(d, endpoint)
+        return kind(Path(d.where.file).name, turtle, Path(d.chart_file).name, chart)
+
+    # --- requests in ----------------------------------------------------------------
+
+    def _accept(self, request: str, params: Mapping[str, Any]) -> None:
+        """Feed a request to the chart, or refuse it if the current state does not wait for it."""
+        event = Command(self.description.protocol, "request", request).event
+        waits = {t.event for t in self.description.transitions if t.source == self.state}
+        if event not in waits:
+            raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
+        self._loop.queue(event, dict(params))
+
+    def _on_xirp_request(self, request: xirp.Request) -> None:
+        try:
+            self._accept(request.name, request.params)
+        except LookupError as exc:
+            raise xirp.RequestFailed(str(exc), xirp.NOT_ACCEPTED) from None
+
+    async def _on_upnp_action(self, action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
+        try:
+            self._accept(action, arguments)
+        except LookupError as exc:
+            raise upnp.ActionFailed(str(exc), upnp.NOT_ACCEPTED_NOW) from None
+        return {"Result": "accepted"}
+
+    # --- events out (the chart's I/O processor) ------------------------------------------
+
+    def send(self, event: Event, target: str | None, type: str) -> None:  # noqa: A002 - the SCXML name
+        """The chart sent ``PROTOCOL.event.NAME``: send it to the controllers."""
+        command = Command.parse(event.name)
+        if command is None or command.kind != "event":
+            raise ValueError(f"device {self.id} cannot send {event.name!r}; expected {type}.event.NAME")
+        if self._xirp is not None:
+            self._xirp.emit(command.name, dict(event.data or {}))
+        elif self._upnp is not None:
+            task = asyncio.get_running_loop().create_task(self._upnp.emit(command.name))
+            self._pending.add(task)
+            task.add_done_callback(self._pending.discard)

@@ -1,0 +1,497 @@
+"""An SCXML runtime with W3C semantics (https://www.w3.org/TR/scxml/#AlgorithmforSCXMLInterpretation).
+
+One synchronous step at a time: :meth:`Interpreter.execute_once` takes the next external
+event and runs the whole macrostep (the event's microstep, then eventless transitions and
+internal events until the configuration is stable) and returns a
+:class:`~plugnproduce.statechart.events.MacroStep`. Time comes from an injected clock;
+delayed sends wait in the session until the clock reaches them. Observers receive meta
+events. Threads and asyncio live apart (:mod:`plugnproduce.statechart.runner`).
+"""
+
+from __future__ import annotations
+
+import logging
+import uuid
+from collections import deque
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+from plugnproduce.errors import ExecutionError
+from plugnproduce.safeio import read_bytes
+from plugnproduce.statechart.actions import Block
+from plugnproduce.statechart.checks import check_structure
+from plugnproduce.statechart.clock import Clock, MonotonicClock
+from plugnproduce.statechart.compiled import ROOT, CompiledChart, CState, CTransition, transition_domain
+from plugnproduce.statechart.datamodel import Datamodel
+from plugnproduce.statechart.dispatch import Dispatcher
+from plugnproduce.statechart.evaluator import EvaluationError, Evaluator, Expr
+from plugnproduce.statechart.events import (
+    EVENT_CONSUMED,
+    STATE_ENTERED,
+    STATE_EXITED,
+    TRANSITION_TAKEN,
+    Event,
+    IOProcessor,
+    MacroStep,
+    MetaEvent,
+    TakenTransition,
+)
+from plugnproduce.statechart.invoke import Invocation, Invoker
+from plugnproduce.statechart.model import Chart
+from plugnproduce.statechart.reader import parse_chart
+
+log = logging.getLogger("plugnproduce.statechart")
+
+Observer = Callable[[MetaEvent], None]
+"""Something that receives meta events."""
+
+_EntrySet = tuple[list[CState], set[CState], dict[CState, Block]]
+
+
+class Interpreter(Datamodel, Dispatcher, Invoker):
+    """Runs one SCXML session. ``trusted=False`` (default) restricts expressions and refuses ``<script>``.
+
+    ``io_processors`` maps ``<send type>`` values (``"xirp"``, ``"upnp"``) to objects with
+    ``send(event, target, type)``; ``base_dir`` is where ``src`` files are looked up.
+    """
+
+    def __init__(self, chart: Chart, *, clock: Clock | None = None, trusted: bool = False,
+                 io_processors: Mapping[str, IOProcessor] | None = None, base_dir: str | Path | None = None,
+                 session_id: str | None = None):
+        check_structure(chart, chart.name or "chart")
+        self._setup(chart, clock or MonotonicClock(), trusted, dict(io_processors or {}),
+                    Path(base_dir) if base_dir is not None else None, session_id or uuid.uuid4().hex)
+
+    @classmethod
+    def from_file(cls, path: str | Path, **options: Any) -> Interpreter:
+        """An interpreter for an SCXML file (``src`` files are looked up beside it)."""
+        path = Path(path)
+        return cls(parse_chart(read_bytes(path), path), base_dir=path.parent, **options)
+
+    def _setup(self, chart: Chart, clock: Clock, trusted: bool, io_processors: dict[str, IOProcessor],
+               base_dir: Path | None, session_id: str) -> None:
+        self.chart = chart
+        self.clock = clock
+        self.trusted = trusted
+        self.io_processors = io_processors
+        self.base_dir = base_dir
+        self.session_id = session_id
+        self.compiled = CompiledChart(chart, Evaluator(trusted), chart.name or "chart")
+        self.running = False
+        self.started = False
+        self.final_state: str | None = None
+        self.invokeid: str | None = None
+        self.internal: deque[Event] = deque()
+        self.external: deque[Event] = deque()
+        self.dm: dict[str, Any] = {}
+        self._config: set[CState] = set()
+        self._atomic: list[CState] | None = None
+        self._history: dict[CState, list[CState]] = {}
+        self._to_invoke: set[CState] = set()
+        self._data_ready: set[CState] = set()
+        self._invocations: dict[str, Invocation] = {}
+        self._overrides: dict[str, Any] = {}
+        self._parent: Interpreter | None = None
+        self._sessions: dict[str, Interpreter] = {session_id: self}
+        self._observers: list[Observer] = []
+        self._step: MacroStep | None = None
+        self._late = chart.binding == "late"
+        self._init_dispatch()
+
+    def _spawn(self, chart: Chart, invokeid: str, values: dict[str, Any], base_dir: Path | None) -> Interpreter:
+        """A child session for ``<invoke>`` (not started)."""
+        child = Interpreter.__new__(Interpreter)
+        child._setup(chart, self.clock, self.trusted, self.io_processors, base_dir, uuid.uuid4().hex)
+        child._parent, child.invokeid, child._overrides = self, invokeid, values
+        child._sessions = self._sessions
+        self._sessions[child.session_id] = child
+        return child
+
+    # --- public API -------------------------------------------------------------------
+
+    @property
+    def configuration(self) -> list[str]:
+        """Ids of the active states in document order."""
+        return [s.id for s in sorted(self._config, key=_doc_order)]
+
+    def is_active(self, state_id: str) -> bool:
+        """True when the state with this id is active."""
+        return self.compiled.by_id.get(state_id) in self._config
+
+    @property
+    def datamodel(self) -> dict[str, Any]:
+        """The datamodel's variables (system variables included, builtins left out)."""
+        return {k: v for k, v in self.dm.items() if k != "__builtins__"}
+
+    def attach(self, observer: Observer) -> None:
+        """Send meta events (state entered/exited, event consumed/sent, ...) to ``observer``."""
+        self._observers.append(observer)
+
+    def detach(self, observer: Observer) -> None:
+        """Stop sending meta events to ``observer``."""
+        self._observers.remove(observer)
+
+    def queue(self, event: str | Event, data: Any = None) -> Interpreter:
+        """Put an external event on the queue (a name, or an :class:`Event`); returns self to chain."""
+        self.external.append(event if isinstance(event, Event) else Event(event, data))
+        return self
+
+    def start(self) -> MacroStep:
+        """Initialise the datamodel and enter the initial configuration: the first macrostep."""
+        if self.started:
+            raise ExecutionError(f"session {self.session_id} of {self.chart.name or 'chart'} is already started")
+        self.started = self.running = True
+        step = self._begin(None)
+        self._init_datamodel()
+        for block in self.compiled.scripts:
+            self._run(block)
+        root = self.compiled.root
+        if root.initial is not None:
+            self._enter([root.initial])
+        self._stabilize()
+        return self._end(step)
+
+    def execute_once(self) -> MacroStep | None:
+        """Process the next external event (starting the session first if need be); None if there is none."""
+        if not self.started:
+            return self.start()
+        if not self.running:
+            return None
+        self._release_due()
+        if self._invocations:
+            self._pump_children()
+        if not self.external:
+            if not self.internal:
+                return None
+            step = self._begin(None)  # errors from delayed deliveries
+            self._stabilize()
+            return self._end(step)
+        event = self.external.popleft()
+        step = self._begin(event)
+        self._consume(event)
+        if self._invocations:
+            self._before_event(event)
+        enabled = self._select(event.name)
+        if enabled:
+            self._microstep(enabled)
+        self._stabilize()
+        return self._end(step)
+
+    def execute(self, max_steps: int = 10_000) -> list[MacroStep]:
+        """Run :meth:`execute_once` until there is nothing to do now (at most ``max_steps`` times)."""
+        steps = []
+        for _ in range(max_steps):
+            step = self.execute_once()
+            if step is None:
+                break
+            steps.append(step)
+        return steps
+
+    # --- macrostep --------------------------------------------------------------------
+
+    def _begin(self, event: Event | None) -> MacroStep:
+        self._step = MacroStep(self.clock.time(), event)
+        return self._step
+
+    def _end(self, step: MacroStep) -> MacroStep:
+        self._step = None
+        return step
+
+    def _stabilize(self) -> None:
+        """Eventless transitions and internal events until stable, then start invocations."""
+        while True:
+            while self.running:
+                enabled = self._select(None)
+                if not enabled:
+                    if not self.internal:
+                        break
+                    event = self.internal.popleft()
+                    self._consume(event)
+                    enabled = self._select(event.name)
+                if enabled:
+                    self._microstep(enabled)
+            if not self.running:
+                self._exit_interpreter()
+                return
+            if self._to_invoke:
+                self._start_invokes()
+            if not self.internal:
+                return
+
+    def _consume(self, event: Event) -> None:
+        self.dm["_event"] = event
+        if self._step is not None:
+            self._step.consumed.append(event)
+        if self._observers:
+            self._notify(EVENT_CONSUMED, event=event)
+
+    def _start_invokes(self) -> None:
+        states = sorted(self._to_invoke, key=_doc_order)
+        self._to_invoke.clear()
+        for state in states:
+            for inv in state.invokes:
+                self._start_invoke(state, inv)
+
+    # --- transition selection ---------------------------------------------------------
+
+    def _atomic_states(self) -> list[CState]:
+        if self._atomic is None:
+            self._atomic = sorted((s for s in self._config if s.is_atomic), key=_doc_order)
+        return self._atomic
+
+    def _select(self, name: str | None) -> list[CTransition]:
+        """The optimal enabled transition set for event ``name`` (None: eventless transitions)."""
+        enabled: list[CTransition] = []
+        for state in self._atomic_states():
+            t = self._first_enabled(state, name)
+            if t is not None and t not in enabled:
+                enabled.append(t)
+        if len(enabled) > 1:
+            return self._without_conflicts(enabled)
+        return enabled
+
+    def _first_enabled(self, state: CState, name: str | None) -> CTransition | None:
+        for s in state.lineage:
+            for t in (s.eventless if name is None else s.evented):
+                if name is not None and not (t.wildcard or name in t.exact or name.startswith(t.prefixes)):
+                    continue
+                if t.cond is None or self.holds(t.cond):
+                    return t
+        return None
+
+    def holds(self, cond: Expr) -> bool:
+        """A condition's truth; one that cannot be evaluated is false and raises ``error.execution``."""
+        try:
+            return bool(cond.evaluate(self.dm))
+        except EvaluationError as exc:
+            self._error("error.execution", str(exc))
+            return False
+
+    def _without_conflicts(self, enabled: list[CTransition]) -> list[CTransition]:
+        filtered: list[CTransition] = []
+        for t1 in enabled:
+            preempted = False
+            to_remove = []
+            exit1 = set(self._exit_set([t1]))
+            for t2 in filtered:
+                if exit1 & set(self._exit_set([t2])):
+                    if t1.source in t2.source.descendants:
+                        to_remove.append(t2)
+                    else:
+                        preempted = True
+                        break
+            if not preempted:
+                for t in to_remove:
+                    filtered.remove(t)
+                filtered.append(t1)
+        return filtered
+
+    # --- microstep --------------------------------------------------------------------
+
+    def _microstep(self, enabled: list[CTransition]) -> None:
+        self._exit_states(enabled)
+        for t in enabled:
+            if self._step is not None:
+                self._step.transitions.append(TakenTransition(t.source.id, tuple(s.id for s in t.targets), t.events))
+            if self._observers:
+                self._notify(TRANSITION_TAKEN, transition=t.node, source=t.source.id)
+            if t.actions:
+                self._run(t.actions)
+        self._enter(enabled)
+
+    def _domain(self, t: CTransition) -> CState | None:
+        if t.domain is not None or not t.targets:
+            return t.domain
+        return transition_domain(t, self._effective_targets(t))
+
+    def _exit_set(self, transitions: list[CTransition]) -> list[CState]:
+        out: set[CState] = set()
+        for t in transitions:
+            domain = self._domain(t)
+            if domain is not None:
+                below = domain.descendants
+                out.update(s for s in self._config if s in below)
+        return sorted(out, key=_doc_order, reverse=True)
+
+    def _exit_states(self, enabled: list[CTransition]) -> None:
+        to_exit = self._exit_set(enabled)
+        if not to_exit:
+            return
+        self._to_invoke.difference_update(to_exit)
+        for s in to_exit:
+            for h in s.histories:
+                if h.deep:
+                    self._history[h] = [x for x in self._config if x.is_atomic and x in s.descendants]
+                else:
+                    self._history[h] = [x for x in self._config if x.parent is s]
+        for s in to_exit:
+            self._exit_one(s)
+        self._atomic = None
+
+    def _exit_one(self, s: CState) -> None:
+        for block in s.onexit:
+            self._run(block)
+        if self._invocations:
+            self._cancel_invokes(s)
+        self._config.discard(s)
+        if self._step is not None:
+            self._step.exited.append(s.id)
+        if self._observers:
+            self._notify(STATE_EXITED, state=s.id)
+
+    def _enter(self, enabled: list[CTransition]) -> None:
+        states, default_entry, history_content = self._entry_set(enabled)
+        for s in states:
+            self._config.add(s)
+            self._atomic = None
+            self._to_invoke.add(s)
+            if self._step is not None:
+                self._step.entered.append(s.id)
+            if self._observers:
+                self._notify(STATE_ENTERED, state=s.id)
+            if self._late and s not in self._data_ready:
+                self._bind(s)
+            for block in s.onentry:
+                self._run(block)
+            if s in default_entry and s.initial is not None and s.initial.actions:
+                self._run(s.initial.actions)
+            if s in history_content:
+                self._run(history_content[s])
+            if s.is_final:
+                self._entered_final(s)
+
+    def _entered_final(self, s: CState) -> None:
+        parent = s.parent
+        assert parent is not None  # a final state is never the root
+        if parent.kind == ROOT:
+            self.running = False
+            self.final_state = s.id
+            return
+        self.internal.append(Event("done.state." + parent.id, self._donedata(s), "internal"))
+        grand = parent.parent
+        if grand is not None and grand.is_parallel and all(self._in_final(c) for c in grand.substates):
+            self.internal.append(Event("done.state." + grand.id, None, "internal"))
+
+    def _in_final(self, s: CState) -> bool:
+        if s.is_compound:
+            return any(c.is_final and c in self._config for c in s.substates)
+        if s.is_parallel:
+            return all(self._in_final(c) for c in s.substates)
+        return False
+
+    def _donedata(self, s: CState) -> Any:
+        if s.donedata is None:
+            return None
+        try:
+            return self._done_data(s.donedata.evaluate(self))
+        except EvaluationError as exc:
+            self._error("error.execution", str(exc))
+            return None
+
+    # --- entry set --------------------------------------------------------------------
+
+    def _entry_set(self, enabled: list[CTransition]) -> _EntrySet:
+        single = enabled[0] if len(enabled) == 1 else None
+        if single is not None and single.entry_cache is not None:
+            return single.entry_cache  # type: ignore[no-any-return]
+        builder = _EntryBuilder(self._history)
+        for t in enabled:
+            if not t.targets:
+                continue
+            for s in t.targets:
+                builder.descendants(s)
+            domain = self._domain(t)
+            for s in self._effective_targets(t):
+                builder.ancestors(s, domain)
+        result = (sorted(builder.states, key=_doc_order), builder.default_entry, builder.history_content)
+        if single is not None and not builder.saw_history:
+            single.entry_cache = result
+        return result
+
+    def _effective_targets(self, t: CTransition) -> list[CState]:
+        out: list[CState] = []
+        for s in t.targets:
+            if not s.is_history:
+                out.append(s)
+            elif s in self._history:
+                out.extend(self._history[s])
+            elif s.initial is not None:
+                out.extend(self._effective_targets(s.initial))
+        return out
+
+    def _exit_interpreter(self) -> None:
+        """Leave every state (onexit runs), cancel invocations, and tell the parent if it was a final state."""
+        final = self.compiled.by_id.get(self.final_state) if self.final_state is not None else None
+        done = self._donedata(final) if final is not None and self._parent is not None else None
+        for s in sorted(self._config, key=_doc_order, reverse=True):
+            self._exit_one(s)
+        self._atomic = None
+        self._sessions.pop(self.session_id, None)
+        if self._parent is not None and final is not None:
+            self._parent._from_child(self.invokeid, Event(f"done.invoke.{self.invokeid}", done))
+
+    def _stop(self) -> None:
+        """Cancelled by the parent: leave every state, send nothing back."""
+        if self.running:
+            self.running = False
+            self.final_state = None
+            self._exit_interpreter()
+
+
+def _doc_order(state: CState) -> int:
+    return state.idx
+
+
+class _EntryBuilder:
+    """The entry set of a microstep (the specification's addDescendant/AncestorStatesToEnter)."""
+
+    def __init__(self, history: dict[CState, list[CState]]) -> None:
+        self.history = history
+        self.states: set[CState] = set()
+        self.default_entry: set[CState] = set()
+        self.history_content: dict[CState, Block] = {}
+        self.saw_history = False
+
+    def descendants(self, state: CState) -> None:
+        """Add ``state`` and what entering it enters below it."""
+        if state.is_history:
+            self.saw_history = True
+            parent = state.parent
+            assert parent is not None  # a history state always has a parent
+            if state in self.history:
+                targets = self.history[state]
+            else:
+                assert state.initial is not None  # the compiler gives every history a default transition
+                if state.initial.actions:
+                    self.history_content[parent] = state.initial.actions
+                targets = state.initial.targets
+            for s in targets:
+                self.descendants(s)
+            for s in targets:
+                self.ancestors(s, parent)
+            return
+        self.states.add(state)
+        if state.is_compound:
+            self.default_entry.add(state)
+            assert state.initial is not None  # a compound state has an initial transition
+            for s in state.initial.targets:
+                self.descendants(s)
+            for s in state.initial.targets:
+                self.ancestors(s, state)
+        elif state.is_parallel:
+            self._children_of_parallel(state)
+
+    def ancestors(self, state: CState, ancestor: CState | None) -> None:
+        """Add the proper ancestors of ``state`` below ``ancestor``, completing parallel ones."""
+        for anc in state.ancestors:
+            if anc is ancestor or anc.kind == ROOT:
+                return
+            self.states.add(anc)
+            if anc.is_parallel:
+                self._children_of_parallel(anc)
+
+    def _children_of_parallel(self, state: CState) -> None:
+        for child in state.substates:
+            if not any(s in child.descendants or s is child for s in self.states):
+                self.descendants(child)

@@ -1,0 +1,93 @@
+"""The executor runs the bin-picking task on the simulated cell over XIRP and UPnP, and stops safely on faults."""
+
+from __future__ import annotations
+
+import asyncio
+from pathlib import Path
+
+import pytest
+
+from plugnproduce import service
+from plugnproduce.discovery import LiveCell
+from plugnproduce.executor.journal import read_journal
+from plugnproduce.executor.run import TaskRun
+from plugnproduce.protocols import upnp
+from plugnproduce.sim.cell import SimulatedCell
+
+TASK = service.builtin("tasks", "bin-picking.yaml")
+CELL = service.builtin("cells", "bin-picking.yaml")
+
+
+async def test_bin_picking_runs_to_the_end_and_the_journal_has_every_command_in_order(tmp_path: Path) -> None:
+    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl")
+    assert report.outcome == "succeeded", report.fault
+    run = read_journal(report.journal)
+    assert run.status == "succeeded"
+    generated = service.generate(TASK, CELL).task.commands()
+    for device in ("robot", "gripper", "sensor3d", "binpicking-pc"):  # each device gets its commands in task order
+        expected = [(step, c.name) for step, d, c in generated if d == device and c.kind == "request"]
+        sent = [(r["step"], r["command"]) for r in run.of_kind("command") if r["device"] == device]
+        assert sent == expected, device
+    assert {r["device"] for r in run.of_kind("event")} == {"robot", "gripper", "sensor3d", "binpicking-pc"}
+    assert [r["step"] for r in run.of_kind("step")] == [1, 2, 3, 4, 5, 6]
+    assert report.device_states["gripper"] == "open"
+
+
+# fault spec -> (fault kind, what the report says)
+FAULTS = {
+    "gripper:drop-response:Close": ("timeout", "command Close: no answer within 2 s"),
+    "gripper:error-response:Close": ("refused", "fault injected"),
+    "gripper:disconnect:Close": ("lost", "connection"),
+    "gripper:drop-event:gripper_closed": ("timeout", "no event from gripper within 2 s"),
+    "gripper:delay-event:gripper_closed:3": ("timeout", "no event from gripper within 2 s"),
+    "gripper:duplicate-event:gripper_closed": ("anomaly", "twice"),
+    "gripper:malformed-event": ("anomaly", "gripper"),
+}
+
+
+@pytest.mark.parametrize("spec", FAULTS)
+async def test_each_fault_stops_the_run_safely_with_a_report(spec: str, tmp_path: Path) -> None:
+    kind, text = FAULTS[spec]
+    report = await service.run_task(TASK, CELL, simulate=True, faults=spec, journal=tmp_path / "run.jsonl")
+    assert report.outcome == "failed"
+    fault = report.fault
+    assert fault is not None and (fault.kind, fault.device) == (kind, "gripper")
+    assert fault.step is not None and fault.command in {"bin-pick", "place"}
+    assert text in fault.message
+    assert fault.state in {"open", "closing", "closed"}
+    run = read_journal(report.journal)
+    kinds = [r["kind"] for r in run.records]
+    assert run.status == "failed" and kinds[-1] == "end"
+    first_fault = kinds.index("fault")
+    assert "command" not in kinds[first_fault:], "no command may go out after the fault"
+    assert run.end is not None and str(fault) == run.end["reason"]
+
+
+async def test_a_device_unplugged_mid_task_stops_the_run(tmp_path: Path, taxonomy) -> None:
+    cell = service.cell(CELL)
+    generated = service.generate(TASK, cell).task
+    network = upnp.private_network()
+    async with SimulatedCell(cell, network=network) as sim, LiveCell(taxonomy, network=network) as live:
+        devices = await service.find_devices(live, [d.id for d in cell.devices], 5.0)
+
+        def unplug_after_first_gripper_event(record: dict[str, object]) -> None:
+            if record["kind"] == "event" and record["device"] == "gripper":
+                asyncio.get_running_loop().create_task(sim.unplug("gripper"))
+
+        run = TaskRun(generated, devices, tmp_path / "run.jsonl", unplug_after_first_gripper_event)
+        report = await run.run()
+    assert report.outcome == "failed"
+    assert report.fault is not None and (report.fault.kind, report.fault.device) == ("lost", "gripper")
+
+
+async def test_an_operator_stop_ends_the_run_as_stopped(tmp_path: Path) -> None:
+    def stop_at_step_2(record: dict[str, object]) -> None:
+        if record["kind"] == "step" and record["step"] == 2:
+            runs[0].stop()
+
+    runs: list[TaskRun] = []
+    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
+                                    observer=stop_at_step_2, started=runs.append)
+    assert report.outcome == "stopped"
+    assert report.fault is not None and report.fault.step == 2
+    assert read_journal(report.journal).status == "stopped"

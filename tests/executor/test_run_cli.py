@@ -1,0 +1,47 @@
+"""``pnp run --sim`` and ``pnp report`` as a user runs them."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from plugnproduce import service
+
+TASKS = service.builtin("tasks")
+
+
+def pnp(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "plugnproduce", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_run_on_the_simulated_cell_then_report(tmp_path: Path) -> None:
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(TASKS / "bin-picking.yaml"), "--sim", "--journal", str(journal))
+    assert result.returncode == 0, result.stderr
+    assert "step 1: bin-pick" in result.stdout and "→ gripper: Close" in result.stdout
+    assert result.stdout.rstrip().splitlines()[-1] == f"succeeded; journal {journal}"
+    shown = pnp("report", str(journal))
+    assert shown.returncode == 0
+    assert "end: succeeded" in shown.stdout and shown.stdout.rstrip().endswith("status: succeeded")
+
+
+def test_a_failed_run_exits_1_with_the_fault(tmp_path: Path) -> None:
+    result = pnp("run", str(TASKS / "bin-picking.yaml"), "--sim", "--json", "--faults", "gripper:error-response",
+                 "--journal", str(tmp_path / "run.jsonl"))
+    assert result.returncode == 1
+    report = json.loads(result.stdout)
+    assert report["outcome"] == "failed" and report["fault"]["device"] == "gripper"
+
+
+def test_an_implausible_task_is_not_run() -> None:
+    result = pnp("run", str(TASKS / "bin-picking-invalid.yaml"), "--sim")
+    assert result.returncode == 1
+    assert "not plausible" in result.stderr and "step 2 (bin-pick)" in result.stderr
+
+
+def test_bad_fault_spec_is_bad_input() -> None:
+    result = pnp("run", str(TASKS / "bin-picking.yaml"), "--sim", "--faults", "gripper:explode")
+    assert result.returncode == 2
+    assert "unknown kind 'explode'" in result.stderr and "Traceback" not in result.stderr

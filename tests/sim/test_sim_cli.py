@@ -1,0 +1,81 @@
+"""``pnp sim up``, ``pnp discover`` and ``pnp sim plug/unplug`` as separate processes, as a user runs them."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from plugnproduce import service
+from plugnproduce.protocols.upnp import private_network
+
+CELL = str(service.builtin("cells", "bin-picking.yaml"))
+
+
+def command(*args: str) -> list[str]:
+    return [sys.executable, "-m", "plugnproduce", *args]
+
+
+@pytest.fixture
+def env(tmp_path: Path) -> dict[str, str]:
+    return {**os.environ, "PNP_SSDP_PORT": str(private_network().port)}
+
+
+@pytest.fixture
+def simulated_cell(env: dict[str, str], tmp_path: Path) -> Iterator[Path]:
+    state = tmp_path / "control.json"
+    log = tmp_path / "sim.log"
+    with log.open("w") as out:
+        up = subprocess.Popen(command("sim", "up", CELL, "--state-file", str(state)), env=env, stdout=out,
+                              stderr=subprocess.STDOUT)
+    deadline = time.monotonic() + 60
+    while not state.exists():
+        assert up.poll() is None, log.read_text()
+        assert time.monotonic() < deadline, "pnp sim up did not come up"
+        time.sleep(0.05)
+    yield state
+    up.send_signal(signal.SIGINT)  # Ctrl-C
+    assert up.wait(timeout=10) == 0, log.read_text()
+    assert "stopped" in log.read_text()
+
+
+def test_discover_lists_the_four_devices_within_5_s(simulated_cell: Path, env: dict[str, str]) -> None:
+    started = time.monotonic()
+    result = subprocess.run(command("discover", "--json"), env=env, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    found = json.loads(result.stdout)
+    assert sorted(d["id"] for d in found["devices"]) == ["binpicking-pc", "gripper", "robot", "sensor3d"]
+    assert "pick" in found["offered"]
+    print(f"discover: {time.monotonic() - started:.2f} s including start-up")
+
+
+def test_unplugging_the_gripper_removes_pick_within_1_s_and_plugging_brings_it_back(
+        simulated_cell: Path, env: dict[str, str]) -> None:
+    watch = subprocess.Popen(command("discover", "--json", "--watch"), env=env, text=True, stdout=subprocess.PIPE)
+    try:
+        assert watch.stdout is not None
+        first = json.loads(watch.stdout.readline())
+        assert "pick" in first["offered"]
+        control = ["--control", ":".join(map(str, json.loads(simulated_cell.read_text()).values()))]
+        unplugged_at = time.monotonic()
+        subprocess.run(command("sim", "unplug", "gripper", *control), env=env, check=True, timeout=60,
+                       capture_output=True)
+        change = json.loads(watch.stdout.readline())
+        assert (change["change"], change["device"]) == ("unplug", "gripper")
+        assert "pick" not in change["offered"] and "bin-pick" not in change["offered"]
+        subprocess.run(command("sim", "plug", "gripper", *control), env=env, check=True, timeout=60,
+                       capture_output=True)
+        change = json.loads(watch.stdout.readline())
+        assert (change["change"], change["device"]) == ("plug", "gripper")
+        assert "pick" in change["offered"]
+        print(f"unplug seen {time.monotonic() - unplugged_at:.2f} s after starting pnp sim unplug (a process start)")
+    finally:
+        watch.terminate()
+        watch.communicate(timeout=10)

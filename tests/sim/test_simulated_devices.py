@@ -1,0 +1,98 @@
+"""Simulated devices run their own charts behind real XIRP and UPnP servers on loopback."""
+
+from __future__ import annotations
+
+import pytest
+
+from plugnproduce import service
+from plugnproduce.discovery import LiveCell
+from plugnproduce.errors import ProtocolError
+from plugnproduce.protocols import upnp, xirp
+from plugnproduce.sim.cell import FaultSpecError, SimulatedCell, parse_faults
+from plugnproduce.sim.device import SimulatedDevice
+
+WAIT = 5.0
+
+
+def device(name: str):
+    return service.cell(service.builtin("cells", "bin-picking.yaml")).device(name) if name != "conveyor" else \
+        next(d for d in service.catalogue() if d.id == name)
+
+
+async def next_change_of(live: LiveCell, kind: str, device: str):
+    """The next change of this kind for this device (earlier ones, e.g. the plugs at start, are passed over)."""
+    while True:
+        change = await live.next_change(WAIT)
+        if (change.kind, change.device) == (kind, device):
+            return change
+
+
+@pytest.fixture
+def network() -> upnp.SsdpNetwork:
+    return upnp.private_network()
+
+
+async def test_gripper_closes_on_request_and_reports_it_over_xirp(network) -> None:
+    async with SimulatedDevice(device("gripper"), network=network) as gripper:
+        async with await xirp.XirpClient.connect_endpoint(gripper.endpoint) as client:
+            assert client.device == "gripper"
+            await client.request("Close", {"GripForce": 40.0})
+            event = await client.next_event(WAIT)
+            assert event.name == "gripper_closed"
+            assert gripper.state == "closed"
+
+
+async def test_a_request_the_chart_does_not_wait_for_is_refused_and_changes_nothing(network) -> None:
+    async with SimulatedDevice(device("gripper"), network=network) as gripper:
+        async with await xirp.XirpClient.connect_endpoint(gripper.endpoint) as client:
+            with pytest.raises(xirp.RemoteFailure) as refused:
+                await client.request("Open")
+            assert refused.value.code == xirp.NOT_ACCEPTED
+            assert "gripper is open" in refused.value.text
+            assert gripper.state == "open"
+
+
+async def test_device_serves_its_description_with_the_endpoint_it_listens_on(network) -> None:
+    async with SimulatedDevice(device("gripper"), network=network) as gripper:
+        async with await xirp.XirpClient.connect_endpoint(gripper.endpoint) as client:
+            files = await client.describe()
+        assert f'pnp:endpoint "{gripper.endpoint}"' in files.description
+    assert 'initial="open"' in files.chart
+
+
+async def test_upnp_sensor_captures_on_an_action_and_reports_by_gena(network) -> None:
+    async with SimulatedDevice(device("sensor3d"), network=network) as sensor:
+        async with await upnp.UpnpDeviceClient.connect(sensor.endpoint, "127.0.0.1") as client:
+            await client.subscribe()
+            assert set(client.actions) >= {"Capture"}
+            await client.call("Capture", Exposure="8")
+            change = await client.next_change(WAIT)
+            assert change.variable == "CaptureDone" and change.value == 1
+
+
+async def test_the_simulated_cell_is_discovered_and_follows_plug_and_unplug(network, taxonomy) -> None:
+    cell = service.cell(service.builtin("cells", "bin-picking.yaml"))
+    async with SimulatedCell(cell, catalogue=service.catalogue(), network=network) as sim, \
+            LiveCell(taxonomy, network=network) as live:
+        found = await service.find_devices(live, ["robot", "gripper", "sensor3d", "binpicking-pc"], WAIT)
+        assert found.device("gripper").endpoint == sim.devices["gripper"].endpoint
+        assert "pick" in service.capabilities(live.cell).commands()
+        await sim.unplug("gripper")
+        change = await next_change_of(live, "unplug", "gripper")
+        assert "pick" not in service.capabilities(change.cell).commands()
+        await sim.plug("gripper")
+        change = await next_change_of(live, "plug", "gripper")
+        assert "pick" in service.capabilities(change.cell).commands()
+        with pytest.raises(ProtocolError, match="plugged in already"):
+            await sim.plug("gripper")
+
+
+def test_fault_specs_are_read_or_refused_with_the_reason() -> None:
+    devices = service.cell(service.builtin("cells", "bin-picking.yaml")).devices
+    faults = parse_faults("gripper:drop-response:Close, robot:delay-event:arrived:3", devices)
+    assert [(f.kind, f.name) for f in faults["gripper"].rules] == [(xirp.FaultKind.DROP_RESPONSE, "Close")]
+    assert faults["robot"].rules[0].delay == 3.0
+    for spec, reason in [("tool:disconnect", "no device 'tool'"), ("gripper:explode", "unknown kind"),
+                         ("sensor3d:disconnect", "speaks upnp"), ("gripper", "expected DEVICE:KIND")]:
+        with pytest.raises(FaultSpecError, match=reason):
+            parse_faults(spec, devices)
