@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import NoReturn
 
 import typer
 
@@ -10,6 +11,17 @@ from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
 
 CELL_OPTION = typer.Option(..., "--cell", help="The cell file (YAML).")
+
+
+def refuse(exc: service.ImplausibleTask, consequence: str, json_out: bool) -> NoReturn:
+    """Say why an implausible task is refused (the reasoner's problems) and exit 1."""
+    if json_out:
+        emit_json(exc.result.to_json())
+    else:
+        typer.echo(f"task {exc.result.task} is not plausible in cell {exc.result.cell}; {consequence}", err=True)
+        for p in exc.result.problems:
+            typer.echo(str(p), err=True)
+    raise typer.Exit(1) from None
 
 
 @app.command()
@@ -28,13 +40,7 @@ def generate(
     try:
         generated = service.generate(task, cell, per_device)
     except service.ImplausibleTask as exc:
-        if json_out:
-            emit_json(exc.result.to_json())
-        else:
-            typer.echo(f"task {exc.result.task} is not plausible in cell {exc.result.cell}; nothing written", err=True)
-            for p in exc.result.problems:
-                typer.echo(str(p), err=True)
-        raise typer.Exit(1) from None
+        refuse(exc, "nothing written", json_out)
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for chart in generated.charts:

@@ -11,6 +11,7 @@ import typer
 
 from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.generate import refuse
 from plugnproduce.executor.journal import describe
 
 if TYPE_CHECKING:
@@ -48,13 +49,7 @@ def run(
         report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
                                               observer=show, started=started))
     except service.ImplausibleTask as exc:
-        if json_out:
-            emit_json(exc.result.to_json())
-        else:
-            typer.echo(f"task {exc.result.task} is not plausible in cell {exc.result.cell}; not run", err=True)
-            for p in exc.result.problems:
-                typer.echo(str(p), err=True)
-        raise typer.Exit(1) from None
+        refuse(exc, "not run", json_out)
     if json_out:
         emit_json(report.to_json())
     else:
