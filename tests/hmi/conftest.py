@@ -1,5 +1,6 @@
-"""Fixtures for the HMI: the application over the bin-picking cell, an in-process HTTP client,
-a real uvicorn server on a free loopback port, and headless Chromium driven by Playwright."""
+"""Fixtures for the HMI: the application over the simulated bin-picking cell (followed by discovery,
+run by the executor), an in-process HTTP client, a real uvicorn server on a free loopback port,
+and headless Chromium driven by Playwright."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import uvicorn
 from fastapi import FastAPI
 
 from plugnproduce import service
-from plugnproduce.hmi import FileCellSource, ModelRunner, create_app
+from plugnproduce.hmi import ExecutorRunner, SimulatedCellSource, create_app
 
 TOKEN = "test-token-0123456789abcdef"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
@@ -35,14 +36,15 @@ class Hmi:
     """An HMI application and what it was built over."""
 
     app: FastAPI
-    source: FileCellSource
-    runner: ModelRunner
+    source: SimulatedCellSource
+    runner: ExecutorRunner
 
 
-def make_hmi(tmp_path: Path, tick: float = 0.05, cell: str = "bin-picking") -> Hmi:
-    """The HMI over a built-in cell, runs journalled under ``tmp_path``."""
-    source = FileCellSource(service.cell(service.builtin("cells", f"{cell}.yaml")), service.catalogue())
-    runner = ModelRunner(lambda: source.cell, tmp_path / "runs", tick=tick)
+def make_hmi(tmp_path: Path, cell: str = "bin-picking", faults: str = "") -> Hmi:
+    """The HMI over a built-in cell, simulated (with ``faults``) once the app starts; runs journalled under ``tmp_path``."""
+    source = SimulatedCellSource(service.cell(service.builtin("cells", f"{cell}.yaml")), service.catalogue(),
+                                 faults=faults)
+    runner = ExecutorRunner(source, tmp_path / "runs")
     return Hmi(create_app(source, runner, TOKEN), source, runner)
 
 
@@ -69,9 +71,12 @@ class Served:
 
 
 @pytest.fixture()
-def served(tmp_path: Path) -> Iterator[Served]:
-    """The HMI served by uvicorn on a free loopback port (listening before the thread starts: no waiting)."""
-    hmi = make_hmi(tmp_path, tick=0.3)  # slow enough to watch a run step by step
+def served(tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[Served]:
+    """The HMI served by uvicorn on a free loopback port (listening before the thread starts: no waiting).
+
+    Parametrize it indirectly with a ``--faults`` spec to inject faults into the simulated devices.
+    """
+    hmi = make_hmi(tmp_path, faults=getattr(request, "param", ""))
     sock = socket.create_server(("127.0.0.1", 0))
     port = sock.getsockname()[1]
     config = uvicorn.Config(hmi.app, log_level="warning", lifespan="on", ws="none", timeout_graceful_shutdown=1)

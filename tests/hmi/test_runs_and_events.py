@@ -1,4 +1,5 @@
-"""Runs through the Runner interface (the model runner), and the server-sent event stream on a real server."""
+"""Runs through the Runner interface (the executor on the simulated cell), and the server-sent event stream
+on a real server."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from collections.abc import AsyncIterator
 import httpx
 import pytest
 
+from plugnproduce.hmi.hub import Hub
 from tests.hmi.conftest import AUTH, Hmi, Served, needs_reasoner
 
 TASK = {"name": "pick-and-place", "steps": [{"command": "pick-and-place"}, {"command": "move-to"}]}
@@ -39,20 +41,31 @@ async def test_a_run_walks_every_step_and_journals_it(client: httpx.AsyncClient,
 
 @needs_reasoner
 async def test_a_device_lost_during_a_run_is_a_fault(client: httpx.AsyncClient, hmi: Hmi) -> None:
+    hub = hmi.app.state.hub
+    gripper_busy = asyncio.Event()
+
+    def on_record(run_id: str, record: dict[str, object]) -> None:
+        if record["kind"] == "command" and record["device"] == "gripper":
+            gripper_busy.set()
+        Hub.on_run_record(hub, run_id, record)
+
+    hub.on_run_record = on_record
     run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
-    await client.delete("/api/cell/devices/gripper", headers=AUTH)
+    await asyncio.wait_for(gripper_busy.wait(), 10)
+    assert (await client.delete("/api/cell/devices/gripper", headers=AUTH)).status_code == 200
     run = await _until_end(client, hmi, run_id)
     assert run["status"] == "failed"
-    (fault,) = run["faults"]  # type: ignore[misc]
-    assert (fault["fault"], fault["device"], fault["step"]) == ("connection", "gripper", 1)
-    assert "left the cell during step 1" in fault["message"]
+    fault = run["faults"][0]  # type: ignore[index]
+    assert (fault["fault"], fault["device"], fault["step"], fault["first"]) == ("lost", "gripper", 1, True)
+    assert "command" not in [r["kind"] for r in (await client.get(f"/api/runs/{run_id}/journal")).json()
+                             if r["seq"] > fault["seq"]]
 
 
 @needs_reasoner
 async def test_a_run_can_be_stopped(client: httpx.AsyncClient) -> None:
     run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
     run = (await client.post(f"/api/runs/{run_id}/stop", headers=AUTH)).json()
-    assert run["status"] == "stopped" and run["end"]["reason"] == "stopped by the operator"
+    assert run["status"] == "stopped" and run["end"]["reason"].endswith(": stopped by the operator")
 
 
 @needs_reasoner

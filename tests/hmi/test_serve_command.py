@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -11,13 +12,15 @@ import httpx
 from typer.testing import CliRunner
 
 from plugnproduce.cli import app
+from plugnproduce.protocols.upnp import private_network
 from tests.hmi.conftest import TOKEN
 
 SERVE = [sys.executable, "-m", "plugnproduce", "serve", "--port", "0"]
 
 
-def _start(*args: str) -> tuple[subprocess.Popen[str], list[str]]:
-    proc = subprocess.Popen([*SERVE, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def _start(*args: str, env: dict[str, str] | None = None) -> tuple[subprocess.Popen[str], list[str]]:
+    proc = subprocess.Popen([*SERVE, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, **(env or {})})
     assert proc.stdout is not None
     lines = [proc.stdout.readline().strip()]  # blocks until the server listens and says where
     return proc, lines
@@ -31,7 +34,7 @@ def _stop(proc: subprocess.Popen[str]) -> str:
 
 
 def test_serve_prints_the_url_and_a_new_token() -> None:
-    proc, lines = _start()
+    proc, lines = _start("--sim")
     try:
         assert proc.stdout is not None
         lines += [proc.stdout.readline().strip(), proc.stdout.readline().strip()]
@@ -52,7 +55,7 @@ def test_serve_takes_the_token_from_a_file_and_the_cell_given(tmp_path: Path) ->
     token_file = tmp_path / "token"
     token_file.write_text(TOKEN + "\n")
     cell = Path(__file__).resolve().parents[2] / "descriptions" / "cells" / "assembly.yaml"
-    proc, lines = _start("--token-file", str(token_file), "--cell", str(cell))
+    proc, lines = _start("--sim", "--token-file", str(token_file), "--cell", str(cell))
     try:
         url = lines[0].rsplit(" ", 1)[1]
         assert httpx.get(url + "api/cell").json()["name"] == "assembly"
@@ -61,6 +64,22 @@ def test_serve_takes_the_token_from_a_file_and_the_cell_given(tmp_path: Path) ->
     finally:
         out = _stop(proc)
     assert TOKEN not in out
+
+
+def test_without_sim_the_cell_is_what_discovery_finds() -> None:
+    proc, lines = _start(env={"PNP_SSDP_PORT": str(private_network().port)})
+    try:
+        url = lines[0].rsplit(" ", 1)[1]
+        cell = httpx.get(url + "api/cell").json()
+        assert (cell["name"], cell["devices"], cell["pluggable"]) == ("live", [], False)
+    finally:
+        _stop(proc)
+
+
+def test_faults_need_sim() -> None:
+    result = CliRunner().invoke(app, ["serve", "--faults", "gripper:drop-response"])
+    assert result.exit_code == 2
+    assert result.output.strip() == "--faults needs --sim: faults are injected into simulated devices"
 
 
 def test_a_missing_token_file_is_one_line_and_exit_2(tmp_path: Path) -> None:

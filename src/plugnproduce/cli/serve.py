@@ -17,30 +17,29 @@ if TYPE_CHECKING:
 LOOPBACK_NAMES = ("127.0.0.1", "localhost")
 
 
-def journal_folder() -> Path:
-    """Where runs leave their journals."""
-    return Path.home() / ".cache" / "plugnproduce" / "runs"
+def cell_source(cell: Path | None, sim: bool, faults: str = "") -> CellSource:
+    """The cell the HMI shows, as discovery sees it.
 
-
-def cell_source(cell: Path | None) -> CellSource:
-    """The cell the HMI shows: a cell file (default: the built-in bin-picking cell), plugged from the catalogue.
-
-    Hook for ``--sim`` and discovery: return a source over the simulated or live cell here
-    (a :class:`~plugnproduce.hmi.CellSource` fed by :class:`~plugnproduce.discovery.LiveCell`).
+    With ``sim`` the devices of ``cell`` (default: the built-in bin-picking cell) are simulated
+    on a private loopback SSDP network and can be plugged and unplugged from the page; without,
+    the devices are the ones on the network (``PNP_SSDP_PORT``) and plug in themselves.
     """
-    from plugnproduce.hmi import FileCellSource
+    if not sim:
+        from plugnproduce.hmi.livecell import LiveCellSource
+        from plugnproduce.protocols.upnp import network_from_env
 
-    return FileCellSource(service.cell(cell or service.builtin("cells", "bin-picking.yaml")), service.catalogue())
+        return LiveCellSource(network_from_env(), name=service.cell(cell).name if cell else "live")
+    from plugnproduce.hmi.simcell import SimulatedCellSource
+
+    the_cell = service.cell(cell or service.builtin("cells", "bin-picking.yaml"))
+    return SimulatedCellSource(the_cell, service.catalogue(), faults=faults)
 
 
 def runner_for(source: CellSource) -> Runner:
-    """Who runs tasks: for now the device models (:class:`~plugnproduce.hmi.ModelRunner`).
+    """Who runs tasks: the executor, on the devices of the source's cell, journalling into the runs folder."""
+    from plugnproduce.hmi.executorrunner import ExecutorRunner
 
-    Hook for the executor: return a :class:`~plugnproduce.hmi.Runner` that drives the devices here.
-    """
-    from plugnproduce.hmi import ModelRunner
-
-    return ModelRunner(lambda: source.cell, journal_folder())
+    return ExecutorRunner(source, service.runs_folder())
 
 
 def _listen(host: str, port: int) -> socket.socket:
@@ -54,7 +53,11 @@ def _listen(host: str, port: int) -> socket.socket:
 @app.command()
 @boundary
 def serve(
-    cell: Path | None = typer.Option(None, "--cell", help="The cell file (default: the built-in bin-picking cell)."),
+    cell: Path | None = typer.Option(None, "--cell", help="With --sim: the cell to simulate (default: the built-in "
+                                     "bin-picking cell); without: only its name is used."),
+    sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices on a private loopback SSDP network; "
+                             "they can be plugged and unplugged from the page."),
+    faults: str = typer.Option("", "--faults", help="With --sim: faults to inject, as for pnp run."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to listen on."),
     port: int = typer.Option(0, "--port", min=0, max=65535, help="Port to listen on (0: any free port)."),
     token_file: Path | None = typer.Option(None, "--token-file",
@@ -70,7 +73,9 @@ def serve(
     from plugnproduce.hmi.security import new_token, read_token
 
     token = read_token(token_file) if token_file else new_token()
-    source = cell_source(cell)
+    if faults and not sim:
+        fail("--faults needs --sim: faults are injected into simulated devices")
+    source = cell_source(cell, sim, faults)
     service.knowledge()  # the taxonomy and processes, loaded once before the first request
     allowed = list(LOOPBACK_NAMES) if host in LOOPBACK_NAMES else None
     application = create_app(source, runner_for(source), token, allowed_hosts=allowed)

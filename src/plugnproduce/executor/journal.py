@@ -1,8 +1,8 @@
 """The run journal: an append-only, fsynced JSON-lines file per run.
 
-Every run writes one record per line: ``start`` (task, cell, chart digest), then
-``command`` (sent to a device), ``event`` (from a device or the chart), ``state``
-(a device region entered a state), ``step`` (a step began), ``fault`` and finally
+Every run writes one record per line: ``start`` (task, cell, chart digest, number of
+steps), then ``command`` (sent to a device), ``event`` (from a device or the chart), ``state``
+(a device region entered a state), ``step`` (a step began, with its role bindings), ``fault`` and finally
 ``end`` (outcome). A line is flushed and fsynced before the run goes on, so after a
 crash the journal holds everything up to the crash, and a run without ``end`` is
 told apart from a finished one. Nothing is ever rewritten.

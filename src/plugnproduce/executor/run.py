@@ -122,6 +122,7 @@ class TaskRun:
         self._digest = hashlib.sha256(data).hexdigest()
         chart = parse_chart(data, f"{generated.task.name}.task.scxml")
         self._states = _chart_map(chart)
+        self._bindings = {s.step.index: dict(s.binding) for s in generated.steps}
         self.interpreter = Interpreter(chart, io_processors={"xirp": self, "upnp": self})
         self.interpreter.attach(self._on_meta)
         self._loop = ChartLoop(self.interpreter, self._on_step)
@@ -139,7 +140,7 @@ class TaskRun:
         """Connect to the devices, run the chart to its end, close everything; the report says how it went."""
         with Journal(self.journal_path) as self._journal:
             self._record("start", task=self.generated.task.name, cell=self.cell.name, chart_sha256=self._digest,
-                         devices={d.id: d.endpoint for d in self.cell.devices})
+                         steps=len(self.generated.steps), devices={d.id: d.endpoint for d in self.cell.devices})
             try:
                 await self._connect()
                 if self.fault is None:
@@ -227,7 +228,7 @@ class TaskRun:
             return
         if info.step is not None and info.step != self.step:
             self.step, self.command = info.step, info.command
-            self._record("step", step=info.step, command=info.command)
+            self._record("step", step=info.step, command=info.command, bindings=self._bindings.get(info.step, {}))
         if info.device is not None and info.device_state is not None:
             if self.device_states.get(info.device) != info.device_state:
                 self.device_states[info.device] = info.device_state

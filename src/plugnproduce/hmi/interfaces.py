@@ -1,14 +1,13 @@
 """What the HMI needs from the rest of the controller, as small protocols.
 
-The HMI shows a cell that changes (devices plug in and unplug) and runs tasks on it.
-Neither is a use case of :mod:`plugnproduce.service` yet, so the HMI is written against
-these interfaces; :mod:`plugnproduce.hmi.filecell` and :mod:`plugnproduce.hmi.modelrunner`
-implement them without devices, and discovery and the executor plug in here later:
+The HMI shows a cell that changes (devices plug in and unplug) and runs tasks on it; it is
+written against these interfaces, which :mod:`plugnproduce.hmi.livecell` and
+:mod:`plugnproduce.hmi.simcell` (discovery) and :mod:`plugnproduce.hmi.executorrunner`
+(the executor) implement:
 
 - :class:`CellSource` gives the current :class:`~plugnproduce.description.model.Cell`
   and tells its listeners about every change (plug, unplug, a device's state);
-- :class:`PluggableCellSource` is a source the HMI may change itself (a cell file with
-  a catalogue, or a simulated cell);
+- :class:`PluggableCellSource` is a source the HMI may change itself (a simulated cell);
 - :class:`Runner` starts and stops runs of a task and reports their progress as the
   records of the run journal (:mod:`plugnproduce.executor.journal`).
 """
@@ -44,7 +43,7 @@ CellListener = Callable[[CellUpdate], None]
 
 @runtime_checkable
 class CellSource(Protocol):
-    """Where the HMI's cell comes from: a cell file now, discovery (:class:`~plugnproduce.discovery.LiveCell`) later."""
+    """Where the HMI's cell comes from: discovery (:class:`~plugnproduce.discovery.LiveCell`)."""
 
     @property
     def cell(self) -> Cell:

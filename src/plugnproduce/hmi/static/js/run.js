@@ -31,7 +31,7 @@ function markCurrentStep(run) {
 
 function faultReport(run) {
   if (run.status !== "failed") return null;
-  const fault = run.faults[run.faults.length - 1];
+  const fault = run.faults.find((f) => f.first !== false) || null; // the first fault is the cause
   const where = fault && fault.step ? `step ${fault.step}` : "";
   return [
     h("h3", {}, "Fault report"),
