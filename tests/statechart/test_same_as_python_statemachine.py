@@ -3,23 +3,26 @@
 from __future__ import annotations
 
 import pytest
+from statechart_support import run_to_end
 from statemachine.io.scxml.processor import SCXMLProcessor
 
 from plugnproduce import service
 from plugnproduce.codegen.closed_world import closed_world_chart
 from plugnproduce.statechart import parse_chart
 from plugnproduce.statechart.clock import ManualClock
-from plugnproduce.statechart.events import EVENT_CONSUMED, MetaEvent
+from plugnproduce.statechart.events import EVENT_CONSUMED, TRANSITION_TAKEN, MetaEvent
 from plugnproduce.statechart.interpreter import Interpreter
 
 CELL = service.builtin("cells", "bin-picking.yaml")
 
 
 def is_command(name: str) -> bool:
+    """A device command of the closed-world chart: ``DEVICE.PROTOCOL.request.NAME``."""
     return ".request." in name
 
 
 def in_python_statemachine(chart: bytes) -> tuple[set[str], list[str]]:
+    """Final configuration, and the commands that device models took transitions on, in order."""
     taken: list[str] = []
 
     class Listener:
@@ -33,23 +36,21 @@ def in_python_statemachine(chart: bytes) -> tuple[set[str], list[str]]:
 
 
 def in_our_runtime(chart: bytes) -> tuple[set[str], list[str]]:
-    consumed: list[str] = []
+    """The same, from this runtime's meta events."""
+    taken: list[str] = []
+    current: list[str] = []
 
     def observe(meta: MetaEvent) -> None:
         if meta.name == EVENT_CONSUMED:
-            consumed.append(meta.data["event"].name)
+            current[:] = [meta.data["event"].name]
+        elif meta.name == TRANSITION_TAKEN and meta.data["transition"].event is not None:
+            taken.extend(current)
 
     clock = ManualClock()
     interpreter = Interpreter(parse_chart(chart, "closed_world"), clock=clock)
     interpreter.attach(observe)
-    interpreter.start()
-    while interpreter.running:
-        interpreter.execute()
-        due = interpreter.next_due()
-        if due is None:
-            break
-        clock.advance_to(due)
-    return {interpreter.final_state or "(still running)"}, [e for e in consumed if is_command(e)]
+    run_to_end(interpreter, clock)
+    return {interpreter.final_state or "(still running)"}, [e for e in taken if is_command(e)]
 
 
 @pytest.mark.parametrize("task", ["bin-picking", "pick-and-place"])

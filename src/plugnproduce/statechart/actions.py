@@ -15,8 +15,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from lxml import etree
-
 from plugnproduce.errors import ExecutionError, PlugNProduceError
 from plugnproduce.safeio import parse_xml_bytes
 from plugnproduce.statechart.evaluator import EvaluationError, Evaluator, Expr, Location
@@ -56,6 +54,7 @@ class Action:
     """One element of executable content, compiled."""
 
     __slots__ = ("line",)
+    line: int | None  # the element's line in the chart
 
     def run(self, rt: Interpreter) -> None:
         """Do the action in the session ``rt``."""
@@ -101,12 +100,11 @@ def markup_value(markup: str) -> Any:
 class ValueSource:
     """Where a value comes from: an expression, inline text, inline markup or an inline chart."""
 
-    __slots__ = ("expr", "value", "has_value")
+    __slots__ = ("expr", "value")
 
     def __init__(self, evaluator: Evaluator, expr: str | None, text: str | None, markup: str | None,
                  chart: Chart | None = None):
         self.expr: Expr | None = evaluator.expr(expr) if expr is not None else None
-        self.has_value = self.expr is None and (text is not None or markup is not None or chart is not None)
         self.value: Any = chart if chart is not None else (
             markup_value(markup) if markup is not None else (literal(text) if text is not None else None))
 
@@ -183,7 +181,7 @@ class RaiseAction(Action):
 
 
 class SendAction(Action):
-    __slots__ = ("event", "target", "type", "delay", "id", "idlocation", "payload", "send_line")
+    __slots__ = ("event", "target", "type", "delay", "id", "idlocation", "payload")
 
     def __init__(self, ev: Evaluator, node: Send):
         self.event = _attr(ev, node.event, node.eventexpr)
@@ -193,17 +191,16 @@ class SendAction(Action):
         self.id = node.id
         self.idlocation = ev.location(node.idlocation) if node.idlocation is not None else None
         self.payload = EventPayload.build(ev, node.namelist, node.params, node.content)
-        self.send_line = node.line
 
     def run(self, rt: Interpreter) -> None:
         sendid = self.id or rt.new_sendid()
         if self.idlocation is not None:
             self.idlocation.assign(rt.dm, sendid)
         try:
-            name = _value(rt, self.event)
-            target = _value(rt, self.target)
-            kind = _value(rt, self.type)
-            delay = parse_delay(_value(rt, self.delay)) if self.delay is not None else 0.0
+            name = value_of(rt, self.event)
+            target = value_of(rt, self.target)
+            kind = value_of(rt, self.type)
+            delay = parse_delay(value_of(rt, self.delay)) if self.delay is not None else 0.0
             data = self.payload.evaluate(rt)
         except EvaluationError as exc:
             raise ActionError(str(exc), sendid=sendid) from exc
@@ -293,14 +290,15 @@ class CancelAction(Action):
         self.sendid = _attr(ev, node.sendid, node.sendidexpr)
 
     def run(self, rt: Interpreter) -> None:
-        rt.cancel(str(_value(rt, self.sendid)))
+        rt.cancel(str(value_of(rt, self.sendid)))
 
 
 def _attr(ev: Evaluator, literal_value: str | None, expr: str | None) -> str | Expr | None:
     return ev.expr(expr) if expr is not None else literal_value
 
 
-def _value(rt: Interpreter, source: str | Expr | None) -> Any:
+def value_of(rt: Interpreter, source: str | Expr | None) -> Any:
+    """The value of a literal-or-expression attribute."""
     return source.evaluate(rt.dm) if isinstance(source, Expr) else source
 
 
@@ -365,13 +363,3 @@ def compile_invoke(evaluator: Evaluator, node: Invoke, where: str) -> CInvoke:
         content=content_source(evaluator, node.content),
         finalize=compile_block(evaluator, node.finalize.actions, where) if node.finalize is not None else (),
     )
-
-
-def is_element(value: Any) -> bool:
-    """True for an XML element value (inline markup or XML read from a file)."""
-    return isinstance(value, etree._Element)
-
-
-def value_of(rt: Interpreter, source: str | Expr | None) -> Any:
-    """The value of a literal-or-expression attribute."""
-    return _value(rt, source)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from plugnproduce.statechart.actions import Action, Block, compile_block, compile_donedata, compile_invoke
+from plugnproduce.statechart.actions import Block, compile_block, compile_donedata, compile_invoke
 from plugnproduce.statechart.evaluator import Evaluator, Expr
 from plugnproduce.statechart.model import (
     Chart,
@@ -29,10 +29,10 @@ ROOT, ATOMIC, COMPOUND, PARALLEL, FINAL, HISTORY = range(6)
 class CState:
     """A state (or the ``<scxml>`` root, or a history pseudo-state) ready to run."""
 
-    __slots__ = ("idx", "id", "kind", "node", "parent", "ancestors", "lineage", "substates", "histories",
-                 "descendants", "initial", "transitions", "evented", "eventless", "onentry", "onexit",
+    __slots__ = ("idx", "id", "kind", "node", "parent", "ancestors", "substates", "histories",
+                 "descendants", "initial", "evented", "eventless", "onentry", "onexit",
                  "invokes", "data", "donedata", "deep", "is_atomic", "is_final", "is_parallel", "is_compound",
-                 "is_history", "data_ready")
+                 "is_history", "eventless_chain", "evented_chain")
 
     def __init__(self, idx: int, state_id: str, kind: int, node: Any, parent: CState | None):
         self.idx = idx
@@ -41,12 +41,10 @@ class CState:
         self.node = node
         self.parent = parent
         self.ancestors: tuple[CState, ...] = (parent,) + parent.ancestors if parent is not None else ()
-        self.lineage: tuple[CState, ...] = ()
         self.substates: list[CState] = []
         self.histories: list[CState] = []
         self.descendants: frozenset[CState] = frozenset()
         self.initial: CTransition | None = None
-        self.transitions: list[CTransition] = []
         self.evented: list[CTransition] = []
         self.eventless: list[CTransition] = []
         self.onentry: list[Block] = []
@@ -60,7 +58,9 @@ class CState:
         self.is_parallel = kind == PARALLEL
         self.is_compound = kind in (COMPOUND, ROOT)
         self.is_history = kind == HISTORY
-        self.data_ready = False
+        # the transitions of the state, then of each ancestor: the order in which they are tried
+        self.eventless_chain: tuple[CTransition, ...] = ()
+        self.evented_chain: tuple[CTransition, ...] = ()
 
     def __repr__(self) -> str:
         return f"<CState {self.id}>"
@@ -69,11 +69,10 @@ class CState:
 class CTransition:
     """A transition ready to run, with a fast event matcher and (when static) its domain."""
 
-    __slots__ = ("idx", "source", "node", "events", "exact", "prefixes", "wildcard", "cond", "targets", "internal",
+    __slots__ = ("source", "node", "events", "exact", "prefixes", "wildcard", "cond", "targets", "internal",
                  "actions", "has_history", "domain", "entry_cache")
 
-    def __init__(self, idx: int, source: CState, node: Transition, evaluator: Evaluator, actions: Block):
-        self.idx = idx
+    def __init__(self, source: CState, node: Transition, evaluator: Evaluator, actions: Block):
         self.source = source
         self.node = node
         descriptors = [_descriptor(d) for d in node.events]
@@ -117,9 +116,8 @@ class CompiledChart:
         self.by_id: dict[str, CState] = {}
         self.transitions: list[CTransition] = []
         self.root = self._state(chart, None, ROOT)
-        self._link(self.root)
+        self._link()
         self.scripts = [compile_block(evaluator, [s], where) for s in chart.scripts]
-        self.all_data: list[tuple[CState, Data]] = [(s, d) for s in self.states for d in s.data]
 
     # --- building --------------------------------------------------------------------
 
@@ -146,7 +144,7 @@ class CompiledChart:
             (cs.histories if cs_child.is_history else cs.substates).append(cs_child)
         return cs
 
-    def _link(self, root: CState) -> None:
+    def _link(self) -> None:
         """Second pass, once every state exists: descendants, transitions, initial entries."""
         for cs in reversed(self.states):
             below: set[CState] = set()
@@ -154,23 +152,25 @@ class CompiledChart:
                 below.add(child)
                 below |= child.descendants
             cs.descendants = frozenset(below)
-            cs.lineage = (cs,) + tuple(a for a in cs.ancestors if a.kind != ROOT)
         for cs in self.states:
             node = cs.node
             if isinstance(node, State | Parallel):
-                cs.transitions = [self._transition(cs, t) for t in node.transitions]
-                cs.evented = [t for t in cs.transitions if t.exact]
-                cs.eventless = [t for t in cs.transitions if not t.exact]
-            if isinstance(node, History) and node.transition is not None:
-                cs.initial = self._transition(cs, node.transition)
+                own = [self._transition(cs, t) for t in node.transitions]
+                cs.evented = [t for t in own if t.exact]
+                cs.eventless = [t for t in own if not t.exact]
+            if isinstance(node, History):
+                cs.initial = self._transition(cs, node.transition or self._parent_default(cs))
             elif cs.is_compound:
                 cs.initial = self._initial(cs)
+        for cs in self.states:
+            lineage = (cs, *cs.ancestors)
+            cs.eventless_chain = tuple(t for s in lineage for t in s.eventless)
+            cs.evented_chain = tuple(t for s in lineage for t in s.evented)
         for t in self.transitions:
             self._domain(t)
 
     def _transition(self, source: CState, node: Transition) -> CTransition:
-        t = CTransition(len(self.transitions), source, node, self.evaluator,
-                        compile_block(self.evaluator, node.actions, self.where))
+        t = CTransition(source, node, self.evaluator, compile_block(self.evaluator, node.actions, self.where))
         for target in node.targets:
             cs = self.by_id.get(target)
             if cs is None:  # only in inline child charts; the reader refuses these at the top
@@ -197,6 +197,12 @@ class CompiledChart:
                 return None
             names = [cs.substates[0].id]
         return self._transition(cs, Transition(targets=list(names), line=node.line))
+
+    def _parent_default(self, history: CState) -> Transition:
+        """A history without a transition (the schema asks for one) defaults to its parent's initial states."""
+        initial = history.parent.initial if history.parent is not None else None
+        return Transition(targets=[s.id for s in initial.targets] if initial is not None else [],
+                          line=history.node.line)
 
     def _domain(self, t: CTransition) -> None:
         """The transition domain, when it does not depend on history (else computed when taken)."""
@@ -234,4 +240,4 @@ def lcca(states: list[CState]) -> CState:
     return head.ancestors[-1]
 
 
-__all__ = ["Action", "CState", "CTransition", "CompiledChart", "lcca", "transition_domain"]
+__all__ = ["CState", "CTransition", "CompiledChart", "lcca", "transition_domain"]

@@ -19,12 +19,16 @@ from __future__ import annotations
 
 import ast
 import builtins
+import functools
 import textwrap
 import warnings
 from collections.abc import Callable
 from typing import Any
 
 from plugnproduce.errors import ExecutionError
+
+EXPRESSIONS_REMEMBERED = 4096
+"""Compiled expressions kept for reuse (they depend only on their text and on trust)."""
 
 
 class EvaluationError(Exception):
@@ -92,19 +96,8 @@ class Evaluator:
         return dict(SAFE_BUILTINS)
 
     def expr(self, source: str) -> Expr:
-        """Compile a value or condition expression."""
-        text = source.strip()
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", SyntaxWarning)
-                tree = ast.parse(text, mode="eval")
-            if not self.trusted:
-                _check(tree)
-            return Expr(source, compile(tree, "<scxml>", "eval"), None)
-        except SyntaxError as exc:
-            return Expr(source, None, f"syntax error ({exc.msg})")
-        except _Refused as exc:
-            return Expr(source, None, f"not allowed by the restricted evaluator: {exc}")
+        """Compile a value or condition expression (remembered: charts run again and again repeat them)."""
+        return _compile_expression(source, self.trusted)
 
     def location(self, source: str) -> Location:
         """Compile an assignment location (a name, attribute or subscript)."""
@@ -188,6 +181,21 @@ class Location:
             raise
         except Exception as exc:
             raise EvaluationError(f"cannot assign to {self.source!r}: {exc}") from exc
+
+
+@functools.lru_cache(maxsize=EXPRESSIONS_REMEMBERED)
+def _compile_expression(source: str, trusted: bool) -> Expr:
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SyntaxWarning)
+            tree = ast.parse(source.strip(), mode="eval")
+        if not trusted:
+            _check(tree)
+        return Expr(source, compile(tree, "<scxml>", "eval"), None)
+    except SyntaxError as exc:
+        return Expr(source, None, f"syntax error ({exc.msg})")
+    except _Refused as exc:
+        return Expr(source, None, f"not allowed by the restricted evaluator: {exc}")
 
 
 class _Refused(Exception):

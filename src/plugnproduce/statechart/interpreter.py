@@ -5,9 +5,47 @@ event and runs the whole macrostep (the event's microstep, then eventless transi
 internal events until the configuration is stable) and returns a
 :class:`~plugnproduce.statechart.events.MacroStep`. Time comes from an injected clock;
 delayed sends wait in the session until the clock reaches them. Observers receive meta
-events. Threads and asyncio live apart (:mod:`plugnproduce.statechart.runner`).
-"""
+events. asyncio lives apart (:class:`plugnproduce.statechart.loop.ChartLoop`).
 
+The public API (kept stable: the executor and the simulated devices use it):
+
+``Interpreter(chart, *, clock=None, trusted=False, io_processors=None, base_dir=None, session_id=None)``
+    A session of a read :class:`~plugnproduce.statechart.model.Chart`, checked first (a
+    :class:`~plugnproduce.errors.DescriptionError` names what is broken). ``clock``: where
+    time comes from (default :class:`~plugnproduce.statechart.clock.MonotonicClock`; tests
+    use :class:`~plugnproduce.statechart.clock.ManualClock`). ``trusted``: expressions are
+    plain Python and ``<script>`` runs; by default expressions go through the restricted
+    evaluator and a ``<script>`` is refused with an :class:`~plugnproduce.errors.ExecutionError`.
+    ``io_processors``: ``<send type>`` → an object with ``send(event, target, type)``.
+    ``base_dir``: the folder ``src`` files are read from. ``session_id``: ``_sessionid``
+    (default: a random one).
+``Interpreter.from_file(path, **options)``
+    The same for an SCXML file, whose folder is ``base_dir``.
+``start()``
+    Initialise the datamodel and enter the initial configuration: the first macrostep.
+``queue(name_or_event, data=None)``
+    Put an external event on the queue; returns the interpreter, to chain.
+``execute_once()`` / ``execute()``
+    Deliver the delayed sends that are due, then process the next external event: one
+    macrostep, or None when there is nothing to do now (starting the session first if
+    need be). ``execute()`` repeats it until then and returns the macrosteps.
+``next_due()``
+    The clock time of the next delayed send (None: none waits): when to execute again.
+``running``, ``started``, ``final_state``
+    Whether the session has started and still runs; the id of the top-level final state
+    it stopped in (None while it runs).
+``configuration``, ``is_active(state_id)``
+    Ids of the active states in document order (empty once stopped); whether one is active.
+``attach(observer)`` / ``detach(observer)``
+    Meta events (:class:`~plugnproduce.statechart.events.MetaEvent`): states entered and
+    exited, events consumed and sent, transitions taken, logs and errors.
+``datamodel``
+    The datamodel's variables, system variables included.
+
+Errors inside the chart (an expression that fails, a send that cannot be delivered) are
+not exceptions: as the specification asks, they become ``error.execution`` or
+``error.communication`` events in the chart (and ``error`` meta events).
+"""
 from __future__ import annotations
 
 import logging
@@ -22,9 +60,10 @@ from plugnproduce.safeio import read_bytes
 from plugnproduce.statechart.actions import Block
 from plugnproduce.statechart.checks import check_structure
 from plugnproduce.statechart.clock import Clock, MonotonicClock
-from plugnproduce.statechart.compiled import ROOT, CompiledChart, CState, CTransition, transition_domain
+from plugnproduce.statechart.compiled import ROOT, CompiledChart, CState, CTransition
 from plugnproduce.statechart.datamodel import Datamodel
 from plugnproduce.statechart.dispatch import Dispatcher
+from plugnproduce.statechart.entry import EntryBuilder, domain_of
 from plugnproduce.statechart.evaluator import EvaluationError, Evaluator, Expr
 from plugnproduce.statechart.events import (
     EVENT_CONSUMED,
@@ -252,12 +291,15 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         return enabled
 
     def _first_enabled(self, state: CState, name: str | None) -> CTransition | None:
-        for s in state.lineage:
-            for t in (s.eventless if name is None else s.evented):
-                if name is not None and not (t.wildcard or name in t.exact or name.startswith(t.prefixes)):
-                    continue
+        """The first transition of the state or its ancestors that the event (None: no event) enables."""
+        if name is None:
+            for t in state.eventless_chain:
                 if t.cond is None or self.holds(t.cond):
                     return t
+            return None
+        for t in state.evented_chain:
+            if t.matches(name) and (t.cond is None or self.holds(t.cond)):
+                return t
         return None
 
     def holds(self, cond: Expr) -> bool:
@@ -273,9 +315,9 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         for t1 in enabled:
             preempted = False
             to_remove = []
-            exit1 = set(self._exit_set([t1]))
+            exit1 = self._exits(t1)
             for t2 in filtered:
-                if exit1 & set(self._exit_set([t2])):
+                if not exit1.isdisjoint(self._exits(t2)):
                     if t1.source in t2.source.descendants:
                         to_remove.append(t2)
                     else:
@@ -300,19 +342,14 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
                 self._run(t.actions)
         self._enter(enabled)
 
-    def _domain(self, t: CTransition) -> CState | None:
-        if t.domain is not None or not t.targets:
-            return t.domain
-        return transition_domain(t, self._effective_targets(t))
+    def _exits(self, t: CTransition) -> set[CState]:
+        """The active states that taking ``t`` exits."""
+        domain = domain_of(t, self._history)
+        return self._config & domain.descendants if domain is not None else set()
 
     def _exit_set(self, transitions: list[CTransition]) -> list[CState]:
-        out: set[CState] = set()
-        for t in transitions:
-            domain = self._domain(t)
-            if domain is not None:
-                below = domain.descendants
-                out.update(s for s in self._config if s in below)
-        return sorted(out, key=_doc_order, reverse=True)
+        """The states the transitions exit, in exit order (reverse document order)."""
+        return sorted(set().union(*map(self._exits, transitions)), key=_doc_order, reverse=True)
 
     def _exit_states(self, enabled: list[CTransition]) -> None:
         to_exit = self._exit_set(enabled)
@@ -395,30 +432,13 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         single = enabled[0] if len(enabled) == 1 else None
         if single is not None and single.entry_cache is not None:
             return single.entry_cache  # type: ignore[no-any-return]
-        builder = _EntryBuilder(self._history)
+        builder = EntryBuilder(self._history)
         for t in enabled:
-            if not t.targets:
-                continue
-            for s in t.targets:
-                builder.descendants(s)
-            domain = self._domain(t)
-            for s in self._effective_targets(t):
-                builder.ancestors(s, domain)
+            builder.add(t)
         result = (sorted(builder.states, key=_doc_order), builder.default_entry, builder.history_content)
         if single is not None and not builder.saw_history:
             single.entry_cache = result
         return result
-
-    def _effective_targets(self, t: CTransition) -> list[CState]:
-        out: list[CState] = []
-        for s in t.targets:
-            if not s.is_history:
-                out.append(s)
-            elif s in self._history:
-                out.extend(self._history[s])
-            elif s.initial is not None:
-                out.extend(self._effective_targets(s.initial))
-        return out
 
     def _exit_interpreter(self) -> None:
         """Leave every state (onexit runs), cancel invocations, and tell the parent if it was a final state."""
@@ -441,57 +461,3 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
 
 def _doc_order(state: CState) -> int:
     return state.idx
-
-
-class _EntryBuilder:
-    """The entry set of a microstep (the specification's addDescendant/AncestorStatesToEnter)."""
-
-    def __init__(self, history: dict[CState, list[CState]]) -> None:
-        self.history = history
-        self.states: set[CState] = set()
-        self.default_entry: set[CState] = set()
-        self.history_content: dict[CState, Block] = {}
-        self.saw_history = False
-
-    def descendants(self, state: CState) -> None:
-        """Add ``state`` and what entering it enters below it."""
-        if state.is_history:
-            self.saw_history = True
-            parent = state.parent
-            assert parent is not None  # a history state always has a parent
-            if state in self.history:
-                targets = self.history[state]
-            else:
-                assert state.initial is not None  # the compiler gives every history a default transition
-                if state.initial.actions:
-                    self.history_content[parent] = state.initial.actions
-                targets = state.initial.targets
-            for s in targets:
-                self.descendants(s)
-            for s in targets:
-                self.ancestors(s, parent)
-            return
-        self.states.add(state)
-        if state.is_compound:
-            self.default_entry.add(state)
-            assert state.initial is not None  # a compound state has an initial transition
-            for s in state.initial.targets:
-                self.descendants(s)
-            for s in state.initial.targets:
-                self.ancestors(s, state)
-        elif state.is_parallel:
-            self._children_of_parallel(state)
-
-    def ancestors(self, state: CState, ancestor: CState | None) -> None:
-        """Add the proper ancestors of ``state`` below ``ancestor``, completing parallel ones."""
-        for anc in state.ancestors:
-            if anc is ancestor or anc.kind == ROOT:
-                return
-            self.states.add(anc)
-            if anc.is_parallel:
-                self._children_of_parallel(anc)
-
-    def _children_of_parallel(self, state: CState) -> None:
-        for child in state.substates:
-            if not any(s in child.descendants or s is child for s in self.states):
-                self.descendants(child)
