@@ -9,6 +9,7 @@ the file and line.
 
 from __future__ import annotations
 
+import codecs
 import re
 from pathlib import Path
 from typing import Any
@@ -26,7 +27,13 @@ MAX_BYTES = 4 * 1024 * 1024
 MAX_XML_DEPTH = 64
 """Deepest XML element nesting accepted."""
 
-_DOCTYPE = re.compile(rb"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
+_DOCTYPE = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
+_COMMENT = re.compile(r"<!--.*?-->", re.DOTALL)
+_WIDE = (  # (leading bytes, codec) of the encodings whose text the byte-wise search would miss
+    (codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
+    (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"),
+    (b"<\0\0\0", "utf-32-le"), (b"\0\0\0<", "utf-32-be"), (b"<\0", "utf-16-le"), (b"\0<", "utf-16-be"),
+)
 
 
 def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
@@ -45,19 +52,25 @@ def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
     return data
 
 
-def _line_of(data: bytes, offset: int) -> int:
-    return data.count(b"\n", 0, offset) + 1
+def _as_text(data: bytes) -> str:
+    """The document as text for the DOCTYPE search: wide encodings decoded, any other byte for byte."""
+    for start, codec in _WIDE:
+        if data.startswith(start):
+            return data.decode(codec, errors="replace")
+    return data.decode("latin-1")  # ASCII-compatible encodings: '<!DOCTYPE' is the same bytes in each
 
 
 def refuse_doctype(data: bytes, source: str | Path) -> None:
-    """Refuse any DOCTYPE or ENTITY declaration: descriptions never need one."""
-    m = _DOCTYPE.search(data)
+    """Refuse any DOCTYPE or ENTITY declaration, in whatever encoding; text inside comments does not count."""
+    text = _as_text(data)
+    blanked = _COMMENT.sub(lambda m: "\n" * m.group().count("\n"), text)  # keep line numbers
+    m = _DOCTYPE.search(blanked)
     if m:
         raise HostileInputError(
             "DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "
             "expected a plain XML document",
             source,
-            _line_of(data, m.start()),
+            blanked.count("\n", 0, m.start()) + 1,
         )
 
 
@@ -80,8 +93,12 @@ def parse_xml_bytes(data: bytes, source: str | Path) -> etree._ElementTree:
         line = exc.lineno if exc.lineno else None
         msg = exc.msg.split(f", line {line}")[0] if exc.msg else "malformed XML"
         raise UnreadableError(f"malformed XML: {msg}", source, line) from exc
+    tree = root.getroottree()
+    if tree.docinfo.internalDTD is not None or tree.docinfo.doctype:  # an encoding the search did not know
+        raise HostileInputError("DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "
+                                "expected a plain XML document", source, 1)
     _check_depth(root, source)
-    return root.getroottree()
+    return tree
 
 
 def parse_xml(path: str | Path) -> etree._ElementTree:
