@@ -145,6 +145,9 @@ def parse_yaml_node(path: str | Path) -> yaml.Node:
         raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
     try:
         node = yaml.compose(text, Loader=_NoAliasLoader)
+    except RecursionError as exc:
+        raise HostileInputError(f"YAML nested too deeply; at most {MAX_YAML_DEPTH} levels are accepted",
+                                path) from exc
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
@@ -154,7 +157,52 @@ def parse_yaml_node(path: str | Path) -> yaml.Node:
         raise UnreadableError(f"malformed YAML: {exc}", path) from exc
     if node is None:
         raise UnreadableError("empty YAML document", path, 1)
+    _check_yaml_values(node, path)
     return node
+
+
+MAX_YAML_DEPTH = 64
+"""Deepest YAML nesting accepted."""
+
+MAX_DIGITS = 30
+"""Longest integer (in digits) a description may hold."""
+
+_PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "bool", "null", "seq", "map")}
+_NOT_A_NUMBER = re.compile(r"^[-+]?\.(nan|inf)$", re.IGNORECASE)
+
+
+def _check_yaml_values(root: yaml.Node, path: str | Path) -> None:
+    """Refuse what a description never needs and what would crash or blow up its reading:
+    tags other than plain data (``!!timestamp``, ``!!omap``, ``!!binary``, ...), NaN and
+    infinities, integers of more than :data:`MAX_DIGITS` digits, nesting deeper than
+    :data:`MAX_YAML_DEPTH`."""
+    stack: list[tuple[yaml.Node, int]] = [(root, 1)]
+    while stack:
+        node, depth = stack.pop()
+        line = node.start_mark.line + 1
+        if depth > MAX_YAML_DEPTH:
+            raise HostileInputError(f"YAML nested {depth} levels deep; at most {MAX_YAML_DEPTH} are accepted",
+                                    path, line)
+        if node.tag not in _PLAIN_TAGS:
+            raise UnreadableError(f"YAML type {node.tag.replace('tag:yaml.org,2002:', '!!')} is not accepted; "
+                                  "expected text, numbers, true/false, lists and mappings (quote a value to mean "
+                                  "text)", path, line)
+        if isinstance(node, yaml.ScalarNode):
+            _check_scalar(node, path, line)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((child, depth + 1) for child in node.value)
+        else:
+            stack.extend((part, depth + 1) for pair in node.value for part in pair)
+
+
+def _check_scalar(node: yaml.ScalarNode, path: str | Path, line: int) -> None:
+    value = str(node.value)
+    if node.tag.endswith(":float") and _NOT_A_NUMBER.match(value.strip()):
+        raise UnreadableError(f"{value.strip()} is not a number a device can be given; expected a finite number",
+                              path, line)
+    if node.tag.endswith(":int") and sum(c.isdigit() for c in value) > MAX_DIGITS:
+        raise UnreadableError(f"an integer of {sum(c.isdigit() for c in value)} digits; at most {MAX_DIGITS} "
+                              "are accepted", path, line)
 
 
 def read_turtle_text(path: str | Path) -> str:
