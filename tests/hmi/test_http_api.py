@@ -234,3 +234,20 @@ def test_the_reasoner_check_matches_the_service() -> None:
         {**PLACE, "params": from_file.steps[1].params}]}).to_task()
     assert [(s.index, s.command, s.bind, s.params) for s in from_json.steps] == \
         [(s.index, s.command, s.bind, s.params) for s in from_file.steps]
+
+
+@pytest.mark.parametrize("path", ["/api/task/validate", "/api/task/check", "/api/task/repair", "/api/task/generate"])
+@pytest.mark.parametrize("value", [b"NaN", b"Infinity", b"-Infinity", b"[0.6, 0, NaN, 0, 0, 0]"])
+async def test_a_parameter_that_is_not_a_finite_number_is_refused_not_a_crash(
+        client: httpx.AsyncClient, path: str, value: bytes) -> None:
+    body = b'{"name": "t", "steps": [{"command": "pick", "params": {"grip_force": ' + value + b"}}]}"
+    res = await client.post(path, content=body, headers={"content-type": "application/json"})
+    assert res.status_code == 422
+    assert "is not a number a device can be given" in res.json()["detail"]
+
+
+async def test_a_task_too_long_once_repeated_is_refused(client: httpx.AsyncClient) -> None:
+    body = {"name": "t", "repeat": 1000, "steps": [{"command": "pick"}] * 1000}
+    res = await client.post("/api/task/check", json=body)
+    assert res.status_code == 422
+    assert "1000 steps repeated 1000 times make 1000000; at most 10000 are accepted" in res.json()["detail"]
