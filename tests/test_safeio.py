@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
 
 from plugnproduce.errors import DescriptionError, HostileInputError
-from plugnproduce.safeio import parse_xml_bytes, parse_yaml_node
+from plugnproduce.safeio import parse_xml_bytes, parse_yaml_node, read_bytes
 
 SCXML = '<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="a"><state id="a"/></scxml>'
 DOCTYPE = '<!DOCTYPE scxml [<!ENTITY a "aaaa">]>\n'
@@ -69,3 +70,15 @@ def test_plain_values_pass(tmp_path: Path) -> None:
     params = parse_yaml_node(f).value[1][1].value[0].value[1][1]
     assert [n.value for n in params.value[0][1].value] == ["0.6", "-0.2", "1e-3", "12", "true", "null", "text",
                                                            "2020-01-01"]
+
+
+def test_a_pipe_named_as_a_description_is_refused_without_blocking(tmp_path: Path) -> None:
+    fifo = tmp_path / "chart.scxml"
+    os.mkfifo(fifo)
+    with pytest.raises(DescriptionError, match="not a regular file"):
+        read_bytes(fifo)
+
+
+def test_a_folder_named_as_a_description_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(DescriptionError, match="not a regular file"):
+        read_bytes(tmp_path)

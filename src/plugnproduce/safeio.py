@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import codecs
 import re
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -40,7 +41,10 @@ def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
     """Read a file whole, refusing one larger than ``limit`` before reading it."""
     p = Path(path)
     try:
-        size = p.stat().st_size
+        info = p.stat()
+        if not stat.S_ISREG(info.st_mode):  # a FIFO or a device would block the reader; a folder is no file
+            raise UnreadableError("not a regular file (a folder, pipe or device); expected a description file", p)
+        size = info.st_size
         if size > limit:
             raise HostileInputError(f"file is {size} bytes; at most {limit} are accepted", p)
         with p.open("rb") as f:
