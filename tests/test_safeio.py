@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from plugnproduce.errors import DescriptionError, HostileInputError
-from plugnproduce.safeio import parse_xml_bytes, parse_yaml_node, read_bytes
+from plugnproduce.safeio import parse_turtle, parse_xml_bytes, parse_yaml_node, read_bytes
 
 SCXML = '<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="a"><state id="a"/></scxml>'
 DOCTYPE = '<!DOCTYPE scxml [<!ENTITY a "aaaa">]>\n'
@@ -82,3 +82,25 @@ def test_a_pipe_named_as_a_description_is_refused_without_blocking(tmp_path: Pat
 def test_a_folder_named_as_a_description_is_refused(tmp_path: Path) -> None:
     with pytest.raises(DescriptionError, match="not a regular file"):
         read_bytes(tmp_path)
+
+
+def test_a_turtle_file_with_too_many_prefixes_is_refused_before_parsing(tmp_path: Path) -> None:
+    f = tmp_path / "d.ttl"
+    f.write_text("".join(f"@prefix p{n}: <http://example.org/{n}#> .\n" for n in range(20_000)))
+    with pytest.raises(HostileInputError, match="more than 500 prefix declarations") as caught:
+        parse_turtle(f)
+    assert caught.value.line == 501
+
+
+def test_a_turtle_file_with_too_many_triples_is_refused(tmp_path: Path) -> None:
+    f = tmp_path / "d.ttl"
+    f.write_text("@prefix p: <http://example.org/> .\n" + "".join(f"p:s{n} p:p {n} .\n" for n in range(60_000)))
+    with pytest.raises(HostileInputError, match="60000 triples; at most 50000"):
+        parse_turtle(f)
+
+
+def test_an_element_with_too_many_attributes_is_refused() -> None:
+    attributes = " ".join(f'a{n}="x"' for n in range(100_000))
+    data = f'<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0"><state id="s" {attributes}/></scxml>'
+    with pytest.raises(HostileInputError, match="an element with 100001 attributes; at most 64"):
+        parse_xml_bytes(data.encode(), "chart.scxml")

@@ -110,16 +110,31 @@ def parse_xml(path: str | Path) -> etree._ElementTree:
     return parse_xml_bytes(read_bytes(path), path)
 
 
+MAX_XML_ELEMENTS = 200_000
+"""Most elements in one XML document."""
+
+MAX_XML_ATTRIBUTES = 64
+"""Most attributes on one XML element."""
+
+
 def _check_depth(root: etree._Element, source: str | Path) -> None:
+    """Refuse documents nested too deep, with too many elements, or an element with too many attributes."""
     stack = [(root, 1)]
+    count = 0
     while stack:
         el, depth = stack.pop()
+        count += 1
         if depth > MAX_XML_DEPTH:
             raise HostileInputError(
                 f"XML nested {depth} levels deep; at most {MAX_XML_DEPTH} are accepted",
                 source,
                 el.sourceline,
             )
+        if count > MAX_XML_ELEMENTS:
+            raise HostileInputError(f"more than {MAX_XML_ELEMENTS} XML elements", source, el.sourceline)
+        if len(el.attrib) > MAX_XML_ATTRIBUTES:
+            raise HostileInputError(f"an element with {len(el.attrib)} attributes; at most {MAX_XML_ATTRIBUTES} "
+                                    "are accepted", source, el.sourceline)
         stack.extend((child, depth + 1) for child in el)
 
 
@@ -209,13 +224,27 @@ def _check_scalar(node: yaml.ScalarNode, path: str | Path, line: int) -> None:
                               "are accepted", path, line)
 
 
+MAX_PREFIXES = 500
+"""Most prefix declarations in one Turtle file (rdflib's parser is quadratic in them)."""
+
+MAX_TRIPLES = 50_000
+"""Most triples in one Turtle file (a description has tens, an ontology extension hundreds)."""
+
+_PREFIX = re.compile(r"^[ \t]*(@prefix|prefix)\b", re.IGNORECASE | re.MULTILINE)
+
+
 def read_turtle_text(path: str | Path) -> str:
-    """Read a Turtle file as text, bounded in size (rdflib's Turtle parser expands no entities)."""
+    """Read a Turtle file as text, bounded in size and prefixes (rdflib's Turtle parser expands no entities)."""
     data = read_bytes(path)
     try:
-        return data.decode("utf-8")
+        text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
+    for count, m in enumerate(_PREFIX.finditer(text), start=1):
+        if count > MAX_PREFIXES:
+            raise HostileInputError(f"more than {MAX_PREFIXES} prefix declarations", path,
+                                    text.count("\n", 0, m.start()) + 1)
+    return text
 
 
 def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
@@ -229,4 +258,6 @@ def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
         raise UnreadableError(f"malformed Turtle: {exc.message}", p, exc.lines + 1) from exc
     except Exception as exc:  # rdflib raises assorted types for bad literals and IRIs
         raise UnreadableError(f"malformed Turtle: {exc}", p) from exc
+    if len(g) > MAX_TRIPLES:
+        raise HostileInputError(f"{len(g)} triples; at most {MAX_TRIPLES} are accepted in one file", p)
     return g, text
