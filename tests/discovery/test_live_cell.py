@@ -103,6 +103,7 @@ async def test_a_bad_device_is_refused_and_the_others_are_still_followed(network
             refused = await live.next_change(WAIT)
             assert refused.kind == "refused" and "\n" not in refused.reason
             assert "root:" not in refused.reason  # nothing of a local file is read, let alone quoted
+            assert "pnp-live-" not in refused.reason  # nor where the controller keeps the device's files
         honest = sensor_server(network)
         await honest.start()
         assert ("plug", "sensor3d") in await changes_until(live, "plug", "sensor3d")

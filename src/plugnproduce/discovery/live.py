@@ -178,11 +178,16 @@ class LiveCell:
         ttl.write_text(files.description, encoding="utf-8")
         chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
         chart.write_text(files.chart, encoding="utf-8")
-        for named in read_description(ttl).graph.objects(None, PNP.stateChart):
-            if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
-                raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected the "
-                                       f"chart it serves ({chart.name})")
-        device = load_device(ttl, self.taxonomy)
+        try:
+            for named in read_description(ttl).graph.objects(None, PNP.stateChart):
+                if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
+                    raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected "
+                                           f"the chart it serves ({chart.name})", ttl)
+            device = load_device(ttl, self.taxonomy)
+        except DescriptionError as exc:  # say where the device serves the file, not where it was kept
+            served = {str(ttl): files.description_url, str(chart): files.chart_url}
+            raise DescriptionError(exc.message.replace(str(folder), ""), served.get(exc.file or "", found.location),
+                                   exc.line) from exc
         if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
             return replace(device, endpoint=found.location)
         host = urlparse(found.location).hostname
