@@ -57,4 +57,7 @@ def emit_json(data: object) -> None:
 
 def main() -> None:
     """Entry point of the ``pnp`` console script."""
+    from plugnproduce.cli.pipes import tolerate_closed_stdout
+
+    tolerate_closed_stdout()
     app()
