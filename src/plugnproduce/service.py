@@ -29,6 +29,7 @@ from plugnproduce.validation import Report, validate_paths
 
 if TYPE_CHECKING:  # execution pulls in the network stack: imported when a run needs it
     from plugnproduce.discovery import LiveCell
+    from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
     from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
 
@@ -270,11 +271,23 @@ async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:
             run.device_lost(change.device, "the device left the network (SSDP byebye)")
 
 
-def report(run: str | Path) -> RunRecord:
-    """A run's journal, by path or by run id (in :func:`runs_folder`)."""
+def report(run: str | Path | None = None) -> RunRecord:
+    """A run's journal, by path or by run id (in :func:`runs_folder`); without either, the latest run's."""
     from plugnproduce.executor.journal import read_journal
 
+    if run is None:
+        past = runs()
+        if not past:
+            raise PlugNProduceError(f"no runs yet in {runs_folder()}")
+        return read_journal(past[0].path)
     path = Path(run)
     if not path.exists() and not path.suffix:
         path = runs_folder() / f"{run}.jsonl"
     return read_journal(path)
+
+
+def runs() -> list[RunSummary]:
+    """The past runs in :func:`runs_folder`, newest first."""
+    from plugnproduce.executor.history import list_runs
+
+    return list_runs(runs_folder())

@@ -21,11 +21,14 @@ if TYPE_CHECKING:
 @app.command()
 @boundary
 def run(
-    task: Path = typer.Argument(..., help="The task file (YAML)."),
-    cell: Path | None = typer.Option(None, "--cell", help="The cell file (default with --sim: the bin-picking cell)."),
+    task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."),
+    cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
+                                     help="The cell file (default with --sim: the bin-picking cell)."),
     sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices for this run (on loopback)."),
-    faults: str = typer.Option("", "--faults", help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
-    journal: Path | None = typer.Option(None, "--journal", help="Journal file (default: a new file in PNP_RUNS)."),
+    faults: str = typer.Option("", "--faults", metavar="SPEC",
+                               help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
+    journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
+                                        help="Journal file (default: a new file in PNP_RUNS)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Check and generate the task, find the devices, run it, and journal every command and event.
@@ -62,7 +65,8 @@ def run(
 
 @app.command()
 @boundary
-def report(run_id: str = typer.Argument(..., metavar="RUN", help="A run id or a journal file."),
+def report(run_id: str | None = typer.Argument(None, metavar="RUN", help="A run id or a journal file "
+                                               "(default: the latest run; 'pnp runs' lists them)."),
            json_out: bool = JSON_OPTION) -> None:
     """Print a run from its journal: every step, command, event and state, and how it ended (or that it crashed)."""
     record = service.report(run_id)

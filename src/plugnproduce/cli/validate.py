@@ -13,7 +13,7 @@ from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
 @app.command()
 @boundary
 def validate(
-    paths: list[Path] = typer.Argument(..., help="Description files or folders."),
+    paths: list[Path] = typer.Argument(..., metavar="PATH...", help="Description files or folders."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Check descriptions: hardened parsing, W3C SCXML schema, SHACL shapes, structure.
