@@ -233,28 +233,39 @@ async def run_task(
     observer: RecordObserver | None = None,
     started: Callable[[TaskRun], None] | None = None,
     discovery_timeout: float = 10.0,
+    progress: Callable[[str], None] | None = None,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
     With ``simulate`` the cell's devices are simulated for the run, on a private SSDP network,
     with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`). ``started`` is
-    given the run once it exists (to stop it). Raises :class:`ImplausibleTask` before anything runs.
+    given the run once it exists (to stop it); ``progress`` is told each phase as it begins
+    (checking, generating, starting devices, discovering, running). Raises :class:`ImplausibleTask`
+    before anything runs.
     """
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.run import TaskRun
     from plugnproduce.protocols.upnp import network_from_env, private_network
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
+    say = progress or (lambda _: None)
+    say("checking the task in the cell")
     the_task, the_cell = _as_task(task_or_path), _as_cell(cell_or_path)
+    if not (result := check(the_task, the_cell)).plausible:
+        raise ImplausibleTask(result)
+    say(f"generating the charts of {len(the_task.steps)} step(s)")
     generated = generate(the_task, the_cell).task
     journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
     network = private_network() if simulate else network_from_env()
     async with contextlib.AsyncExitStack() as stack:
         if simulate:
+            say(f"starting {len(the_cell.devices)} simulated device(s) on loopback")
             sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices))
             await stack.enter_async_context(sim)
+        say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         live = await stack.enter_async_context(LiveCell(knowledge().taxonomy, network=network, name=the_cell.name))
         devices = await find_devices(live, [d.id for d in the_cell.devices], discovery_timeout)
+        say("running")
         run = TaskRun(generated, devices, journal, observer)
         if started is not None:
             started(run)

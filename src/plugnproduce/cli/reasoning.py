@@ -18,6 +18,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from plugnproduce import reasoning, service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
+from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.description.loader import task_to_yaml
 
 CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
@@ -186,7 +187,7 @@ def batch(
         configurations = reasoning.read_configurations(configs)  # type: ignore[arg-type]
     err = Console(stderr=True)
     columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=err, transient=True) as bar:
+    with Progress(*columns, console=err, transient=True, disable=not on_a_terminal()) as bar:
         job = bar.add_task("batch", total=len(configurations))
         rows = list(service.batch(configurations, devices, list(tasks), workers,
                                   progress=lambda n: bar.advance(job, n)))

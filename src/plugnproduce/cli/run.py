@@ -12,6 +12,7 @@ import typer
 from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
 from plugnproduce.cli.generate import refuse
+from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.executor.journal import describe
 
 if TYPE_CHECKING:
@@ -41,7 +42,11 @@ def run(
             raise typer.BadParameter("give --cell CELL, or --sim to run on the simulated bin-picking cell")
         cell = service.builtin("cells", "bin-picking.yaml")
 
+    phases = Phases(on_a_terminal(json_out))
+
     def show(record: dict[str, object]) -> None:
+        if record["kind"] == "step":
+            phases.update(f"step {record.get('step')} ({record.get('command')})")
         if not json_out:
             typer.echo(describe(record))
 
@@ -49,8 +54,10 @@ def run(
         asyncio.get_running_loop().add_signal_handler(signal.SIGINT, the_run.stop)
 
     try:
-        report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
-                                              observer=show, started=started))
+        with phases:
+            report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
+                                                  observer=show, started=started, progress=phases))
+            phases.close(last_done=True)
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)
     if json_out:
