@@ -57,9 +57,9 @@ def knowledge(processes_dir: Path | None = None) -> Knowledge:
     return Knowledge(taxonomy, tuple(load_processes(folder)))
 
 
-def validate(paths: list[str | Path]) -> Report:
-    """Validate description files and folders."""
-    return validate_paths(paths, knowledge().taxonomy)
+def validate(paths: list[str | Path], progress: Callable[[str], None] | None = None) -> Report:
+    """Validate description files and folders; ``progress`` is told each phase as it begins."""
+    return validate_paths(paths, knowledge().taxonomy, progress=progress)
 
 
 def cell(path: str | Path) -> Cell:

@@ -83,6 +83,18 @@ def test_batch_on_a_terminal_shows_its_progress() -> None:
     assert "batch" in terminal and "/3" in terminal
 
 
+def test_validate_on_a_terminal_says_what_it_is_doing() -> None:
+    code, out, terminal = run_with_terminal_stderr("validate", str(service.builtin("devices")))
+    assert code == 0 and out.endswith("files valid\n")
+    assert "✓ checking the SHACL shapes" in terminal and "description file(s)" in terminal
+
+
+def test_validate_piped_shows_no_progress() -> None:
+    result = subprocess.run([sys.executable, "-m", "plugnproduce", "validate", str(service.builtin("devices"))],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0 and result.stderr == ""
+
+
 def test_each_finished_phase_stays_as_a_line() -> None:
     buf = io.StringIO()
     with Phases(True, Console(file=buf, force_terminal=True, color_system=None, width=80)) as phases:

@@ -8,6 +8,7 @@ import typer
 
 from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.progress import Phases, on_a_terminal
 
 
 @app.command()
@@ -20,7 +21,9 @@ def validate(
 
     Exit 0 valid, 1 invalid, 2 unreadable or hostile input.
     """
-    report = service.validate(list(paths))
+    with Phases(on_a_terminal(json_out)) as phases:
+        report = service.validate(list(paths), progress=phases)
+        phases.close(last_done=True)
     problems = report.sorted()
     if json_out:
         emit_json({"valid": report.valid, "files": len(report.files), "problems": [p.to_json() for p in problems]})
