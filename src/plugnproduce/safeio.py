@@ -9,7 +9,9 @@ the file and line.
 
 from __future__ import annotations
 
+import codecs
 import re
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -26,14 +28,23 @@ MAX_BYTES = 4 * 1024 * 1024
 MAX_XML_DEPTH = 64
 """Deepest XML element nesting accepted."""
 
-_DOCTYPE = re.compile(rb"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
+_DOCTYPE = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
+_COMMENT = re.compile(r"<!--.*?-->", re.DOTALL)
+_WIDE = (  # (leading bytes, codec) of the encodings whose text the byte-wise search would miss
+    (codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
+    (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"),
+    (b"<\0\0\0", "utf-32-le"), (b"\0\0\0<", "utf-32-be"), (b"<\0", "utf-16-le"), (b"\0<", "utf-16-be"),
+)
 
 
 def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
     """Read a file whole, refusing one larger than ``limit`` before reading it."""
     p = Path(path)
     try:
-        size = p.stat().st_size
+        info = p.stat()
+        if not stat.S_ISREG(info.st_mode):  # a FIFO or a device would block the reader; a folder is no file
+            raise UnreadableError("not a regular file (a folder, pipe or device); expected a description file", p)
+        size = info.st_size
         if size > limit:
             raise HostileInputError(f"file is {size} bytes; at most {limit} are accepted", p)
         with p.open("rb") as f:
@@ -45,19 +56,25 @@ def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
     return data
 
 
-def _line_of(data: bytes, offset: int) -> int:
-    return data.count(b"\n", 0, offset) + 1
+def _as_text(data: bytes) -> str:
+    """The document as text for the DOCTYPE search: wide encodings decoded, any other byte for byte."""
+    for start, codec in _WIDE:
+        if data.startswith(start):
+            return data.decode(codec, errors="replace")
+    return data.decode("latin-1")  # ASCII-compatible encodings: '<!DOCTYPE' is the same bytes in each
 
 
 def refuse_doctype(data: bytes, source: str | Path) -> None:
-    """Refuse any DOCTYPE or ENTITY declaration: descriptions never need one."""
-    m = _DOCTYPE.search(data)
+    """Refuse any DOCTYPE or ENTITY declaration, in whatever encoding; text inside comments does not count."""
+    text = _as_text(data)
+    blanked = _COMMENT.sub(lambda m: "\n" * m.group().count("\n"), text)  # keep line numbers
+    m = _DOCTYPE.search(blanked)
     if m:
         raise HostileInputError(
             "DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "
             "expected a plain XML document",
             source,
-            _line_of(data, m.start()),
+            blanked.count("\n", 0, m.start()) + 1,
         )
 
 
@@ -80,8 +97,12 @@ def parse_xml_bytes(data: bytes, source: str | Path) -> etree._ElementTree:
         line = exc.lineno if exc.lineno else None
         msg = exc.msg.split(f", line {line}")[0] if exc.msg else "malformed XML"
         raise UnreadableError(f"malformed XML: {msg}", source, line) from exc
+    tree = root.getroottree()
+    if tree.docinfo.internalDTD is not None or tree.docinfo.doctype:  # an encoding the search did not know
+        raise HostileInputError("DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "
+                                "expected a plain XML document", source, 1)
     _check_depth(root, source)
-    return root.getroottree()
+    return tree
 
 
 def parse_xml(path: str | Path) -> etree._ElementTree:
@@ -128,6 +149,9 @@ def parse_yaml_node(path: str | Path) -> yaml.Node:
         raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
     try:
         node = yaml.compose(text, Loader=_NoAliasLoader)
+    except RecursionError as exc:
+        raise HostileInputError(f"YAML nested too deeply; at most {MAX_YAML_DEPTH} levels are accepted",
+                                path) from exc
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
@@ -137,7 +161,52 @@ def parse_yaml_node(path: str | Path) -> yaml.Node:
         raise UnreadableError(f"malformed YAML: {exc}", path) from exc
     if node is None:
         raise UnreadableError("empty YAML document", path, 1)
+    _check_yaml_values(node, path)
     return node
+
+
+MAX_YAML_DEPTH = 64
+"""Deepest YAML nesting accepted."""
+
+MAX_DIGITS = 30
+"""Longest integer (in digits) a description may hold."""
+
+_PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "bool", "null", "seq", "map")}
+_NOT_A_NUMBER = re.compile(r"^[-+]?\.(nan|inf)$", re.IGNORECASE)
+
+
+def _check_yaml_values(root: yaml.Node, path: str | Path) -> None:
+    """Refuse what a description never needs and what would crash or blow up its reading:
+    tags other than plain data (``!!timestamp``, ``!!omap``, ``!!binary``, ...), NaN and
+    infinities, integers of more than :data:`MAX_DIGITS` digits, nesting deeper than
+    :data:`MAX_YAML_DEPTH`."""
+    stack: list[tuple[yaml.Node, int]] = [(root, 1)]
+    while stack:
+        node, depth = stack.pop()
+        line = node.start_mark.line + 1
+        if depth > MAX_YAML_DEPTH:
+            raise HostileInputError(f"YAML nested {depth} levels deep; at most {MAX_YAML_DEPTH} are accepted",
+                                    path, line)
+        if node.tag not in _PLAIN_TAGS:
+            raise UnreadableError(f"YAML type {node.tag.replace('tag:yaml.org,2002:', '!!')} is not accepted; "
+                                  "expected text, numbers, true/false, lists and mappings (quote a value to mean "
+                                  "text)", path, line)
+        if isinstance(node, yaml.ScalarNode):
+            _check_scalar(node, path, line)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((child, depth + 1) for child in node.value)
+        else:
+            stack.extend((part, depth + 1) for pair in node.value for part in pair)
+
+
+def _check_scalar(node: yaml.ScalarNode, path: str | Path, line: int) -> None:
+    value = str(node.value)
+    if node.tag.endswith(":float") and _NOT_A_NUMBER.match(value.strip()):
+        raise UnreadableError(f"{value.strip()} is not a number a device can be given; expected a finite number",
+                              path, line)
+    if node.tag.endswith(":int") and sum(c.isdigit() for c in value) > MAX_DIGITS:
+        raise UnreadableError(f"an integer of {sum(c.isdigit() for c in value)} digits; at most {MAX_DIGITS} "
+                              "are accepted", path, line)
 
 
 def read_turtle_text(path: str | Path) -> str:

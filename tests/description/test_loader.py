@@ -89,6 +89,8 @@ def test_task_yaml_round_trip(tmp_path: Path, name: str) -> None:
         ("task: t\nrepeat: 0\nsteps:\n  - command: pick\n", 2, "repeat must be"),
         ("task: t\nsteps:\n  - command: pick\n    colour: red\n", 4, "unknown key 'colour'"),
         ("task: t\ntask: u\nsteps: []\n", 2, "appears twice"),
+        ("task: t\nrepeat: 1000\nsteps:\n" + "  - command: pick\n" * 11, 4,
+         "11 steps repeated 1000 times make 11000; at most 10000 are accepted"),
     ],
 )
 def test_bad_task_names_file_and_line(tmp_path: Path, text: str, line: int, needle: str) -> None:

@@ -9,6 +9,7 @@ from typing import Any
 import pytest
 
 from plugnproduce.discovery import LiveCell
+from plugnproduce.discovery.live import CONFIRM_TIMEOUT
 from plugnproduce.protocols.upnp import (
     DeviceFiles,
     SsdpNetwork,
@@ -65,3 +66,57 @@ async def test_plug_and_unplug_are_followed(network, taxonomy) -> None:
         unplugged = await live.next_change(WAIT)
         assert (unplugged.kind, unplugged.device) == ("unplug", "sensor3d")
         assert unplugged.cell.devices == ()
+
+
+# --- one bad device costs only itself ------------------------------------------------------
+
+
+def bad_sensor(network: SsdpNetwork, turtle_edit: tuple[str, str], device_id: str = "evil") -> UpnpDeviceServer:
+    folder = descriptions_path() / "devices"
+    turtle = (folder / "sensor3d.ttl").read_text().replace("dev:sensor3d", f"dev:{device_id}")
+    assert turtle_edit[0] in turtle
+    files = DeviceFiles("sensor3d.ttl", turtle.replace(*turtle_edit), "sensor3d.scxml",
+                        (folder / "sensor3d.scxml").read_text())
+    spec = service_spec_from_chart_events({"Capture": ["Exposure"]}, ["CaptureDone"])
+    return UpnpDeviceServer(device_id, "3D sensor", device_type_for("StereoCamera"), spec, answer, files=files,
+                            network=network)
+
+
+async def changes_until(live: LiveCell, kind: str, device: str) -> list[tuple[str, str]]:
+    seen = []
+    while (kind, device) not in seen:
+        change = await live.next_change(WAIT)
+        seen.append((change.kind, change.device))
+    return seen
+
+
+@pytest.mark.parametrize("edit", [
+    ("pnp:stateChart <sensor3d.scxml>", "pnp:stateChart <file:///etc/passwd>"),
+    ("pnp:stateChart <sensor3d.scxml>", f"pnp:stateChart <{(descriptions_path() / 'devices' / 'sensor3d.scxml').as_uri()}>"),
+    ("pnp:stateChart <sensor3d.scxml>", "pnp:stateChart <http://192.0.2.1/sensor3d.scxml>"),
+    ("pnp:protocol", 'pnp:cost "abc"^^<http://www.w3.org/2001/XMLSchema#decimal> ;\n    pnp:protocol'),
+    ("pnp:protocol pnp:UPnP", "pnp:protocol pnp:UPnP ; ; ; ."),
+], ids=["system file chart", "local chart", "chart on another host", "bad literal", "malformed"])
+async def test_a_bad_device_is_refused_and_the_others_are_still_followed(network, taxonomy, edit) -> None:
+    async with LiveCell(taxonomy, network=network) as live:
+        async with bad_sensor(network, edit):
+            refused = await live.next_change(WAIT)
+            assert refused.kind == "refused" and "\n" not in refused.reason
+            assert "root:" not in refused.reason  # nothing of a local file is read, let alone quoted
+        honest = sensor_server(network)
+        await honest.start()
+        assert ("plug", "sensor3d") in await changes_until(live, "plug", "sensor3d")
+        await honest.stop()
+        assert ("unplug", "sensor3d") in await changes_until(live, "unplug", "sensor3d")
+        assert live.cell.devices == ()
+
+
+async def test_a_spoofed_byebye_does_not_unplug_a_device_that_still_answers(network, taxonomy) -> None:
+    async with sensor_server(network), LiveCell(taxonomy, network=network) as live:
+        assert (await live.next_change(WAIT)).kind == "plug"
+        impostor = sensor_server(network)  # same predictable UDN, another address
+        await impostor.start()
+        await impostor.stop()  # its byebye names the real device's UDN
+        with pytest.raises(TimeoutError):
+            await live.next_change(2 * CONFIRM_TIMEOUT + 0.5)
+        assert [d.id for d in live.cell.devices] == ["sensor3d"]

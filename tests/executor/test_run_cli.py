@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -45,3 +46,41 @@ def test_bad_fault_spec_is_bad_input() -> None:
     result = pnp("run", str(TASKS / "bin-picking.yaml"), "--sim", "--faults", "gripper:explode")
     assert result.returncode == 2
     assert "unknown kind 'explode'" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_sigterm_stops_the_run_safely_and_the_journal_ends(tmp_path: Path) -> None:
+    """A supervisor's SIGTERM mid-run: no traceback, exit 1, and the journal ends with the stop."""
+    journal = tmp_path / "run.jsonl"
+    proc = subprocess.Popen([sys.executable, "-m", "plugnproduce", "run", str(TASKS / "bin-picking.yaml"), "--sim",
+                             "--journal", str(journal)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        for line in proc.stdout:  # wait for the first command to reach a device
+            if line.startswith("→"):
+                break
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 1, err
+    assert "Traceback" not in err
+    shown = service.report(journal)
+    assert shown.status == "stopped"
+
+
+def test_two_runs_never_share_a_journal(tmp_path: Path) -> None:
+    journal = tmp_path / "run.jsonl"
+    journal.write_text("")
+    result = pnp("run", str(TASKS / "bin-picking.yaml"), "--sim", "--journal", str(journal))
+    assert result.returncode == 2
+    assert "already exists" in result.stderr and "Traceback" not in result.stderr
+    assert journal.read_text() == ""
+
+
+def test_a_journal_that_is_not_text_is_reported_at_its_line(tmp_path: Path) -> None:
+    journal = tmp_path / "run.jsonl"
+    journal.write_bytes(b'{"kind": "start", "seq": 1}\n\xff\xfe\n')
+    result = pnp("report", str(journal))
+    assert result.returncode == 2
+    assert f"{journal}:2: not a journal: not UTF-8 text" in result.stderr
+    assert "Traceback" not in result.stderr

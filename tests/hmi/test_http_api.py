@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import AsyncIterator
+
 import httpx
 import pytest
 import yaml
@@ -116,6 +118,9 @@ async def test_validate_accepts_the_bin_picking_task(client: httpx.AsyncClient) 
     assert (await client.post("/api/task/validate", json=TASK)).json() == {"valid": True, "problems": []}
 
 
+YAML = {"content-type": "application/yaml"}
+
+
 async def test_yaml_export_and_import_round_trip(client: httpx.AsyncClient) -> None:
     res = await client.post("/api/task/export", json=TASK)
     assert res.headers["content-type"].startswith("application/yaml")
@@ -126,15 +131,36 @@ async def test_yaml_export_and_import_round_trip(client: httpx.AsyncClient) -> N
 
 async def test_yaml_import_errors_name_the_file_and_line(client: httpx.AsyncClient) -> None:
     text = b"task: t\nsteps:\n  - command: pick\n    speed: 3\n"
-    res = await client.post("/api/task/import?filename=mine.yaml", content=text)
+    res = await client.post("/api/task/import?filename=mine.yaml", content=text, headers=YAML)
     assert res.status_code == 400
     assert res.json()["detail"] == "mine.yaml:4: step: unknown key 'speed'; expected one of bind, command, params"
 
 
 async def test_yaml_import_refuses_aliases(client: httpx.AsyncClient) -> None:
     text = b"task: t\nsteps:\n  - &s {command: pick}\n  - *s\n"
-    res = await client.post("/api/task/import", content=text)
+    res = await client.post("/api/task/import", content=text, headers=YAML)
     assert res.status_code == 400 and res.json()["detail"].startswith("task.yaml:")
+
+
+@pytest.mark.parametrize("kind", ["text/plain", "application/x-www-form-urlencoded", "multipart/form-data", None])
+async def test_yaml_import_refuses_what_a_cross_site_form_could_send(client: httpx.AsyncClient, kind: str | None) -> None:
+    headers = {"content-type": kind} if kind else {}
+    res = await client.post("/api/task/import", content=b"task: t\nsteps:\n  - command: pick\n", headers=headers)
+    assert res.status_code == 415 and "send the task as application/yaml" in res.json()["detail"]
+
+
+async def test_an_oversized_chunked_body_is_refused_as_it_streams(client: httpx.AsyncClient) -> None:
+    async def chunks() -> AsyncIterator[bytes]:
+        for _ in range(200):  # 12.5 MiB in all, with no content-length
+            yield b" " * 65536
+
+    res = await client.post("/api/task/check", content=chunks(), headers={"content-type": "application/json"})
+    assert res.status_code == 413 and "larger than the 4194304 bytes accepted" in res.json()["detail"]
+
+
+async def test_an_oversized_declared_body_is_refused_before_it_is_read(client: httpx.AsyncClient) -> None:
+    res = await client.post("/api/task/import", content=b"x" * (5 * 1024 * 1024), headers=YAML)
+    assert res.status_code == 413
 
 
 async def test_device_and_process_pictures_are_svg(client: httpx.AsyncClient) -> None:
@@ -234,3 +260,20 @@ def test_the_reasoner_check_matches_the_service() -> None:
         {**PLACE, "params": from_file.steps[1].params}]}).to_task()
     assert [(s.index, s.command, s.bind, s.params) for s in from_json.steps] == \
         [(s.index, s.command, s.bind, s.params) for s in from_file.steps]
+
+
+@pytest.mark.parametrize("path", ["/api/task/validate", "/api/task/check", "/api/task/repair", "/api/task/generate"])
+@pytest.mark.parametrize("value", [b"NaN", b"Infinity", b"-Infinity", b"[0.6, 0, NaN, 0, 0, 0]"])
+async def test_a_parameter_that_is_not_a_finite_number_is_refused_not_a_crash(
+        client: httpx.AsyncClient, path: str, value: bytes) -> None:
+    body = b'{"name": "t", "steps": [{"command": "pick", "params": {"grip_force": ' + value + b"}}]}"
+    res = await client.post(path, content=body, headers={"content-type": "application/json"})
+    assert res.status_code == 422
+    assert "is not a number a device can be given" in res.json()["detail"]
+
+
+async def test_a_task_too_long_once_repeated_is_refused(client: httpx.AsyncClient) -> None:
+    body = {"name": "t", "repeat": 1000, "steps": [{"command": "pick"}] * 1000}
+    res = await client.post("/api/task/check", json=body)
+    assert res.status_code == 422
+    assert "1000 steps repeated 1000 times make 1000000; at most 10000 are accepted" in res.json()["detail"]

@@ -275,3 +275,38 @@ async def test_a_controller_running_far_ahead_is_answered_in_order() -> None:
             release.set()
             assert await first == {"N": 0}
             assert [r["N"] for r in await asyncio.gather(*rest)] == list(range(200))
+
+
+# ---------------------------------------------------------------- a device flooding the controller
+
+
+def _raw_frame(document: str) -> bytes:
+    data = document.encode()
+    return len(data).to_bytes(4, "big") + data
+
+
+async def test_an_event_with_an_overlong_sequence_number_is_malformed_and_the_connection_lives() -> None:
+    hello = encode_frame(Hello("robot", ROBOT))
+    huge = _raw_frame(f'<event xmlns="{NAMESPACE}" name="moved" seq="{"9" * 5000}" time="2026-01-01T00:00:00Z"/>')
+    fine = _raw_frame(f'<event xmlns="{NAMESPACE}" name="moved" seq="1" time="2026-01-01T00:00:00Z"/>')
+    fake, port = await _fake_device(lambda writer: writer.write(hello + huge + fine))
+    async with fake, await XirpClient.connect(HOST, port, timeout=WAIT) as controller:
+        event = await controller.next_event()
+        assert (event.name, event.seq) == ("moved", 1)
+        assert controller.stats.malformed == 1
+        assert controller.connected
+
+
+async def test_a_flood_of_unsolicited_errors_is_counted_kept_bounded_and_logged_sparingly(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    hello = encode_frame(Hello("robot", ROBOT))
+    flood = b"".join(encode_frame(ErrorMessage("failed", f"complaint {n}")) for n in range(3000))
+    fake, port = await _fake_device(lambda writer: writer.write(hello + flood))
+    async with fake, await XirpClient.connect(HOST, port, timeout=WAIT) as controller:
+        await until(lambda: controller.stats.reported == 3000)
+        assert len(controller.stats.errors) <= 64
+        assert controller.stats.errors[-1].text == "complaint 2999"
+        assert controller.connected
+    complaints = [r for r in caplog.records if "complaint" in r.getMessage()]
+    assert 0 < len(complaints) <= 10

@@ -312,3 +312,23 @@ def test_from_file_reads_data_beside_the_chart(tmp_path: Path) -> None:
     interpreter.start()
     assert interpreter.final_state == "ok"
     assert interpreter.datamodel["_sessionid"] == "one"
+
+
+def test_a_chart_that_never_settles_stops_with_a_clear_error() -> None:
+    interpreter = session("""
+    <state id="a"><transition target="b"/></state>
+    <state id="b"><transition target="a"/></state>""")
+    with pytest.raises(ExecutionError, match="no stable configuration after 100000 microsteps"):
+        interpreter.start()
+    assert not interpreter.running
+
+
+def test_a_hostile_expression_in_a_chart_is_an_execution_error_not_a_hang() -> None:
+    interpreter = started("""
+    <datamodel><data id="x" expr="0"/></datamodel>
+    <state id="s">
+      <onentry><assign location="x" expr="10**10**10"/></onentry>
+      <transition event="error.execution" target="refused"/>
+    </state>
+    <state id="refused"/>""")
+    assert interpreter.is_active("refused") and interpreter.datamodel["x"] == 0

@@ -35,7 +35,7 @@ def run(
     """Check and generate the task, find the devices, run it, and journal every command and event.
 
     Exit 0 the task succeeded, 1 it failed or is implausible (with the report), 2 bad input.
-    Ctrl-C stops the run safely.
+    Ctrl-C or SIGTERM stops the run safely: no further command, and the journal ends with the stop.
     """
     if cell is None:
         if not sim:
@@ -51,7 +51,9 @@ def run(
             typer.echo(describe(record))
 
     def started(the_run: TaskRun) -> None:
-        asyncio.get_running_loop().add_signal_handler(signal.SIGINT, the_run.stop)
+        loop = asyncio.get_running_loop()
+        for signum in (signal.SIGINT, signal.SIGTERM):  # a supervisor stops with SIGTERM, a terminal with Ctrl-C
+            loop.add_signal_handler(signum, the_run.stop)
 
     try:
         with phases:

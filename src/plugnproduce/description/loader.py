@@ -258,6 +258,10 @@ def load_task(path: str | Path) -> Task:
     steps_node = top["steps"]
     if not isinstance(steps_node, yaml.SequenceNode) or not steps_node.value:
         raise DescriptionError("steps must be a non-empty list", p, steps_node.start_mark.line + 1)
+    if len(steps_node.value) * repeat > Task.MAX_STEPS:
+        raise DescriptionError(f"{len(steps_node.value)} steps repeated {repeat} times make "
+                               f"{len(steps_node.value) * repeat}; at most {Task.MAX_STEPS} are accepted",
+                               p, steps_node.start_mark.line + 1)
     one_round: list[tuple[str, dict[str, str], dict[str, object], int, dict[str, int]]] = []
     for node in steps_node.value:
         line = node.start_mark.line + 1

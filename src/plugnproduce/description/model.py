@@ -203,6 +203,9 @@ class Step:
 class Task:
     """A task description: an ordered list of process commands."""
 
+    MAX_STEPS = 10_000
+    """Most steps a task may have once its repeats are expanded."""
+
     name: str
     steps: tuple[Step, ...]
     file: str

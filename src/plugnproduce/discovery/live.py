@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import logging
 import re
 import shutil
 import tempfile
@@ -21,10 +22,11 @@ from pathlib import Path
 from typing import Literal
 from urllib.parse import urlparse
 
-from plugnproduce.description.loader import load_device
+from plugnproduce.description.loader import file_of, load_device, read_description
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.errors import DescriptionError, ProtocolError
 from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import PNP
 from plugnproduce.protocols.upnp import (
     LOOPBACK,
     Advertisement,
@@ -37,6 +39,18 @@ from plugnproduce.protocols.upnp import (
     discover,
 )
 from plugnproduce.protocols.xirp import parse_endpoint
+
+
+_LOGGER = logging.getLogger(__name__)
+
+CONFIRM_TIMEOUT = 1.0
+"""Seconds a device's address is given to answer before its byebye is believed."""
+
+
+def _safe_name(name: str) -> str:
+    """A file name that stays inside its folder, from anything a device sends."""
+    cleaned = re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".")
+    return cleaned[:100] or "unnamed"
 
 
 @dataclass(frozen=True)
@@ -65,6 +79,7 @@ class LiveCell:
         self.name = name
         self.search_timeout = search_timeout
         self._devices: dict[str, DeviceDescription] = {}
+        self._found: dict[str, FoundDevice] = {}
         self._changes: asyncio.Queue[CellChange] = asyncio.Queue()
         self._listener = AdvertisementListener(network)
         self._task: asyncio.Task[None] | None = None
@@ -103,16 +118,33 @@ class LiveCell:
         return await asyncio.wait_for(self._changes.get(), timeout)
 
     def _publish(self, change: CellChange) -> None:
+        if change.reason:  # one line, whatever a device made the reason of
+            change = replace(change, reason=" ".join(change.reason.split())[:500])
         self._changes.put_nowait(change)
 
     async def _follow(self) -> None:
         while True:
             ad = await self._listener.next(None)
-            if ad.alive and ad.udn not in self._devices:
-                await self._plug_advertised(ad)
-            elif not ad.alive and ad.udn in self._devices:
-                device = self._devices.pop(ad.udn)
-                self._publish(CellChange("unplug", device.id, self.cell))
+            try:
+                if ad.alive and ad.udn not in self._devices:
+                    await self._plug_advertised(ad)
+                elif not ad.alive and ad.udn in self._devices:
+                    await self._unplug_confirmed(ad.udn)
+            except Exception as exc:  # noqa: BLE001 - one device's defect must never stop following the others
+                _LOGGER.warning("device %s: %s: %s", ad.udn, type(exc).__name__, exc)
+                self._publish(CellChange("refused", ad.udn, self.cell, f"{type(exc).__name__}: {exc}"))
+
+    async def _unplug_confirmed(self, udn: str) -> None:
+        """Unplug on a byebye only if the device's own address confirms it is gone (a byebye may be spoofed)."""
+        found = self._found[udn]
+        try:
+            await describe(Advertisement(udn, True, found.location, found.source_host), timeout=CONFIRM_TIMEOUT)
+        except ProtocolError:
+            device = self._devices.pop(udn)
+            del self._found[udn]
+            self._publish(CellChange("unplug", device.id, self.cell))
+            return
+        _LOGGER.warning("byebye for %s ignored: the device still answers at %s", udn, found.location)
 
     async def _plug_advertised(self, ad: Advertisement) -> None:
         try:
@@ -128,18 +160,28 @@ class LiveCell:
         except (ProtocolError, DescriptionError) as exc:
             self._publish(CellChange("refused", found.udn, self.cell, str(exc)))
             return
+        except Exception as exc:  # noqa: BLE001 - whatever a device sends, it costs only that device
+            reason = f"its description cannot be read ({type(exc).__name__}: {exc})"
+            self._publish(CellChange("refused", found.udn, self.cell, reason))
+            return
         self._devices[found.udn] = device
+        self._found[found.udn] = found
         self._publish(CellChange("plug", device.id, self.cell))
 
     async def _fetch(self, found: FoundDevice) -> DeviceDescription:
         """Fetch the device's own description files and read them as any description."""
         async with await UpnpDeviceClient.from_found(found) as client:
             files = await client.fetch_files()
-        folder = self._workdir / re.sub(r"[^A-Za-z0-9_.-]", "_", found.udn)
+        folder = self._workdir / _safe_name(found.udn)
         folder.mkdir(exist_ok=True)
-        ttl = folder / Path(urlparse(files.description_url).path).name
+        ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
         ttl.write_text(files.description, encoding="utf-8")
-        (folder / Path(urlparse(files.chart_url).path).name).write_text(files.chart, encoding="utf-8")
+        chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
+        chart.write_text(files.chart, encoding="utf-8")
+        for named in read_description(ttl).graph.objects(None, PNP.stateChart):
+            if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
+                raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected the "
+                                       f"chart it serves ({chart.name})")
         device = load_device(ttl, self.taxonomy)
         if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
             return replace(device, endpoint=found.location)

@@ -18,9 +18,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, PlugNProduceError
 
 KINDS = ("start", "step", "command", "event", "state", "fault", "end")
+
+
+class JournalInUse(PlugNProduceError):
+    """A run was given a journal file that already exists."""
 
 
 class Journal:
@@ -30,7 +34,10 @@ class Journal:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._clock = clock
-        self._file: TextIO | None = self.path.open("a", encoding="utf-8")
+        try:  # created here, never shared: two runs given one path must not interleave their records
+            self._file: TextIO | None = self.path.open("x", encoding="utf-8")
+        except FileExistsError as exc:
+            raise JournalInUse(f"journal {self.path} already exists (another run's); give each run its own") from exc
         self._seq = 0
 
     def write(self, kind: str, **data: Any) -> dict[str, Any]:
@@ -92,9 +99,13 @@ def read_journal(path: str | Path) -> RunRecord:
     """Read a journal; a torn last line (a crash mid-write) is ignored, any other bad line is an error."""
     p = Path(path)
     try:
-        lines = p.read_text(encoding="utf-8").splitlines()
+        data = p.read_bytes()
     except OSError as exc:
         raise DescriptionError(f"cannot read journal: {exc.strerror or exc}", p) from exc
+    try:
+        lines = data.decode("utf-8").splitlines()
+    except UnicodeDecodeError as exc:
+        raise DescriptionError(f"not a journal: not UTF-8 text ({exc.reason})", p, data.count(b"\n", 0, exc.start) + 1) from exc
     run = RunRecord(p)
     for number, line in enumerate(lines, start=1):
         try:

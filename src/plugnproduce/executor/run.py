@@ -24,7 +24,7 @@ from typing import Any
 
 from plugnproduce.codegen import DONE, GeneratedTask
 from plugnproduce.description.model import Cell, Command
-from plugnproduce.errors import PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
+from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
@@ -45,7 +45,8 @@ _STEP, _COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("step", 
 class Fault:
     """What stopped a run.
 
-    ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected`` or ``stopped``.
+    ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected``, ``chart`` (the task chart
+    broke down) or ``stopped``.
     """
 
     kind: str
@@ -145,6 +146,8 @@ class TaskRun:
                 await self._connect()
                 if self.fault is None:
                     await self._loop.run()
+            except ExecutionError as exc:  # the task chart itself broke down: a fault like any other
+                self._fail(Fault("chart", str(exc), self.step, self.command))
             finally:
                 for task in self._commands:
                     task.cancel()

@@ -19,7 +19,8 @@ from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.interfaces import CellSource, Runner
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
 from plugnproduce.hmi.routes import cell, charts, runs, task
-from plugnproduce.hmi.security import SecurityHeaders
+from plugnproduce.hmi.security import BodyLimit, SecurityHeaders
+from plugnproduce.safeio import MAX_BYTES
 
 DESCRIPTION = """\
 The Generic HMI of a Plug'n'Produce cell: the live cell, the process commands it offers,
@@ -75,6 +76,7 @@ def create_app(
         return FileResponse(folder / "index.html", headers={"Cache-Control": "no-cache"})
 
     app.add_middleware(SecurityHeaders)
+    app.add_middleware(BodyLimit, limit=MAX_BYTES)
     if allowed_hosts:
         app.add_middleware(TrustedHostMiddleware, allowed_hosts=allowed_hosts)
     return app

@@ -12,6 +12,7 @@ chart does not wait for in its current state is refused (XIRP ``not-accepted``, 
 from __future__ import annotations
 
 import asyncio
+import logging
 import re
 from collections.abc import Mapping
 from pathlib import Path
@@ -47,6 +48,8 @@ def requests_and_events(device: DeviceDescription) -> tuple[dict[str, list[str]]
             names.extend(local_name(q) for q in t.accepts if local_name(q) not in names)
         events.extend(c.name for c in t.sends if c.kind == "event" and c.name not in events)
     return requests, events
+
+_LOGGER = logging.getLogger(__name__)
 
 
 class SimulatedDevice:
@@ -96,6 +99,7 @@ class SimulatedDevice:
         """Start the chart, listen on the protocol, then announce the device."""
         d = self.description
         self._task = asyncio.create_task(self._loop.run(), name=f"device {d.id}")
+        self._task.add_done_callback(self._chart_ended)
         device_class = local_name(d.classes[0])
         requests, events = requests_and_events(d)
         if d.protocol == "xirp":
@@ -111,6 +115,11 @@ class SimulatedDevice:
         self._upnp = upnp.UpnpDeviceServer(d.id, d.label, upnp.device_type_for(device_class), spec,
                                            self._on_upnp_action, files=files, network=self.network)
         await self._upnp.start()
+
+    def _chart_ended(self, task: asyncio.Task[None]) -> None:
+        """A chart that broke down (e.g. never settles) is said so; the device then refuses every request."""
+        if not task.cancelled() and task.exception() is not None:
+            _LOGGER.error("simulated device %s: its chart stopped: %s", self.description.id, task.exception())
 
     async def stop(self) -> None:
         """Say goodbye (SSDP byebye, XIRP bye) and stop the chart."""

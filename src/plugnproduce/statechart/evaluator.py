@@ -43,6 +43,17 @@ SAFE_BUILTINS: dict[str, Any] = {
 }
 SAFE_BUILTINS.update({"True": True, "False": False, "None": None, "true": True, "false": False, "null": None})
 
+MAX_SOURCE = 10_000
+"""Longest expression an untrusted chart may hold (characters)."""
+MAX_NODES = 2_000
+"""Most syntax nodes in one untrusted expression."""
+MAX_ITEMS = 1_000_000
+"""Largest sequence (characters or items) an untrusted expression may build, and its longest ``range``."""
+MAX_INT_BITS = 65_536
+"""Largest integer (in bits) an untrusted ``**`` or ``<<`` may produce."""
+MAX_STEPS = 1_000_000
+"""Most comprehension iterations one untrusted evaluation may take."""
+
 SAFE_METHODS = frozenset({
     "get", "keys", "values", "items", "copy", "count", "index", "append", "extend", "insert", "pop", "remove",
     "update", "setdefault", "clear", "startswith", "endswith", "lower", "upper", "strip", "lstrip", "rstrip",
@@ -77,6 +88,7 @@ class Expr:
         """The expression's value in ``namespace``."""
         if self.code is None:
             raise EvaluationError(f"cannot evaluate {self.source!r}: {self.problem}")
+        _steps[0] = MAX_STEPS
         try:
             return eval(self.code, namespace)  # noqa: S307 - compiled from a checked AST (or trusted)
         except Exception as exc:
@@ -93,7 +105,7 @@ class Evaluator:
         """The ``__builtins__`` of a fresh namespace."""
         if self.trusted:
             return {**vars(builtins), "true": True, "false": False, "null": None}
-        return dict(SAFE_BUILTINS)
+        return {**SAFE_BUILTINS, **_GUARDS}
 
     def expr(self, source: str) -> Expr:
         """Compile a value or condition expression (remembered: charts run again and again repeat them)."""
@@ -186,16 +198,21 @@ class Location:
 @functools.lru_cache(maxsize=EXPRESSIONS_REMEMBERED)
 def _compile_expression(source: str, trusted: bool) -> Expr:
     try:
+        if not trusted and len(source) > MAX_SOURCE:
+            raise _Refused(f"the expression is {len(source)} characters long; at most {MAX_SOURCE} are allowed")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SyntaxWarning)
             tree = ast.parse(source.strip(), mode="eval")
         if not trusted:
             _check(tree)
+            tree = ast.fix_missing_locations(_Guard().visit(tree))
         return Expr(source, compile(tree, "<scxml>", "eval"), None)
     except SyntaxError as exc:
         return Expr(source, None, f"syntax error ({exc.msg})")
     except _Refused as exc:
         return Expr(source, None, f"not allowed by the restricted evaluator: {exc}")
+    except (RecursionError, MemoryError):
+        return Expr(source, None, "the expression is nested too deeply")
 
 
 class _Refused(Exception):
@@ -203,7 +220,9 @@ class _Refused(Exception):
 
 
 def _check(tree: ast.AST) -> None:
-    for node in ast.walk(tree):
+    for count, node in enumerate(ast.walk(tree), start=1):
+        if count > MAX_NODES:
+            raise _Refused(f"the expression has more than {MAX_NODES} parts")
         if not isinstance(node, _ALLOWED_NODES):
             raise _Refused(f"{type(node).__name__} is not allowed")
         if isinstance(node, ast.Name) and node.id.startswith("__"):
@@ -212,6 +231,8 @@ def _check(tree: ast.AST) -> None:
             raise _Refused(f"the attribute {node.attr!r} is not allowed")
         if isinstance(node, ast.Call):
             _check_call(node)
+        if isinstance(node, ast.FormattedValue) and node.format_spec is not None:
+            raise _Refused("format specifications in f-strings are not allowed")
 
 
 def _check_call(node: ast.Call) -> None:
@@ -221,3 +242,102 @@ def _check_call(node: ast.Call) -> None:
     if isinstance(func, ast.Attribute) and func.attr in SAFE_METHODS:
         return
     raise _Refused(f"calling {ast.unparse(func)!r} is not allowed")
+
+
+# ---------------------------------------------------------------- budgets of untrusted expressions
+#
+# The allow-list keeps an untrusted expression from reaching anything; these guards keep it
+# from costing unbounded time or memory. The operators that can blow up (``**``, ``*``, ``<<``),
+# the string methods that multiply their input (``join``, ``replace``) and ``range`` are
+# checked before they compute, and every comprehension draws its iterations from one budget
+# per evaluation. The guard names start with ``__``, which no checked expression may name.
+
+_steps = [MAX_STEPS]
+
+
+def _too_large(what: str) -> EvaluationError:
+    return EvaluationError(f"{what} would exceed the restricted evaluator's limits")
+
+
+def _size(value: Any) -> int | None:
+    return len(value) if isinstance(value, str | bytes | list | tuple) else None
+
+
+def _binop(op: str, left: Any, right: Any) -> Any:
+    if op == "Pow":
+        if (isinstance(left, int) and isinstance(right, int) and right > 0 and abs(left) > 1
+                and right * max(abs(left).bit_length() - 1, 1) > MAX_INT_BITS):
+            raise _too_large(f"{left!r} ** {right!r}")
+        return left**right
+    if op == "LShift":
+        if isinstance(right, int) and right > MAX_INT_BITS:
+            raise _too_large(f"shifting left by {right}")
+        return left << right
+    for seq, times in ((left, right), (right, left)):  # Mult
+        size = _size(seq)
+        if size is not None and isinstance(times, int) and size * times > MAX_ITEMS:
+            raise _too_large(f"a sequence of {size} items repeated {times} times")
+    return left * right
+
+
+def _iterate(iterable: Any) -> Any:
+    for item in iterable:
+        _steps[0] -= 1
+        if _steps[0] < 0:
+            raise _too_large(f"more than {MAX_STEPS} iterations")
+        yield item
+
+
+def _method(target: Any, name: str, *args: Any, **kwargs: Any) -> Any:
+    if isinstance(target, str) and name == "join" and args:
+        parts = list(_iterate(args[0]))
+        if sum(len(p) if isinstance(p, str) else 0 for p in parts) + len(target) * len(parts) > MAX_ITEMS:
+            raise _too_large("joining these strings")
+        args = (parts, *args[1:])
+    if isinstance(target, str) and name == "replace" and len(args) >= 2 and isinstance(args[1], str):
+        if len(target) + (len(target) + 1) * len(args[1]) > MAX_ITEMS:
+            raise _too_large("this replace")
+    return getattr(target, name)(*args, **kwargs)
+
+
+def _range(*args: int) -> range:
+    r = range(*args)
+    try:
+        if len(r) <= MAX_ITEMS:
+            return r
+    except OverflowError:
+        pass
+    raise _too_large(f"range{args}")
+
+
+_GUARDS: dict[str, Any] = {"__pnp_binop": _binop, "__pnp_iter": _iterate, "__pnp_method": _method, "range": _range}
+_GUARDED_OPS = (ast.Pow, ast.Mult, ast.LShift)
+_GUARDED_METHODS = frozenset({"join", "replace"})
+
+
+def _guard_call(name: str, *args: ast.expr, keywords: list[ast.keyword] | None = None) -> ast.Call:
+    return ast.Call(func=ast.Name(id=name, ctx=ast.Load()), args=list(args), keywords=keywords or [])
+
+
+class _Guard(ast.NodeTransformer):
+    """Rewrites a checked expression so that its costly operations go through the guards."""
+
+    def visit_BinOp(self, node: ast.BinOp) -> ast.expr:  # noqa: N802 - ast's visitor naming
+        self.generic_visit(node)
+        if not isinstance(node.op, _GUARDED_OPS):
+            return node
+        return ast.copy_location(
+            _guard_call("__pnp_binop", ast.Constant(type(node.op).__name__), node.left, node.right), node)
+
+    def visit_comprehension(self, node: ast.comprehension) -> ast.comprehension:
+        self.generic_visit(node)
+        node.iter = _guard_call("__pnp_iter", node.iter)
+        return node
+
+    def visit_Call(self, node: ast.Call) -> ast.expr:  # noqa: N802 - ast's visitor naming
+        self.generic_visit(node)
+        func = node.func
+        if not (isinstance(func, ast.Attribute) and func.attr in _GUARDED_METHODS):
+            return node
+        call = _guard_call("__pnp_method", func.value, ast.Constant(func.attr), *node.args, keywords=node.keywords)
+        return ast.copy_location(call, node)

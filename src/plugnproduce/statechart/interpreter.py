@@ -82,6 +82,9 @@ from plugnproduce.statechart.reader import parse_chart
 
 log = logging.getLogger("plugnproduce.statechart")
 
+MAX_MICROSTEPS = 100_000
+"""Most microsteps one macrostep may take before the chart is stopped as one that never settles."""
+
 Observer = Callable[[MetaEvent], None]
 """Something that receives meta events."""
 
@@ -238,9 +241,20 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         return step
 
     def _stabilize(self) -> None:
-        """Eventless transitions and internal events until stable, then start invocations."""
+        """Eventless transitions and internal events until stable, then start invocations.
+
+        A chart that never settles (eventless transitions or internal events in a cycle) stops
+        with :class:`ExecutionError` after :data:`MAX_MICROSTEPS` microsteps of one macrostep.
+        """
+        budget = MAX_MICROSTEPS
         while True:
             while self.running:
+                budget -= 1
+                if budget < 0:
+                    self.running = False
+                    raise ExecutionError(f"{self.chart.name or 'chart'} found no stable configuration after "
+                                         f"{MAX_MICROSTEPS} microsteps: its eventless transitions or internal "
+                                         "events run in a cycle")
                 enabled = self._select(None)
                 if not enabled:
                     if not self.internal:

@@ -19,7 +19,6 @@ from plugnproduce.hmi.routes import hub_of, require_reasoner
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.security import allow_read
 from plugnproduce.hmi.views import task_json
-from plugnproduce.safeio import MAX_BYTES
 
 router = APIRouter(prefix="/api/task", tags=["task"], dependencies=[Depends(allow_read)])
 reasoner = [Depends(require_reasoner)]
@@ -96,6 +95,7 @@ def export(task: TaskIn) -> PlainTextResponse:
                              headers={"Content-Disposition": f'attachment; filename="{filename}.yaml"'})
 
 
+YAML_TYPES = ("application/yaml", "application/x-yaml", "text/yaml", "text/x-yaml")
 YAML_BODY = {"requestBody": {"required": True, "description": "A YAML task description",
                              "content": {"application/yaml": {"schema": {"type": "string"}}}}}
 
@@ -105,10 +105,14 @@ async def import_(
     request: Request,
     filename: str = Query("task.yaml", max_length=200, description="The file's name, for error messages"),
 ) -> dict[str, Any]:
-    """Parse YAML with the task file's hardened reader; errors are ``FILE:LINE: message``."""
-    size = int(request.headers.get("content-length") or 0)
-    if size > MAX_BYTES:
-        raise HTTPException(status.HTTP_413_CONTENT_TOO_LARGE,
-                            f"{filename}: file is {size} bytes; at most {MAX_BYTES} are accepted")
+    """Parse YAML with the task file's hardened reader; errors are ``FILE:LINE: message``.
+
+    The body must be sent as YAML (``application/yaml``): a type a cross-site form may send
+    without asking (``text/plain``, forms) is refused, so no other page can post here.
+    """
+    kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+    if kind not in YAML_TYPES:
+        raise HTTPException(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE,
+                            f"{filename}: send the task as application/yaml; found {kind or 'no content type'}")
     data = await request.body()
     return task_json(taskfiles.import_yaml(data, filename))

@@ -150,10 +150,7 @@ class NoRedirectRequester(UpnpRequester):
                     data=http_request.body,
                     allow_redirects=False,
                 ) as response:
-                    data = await response.content.read(self._limit + 1)
-                    if len(data) > self._limit:
-                        raise UpnpCommunicationError(f"answer larger than the {self._limit} bytes accepted")
-                    body = data.decode(response.charset or "utf-8")
+                    body = (await self._read_body(response)).decode(response.charset or "utf-8")
                     return HttpResponse(response.status, response.headers, body)
         except TimeoutError as exc:
             raise UpnpConnectionTimeoutError(repr(exc)) from exc
@@ -161,6 +158,18 @@ class NoRedirectRequester(UpnpRequester):
             raise UpnpConnectionError(repr(exc)) from exc
         except (aiohttp.ClientError, UnicodeDecodeError, LookupError) as exc:
             raise UpnpCommunicationError(repr(exc)) from exc
+
+
+    async def _read_body(self, response: aiohttp.ClientResponse) -> bytes:
+        """The whole body, read to its end (a single read returns only what is buffered), within the limit."""
+        chunks: list[bytes] = []
+        size = 0
+        async for chunk in response.content.iter_chunked(64 * 1024):
+            size += len(chunk)
+            if size > self._limit:
+                raise UpnpCommunicationError(f"answer larger than the {self._limit} bytes accepted")
+            chunks.append(chunk)
+        return b"".join(chunks)
 
 
 class TrustedRequester(UpnpRequester):

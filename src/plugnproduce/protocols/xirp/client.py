@@ -350,7 +350,7 @@ class XirpClient:
             message = decode(data, self._source)
         except MessageError as exc:
             self.stats.malformed += 1
-            _LOGGER.warning("%s", exc)
+            self._inbox.log.log(logging.WARNING, "%s", exc)
             self.stats.tell(str(exc))
             self._link.send(encode_frame(ErrorMessage(exc.code, str(exc), exc.ref)))
             return None
@@ -359,7 +359,8 @@ class XirpClient:
             if waiting is not None and not waiting.future.done():
                 waiting.future.set_result(message)
             else:
-                _LOGGER.info("%s: response to request %s, which no one waits for; ignored", self._what, message.id)
+                self._inbox.log.log(logging.INFO, "%s: response to request %s, which no one waits for; ignored",
+                                    self._what, message.id)
         elif isinstance(message, Event):
             self._inbox.put(message)
         elif isinstance(message, ErrorMessage):
@@ -378,7 +379,8 @@ class XirpClient:
             waiting.future.set_exception(RemoteFailure(message, error.code, error.text, waiting.name))
             return
         self.stats.errors.append(error)
-        _LOGGER.warning("%s reports %s: %s", self._what, error.code, error.text)
+        self.stats.reported += 1
+        self._inbox.log.log(logging.WARNING, "%s reports %s: %s", self._what, error.code, error.text[:200])
         self.stats.tell(f"{self._what} reports {error.code}: {error.text}")
 
     async def close(self) -> None:

@@ -40,6 +40,9 @@ from plugnproduce.safeio import parse_xml_bytes, read_bytes
 
 _NS = "{" + NAMESPACE + "}"
 
+MAX_SEQ = 2**63 - 1
+"""Largest event sequence number accepted (a device numbers its events from 1)."""
+
 
 @lru_cache(maxsize=1)
 def schema() -> etree.XMLSchema:
@@ -186,7 +189,8 @@ def _read_values(el: etree._Element) -> dict[str, Value]:
 
 
 def _decode_hello(el: etree._Element) -> Hello:
-    return Hello(el.get("device"), el.get("class"), el.get("label"), el.get("describe"), int(el.get("version")))
+    version = _integer(el.get("version"))
+    return Hello(el.get("device"), el.get("class"), el.get("label"), el.get("describe"), version)
 
 
 def _decode_request(el: etree._Element) -> Request:
@@ -216,7 +220,10 @@ def _decode_event(el: etree._Element) -> Event:
         raise MessageError(f"event time {text!r} cannot be read ({exc})", MALFORMED) from exc
     if time.tzinfo is None:
         time = time.replace(tzinfo=UTC)
-    return Event(el.get("name"), int(el.get("seq")), time, _read_values(el) if len(el) else {})
+    seq = _integer(el.get("seq"))
+    if seq > MAX_SEQ:
+        raise MessageError(f"event sequence number of {len(str(seq))} digits is larger than {MAX_SEQ}", MALFORMED)
+    return Event(el.get("name"), seq, time, _read_values(el) if len(el) else {})
 
 
 def _decode_error(el: etree._Element) -> ErrorMessage:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -25,6 +26,38 @@ EventCallback = Callable[[Event], None]
 SEEN_WINDOW = 4096
 """How many recent sequence numbers are remembered to recognise duplicates."""
 
+KEPT_ERRORS = 64
+"""How many of a device's unsolicited protocol errors are kept (the newest; all are counted)."""
+
+
+class PeerLog:
+    """Log lines about one misbehaving peer, at most ``burst`` per ``period`` seconds.
+
+    A device that floods bad frames must not flood the log: past the burst its lines
+    are counted, and the count is logged with the next line the period lets through.
+    """
+
+    def __init__(self, logger: logging.Logger, burst: int = 5, period: float = 10.0) -> None:
+        self._logger, self._burst, self._period = logger, burst, period
+        self._window_start = -period
+        self._in_window = 0
+        self.suppressed = 0
+        """Lines not logged since the last one that was."""
+
+    def log(self, level: int, message: str, *args: object) -> None:
+        """Log ``message % args`` at ``level`` unless this peer has used up its burst."""
+        now = time.monotonic()
+        if now - self._window_start >= self._period:
+            self._window_start, self._in_window = now, 0
+        if self._in_window >= self._burst:
+            self.suppressed += 1
+            return
+        self._in_window += 1
+        if self.suppressed:
+            message += f" ({self.suppressed} similar line(s) suppressed)"
+            self.suppressed = 0
+        self._logger.log(level, message, *args)
+
 
 @dataclass
 class LinkStats:
@@ -36,8 +69,10 @@ class LinkStats:
     """Events dropped because their sequence number was seen before."""
     overflowed: int = 0
     """Events dropped because the event buffer was full (oldest first)."""
-    errors: list[ErrorMessage] = field(default_factory=list)
-    """Protocol errors the device reported that named no waiting request."""
+    errors: deque[ErrorMessage] = field(default_factory=lambda: deque(maxlen=KEPT_ERRORS))
+    """The newest protocol errors the device reported that named no waiting request."""
+    reported: int = 0
+    """How many such errors the device reported in all."""
     on_anomaly: Callable[[str], None] | None = field(default=None, repr=False, compare=False)
     """Told, in a sentence, about each of the above as it happens (e.g. so an executor can stop)."""
 
@@ -60,12 +95,14 @@ class EventInbox:
         self._seen_order: deque[int] = deque()
         self._stats = stats
         self._ended: str | None = None
+        self.log = PeerLog(_LOGGER)
+        """The rate-limited log for this connection's peer."""
 
     def put(self, event: Event) -> None:
         """Take one event from the connection."""
         if event.seq in self._seen:
             self._stats.duplicates += 1
-            _LOGGER.info("%s: event %s #%d received twice; dropped", self.what, event.name, event.seq)
+            self.log.log(logging.INFO, "%s: event %s #%d received twice; dropped", self.what, event.name, event.seq)
             self._stats.tell(f"{self.what} sent event {event.name} #{event.seq} twice")
             return
         self._seen.add(event.seq)
@@ -80,7 +117,7 @@ class EventInbox:
             return
         if len(self._buffer) == self._buffer.maxlen:
             self._stats.overflowed += 1
-            _LOGGER.warning("%s: event buffer full; the oldest event is dropped", self.what)
+            self.log.log(logging.WARNING, "%s: event buffer full; the oldest event is dropped", self.what)
         self._buffer.append(event)
         self._ready.set()
 

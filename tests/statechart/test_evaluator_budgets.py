@@ -1,0 +1,59 @@
+"""The restricted evaluator's budgets: an untrusted chart's expression cannot cost unbounded time or memory.
+
+Each hostile expression ends as an :class:`EvaluationError` (the chart gets ``error.execution``)
+instead of hanging, exhausting memory or raising past the interpreter.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from plugnproduce.statechart.evaluator import EvaluationError, Evaluator
+
+UNTRUSTED = Evaluator()
+
+
+def evaluate(source: str, **data: object) -> object:
+    return UNTRUSTED.expr(source).evaluate({"__builtins__": UNTRUSTED.builtins(), **data})
+
+
+@pytest.mark.parametrize(("source", "needle"), [
+    ("10**10**10", "exceed"),
+    ("2 << 10**9", "exceed"),
+    ("'a' * 10**10", "exceed"),
+    ("[0] * 10**9", "exceed"),
+    ("list(range(10**12))", "exceed"),
+    ("[a * b for a in range(5000) for b in range(5000)]", "iterations"),
+    ("s.replace('', s)", "exceed"),
+    ("s.join([s, s, s, s, s, s, s, s, s, s, s, s])", "exceed"),
+    ("f'{1:>999999999}'", "format specifications"),
+    ("+".join(["1"] * 1000), "parts"),
+    ("1" + "+1" * 20_000, "characters long"),
+    ("(" * 5000 + "1" + ")" * 5000, "cannot evaluate"),
+], ids=["power", "shift", "string", "list", "range", "iterations", "replace", "join", "format", "1000 terms",
+        "long", "nested"])
+def test_a_costly_expression_is_an_evaluation_error(source: str, needle: str) -> None:
+    with pytest.raises(EvaluationError, match=needle):
+        evaluate(source, s="ab" * 100_000)
+
+
+@pytest.mark.parametrize(("source", "value"), [
+    ("2**10", 1024),
+    ("(-3) ** 3", -27),
+    ("2 ** -1", 0.5),
+    ("1 << 8", 256),
+    ("'ab' * 3", "ababab"),
+    ("3 * [0]", [0, 0, 0]),
+    ("[x * 2 for x in range(3)]", [0, 2, 4]),
+    ("{k: v for k, v in zip('ab', range(2))}", {"a": 0, "b": 1}),
+    ("','.join(['a', 'b'])", "a,b"),
+    ("'abc'.replace('b', 'x')", "axc"),
+    ("sum(range(1000))", 499500),
+])
+def test_ordinary_expressions_keep_their_values(source: str, value: object) -> None:
+    assert evaluate(source) == value
+
+
+def test_a_trusted_evaluator_is_not_budgeted() -> None:
+    trusted = Evaluator(trusted=True)
+    assert trusted.expr("len('a' * 2_000_000)").evaluate({"__builtins__": trusted.builtins()}) == 2_000_000
