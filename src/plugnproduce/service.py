@@ -29,6 +29,7 @@ from plugnproduce.validation import Report, validate_paths
 
 if TYPE_CHECKING:  # execution pulls in the network stack: imported when a run needs it
     from plugnproduce.discovery import LiveCell
+    from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
     from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
 
@@ -56,9 +57,9 @@ def knowledge(processes_dir: Path | None = None) -> Knowledge:
     return Knowledge(taxonomy, tuple(load_processes(folder)))
 
 
-def validate(paths: list[str | Path]) -> Report:
-    """Validate description files and folders."""
-    return validate_paths(paths, knowledge().taxonomy)
+def validate(paths: list[str | Path], progress: Callable[[str], None] | None = None) -> Report:
+    """Validate description files and folders; ``progress`` is told each phase as it begins."""
+    return validate_paths(paths, knowledge().taxonomy, progress=progress)
 
 
 def cell(path: str | Path) -> Cell:
@@ -232,28 +233,39 @@ async def run_task(
     observer: RecordObserver | None = None,
     started: Callable[[TaskRun], None] | None = None,
     discovery_timeout: float = 10.0,
+    progress: Callable[[str], None] | None = None,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
     With ``simulate`` the cell's devices are simulated for the run, on a private SSDP network,
     with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`). ``started`` is
-    given the run once it exists (to stop it). Raises :class:`ImplausibleTask` before anything runs.
+    given the run once it exists (to stop it); ``progress`` is told each phase as it begins
+    (checking, generating, starting devices, discovering, running). Raises :class:`ImplausibleTask`
+    before anything runs.
     """
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.run import TaskRun
     from plugnproduce.protocols.upnp import network_from_env, private_network
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
+    say = progress or (lambda _: None)
+    say("checking the task in the cell")
     the_task, the_cell = _as_task(task_or_path), _as_cell(cell_or_path)
+    if not (result := check(the_task, the_cell)).plausible:
+        raise ImplausibleTask(result)
+    say(f"generating the charts of {len(the_task.steps)} step(s)")
     generated = generate(the_task, the_cell).task
     journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
     network = private_network() if simulate else network_from_env()
     async with contextlib.AsyncExitStack() as stack:
         if simulate:
+            say(f"starting {len(the_cell.devices)} simulated device(s) on loopback")
             sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices))
             await stack.enter_async_context(sim)
+        say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         live = await stack.enter_async_context(LiveCell(knowledge().taxonomy, network=network, name=the_cell.name))
         devices = await find_devices(live, [d.id for d in the_cell.devices], discovery_timeout)
+        say("running")
         run = TaskRun(generated, devices, journal, observer)
         if started is not None:
             started(run)
@@ -270,11 +282,23 @@ async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:
             run.device_lost(change.device, "the device left the network (SSDP byebye)")
 
 
-def report(run: str | Path) -> RunRecord:
-    """A run's journal, by path or by run id (in :func:`runs_folder`)."""
+def report(run: str | Path | None = None) -> RunRecord:
+    """A run's journal, by path or by run id (in :func:`runs_folder`); without either, the latest run's."""
     from plugnproduce.executor.journal import read_journal
 
+    if run is None:
+        past = runs()
+        if not past:
+            raise PlugNProduceError(f"no runs yet in {runs_folder()}")
+        return read_journal(past[0].path)
     path = Path(run)
     if not path.exists() and not path.suffix:
         path = runs_folder() / f"{run}.jsonl"
     return read_journal(path)
+
+
+def runs() -> list[RunSummary]:
+    """The past runs in :func:`runs_folder`, newest first."""
+    from plugnproduce.executor.history import list_runs
+
+    return list_runs(runs_folder())

@@ -16,12 +16,29 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # plain help: no "<bool>" after flags, no boxes
     help="Plug'n'Produce cell controller: from device and process descriptions to executable SCXML.",
 )
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 JSON_OPTION = typer.Option(False, "--json", help="Machine-readable output.")
+
+
+def _print_version(wanted: bool) -> None:
+    if wanted:
+        from plugnproduce import __version__
+
+        typer.echo(f"pnp (plugnproduce) {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
+                                 help="Print the version and exit."),
+) -> None:
+    """Plug'n'Produce cell controller: from device and process descriptions to executable SCXML."""
 
 
 def fail(message: str, code: int = 2) -> NoReturn:
@@ -57,4 +74,7 @@ def emit_json(data: object) -> None:
 
 def main() -> None:
     """Entry point of the ``pnp`` console script."""
+    from plugnproduce.cli.pipes import tolerate_closed_stdout
+
+    tolerate_closed_stdout()
     app()

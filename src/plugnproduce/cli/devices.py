@@ -51,7 +51,7 @@ def _change_json(change: CellChange) -> dict[str, object]:
 def discover(
     json_out: bool = JSON_OPTION,
     watch: bool = typer.Option(False, "--watch", help="Keep watching: stream plug and unplug events."),
-    timeout: float = typer.Option(2.0, help="Seconds to search for devices."),
+    timeout: float = typer.Option(2.0, metavar="SECONDS", help="Seconds to search for devices."),
 ) -> None:
     """List the devices found on the network (SSDP on loopback), with class and skills."""
     try:
@@ -97,12 +97,14 @@ def _address(control_address: str | None) -> tuple[str, int]:
     return control.read_state()
 
 
-CONTROL = typer.Option(None, "--control", help="HOST:PORT of the running simulated cell (default: the last started).")
+CONTROL = typer.Option(None, "--control", metavar="HOST:PORT",
+                       help="HOST:PORT of the running simulated cell (default: the last started).")
 
 
 @sim_app.command("plug")
 @boundary
-def sim_plug(device: str = typer.Argument(..., help="A catalogue device id or a device description file."),
+def sim_plug(device: str = typer.Argument(..., metavar="DEVICE",
+                                          help="A catalogue device id or a device description file."),
              control_address: str | None = CONTROL) -> None:
     """Plug a simulated device into the running cell."""
     _control("plug", device, control_address)
@@ -110,7 +112,7 @@ def sim_plug(device: str = typer.Argument(..., help="A catalogue device id or a 
 
 @sim_app.command("unplug")
 @boundary
-def sim_unplug(device: str = typer.Argument(..., help="The id of a running device."),
+def sim_unplug(device: str = typer.Argument(..., metavar="DEVICE", help="The id of a running device."),
                control_address: str | None = CONTROL) -> None:
     """Unplug a simulated device from the running cell."""
     _control("unplug", device, control_address)
@@ -127,10 +129,11 @@ def _control(op: str, device: str, control_address: str | None) -> None:
 @sim_app.command("up")
 @boundary
 def sim_up(
-    cell: Path = typer.Argument(..., help="A cell file, e.g. descriptions/cells/bin-picking.yaml."),
-    faults: str = typer.Option("", "--faults", help="Faults to inject: DEVICE:KIND[:NAME[:SECONDS]],... "
-                                "e.g. 'gripper:drop-response:Close'."),
-    state_file: Path | None = typer.Option(None, help="Where to record the control address."),
+    cell: Path = typer.Argument(..., metavar="CELL", help="A cell file, e.g. descriptions/cells/bin-picking.yaml."),
+    faults: str = typer.Option("", "--faults", metavar="SPEC",
+                               help="Faults to inject: DEVICE:KIND[:NAME[:SECONDS]],... "
+                                    "e.g. 'gripper:drop-response:Close'."),
+    state_file: Path | None = typer.Option(None, metavar="FILE", help="Where to record the control address."),
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
 

@@ -13,8 +13,9 @@ from plugnproduce.drawing import draw_chart
 @app.command()
 @boundary
 def draw(
-    chart: Path = typer.Argument(..., help="An SCXML chart: device, process, task or closed-world."),
-    output: Path = typer.Option(..., "-o", "--output", help="Picture to write: .svg, .png, .pdf or .dot."),
+    chart: Path = typer.Argument(..., metavar="CHART", help="An SCXML chart: device, process, task or closed-world."),
+    output: Path = typer.Option(..., "-o", "--output", metavar="FILE",
+                                help="Picture to write: .svg, .png, .pdf or .dot."),
 ) -> None:
     """Draw a state chart: regions as clusters, commands on the edges."""
     typer.echo(f"wrote {draw_chart(chart, output)}")

@@ -10,7 +10,7 @@ import typer
 from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
 
-CELL_OPTION = typer.Option(..., "--cell", help="The cell file (YAML).")
+CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
 
 
 def refuse(exc: service.ImplausibleTask, consequence: str, json_out: bool) -> NoReturn:
@@ -27,9 +27,10 @@ def refuse(exc: service.ImplausibleTask, consequence: str, json_out: bool) -> No
 @app.command()
 @boundary
 def generate(
-    task: Path = typer.Argument(..., help="The task file (YAML)."),
+    task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."),
     cell: Path = CELL_OPTION,
-    out: Path = typer.Option(..., "--output", "-o", help="Folder to write the charts to (created if missing)."),
+    out: Path = typer.Option(..., "--output", "-o", metavar="DIR",
+                             help="Folder to write the charts to (created if missing)."),
     per_device: bool = typer.Option(False, "--per-device", help="Also write each device's program."),
     json_out: bool = JSON_OPTION,
 ) -> None:

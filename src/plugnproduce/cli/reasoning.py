@@ -18,9 +18,10 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from plugnproduce import reasoning, service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
+from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.description.loader import task_to_yaml
 
-CELL_OPTION = typer.Option(..., "--cell", help="The cell file (YAML).")
+CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
 
 
 def _bindings(bindings: tuple[dict[str, str], ...]) -> str:
@@ -62,7 +63,7 @@ def _print_problems(result: reasoning.CheckResult) -> None:
 
 @app.command()
 @boundary
-def check(task: Path = typer.Argument(..., help="The task file (YAML)."), cell: Path = CELL_OPTION,
+def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
           json_out: bool = JSON_OPTION) -> None:
     """Check that a task is plausible: each step finds its devices in the states it starts from.
 
@@ -82,10 +83,11 @@ def check(task: Path = typer.Argument(..., help="The task file (YAML)."), cell: 
 @app.command()
 @boundary
 def repair(
-    task: Path = typer.Argument(..., help="The task file (YAML)."),
+    task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."),
     cell: Path = CELL_OPTION,
-    catalogue: Path | None = typer.Option(None, "--catalogue", help="Devices a repair may add (a folder)."),
-    top: int = typer.Option(3, "--top", min=1, max=20, help="How many distinct repairs, cheapest first."),
+    catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
+                                          help="Devices a repair may add (a folder)."),
+    top: int = typer.Option(3, "--top", min=1, max=20, metavar="K", help="How many distinct repairs, cheapest first."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
@@ -115,9 +117,10 @@ def repair(
 @app.command()
 @boundary
 def explain(
-    target: str = typer.Argument(..., help="A process command, or with --step a task file."),
+    target: str = typer.Argument(..., metavar="TARGET", help="A process command, or with --step a task file."),
     cell: Path = CELL_OPTION,
-    step: int | None = typer.Option(None, "--step", help="Explain this step (1-based) of the task TARGET."),
+    step: int | None = typer.Option(None, "--step", metavar="N",
+                                    help="Explain this step (1-based) of the task TARGET."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Why a process command is (not) offered, or why a task's step is (not) plausible. Exit 1 when it is not."""
@@ -156,14 +159,20 @@ def _sizes(text: str) -> tuple[int, int]:
 @app.command()
 @boundary
 def batch(
-    configs: Path | None = typer.Argument(None, help="Configurations: JSONL ({\"config\", \"devices\"}) or CSV."),
-    generate: int | None = typer.Option(None, "--generate", help="Generate this many random configurations."),
-    sizes: str = typer.Option("2-6", "--sizes", help="Devices per generated configuration, MIN-MAX."),
-    seed: int = typer.Option(1, "--seed", help="Seed of the generator."),
-    catalogue: Path | None = typer.Option(None, "--catalogue", help="Device folder (default: built-in devices)."),
-    tasks: list[Path] = typer.Option([], "--task", help="A task to check in every configuration (repeatable)."),
-    output: Path | None = typer.Option(None, "-o", "--output", help="Report file: .jsonl or .csv (default: stdout)."),
-    workers: int = typer.Option(2, "--workers", min=1, help="Worker processes."),
+    configs: Path | None = typer.Argument(None, metavar="CONFIGS",
+                                          help="Configurations: JSONL ({\"config\", \"devices\"}) or CSV."),
+    generate: int | None = typer.Option(None, "--generate", metavar="N",
+                                        help="Generate this many random configurations."),
+    sizes: str = typer.Option("2-6", "--sizes", metavar="MIN-MAX",
+                              help="Devices per generated configuration, MIN-MAX."),
+    seed: int = typer.Option(1, "--seed", metavar="N", help="Seed of the generator."),
+    catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
+                                          help="Device folder (default: built-in devices)."),
+    tasks: list[Path] = typer.Option([], "--task", metavar="TASK",
+                                     help="A task to check in every configuration (repeatable)."),
+    output: Path | None = typer.Option(None, "-o", "--output", metavar="FILE",
+                                       help="Report file: .jsonl or .csv (default: stdout)."),
+    workers: int = typer.Option(2, "--workers", min=1, metavar="N", help="Worker processes."),
 ) -> None:
     """Feasibility of many cell configurations: offered processes, plausible tasks, cheapest device to add."""
     if (configs is None) == (generate is None):
@@ -178,7 +187,7 @@ def batch(
         configurations = reasoning.read_configurations(configs)  # type: ignore[arg-type]
     err = Console(stderr=True)
     columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=err, transient=True) as bar:
+    with Progress(*columns, console=err, transient=True, disable=not on_a_terminal()) as bar:
         job = bar.add_task("batch", total=len(configurations))
         rows = list(service.batch(configurations, devices, list(tasks), workers,
                                   progress=lambda n: bar.advance(job, n)))

@@ -12,6 +12,7 @@ import typer
 from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
 from plugnproduce.cli.generate import refuse
+from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.executor.journal import describe
 
 if TYPE_CHECKING:
@@ -21,11 +22,14 @@ if TYPE_CHECKING:
 @app.command()
 @boundary
 def run(
-    task: Path = typer.Argument(..., help="The task file (YAML)."),
-    cell: Path | None = typer.Option(None, "--cell", help="The cell file (default with --sim: the bin-picking cell)."),
+    task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."),
+    cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
+                                     help="The cell file (default with --sim: the bin-picking cell)."),
     sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices for this run (on loopback)."),
-    faults: str = typer.Option("", "--faults", help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
-    journal: Path | None = typer.Option(None, "--journal", help="Journal file (default: a new file in PNP_RUNS)."),
+    faults: str = typer.Option("", "--faults", metavar="SPEC",
+                               help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
+    journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
+                                        help="Journal file (default: a new file in PNP_RUNS)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Check and generate the task, find the devices, run it, and journal every command and event.
@@ -38,7 +42,11 @@ def run(
             raise typer.BadParameter("give --cell CELL, or --sim to run on the simulated bin-picking cell")
         cell = service.builtin("cells", "bin-picking.yaml")
 
+    phases = Phases(on_a_terminal(json_out))
+
     def show(record: dict[str, object]) -> None:
+        if record["kind"] == "step":
+            phases.update(f"step {record.get('step')} ({record.get('command')})")
         if not json_out:
             typer.echo(describe(record))
 
@@ -48,8 +56,10 @@ def run(
             loop.add_signal_handler(signum, the_run.stop)
 
     try:
-        report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
-                                              observer=show, started=started))
+        with phases:
+            report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
+                                                  observer=show, started=started, progress=phases))
+            phases.close(last_done=True)
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)
     if json_out:
@@ -64,7 +74,8 @@ def run(
 
 @app.command()
 @boundary
-def report(run_id: str = typer.Argument(..., metavar="RUN", help="A run id or a journal file."),
+def report(run_id: str | None = typer.Argument(None, metavar="RUN", help="A run id or a journal file "
+                                               "(default: the latest run; 'pnp runs' lists them)."),
            json_out: bool = JSON_OPTION) -> None:
     """Print a run from its journal: every step, command, event and state, and how it ended (or that it crashed)."""
     record = service.report(run_id)

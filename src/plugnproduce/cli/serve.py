@@ -53,14 +53,16 @@ def _listen(host: str, port: int) -> socket.socket:
 @app.command()
 @boundary
 def serve(
-    cell: Path | None = typer.Option(None, "--cell", help="With --sim: the cell to simulate (default: the built-in "
-                                     "bin-picking cell); without: only its name is used."),
+    cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
+                                     help="With --sim: the cell to simulate (default: the built-in "
+                                          "bin-picking cell); without: only its name is used."),
     sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices on a private loopback SSDP network; "
                              "they can be plugged and unplugged from the page."),
-    faults: str = typer.Option("", "--faults", help="With --sim: faults to inject, as for pnp run."),
-    host: str = typer.Option("127.0.0.1", "--host", help="Address to listen on."),
-    port: int = typer.Option(0, "--port", min=0, max=65535, help="Port to listen on (0: any free port)."),
-    token_file: Path | None = typer.Option(None, "--token-file",
+    faults: str = typer.Option("", "--faults", metavar="SPEC", help="With --sim: faults to inject, as for pnp run."),
+    host: str = typer.Option("127.0.0.1", "--host", metavar="ADDRESS", help="Address to listen on."),
+    port: int = typer.Option(0, "--port", min=0, max=65535, metavar="PORT",
+                             help="Port to listen on (0: any free port)."),
+    token_file: Path | None = typer.Option(None, "--token-file", metavar="FILE",
                                            help="Read the bearer token from this file (default: a new one)."),
 ) -> None:
     """Serve the Generic HMI: the live cell, offered commands, task editor, check/repair, runs.

@@ -8,19 +8,22 @@ import typer
 
 from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.progress import Phases, on_a_terminal
 
 
 @app.command()
 @boundary
 def validate(
-    paths: list[Path] = typer.Argument(..., help="Description files or folders."),
+    paths: list[Path] = typer.Argument(..., metavar="PATH...", help="Description files or folders."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Check descriptions: hardened parsing, W3C SCXML schema, SHACL shapes, structure.
 
     Exit 0 valid, 1 invalid, 2 unreadable or hostile input.
     """
-    report = service.validate(list(paths))
+    with Phases(on_a_terminal(json_out)) as phases:
+        report = service.validate(list(paths), progress=phases)
+        phases.close(last_done=True)
     problems = report.sorted()
     if json_out:
         emit_json({"valid": report.valid, "files": len(report.files), "problems": [p.to_json() for p in problems]})

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from rdflib.namespace import OWL, RDF
@@ -45,14 +45,17 @@ def expand(paths: Iterable[str | Path]) -> list[Path]:
 
 
 def validate_paths(
-    paths: Iterable[str | Path], taxonomy: Taxonomy | None = None, ontology: list[Path] | None = None
+    paths: Iterable[str | Path], taxonomy: Taxonomy | None = None, ontology: list[Path] | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> Report:
     """Validate every description under ``paths`` against the schema, shapes and structure rules.
 
     ``ontology`` names the TBox files (default: the built-in ontology); ``taxonomy`` is their
-    closure if the caller has it already.
+    closure if the caller has it already. ``progress`` is told each phase as it begins.
     """
+    say = progress or (lambda _: None)
     files = expand(paths)
+    say(f"reading {len(files)} description file(s)")
     report = Report(files=[str(f) for f in files])
     tbox_files = ontology or ontology_files()
     taxonomy = taxonomy or load_taxonomy(tbox_files)
@@ -87,6 +90,7 @@ def validate_paths(
             report.add(p)
         kg.add_task(task, known)
     if not report.unreadable:
+        say("checking the SHACL shapes")
         for p in shape_problems(kg):
             report.add(p)
     return report

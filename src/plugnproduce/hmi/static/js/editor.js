@@ -29,6 +29,7 @@ export function setTask(task, message) {
   state.check = null; // about the task as it was; the check below replaces it
   saveTask();
   renderTask();
+  changed("task", task);
   scheduleCheck();
   if (message) announce(message);
 }

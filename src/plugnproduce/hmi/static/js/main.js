@@ -5,8 +5,9 @@ import { initCell, takeCell } from "./cell.js";
 import { initCharts, renderChartChoices, showChart } from "./charts.js";
 import { $ } from "./dom.js";
 import { addStep, initEditor, renderTask, scheduleCheck } from "./editor.js";
-import { initRun, renderRun, takeDeviceState, takeRecord } from "./run.js";
+import { initRun, renderRun, renderStart, takeDeviceState, takeRecord } from "./run.js";
 import { loadTask, on, state } from "./state.js";
+import { initZoom } from "./zoom.js";
 
 function askToken() {
   const dialog = $("#token-dialog");
@@ -75,9 +76,12 @@ async function boot() {
   initCell({ onAdd: addStep, onChart: showChart });
   initEditor();
   initCharts();
+  initZoom();
   loadTask();
   renderTask();
   on("cell", () => renderTask());
+  on("task", renderStart);
+  on("check", renderStart);
   follow();
   await initRun();
   scheduleCheck();

@@ -45,17 +45,37 @@ function faultReport(run) {
   ];
 }
 
+/** Why the task being edited cannot be started now ("" when it can): it must be checked and plausible. */
+function startBlocked() {
+  if (state.task.steps.length === 0) return "Add steps to the task to run it.";
+  const c = state.check;
+  if (!c) return "Checking the task…";
+  if (c.error) return `The task cannot be checked: ${c.error}`;
+  if (!c.plausible) return "The task is not plausible: repair it to run it.";
+  return "";
+}
+
+/** Enable "Start run" only for a checked, plausible task while no run is running; say why it is disabled. */
+export function renderStart() {
+  const running = Boolean(state.run && state.run.status === "running");
+  const why = running ? "" : startBlocked();
+  $("#run-start").disabled = running || Boolean(why);
+  $("#run-start-why").textContent = why;
+}
+
 /** Show a run as its journal tells it. */
 export function renderRun() {
   const run = state.run;
   const running = Boolean(run && run.status === "running");
-  $("#run-start").disabled = running;
+  renderStart();
   $("#run-stop").disabled = !running;
   if (!run) return;
   const status = $("#run-status");
   status.textContent = statusText(run);
   status.dataset.status = run.status;
-  $("#run-step").textContent = run.step ? `Current step: ${run.step.step} of ${run.steps}, ${run.step.command}` : "";
+  // the current step only while running: a finished run's last step is in its status, journal and fault report
+  $("#run-step").textContent = running && run.step
+    ? `Current step: ${run.step.step} of ${run.steps}, ${run.step.command}` : "";
   const table = $("#run-states");
   table.hidden = Object.keys(run.states).length === 0;
   const used = new Set(Object.values((run.step && run.step.bindings) || {}));
@@ -116,6 +136,7 @@ async function start() {
   } catch (err) {
     status.textContent = err.message;
     status.dataset.status = "refused";
+    $("#run-step").textContent = ""; // the previous run's step is not this task's
   }
 }
 
@@ -135,8 +156,6 @@ export async function initRun() {
   $("#run-stop").addEventListener("click", stop);
   const runs = await get("/api/runs");
   const last = runs.active || (runs.runs.length ? runs.runs[runs.runs.length - 1].run : null);
-  if (last) {
-    state.run = await get(`/api/runs/${encodeURIComponent(last)}`);
-    renderRun();
-  }
+  if (last) state.run = await get(`/api/runs/${encodeURIComponent(last)}`);
+  renderRun();
 }
