@@ -8,7 +8,7 @@ from lxml import etree
 from plugnproduce import service
 from plugnproduce.codegen import ImplausibleStep, generate_task
 from plugnproduce.codegen.outputs import all_charts
-from plugnproduce.statechart.schema import schema_problems
+from plugnproduce.statechart.io.schema import schema_problems
 from tests.codegen.conftest import bind_by_skill, generate
 
 NS = {"s": "http://www.w3.org/2005/07/scxml", "pnp": "http://plugnproduce.org/ontology#"}

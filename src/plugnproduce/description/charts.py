@@ -3,7 +3,7 @@
 Lifts the parts of a chart the descriptions give meaning to (``pnp:concept``,
 ``pnp:accepts``, ``pnp:role``, ``pnp:params``, protocol-prefixed events), with their
 lines. The chart is parsed with the hardened parser; schema validity is checked
-separately (:mod:`plugnproduce.statechart.schema`).
+separately (:mod:`plugnproduce.statechart.io.schema`).
 """
 
 from __future__ import annotations

@@ -21,9 +21,9 @@ from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.statechart import read_chart
-from plugnproduce.statechart.events import Event
-from plugnproduce.statechart.interpreter import Interpreter
-from plugnproduce.statechart.loop import ChartLoop
+from plugnproduce.statechart.runtime.events import Event
+from plugnproduce.statechart.runtime.interpreter import Interpreter
+from plugnproduce.statechart.runtime.loop import ChartLoop
 
 _ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
 

@@ -1,8 +1,8 @@
 """A neutral model of a W3C SCXML 1.0 document, as plain dataclasses.
 
-The reader (:mod:`plugnproduce.statechart.reader`) turns a document into a :class:`Chart`,
-the writer (:mod:`plugnproduce.statechart.writer`) turns one back into XML, and the
-interpreter (:mod:`plugnproduce.statechart.interpreter`) runs one. Expressions stay
+The reader (:mod:`plugnproduce.statechart.io.reader`) turns a document into a :class:`Chart`,
+the writer (:mod:`plugnproduce.statechart.io.writer`) turns one back into XML, and the
+interpreter (:mod:`plugnproduce.statechart.runtime.interpreter`) runs one. Expressions stay
 strings here; nothing is evaluated.
 
 Every node keeps its source ``line`` (ignored when nodes are compared) and

@@ -25,7 +25,7 @@ from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_fil
 from plugnproduce.ontology.vocabulary import PNP
 from plugnproduce.resources import descriptions_path
 from plugnproduce.safeio import read_bytes
-from plugnproduce.statechart.schema import schema_problems
+from plugnproduce.statechart.io.schema import schema_problems
 from plugnproduce.validation.findings import Problem, Report
 from plugnproduce.validation.shapes import shape_problems
 from plugnproduce.validation.structure import device_problems, process_problems, task_problems
