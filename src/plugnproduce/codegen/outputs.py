@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
-import copy
+import dataclasses
 from dataclasses import dataclass
 
 from plugnproduce.codegen.closed_world import closed_world_chart
-from plugnproduce.codegen.emit import el, pnp_attr, to_bytes
 from plugnproduce.codegen.projection import device_program
-from plugnproduce.codegen.task import GeneratedTask
+from plugnproduce.codegen.task import GeneratedTask, specific_name
 from plugnproduce.description.model import Cell
+from plugnproduce.statechart.io.writer import write_chart
+from plugnproduce.statechart.model import Chart as Document
+from plugnproduce.statechart.model import Final, Transition, pnp
 
 
 @dataclass(frozen=True)
@@ -23,20 +25,16 @@ class Chart:
 
 
 def specific_charts(generated: GeneratedTask) -> list[Chart]:
-    """One Specific Process State Chart per step: its process bound to the step's devices."""
+    """The Specific Process State Charts: a step's process bound to its devices, written once for all the
+    steps that share it (the task chart's step states name theirs in ``pnp:chart``)."""
     out = []
-    for step in generated.steps:
+    for step in generated.bodies():
         index = step.step.index
-        root = el("scxml", version="1.0", datamodel="python", initial=f"s{index}",
-                  name=f"s{index}-{step.process.id}")
-        root.set(pnp_attr("command"), step.process.id)
-        parallel = el("parallel", id=f"s{index}")
-        for region in step.regions:
-            parallel.append(copy.deepcopy(region.element))
-        parallel.append(el("transition", event=f"done.state.s{index}", target="done"))
-        root.append(parallel)
-        root.append(el("final", id="done"))
-        out.append(Chart(f"step{index:02d}-{step.process.id}.scxml", "specific", to_bytes(root)))
+        parallel = dataclasses.replace(step.element, children=[r.element for r in step.regions], extra_attrs={},
+                                       transitions=[Transition(event=f"done.state.s{index}", targets=["done"])])
+        root = Document(name=f"s{index}-{step.process.id}", initial=[f"s{index}"], datamodel="python",
+                        children=[parallel, Final(id="done")], extra_attrs={pnp("command"): step.process.id})
+        out.append(Chart(specific_name(index, step.process.id), "specific", write_chart(root)))
     return out
 
 

@@ -11,45 +11,37 @@ from __future__ import annotations
 
 import copy
 
-from lxml import etree
-
-from plugnproduce.codegen.emit import SCXML_NS, el, pnp_attr, to_bytes
 from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
-from plugnproduce.safeio import parse_xml
-
-S = f"{{{SCXML_NS}}}"
+from plugnproduce.statechart.io.writer import write_chart
+from plugnproduce.statechart.model import Chart, Final, State, Transition, pnp
 
 
 def device_program(generated: GeneratedTask, device: DeviceDescription) -> bytes:
     """The SCXML program of ``device`` for the generated task."""
-    chart = parse_xml(device.chart_file).getroot()
-    states = {s.get("id"): s for s in chart if isinstance(s.tag, str) and s.tag in (f"{S}state", f"{S}final")}
+    states = {s.id: s for s in device.chart.children if isinstance(s, State | Final)}
     path = [t for _, steps in generated.device_paths(device.id) for t in steps]
     visits = [device.initial] + [t.target for t in path]
     ids = [f"p{n}_{state_id}" for n, state_id in enumerate(visits)]
-    root = el("scxml", version="1.0", name=f"{device.id}-program", initial=ids[0])
-    root.set(pnp_attr("device"), device.id)
+    root = Chart(name=f"{device.id}-program", initial=ids[:1], extra_attrs={pnp("device"): device.id})
     for n, state_id in enumerate(visits):
         last = n == len(visits) - 1
-        state = el("final" if last else "state", id=ids[n])
-        state.set(pnp_attr("deviceState"), state_id)
+        state: State | Final = (Final if last else State)(id=ids[n], extra_attrs={pnp("deviceState"): state_id})
         concept = device.state(state_id).concept
         if concept:
-            state.set(pnp_attr("concept"), local_name(concept))
-        onentry = states[state_id].find(f"{S}onentry")
-        if onentry is not None:
-            state.append(copy.deepcopy(onentry))
-        if not last:
-            state.append(_step(states[state_id], path[n], ids[n + 1]))
-        root.append(state)
-    return to_bytes(root)
+            state.extra_attrs[pnp("concept")] = local_name(concept)
+        state.onentry = copy.deepcopy(states[state_id].onentry[:1])
+        if isinstance(state, State):
+            state.transitions.append(_step(states[state_id], path[n], ids[n + 1]))
+        root.children.append(state)
+    return write_chart(root)
 
 
-def _step(source: etree._Element, transition: ChartTransition, target: str) -> etree._Element:
+def _step(source: State | Final, transition: ChartTransition, target: str) -> Transition:
     """The chart's transition taken at this point, copied with a new target."""
-    original = next(t for t in source.findall(f"{S}transition") if t.sourceline == transition.line)
+    taken = source.transitions if isinstance(source, State) else []
+    original = next(t for t in taken if t.line == transition.line)
     t = copy.deepcopy(original)
-    t.set("target", target)
+    t.targets = [target]
     return t

@@ -20,7 +20,6 @@ from typing import Any
 from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols import upnp, xirp
-from plugnproduce.statechart import read_chart
 from plugnproduce.statechart.runtime.events import Event
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
@@ -57,8 +56,7 @@ class SimulatedDevice:
         self.description = device
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
-        chart = read_chart(device.chart_file)
-        self.interpreter = Interpreter(chart, io_processors={device.protocol: self},
+        self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
         self._loop = ChartLoop(self.interpreter)
         self._task: asyncio.Task[None] | None = None

@@ -28,6 +28,11 @@ CONCEPT = "{" + PNP_NS + "}concept"
 """Clark name of the ``pnp:concept`` annotation on states."""
 
 
+def pnp(name: str) -> str:
+    """The Clark name of a ``pnp:`` annotation attribute (``pnp("device")``)."""
+    return "{" + PNP_NS + "}" + name
+
+
 @dataclass(kw_only=True)
 class Node:
     """What every element of the model has: its source line and foreign-namespace attributes."""

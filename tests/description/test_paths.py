@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from plugnproduce import service
-from plugnproduce.codegen.paths import NoPath, find_path
+from plugnproduce.description.paths import NoPath, find_path
 from plugnproduce.description.model import Command
 
 P = "http://plugnproduce.org/ontology#"
