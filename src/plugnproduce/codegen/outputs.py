@@ -10,12 +10,12 @@ from plugnproduce.codegen.projection import device_program
 from plugnproduce.codegen.task import GeneratedTask, specific_name
 from plugnproduce.description.model import Cell
 from plugnproduce.statechart.io.writer import write_chart
-from plugnproduce.statechart.model import Chart as Document
+from plugnproduce.statechart.model import Chart
 from plugnproduce.statechart.model import Final, Transition, pnp
 
 
 @dataclass(frozen=True)
-class Chart:
+class GeneratedChart:
     """A generated document and the file name it is written under."""
 
     name: str
@@ -24,7 +24,7 @@ class Chart:
     data: bytes
 
 
-def specific_charts(generated: GeneratedTask) -> list[Chart]:
+def specific_charts(generated: GeneratedTask) -> list[GeneratedChart]:
     """The Specific Process State Charts: a step's process bound to its devices, written once for all the
     steps that share it (the task chart's step states name theirs in ``pnp:chart``)."""
     out = []
@@ -32,21 +32,21 @@ def specific_charts(generated: GeneratedTask) -> list[Chart]:
         index = step.step.index
         parallel = dataclasses.replace(step.element, children=[r.element for r in step.regions], extra_attrs={},
                                        transitions=[Transition(event=f"done.state.s{index}", targets=["done"])])
-        root = Document(name=f"s{index}-{step.process.id}", initial=[f"s{index}"], datamodel="python",
+        root = Chart(name=f"s{index}-{step.process.id}", initial=[f"s{index}"], datamodel="python",
                         children=[parallel, Final(id="done")], extra_attrs={pnp("command"): step.process.id})
-        out.append(Chart(specific_name(index, step.process.id), "specific", write_chart(root)))
+        out.append(GeneratedChart(specific_name(index, step.process.id), "specific", write_chart(root)))
     return out
 
 
-def all_charts(generated: GeneratedTask, cell: Cell, per_device: bool = False) -> list[Chart]:
+def all_charts(generated: GeneratedTask, cell: Cell, per_device: bool = False) -> list[GeneratedChart]:
     """The specific process charts, the task chart, the closed-world chart and, if asked, device programs."""
     name = generated.task.name
     charts = specific_charts(generated)
-    charts.append(Chart(f"{name}.task.scxml", "task", generated.task_chart()))
-    charts.append(Chart(f"{name}.closed-world.scxml", "closed-world", closed_world_chart(generated, cell)))
+    charts.append(GeneratedChart(f"{name}.task.scxml", "task", generated.task_chart()))
+    charts.append(GeneratedChart(f"{name}.closed-world.scxml", "closed-world", closed_world_chart(generated, cell)))
     if per_device:
         used = sorted({r.device.id for s in generated.steps for r in s.regions})
         for device in used:
-            charts.append(Chart(f"{name}.{device}.program.scxml", "device-program",
+            charts.append(GeneratedChart(f"{name}.{device}.program.scxml", "device-program",
                                 device_program(generated, cell.device(device))))
     return charts
