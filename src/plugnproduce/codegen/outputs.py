@@ -10,8 +10,7 @@ from plugnproduce.codegen.projection import device_program
 from plugnproduce.codegen.task import GeneratedTask, specific_name
 from plugnproduce.description.model import Cell
 from plugnproduce.statechart.io.writer import write_chart
-from plugnproduce.statechart.model import Chart
-from plugnproduce.statechart.model import Final, Transition, pnp
+from plugnproduce.statechart.model import Chart, Final, Transition, pnp
 
 
 @dataclass(frozen=True)

@@ -29,10 +29,10 @@ from plugnproduce.errors import PlugNProduceError, ProtocolConnectionError, Prot
 from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
+from plugnproduce.statechart.model import StateNode
 from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, MacroStep, MetaEvent
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
-from plugnproduce.statechart.model import StateNode
 
 RecordObserver = Callable[[dict[str, Any]], None]
 """Called with each journal record as soon as it is written."""

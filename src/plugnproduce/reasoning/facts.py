@@ -15,8 +15,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
-from plugnproduce.description.paths import NoPath, find_path
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
+from plugnproduce.description.paths import NoPath, find_path
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP_IRI
 from plugnproduce.reasoning import schema as s

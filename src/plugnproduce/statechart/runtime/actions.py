@@ -17,8 +17,6 @@ from typing import TYPE_CHECKING, Any
 
 from plugnproduce.errors import ExecutionError, PlugNProduceError
 from plugnproduce.safeio import parse_xml_bytes
-from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator, Expr, Location
-from plugnproduce.statechart.runtime.events import EventData
 from plugnproduce.statechart.model import (
     Assign,
     Cancel,
@@ -35,6 +33,8 @@ from plugnproduce.statechart.model import (
     Script,
     Send,
 )
+from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator, Expr, Location
+from plugnproduce.statechart.runtime.events import EventData
 
 if TYPE_CHECKING:
     from plugnproduce.statechart.runtime.interpreter import Interpreter

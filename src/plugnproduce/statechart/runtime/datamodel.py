@@ -22,8 +22,8 @@ from plugnproduce.statechart.runtime.events import ERROR, LOG, Event, MetaEvent
 from plugnproduce.statechart.runtime.invoke import resolve_src, value_from_file
 
 if TYPE_CHECKING:
-    from plugnproduce.statechart.runtime.compiled import CompiledChart, CState
     from plugnproduce.statechart.model import Chart, Data
+    from plugnproduce.statechart.runtime.compiled import CompiledChart, CState
 
 log = logging.getLogger("plugnproduce.statechart")
 

@@ -57,8 +57,10 @@ from typing import Any
 
 from plugnproduce.errors import ExecutionError
 from plugnproduce.safeio import read_bytes
-from plugnproduce.statechart.runtime.actions import Block
 from plugnproduce.statechart.io.checks import check_structure
+from plugnproduce.statechart.io.reader import parse_chart
+from plugnproduce.statechart.model import Chart
+from plugnproduce.statechart.runtime.actions import Block
 from plugnproduce.statechart.runtime.clock import Clock, MonotonicClock
 from plugnproduce.statechart.runtime.compiled import ROOT, CompiledChart, CState, CTransition
 from plugnproduce.statechart.runtime.datamodel import Datamodel
@@ -77,8 +79,6 @@ from plugnproduce.statechart.runtime.events import (
     TakenTransition,
 )
 from plugnproduce.statechart.runtime.invoke import Invocation, Invoker
-from plugnproduce.statechart.model import Chart
-from plugnproduce.statechart.io.reader import parse_chart
 
 log = logging.getLogger("plugnproduce.statechart")
 

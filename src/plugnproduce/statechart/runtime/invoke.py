@@ -18,9 +18,9 @@ from lxml import etree
 
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.safeio import parse_xml_bytes, read_bytes
+from plugnproduce.statechart.model import Chart
 from plugnproduce.statechart.runtime.actions import ActionError, Block, CInvoke, literal, value_of
 from plugnproduce.statechart.runtime.events import SCXML_TYPES, Event, EventData
-from plugnproduce.statechart.model import Chart
 
 if TYPE_CHECKING:
     from plugnproduce.statechart.runtime.compiled import CState
