@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import ast
 from pathlib import Path
 
 import pytest
+from statemachine.io.scxml.processor import SCXMLProcessor
 
 from plugnproduce import service
 from plugnproduce.resources import descriptions_path
 from plugnproduce.safeio import MAX_BYTES
 from plugnproduce.statechart import PNP_NS, Parallel, parse_chart
+from plugnproduce.statechart.model import Send, walk
 from plugnproduce.validation.validate import validate_paths
 
 STEPS = 1000
@@ -58,3 +61,35 @@ def test_long_task_output_is_small_and_accepted_by_validate(written: list[Path])
     assert sum(f.stat().st_size for f in written) < STEPS * 1024
     report = validate_paths(written)
     assert report.valid, [str(p) for p in report.sorted()]
+
+
+@pytest.fixture(scope="module")
+def varying_speeds(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Four bin-pick/place cycles that differ only in the place speed."""
+    text = (descriptions_path() / "tasks" / "bin-picking.yaml").read_text(encoding="utf-8")
+    head, body = text.split("steps:\n")
+    steps = "".join(body.replace("speed: 80", f"speed: {speed}") for speed in (20, 40, 60, 80))
+    path = tmp_path_factory.mktemp("speeds") / "bin-picking-speeds.yaml"
+    path.write_text(head.replace("repeat: 3", "repeat: 1") + "steps:\n" + steps, encoding="utf-8")
+    return path
+
+
+def test_steps_that_differ_only_in_values_share_a_chart_and_the_values_travel_as_data(varying_speeds: Path) -> None:
+    cell = service.cell(descriptions_path() / "cells" / "bin-picking.yaml")
+    charts = {c.name: c.data for c in service.generate(varying_speeds, cell).charts}
+    assert sorted(n for n in charts if n.startswith("step")) == ["step01-bin-pick.scxml", "step02-place.scxml",
+                                                                 "step03-bin-pick.scxml"]
+    task = parse_chart(charts["bin-picking.task.scxml"], "task")
+    values = next(d for d in task.data if d.id == "pnp_values")
+    assert [row.get("speed") for row in ast.literal_eval(values.expr or "")] == [None, 20, None, 40, None, 60, None, 80]
+    shared = next(s for s in task.states() if s.id == "s2")  # every place step runs it
+    params = [p.expr for n in walk(shared) if isinstance(n, Send) for p in n.params]
+    assert "pnp_values[pnp_step]['speed']" in params
+
+
+def test_values_read_from_the_datamodel_run_to_done_in_an_independent_interpreter(varying_speeds: Path) -> None:
+    cell = service.cell(descriptions_path() / "cells" / "bin-picking.yaml")
+    world = next(c for c in service.generate(varying_speeds, cell).charts if c.kind == "closed-world")
+    processor = SCXMLProcessor()
+    processor.parse_scxml("closed_world", world.data.decode())
+    assert set(processor.start().configuration_values) == {"done"}

@@ -19,6 +19,22 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
 
+PLAN, STEP, VALUES = "pnp_plan", "pnp_step", "pnp_values"
+"""Task chart datamodel: the chart each step runs (then 0), how many steps have ended, and each
+step's parameter values that differ between the steps sharing a chart."""
+
+
+@dataclass(frozen=True)
+class Varying:
+    """A parameter value that differs between the steps sharing a chart: read from the step's values."""
+
+    name: str
+
+    @property
+    def expr(self) -> str:
+        """The expression that reads it at run time."""
+        return f"{VALUES}[{STEP}][{self.name!r}]"
+
 
 @dataclass
 class RegionResult:
@@ -133,11 +149,12 @@ def _request(
     for name, value in sorted(values.items()):
         quantity = process.parameter(name).quantity
         if quantity in accepts:
-            send.params.append(Param(name=local_name(quantity), expr=_literal(value)))
+            expr = value.expr if isinstance(value, Varying) else literal(value)
+            send.params.append(Param(name=local_name(quantity), expr=expr))
     return send
 
 
-def _literal(value: object) -> str:
+def literal(value: object) -> str:
     """A Python-datamodel expression for a parameter value."""
     if isinstance(value, str) and not _is_pose(value):
         return repr(value)

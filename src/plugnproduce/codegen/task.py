@@ -12,7 +12,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from plugnproduce.codegen.specific import RegionResult, controller_ids, specific_region
+from plugnproduce.codegen.specific import (
+    PLAN,
+    STEP,
+    VALUES,
+    RegionResult,
+    Varying,
+    controller_ids,
+    literal,
+    specific_region,
+)
 from plugnproduce.description.model import Cell, ChartTransition, Command, ProcessDescription, Step, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -36,8 +45,8 @@ from plugnproduce.statechart.model import (
 DONE, FAILED = "done", "failed"
 NEXT = "next_step"
 """The state that picks the next step's chart from the plan."""
-PLAN, STEP = "pnp_plan", "pnp_step"
-"""Datamodel variables: the body number of every step (then 0), and how many steps have ended."""
+__all__ = ["DONE", "FAILED", "NEXT", "PLAN", "STEP", "VALUES", "GeneratedTask", "ImplausibleStep", "StepChart",
+           "generate_task", "specific_name", "step_values"]
 
 
 class ImplausibleStep(PlugNProduceError):
@@ -104,7 +113,7 @@ def step_values(step: Step, process: ProcessDescription) -> dict[str, object]:
     return values
 
 
-_Key = tuple[str, tuple[tuple[str, str], ...], tuple[tuple[str, str], ...], str]
+_Key = tuple[str, tuple[tuple[str, str], ...], tuple[tuple[str, str], ...], tuple[str, ...]]
 
 
 def generate_task(
@@ -116,28 +125,61 @@ def generate_task(
 ) -> GeneratedTask:
     """Generate the Task State Chart of a task whose steps are bound to devices (``bindings[i]`` for step i+1).
 
-    A step whose process, bindings, parameter values and device states equal an earlier
-    step's would generate the same chart: it reuses that chart, and the plan in the
-    task chart's datamodel says which chart runs at each step (no unrolling).
+    Steps with the same process, bindings, parameters and device states take the same
+    paths: they share one chart. The task chart's datamodel carries the plan (which chart
+    runs at each step) and the parameter values that differ between the steps sharing a
+    chart; nothing is unrolled.
     """
+    keys, values, firsts = _plan(task, cell, bindings, processes, taxonomy)
+    varying = {key: _varying([values[i] for i, k in enumerate(keys) if k == key]) for key in firsts}
+    charts: dict[_Key, StepChart] = {}
     current = {d.id: d.initial for d in cell.devices}
     steps: list[StepChart] = []
-    seen: dict[_Key, tuple[StepChart, dict[str, str]]] = {}
+    for i, (step, binding) in enumerate(zip(task.steps, bindings, strict=True)):
+        key, process = keys[i], processes[step.command]
+        if key not in charts:
+            bound = {n: Varying(n) if n in varying[key] else v for n, v in values[i].items()}
+            charts[key] = _step(step, process, binding, cell, dict(current), taxonomy, bound)
+        first = charts[key]
+        steps.append(StepChart(step, process, binding, first.regions, first.element, first.body))
+        current.update({r.device.id: r.end_state for r in first.regions})
+    rows = [{n: v for n, v in values[i].items() if n in varying[keys[i]]} for i in range(len(keys))]
+    return GeneratedTask(task, steps, _task_chart(task, steps, rows), current)
+
+
+def _plan(
+    task: Task,
+    cell: Cell,
+    bindings: list[dict[str, str]],
+    processes: dict[str, ProcessDescription],
+    taxonomy: Taxonomy,
+) -> tuple[list[_Key], list[dict[str, object]], dict[_Key, int]]:
+    """Each step's key (what its chart depends on) and values, and the first step of each key."""
+    current = {d.id: d.initial for d in cell.devices}
+    keys: list[_Key] = []
+    values: list[dict[str, object]] = []
+    after: dict[_Key, dict[str, str]] = {}
+    firsts: dict[_Key, int] = {}
     for step, binding in zip(task.steps, bindings, strict=True):
         process = processes[step.command]
-        values = step_values(step, process)
-        key = (process.id, tuple(sorted(binding.items())), tuple(sorted(current.items())), repr(sorted(values.items())))
-        if key not in seen:
-            chart = _step(step, process, binding, cell, current, taxonomy, values)
-            seen[key] = (chart, dict(current))
-        first, after = seen[key]
-        steps.append(StepChart(step, process, binding, first.regions, first.element, first.body))
-        current = dict(after)
-    return GeneratedTask(task, steps, _task_chart(task, steps), dict(current))
+        values.append(step_values(step, process))
+        key = (process.id, tuple(sorted(binding.items())), tuple(sorted(current.items())), tuple(sorted(values[-1])))
+        if key not in after:
+            placeholders: dict[str, object] = {n: Varying(n) for n in values[-1]}
+            _step(step, process, binding, cell, current, taxonomy, placeholders)
+            after[key], firsts[key] = dict(current), step.index
+        keys.append(key)
+        current = dict(after[key])
+    return keys, values, firsts
 
 
-def _task_chart(task: Task, steps: list[StepChart]) -> Chart:
-    """The task chart: each distinct step chart once, and the plan of which runs when."""
+def _varying(rows: list[dict[str, object]]) -> set[str]:
+    """The parameters whose values differ between these steps."""
+    return {n for n in rows[0] if any(repr(r[n]) != repr(rows[0][n]) for r in rows)}
+
+
+def _task_chart(task: Task, steps: list[StepChart], rows: list[dict[str, object]]) -> Chart:
+    """The task chart: each distinct step chart once, the plan of which runs when, and the values that vary."""
     bodies = [s for s in steps if s.body == s.step.index]
     plan = [s.body for s in steps] + [0]
     pick = State(id=NEXT, transitions=[Transition(cond=f"{PLAN}[{STEP}] == {b.body}", targets=[f"s{b.body}"])
@@ -145,8 +187,11 @@ def _task_chart(task: Task, steps: list[StepChart]) -> Chart:
     pick.transitions.append(Transition(cond=f"{PLAN}[{STEP}] == 0", targets=[DONE]))
     body = State(id="task", initial=[NEXT], transitions=[Transition(event="timeout error", targets=[FAILED])],
                  children=[pick, *(b.element for b in bodies)])
-    return Chart(name=f"task-{task.name}", initial=["task"], datamodel="python",
-                 data=[Data(id=PLAN, expr="[" + ", ".join(map(str, plan)) + "]"), Data(id=STEP, expr="0")],
+    data = [Data(id=PLAN, expr="[" + ", ".join(map(str, plan)) + "]"), Data(id=STEP, expr="0")]
+    if any(rows):
+        data.append(Data(id=VALUES, expr="[" + ", ".join(
+            "{" + ", ".join(f"{n!r}: {literal(v)}" for n, v in sorted(r.items())) + "}" for r in rows) + "]"))
+    return Chart(name=f"task-{task.name}", initial=["task"], datamodel="python", data=data,
                  children=[body, Final(id=DONE), Final(id=FAILED)])
 
 
