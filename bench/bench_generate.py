@@ -8,7 +8,7 @@ repeated) on the built-in bin-picking cell:
 - **baseline**: reading the task and writing its expanded steps as JSON, one line per step
   (what any tool that touches every step pays);
 - **check**: the reasoner's plausibility check and role bindings;
-- **generate**: the charts built (task, specific, closed-world) and written to a folder;
+- **generate**: the charts built (specific, task, closed-world, device programs) and written to a folder;
 - **bytes/step**: per chart kind, the bytes written divided by the number of steps, and the
   files written; every file must stay within the input limit of ``pnp validate``
   (``plugnproduce.safeio.MAX_BYTES``), and all are validated at the end.
@@ -83,7 +83,7 @@ def measure(steps: int, repeat: int, folder: Path) -> None:
     def generate() -> list[Path]:
         generated = generate_task(task, cell, bindings, processes, knowledge.taxonomy)
         written = []
-        for chart in all_charts(generated, cell):
+        for chart in all_charts(generated, cell, per_device=True):
             (out / chart.name).write_bytes(chart.data)
             written.append(out / chart.name)
         return written
