@@ -7,13 +7,11 @@ the model's :class:`~plugnproduce.description.model.Task` with :meth:`TaskIn.to_
 
 from __future__ import annotations
 
-import math
 from typing import Annotated, Any
 
-from pydantic import AfterValidator, AliasChoices, BaseModel, ConfigDict, Field, WithJsonSchema, model_validator
+from pydantic import AfterValidator, AliasChoices, BaseModel, ConfigDict, Field, WithJsonSchema
 
 from plugnproduce.description.model import Step, Task
-from plugnproduce.safeio import MAX_DIGITS
 
 TASK_SOURCE = "task"
 """The ``file`` of a task that came as JSON: problems name its steps, not a file."""
@@ -21,18 +19,11 @@ TASK_SOURCE = "task"
 POSE_HELP = "a pose [x, y, z, rx, ry, rz] (metres, degrees)"
 
 
-def _number(value: Any) -> bool:
-    if isinstance(value, float) and not math.isfinite(value):
-        raise ValueError(f"{value} is not a number a device can be given; expected a finite number")
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**MAX_DIGITS:
-        raise ValueError(f"an integer of more than {MAX_DIGITS} digits")
-    return isinstance(value, int | float) and not isinstance(value, bool)
-
-
 def _param_value(value: Any) -> Any:
-    if isinstance(value, str | bool) or _number(value):
+    if isinstance(value, bool | int | float | str):
         return value
-    if isinstance(value, list) and len(value) <= 16 and all(_number(v) for v in value):
+    if isinstance(value, list) and len(value) <= 16 and all(
+            isinstance(v, int | float) and not isinstance(v, bool) for v in value):
         return value
     kind = "a mapping" if isinstance(value, dict) else ("null" if value is None else "a list of non-numbers")
     raise ValueError(f"a parameter value is a number, text, true or false, or {POSE_HELP}; found {kind}")
@@ -73,13 +64,6 @@ class TaskIn(BaseModel):
     description: str = Field("", max_length=2000)
     repeat: int = Field(1, ge=1, le=1000, description="The steps run this many times in a row.")
     steps: list[StepIn] = Field(min_length=1, max_length=1000)
-
-    @model_validator(mode="after")
-    def _not_too_long(self) -> TaskIn:
-        if len(self.steps) * self.repeat > Task.MAX_STEPS:
-            raise ValueError(f"{len(self.steps)} steps repeated {self.repeat} times make "
-                             f"{len(self.steps) * self.repeat}; at most {Task.MAX_STEPS} are accepted")
-        return self
 
     def to_task(self) -> Task:
         """The model's task: steps numbered from 1 in the expanded (repeated) order."""
