@@ -93,3 +93,10 @@ def test_values_read_from_the_datamodel_run_to_done_in_an_independent_interprete
     processor = SCXMLProcessor()
     processor.parse_scxml("closed_world", world.data.decode())
     assert set(processor.start().configuration_values) == {"done"}
+
+
+def test_a_shared_specific_chart_carries_the_values_of_its_first_step(varying_speeds: Path) -> None:
+    cell = service.cell(descriptions_path() / "cells" / "bin-picking.yaml")
+    place = next(c for c in service.generate(varying_speeds, cell).charts if c.name == "step02-place.scxml")
+    chart = parse_chart(place.data, place.name)
+    assert {d.id: d.expr for d in chart.data} == {"pnp_step": "0", "pnp_values": "[{'speed': 20}]"}

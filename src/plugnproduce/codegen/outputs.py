@@ -7,10 +7,10 @@ from dataclasses import dataclass
 
 from plugnproduce.codegen.closed_world import closed_world_chart
 from plugnproduce.codegen.projection import device_program
-from plugnproduce.codegen.task import GeneratedTask, specific_name
+from plugnproduce.codegen.task import STEP, GeneratedTask, specific_name, values_data
 from plugnproduce.description.model import Cell
 from plugnproduce.statechart.io.writer import write_chart
-from plugnproduce.statechart.model import Chart, Final, Transition, pnp
+from plugnproduce.statechart.model import Chart, Data, Final, Transition, pnp
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,9 @@ def specific_charts(generated: GeneratedTask) -> list[GeneratedChart]:
         parallel = dataclasses.replace(step.element, children=[r.element for r in step.regions], extra_attrs={},
                                        transitions=[Transition(event=f"done.state.s{index}", targets=["done"])])
         root = Chart(name=f"s{index}-{step.process.id}", initial=[f"s{index}"], datamodel="python",
-                        children=[parallel, Final(id="done")], extra_attrs={pnp("command"): step.process.id})
+                     children=[parallel, Final(id="done")], extra_attrs={pnp("command"): step.process.id})
+        if step.varying:  # values its other steps change: this chart runs with those of its first step
+            root.data = [Data(id=STEP, expr="0"), values_data([step.varying])]
         out.append(GeneratedChart(specific_name(index, step.process.id), "specific", write_chart(root)))
     return out
 

@@ -46,7 +46,7 @@ DONE, FAILED = "done", "failed"
 NEXT = "next_step"
 """The state that picks the next step's chart from the plan."""
 __all__ = ["DONE", "FAILED", "NEXT", "PLAN", "STEP", "VALUES", "GeneratedTask", "ImplausibleStep", "StepChart",
-           "generate_task", "specific_name", "step_values"]
+           "generate_task", "specific_name", "step_values", "values_data"]
 
 
 class ImplausibleStep(PlugNProduceError):
@@ -72,6 +72,8 @@ class StepChart:
     regions: list[RegionResult]
     element: Parallel
     body: int
+    varying: dict[str, object] = field(default_factory=dict)
+    """This step's values of the parameters that differ between the steps sharing its chart."""
 
 
 @dataclass
@@ -141,10 +143,10 @@ def generate_task(
             bound = {n: Varying(n) if n in varying[key] else v for n, v in values[i].items()}
             charts[key] = _step(step, process, binding, cell, dict(current), taxonomy, bound)
         first = charts[key]
-        steps.append(StepChart(step, process, binding, first.regions, first.element, first.body))
+        row = {n: v for n, v in values[i].items() if n in varying[key]}
+        steps.append(StepChart(step, process, binding, first.regions, first.element, first.body, row))
         current.update({r.device.id: r.end_state for r in first.regions})
-    rows = [{n: v for n, v in values[i].items() if n in varying[keys[i]]} for i in range(len(keys))]
-    return GeneratedTask(task, steps, _task_chart(task, steps, rows), current)
+    return GeneratedTask(task, steps, _task_chart(task, steps), current)
 
 
 def _plan(
@@ -178,7 +180,13 @@ def _varying(rows: list[dict[str, object]]) -> set[str]:
     return {n for n in rows[0] if any(repr(r[n]) != repr(rows[0][n]) for r in rows)}
 
 
-def _task_chart(task: Task, steps: list[StepChart], rows: list[dict[str, object]]) -> Chart:
+def values_data(rows: list[dict[str, object]]) -> Data:
+    """The ``pnp_values`` datamodel entry: per step, the values that differ between steps sharing a chart."""
+    return Data(id=VALUES, expr="[" + ", ".join(
+        "{" + ", ".join(f"{n!r}: {literal(v)}" for n, v in sorted(r.items())) + "}" for r in rows) + "]")
+
+
+def _task_chart(task: Task, steps: list[StepChart]) -> Chart:
     """The task chart: each distinct step chart once, the plan of which runs when, and the values that vary."""
     bodies = [s for s in steps if s.body == s.step.index]
     plan = [s.body for s in steps] + [0]
@@ -188,9 +196,8 @@ def _task_chart(task: Task, steps: list[StepChart], rows: list[dict[str, object]
     body = State(id="task", initial=[NEXT], transitions=[Transition(event="timeout error", targets=[FAILED])],
                  children=[pick, *(b.element for b in bodies)])
     data = [Data(id=PLAN, expr="[" + ", ".join(map(str, plan)) + "]"), Data(id=STEP, expr="0")]
-    if any(rows):
-        data.append(Data(id=VALUES, expr="[" + ", ".join(
-            "{" + ", ".join(f"{n!r}: {literal(v)}" for n, v in sorted(r.items())) + "}" for r in rows) + "]"))
+    if any(s.varying for s in steps):
+        data.append(values_data([s.varying for s in steps]))
     return Chart(name=f"task-{task.name}", initial=["task"], datamodel="python", data=data,
                  children=[body, Final(id=DONE), Final(id=FAILED)])
 
