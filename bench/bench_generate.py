@@ -1,9 +1,10 @@
 """Benchmark of code generation for long tasks (prints figures; not a test).
 
-    python bench/bench_generate.py [--steps 100 1000 10000] [--repeat 3]
+    python bench/bench_generate.py [--steps 100 1000 10000] [--repeat 3] [--tasks repeated distinct]
 
-For each size, a bin-picking task of that many steps (ten steps of bin-pick/place,
-repeated) on the built-in bin-picking cell:
+For each size, bin-picking tasks of that many steps on the built-in bin-picking cell:
+``repeated`` (ten steps of bin-pick/place written out, repeated) and ``distinct`` (every
+step written out, each with its own grip force or speed, so no two steps are the same):
 
 - **baseline**: reading the task and writing its expanded steps as JSON, one line per step
   (what any tool that touches every step pays);
@@ -38,12 +39,17 @@ CYCLE = 10
 """Steps written out in the task file; ``repeat`` makes up the rest."""
 
 
-def task_file(folder: Path, steps: int) -> Path:
-    """A bin-picking task of ``steps`` steps: ten steps written out, repeated."""
+def task_file(folder: Path, steps: int, kind: str) -> Path:
+    """A bin-picking task of ``steps`` steps: ten written out and repeated, or all written out and distinct."""
     text = (descriptions_path() / "tasks" / "bin-picking.yaml").read_text(encoding="utf-8")
     head, body = text.split("steps:\n")
+    path = folder / f"bin-picking-{kind}-{steps}.yaml"
+    if kind == "distinct":
+        cycles = (body.replace("grip_force: 45", f"grip_force: {20 + i % 50}").replace("speed: 80", f"speed: {i + 1}")
+                  for i in range(steps // 2))
+        path.write_text(head.replace("repeat: 3", "repeat: 1") + "steps:\n" + "".join(cycles), encoding="utf-8")
+        return path
     cycle = min(steps, CYCLE)
-    path = folder / f"bin-picking-{steps}.yaml"
     path.write_text(head.replace("repeat: 3", f"repeat: {steps // cycle}") + "steps:\n" + body * (cycle // 2),
                     encoding="utf-8")
     return path
@@ -59,9 +65,9 @@ def best(repeat: int, work: Callable[[], object]) -> tuple[float, object]:
     return min(times), result
 
 
-def measure(steps: int, repeat: int, folder: Path) -> None:
+def measure(steps: int, kind: str, repeat: int, folder: Path) -> None:
     """Print the figures for a task of ``steps`` steps."""
-    path = task_file(folder, steps)
+    path = task_file(folder, steps, kind)
     cell = service.cell(descriptions_path() / "cells" / "bin-picking.yaml")
     knowledge = service.knowledge()
     processes = {p.id: p for p in knowledge.processes}
@@ -77,7 +83,7 @@ def measure(steps: int, repeat: int, folder: Path) -> None:
     task = service.task(path)
     t_check, result = best(repeat, lambda: service.check(task, cell))
     bindings = result.bindings()  # type: ignore[attr-defined]
-    out = folder / f"out-{steps}"
+    out = folder / f"out-{kind}-{steps}"
     out.mkdir(exist_ok=True)
 
     def generate() -> list[Path]:
@@ -91,15 +97,14 @@ def measure(steps: int, repeat: int, folder: Path) -> None:
     t_gen, files = best(repeat, generate)
     by_kind: dict[str, list[int]] = defaultdict(list)
     for f in files:  # type: ignore[attr-defined]
-        kind = "specific" if f.name.startswith("step") else f.name.split(".")[-2]
-        by_kind[kind].append(f.stat().st_size)
-    print(f"{steps:>6} steps  baseline {t_base:7.3f} s {base_bytes / steps:6.1f} B/step | "
+        by_kind["specific" if f.name.startswith("step") else f.name.split(".")[-2]].append(f.stat().st_size)
+    print(f"{steps:>6} steps {kind:<9} baseline {t_base:7.3f} s {base_bytes / steps:6.1f} B/step | "
           f"check {t_check:7.3f} s | generate {t_gen:7.3f} s ({t_gen / t_base:5.1f}x baseline)")
-    for kind, sizes in sorted(by_kind.items()):
-        print(f"{'':>14}{kind:<13} {len(sizes):>3} file(s) {sum(sizes) / steps:8.1f} B/step  "
+    for chart_kind, sizes in sorted(by_kind.items()):
+        print(f"{'':>24}{chart_kind:<13} {len(sizes):>3} file(s) {sum(sizes) / steps:8.1f} B/step  "
               f"largest {max(sizes):>9} B  within validate's limit: {max(sizes) <= MAX_BYTES}")
     report = validate_paths(files)  # type: ignore[arg-type]
-    print(f"{'':>14}pnp validate: {'valid' if report.valid else 'NOT VALID'} ({len(files)} files)")  # type: ignore[arg-type]
+    print(f"{'':>24}pnp validate: {'valid' if report.valid else 'NOT VALID'} ({len(files)} files)")  # type: ignore[arg-type]
 
 
 def main() -> None:
@@ -107,10 +112,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--steps", type=int, nargs="+", default=[100, 1000, 10000])
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--tasks", nargs="+", choices=("repeated", "distinct"), default=["repeated", "distinct"])
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="bench-generate-") as tmp:
         for steps in args.steps:
-            measure(steps, args.repeat, Path(tmp))
+            for kind in args.tasks:
+                measure(steps, kind, args.repeat, Path(tmp))
 
 
 if __name__ == "__main__":
