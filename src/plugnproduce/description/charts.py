@@ -14,13 +14,22 @@ from pathlib import Path
 
 from plugnproduce.description.model import ChartState, ChartTransition, Command, RegionState
 from plugnproduce.errors import DescriptionError
-from plugnproduce.ontology.vocabulary import PNP_IRI, concept_iri
-from plugnproduce.statechart.model import Chart, Final, Node, Parallel, Send, State, StateNode, Transition, walk
+from plugnproduce.ontology.vocabulary import concept_iri
+from plugnproduce.statechart.model import (
+    CONCEPT,
+    Chart,
+    Final,
+    Node,
+    Parallel,
+    Send,
+    State,
+    StateNode,
+    Transition,
+    pnp,
+    walk,
+)
 
-CONCEPT = "{" + PNP_IRI + "}concept"
-ACCEPTS = "{" + PNP_IRI + "}accepts"
-ROLE = "{" + PNP_IRI + "}role"
-PARAMS = "{" + PNP_IRI + "}params"
+ACCEPTS, ROLE, PARAMS = pnp("accepts"), pnp("role"), pnp("params")
 _IN = re.compile(r"""In\(\s*['"]([^'"]+)['"]\s*\)""")
 
 
