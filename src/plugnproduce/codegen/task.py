@@ -132,8 +132,11 @@ def generate_task(
     runs at each step) and the parameter values that differ between the steps sharing a
     chart; nothing is unrolled.
     """
-    keys, values, firsts = _plan(task, cell, bindings, processes, taxonomy)
-    varying = {key: _varying([values[i] for i, k in enumerate(keys) if k == key]) for key in firsts}
+    keys, values = _plan(task, cell, bindings, processes, taxonomy)
+    groups: dict[_Key, list[dict[str, object]]] = {}
+    for key, row in zip(keys, values, strict=True):
+        groups.setdefault(key, []).append(row)
+    varying = {key: _varying(rows) for key, rows in groups.items()}
     charts: dict[_Key, StepChart] = {}
     current = {d.id: d.initial for d in cell.devices}
     steps: list[StepChart] = []
@@ -155,13 +158,12 @@ def _plan(
     bindings: list[dict[str, str]],
     processes: dict[str, ProcessDescription],
     taxonomy: Taxonomy,
-) -> tuple[list[_Key], list[dict[str, object]], dict[_Key, int]]:
-    """Each step's key (what its chart depends on) and values, and the first step of each key."""
+) -> tuple[list[_Key], list[dict[str, object]]]:
+    """Each step's key (what its chart depends on: process, bindings, device states, parameters) and values."""
     current = {d.id: d.initial for d in cell.devices}
     keys: list[_Key] = []
     values: list[dict[str, object]] = []
     after: dict[_Key, dict[str, str]] = {}
-    firsts: dict[_Key, int] = {}
     for step, binding in zip(task.steps, bindings, strict=True):
         process = processes[step.command]
         values.append(step_values(step, process))
@@ -169,10 +171,10 @@ def _plan(
         if key not in after:
             placeholders: dict[str, object] = {n: Varying(n) for n in values[-1]}
             _step(step, process, binding, cell, current, taxonomy, placeholders)
-            after[key], firsts[key] = dict(current), step.index
+            after[key] = dict(current)
         keys.append(key)
         current = dict(after[key])
-    return keys, values, firsts
+    return keys, values
 
 
 def _varying(rows: list[dict[str, object]]) -> set[str]:
