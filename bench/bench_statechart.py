@@ -29,9 +29,9 @@ from statemachine.io.scxml.processor import SCXMLProcessor
 from plugnproduce import service
 from plugnproduce.codegen.closed_world import closed_world_chart
 from plugnproduce.statechart import parse_chart
-from plugnproduce.statechart.clock import ManualClock
-from plugnproduce.statechart.interpreter import Interpreter
 from plugnproduce.statechart.model import Chart
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 TOGGLE = b"""<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="off" datamodel="python">
   <state id="off"><transition event="toggle" target="on"/></state>

@@ -9,6 +9,7 @@ import pytest
 from plugnproduce.drawing import chart_to_dot, draw_chart
 from plugnproduce.errors import DescriptionError
 from plugnproduce.resources import descriptions_path
+from plugnproduce.statechart import Chart, State, Transition
 
 D = descriptions_path()
 
@@ -37,3 +38,11 @@ def test_draw_writes_a_picture(tmp_path: Path, suffix: str) -> None:
 def test_unknown_picture_format_is_refused(tmp_path: Path) -> None:
     with pytest.raises(DescriptionError, match="expected a file ending in .svg"):
         draw_chart(D / "devices" / "gripper.scxml", tmp_path / "x.gif")
+
+
+def test_a_chart_model_is_drawn_without_a_file() -> None:
+    chart = Chart(name="toggle", initial=["off"], children=[
+        State(id="off", transitions=[Transition(event="flip", targets=["on"])]),
+        State(id="on", transitions=[Transition(event="flip", targets=["off"])])])
+    dot = chart_to_dot(chart).source
+    assert "digraph toggle" in dot and "off -> on" in dot and "flip" in dot

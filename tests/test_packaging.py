@@ -32,7 +32,7 @@ def test_wheel_ships_the_data_folders(tmp_path: Path) -> None:
         "plugnproduce/data/ontology/shapes.ttl",
         "plugnproduce/data/descriptions/cells/bin-picking.yaml",
         "plugnproduce/data/descriptions/devices/gripper.scxml",
-        "plugnproduce/statechart/w3c/scxml.xsd",
+        "plugnproduce/statechart/io/w3c/scxml.xsd",
         "plugnproduce/py.typed",
     ):
         assert needed in names, needed

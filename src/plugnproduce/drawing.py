@@ -10,86 +10,86 @@ from __future__ import annotations
 from pathlib import Path
 
 import graphviz
-from lxml import etree
 
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
-from plugnproduce.safeio import parse_xml
+from plugnproduce.statechart.io.reader import read_chart
+from plugnproduce.statechart.model import Chart, Final, Parallel, Raise, Send, State, StateNode, Transition, walk
 
-SCXML = "{http://www.w3.org/2005/07/scxml}"
-_CONTAINERS = {SCXML + "state", SCXML + "parallel", SCXML + "final", SCXML + "history", SCXML + "initial"}
 FORMATS = ("svg", "png", "pdf", "dot")
+_Edge = tuple[str, str, str, "str | None"]
 
 
-def _is_compound(el: etree._Element) -> bool:
-    return el.tag == SCXML + "parallel" or any(c.tag in _CONTAINERS for c in el)
+def _is_compound(node: StateNode) -> bool:
+    return isinstance(node, Parallel) or (isinstance(node, State) and bool(node.children))
 
 
-def _anchor(el: etree._Element) -> str:
-    """The node an edge to ``el`` points at: itself, or its first atomic descendant."""
-    while _is_compound(el):
-        el = next(c for c in el if c.tag in _CONTAINERS and c.tag != SCXML + "initial")
-    return el.get("id", "")
+def _anchor(node: StateNode) -> str:
+    """The node an edge to ``node`` points at: itself, or its first atomic descendant."""
+    while isinstance(node, State | Parallel) and node.children:
+        node = node.children[0]
+    return node.id or ""
 
 
-def _label(t: etree._Element) -> str:
+def _label(t: Transition) -> str:
     parts = []
-    if t.get("event"):
-        parts.append(t.get("event", ""))
-    if t.get("cond"):
-        parts.append(f"[{t.get('cond')}]")
+    if t.event:
+        parts.append(t.event)
+    if t.cond:
+        parts.append(f"[{t.cond}]")
     actions = []
-    for a in t.iter(SCXML + "send", SCXML + "raise"):
-        verb = "send" if a.tag == SCXML + "send" else "raise"
-        target = f" → {a.get('target')}" if a.get("target") else ""
-        actions.append(f"{verb} {a.get('event', '')}{target}")
+    for a in (n for action in t.actions for n in walk(action, into_charts=False)):
+        if isinstance(a, Send | Raise):
+            verb = "send" if isinstance(a, Send) else "raise"
+            target = f" → {a.target}" if isinstance(a, Send) and a.target else ""
+            actions.append(f"{verb} {a.event or ''}{target}")
     if actions:
         parts.append("/ " + "\\n".join(actions))
     return "\\n".join(parts)
 
 
-def _state_label(el: etree._Element) -> str:
-    concept = el.get("{" + PNP_IRI + "}concept")
-    return f"{el.get('id')}\\n«{local_name(concept)}»" if concept else str(el.get("id"))
+def _state_label(node: StateNode) -> str:
+    concept = node.extra_attrs.get("{" + PNP_IRI + "}concept")
+    return f"{node.id}\\n«{local_name(concept)}»" if concept else str(node.id)
 
 
-def _add(graph: graphviz.Digraph, el: etree._Element, edges: list[tuple[str, str, str, str | None]]) -> None:
-    for child in el:
-        if child.tag not in _CONTAINERS or child.tag == SCXML + "initial":
+def _add(graph: graphviz.Digraph, container: Chart | State | Parallel, edges: list[_Edge]) -> None:
+    for child in container.children:
+        if not isinstance(child, State | Parallel | Final):
             continue
-        sid = child.get("id", "")
+        sid = child.id or ""
         if _is_compound(child):
             with graph.subgraph(name=f"cluster_{sid}") as sub:
-                style = "dashed" if child.tag == SCXML + "parallel" else "rounded"
-                role = child.get("{" + PNP_IRI + "}role")
+                style = "dashed" if isinstance(child, Parallel) else "rounded"
+                role = child.extra_attrs.get("{" + PNP_IRI + "}role")
                 sub.attr(label=f"{sid}" + (f" (role {role})" if role else ""), style=style)
-                _add(sub, child, edges)
+                _add(sub, child, edges)  # type: ignore[arg-type]
         else:
-            final = "2" if child.tag == SCXML + "final" else "1"
+            final = "2" if isinstance(child, Final) else "1"
             graph.node(sid, _state_label(child), shape="box", style="rounded", peripheries=final)
-        for t in child.findall(SCXML + "transition"):
-            for target in (t.get("target") or "").split():
+        for t in child.transitions if isinstance(child, State | Parallel) else ():
+            for target in t.targets:
                 edges.append((sid, target, _label(t), f"cluster_{sid}" if _is_compound(child) else None))
 
 
-def chart_to_dot(path: str | Path) -> graphviz.Digraph:
-    """The Graphviz graph of an SCXML chart."""
-    root = parse_xml(path).getroot()
-    if root.tag != SCXML + "scxml":
-        raise DescriptionError("expected an <scxml> document", path, root.sourceline)
-    graph = graphviz.Digraph(name=root.get("name") or Path(path).stem)
-    graph.attr(rankdir="LR", compound="true", fontname="Helvetica", label=root.get("name") or Path(path).stem)
+def chart_to_dot(chart: Chart | str | Path, name: str | None = None) -> graphviz.Digraph:
+    """The Graphviz graph of a chart (a model, or an SCXML file read with the one reader)."""
+    if not isinstance(chart, Chart):
+        name = name or Path(chart).stem
+        chart = read_chart(chart)
+    title = chart.name or name or "chart"
+    graph = graphviz.Digraph(name=title)
+    graph.attr(rankdir="LR", compound="true", fontname="Helvetica", label=title)
     graph.attr("node", fontname="Helvetica", fontsize="10")
     graph.attr("edge", fontname="Helvetica", fontsize="8")
-    edges: list[tuple[str, str, str, str | None]] = []
-    _add(graph, root, edges)
-    ids = {el.get("id"): el for el in root.iter() if el.get("id")}
+    edges: list[_Edge] = []
+    _add(graph, chart, edges)
+    ids = {node.id: node for node in chart.states() if node.id}
     for source, target, label, ltail in edges:
         if target not in ids:
             continue
         attrs = {"label": label}
-        src_el = ids.get(source)
-        src = _anchor(src_el) if src_el is not None else source
+        src = _anchor(ids[source]) if source in ids else source
         if ltail:
             attrs["ltail"] = ltail
         if _is_compound(ids[target]):

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from plugnproduce import reasoning
 from plugnproduce.codegen import GeneratedTask, generate_task
-from plugnproduce.codegen.outputs import Chart, all_charts
+from plugnproduce.codegen.outputs import GeneratedChart, all_charts
 from plugnproduce.description.loader import load_cell, load_devices, load_processes, load_task
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import PlugNProduceError
@@ -178,7 +178,7 @@ class Generated:
     """A task's generated program: the task chart model and every chart written for it."""
 
     task: GeneratedTask
-    charts: list[Chart]
+    charts: list[GeneratedChart]
 
 
 def generate(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path, per_device: bool = False) -> Generated:

@@ -8,7 +8,10 @@ from lxml import etree
 from plugnproduce import service
 from plugnproduce.codegen import ImplausibleStep, generate_task
 from plugnproduce.codegen.outputs import all_charts
-from plugnproduce.statechart.schema import schema_problems
+from plugnproduce.statechart import parse_chart
+from plugnproduce.statechart.io.schema import schema_problems
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.interpreter import Interpreter
 from tests.codegen.conftest import bind_by_skill, generate
 
 NS = {"s": "http://www.w3.org/2005/07/scxml", "pnp": "http://plugnproduce.org/ontology#"}
@@ -74,6 +77,25 @@ def test_implausible_step_is_refused(bin_picking_cell, processes) -> None:
 
 def test_device_program_lists_the_gripper_commands_in_order(generated, bin_picking_cell) -> None:
     program = next(c for c in all_charts(generated, bin_picking_cell, True) if c.name == "bin-picking.gripper.program.scxml")
-    tree = etree.fromstring(program.data)
-    requests = [t.get("event") for t in tree.iterfind(".//s:transition", NS) if "request" in (t.get("event") or "")]
-    assert requests == ["xirp.request.Close", "xirp.request.Open"] * 3
+    sent: list[str] = []
+
+    class Wire:
+        def send(self, event, target, type) -> None:  # noqa: A002 - the SCXML name
+            sent.append(event.name)
+
+    clock = ManualClock()
+    program_run = Interpreter(parse_chart(program.data, program.name), clock=clock, io_processors={"xirp": Wire()})
+    program_run.start()
+    for request in ["xirp.request.Close", "xirp.request.Open"] * 3:
+        program_run.queue(request).execute()
+        clock.advance(1.0)
+        program_run.execute()
+    assert sent == ["xirp.event.gripper_closed", "xirp.event.gripper_opened"] * 3
+    assert program_run.final_state == "end"
+
+
+def test_device_program_writes_each_distinct_path_once(generated, bin_picking_cell) -> None:
+    program = next(c for c in all_charts(generated, bin_picking_cell, True) if c.name == "bin-picking.gripper.program.scxml")
+    requests = [t.event for s in parse_chart(program.data, program.name).states() for t in getattr(s, "transitions", [])
+                if "request" in (t.event or "")]
+    assert requests == ["xirp.request.Close", "xirp.request.Open"]

@@ -8,7 +8,8 @@ from decimal import Decimal
 import pytest
 from lxml import etree
 
-from plugnproduce.errors import ProtocolError
+from plugnproduce.errors import DescriptionError, ProtocolError
+from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.xirp import (
     MAX_FRAME,
     NAMESPACE,
@@ -25,8 +26,10 @@ from plugnproduce.protocols.xirp import (
     Request,
     Response,
     decode,
+    documents_of,
     encode,
     encode_frame,
+    files_from_documents,
     format_endpoint,
     frame,
     parse_endpoint,
@@ -34,6 +37,7 @@ from plugnproduce.protocols.xirp import (
 )
 from plugnproduce.protocols.xirp.codec import frame_length
 from plugnproduce.protocols.xirp.decoding import _decode_document
+from plugnproduce.protocols.xirp.messages import SCXML, TURTLE
 
 NS = f'xmlns="{NAMESPACE}"'
 TIME = datetime(2024, 5, 17, 9, 30, 12, 250000, tzinfo=UTC)
@@ -282,11 +286,18 @@ def test_a_frame_is_a_big_endian_length_and_the_document() -> None:
 
 def test_device_files_come_back_from_the_documents_of_a_describe_response() -> None:
     files = DeviceFiles("gripper.ttl", "@prefix pnp: <x#> .\n", "gripper.scxml", "<scxml/>")
-    assert DeviceFiles.from_documents(files.documents(), "describe") == files
+    assert files_from_documents(documents_of(files), "describe") == files
     with pytest.raises(MessageError, match="expected a application/scxml"):
-        DeviceFiles.from_documents(files.documents()[:1], "describe of gripper")
-    with pytest.raises(MessageError, match="plain file name"):
+        files_from_documents(documents_of(files)[:1], "describe of gripper")
+    with pytest.raises(DescriptionError, match="plain file name"):
         DeviceFiles("../etc/passwd", "", "g.scxml", "")
+    bad = (Document("../x.ttl", TURTLE, ""), Document("g.scxml", SCXML, ""))
+    with pytest.raises(MessageError, match="describe of gripper: .*plain file name"):
+        files_from_documents(bad, "describe of gripper")
+
+
+def test_one_device_files_class_serves_both_protocols() -> None:
+    assert xirp.DeviceFiles is upnp.DeviceFiles
 
 
 @pytest.mark.parametrize(

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import pytest
 
+from plugnproduce.reasoning import solver
+from plugnproduce.resources import rules_path
 from tests.reasoning.conftest import answer_sets
 
 GRIPPER = """
@@ -49,8 +51,8 @@ recovers(P,R,D,Y) :- leaves(P,R,D,_,Y).
 WORLD = GRIPPER + ROBOT + PROCESSES + LEAVES
 SECOND_GRIPPER = GRIPPER.replace('"g"', '"h"').replace("1000", "500")
 
-OFFERED = ["roles.lp", "offered.lp", "bindings.lp", "explain.lp"]
-CHECK = ["roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"]
+OFFERED = list(solver.rules("capabilities", show=False))
+CHECK = list(solver.rules("check", show=False))
 
 
 def cell(*devices: str) -> str:
@@ -194,7 +196,7 @@ def test_a_shared_device_plays_its_roles_in_role_order() -> None:
     assert model == {'at("c","t",1,"g","o")', 'at("c","t",2,"g","c")', 'plausible("c","t")'}
 
 
-REPAIR = ["roles.lp", "chain.lp", "params.lp", "repair.lp"]
+REPAIR = list(solver.rules("repair", show=False))
 COSTS = ('edit_cost("insert",P,100+100*N) :- nroles(P,N). edit_cost("remove","",400). edit_cost("swap","",300). '
          'edit_cost("rebind","",200). edit_cost("reset","",100).')
 
@@ -237,7 +239,7 @@ def test_repair(facts: str, expected: list[set[str]]) -> None:
     assert sorted(map(sorted, found)) == sorted(map(sorted, expected))
 
 
-BATCH = ["roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"]
+BATCH = list(solver.rules("batch", show=False))
 
 
 def test_batch_stage1_proposes_devices_that_fill_every_missing_role() -> None:
@@ -252,3 +254,8 @@ def test_batch_stage2_keeps_the_cheapest_device_that_works() -> None:
              + 'config("v2"). member("v2","r"). member("v2","h"). variant("v2","c","h"). check("v2","t").')
     (model,) = answer_sets(BATCH, facts, ["cheapest/3"])
     assert model == {'cheapest("c","t","h")'}
+
+
+def test_every_encoding_file_belongs_to_a_program_and_every_program_names_files_that_exist() -> None:
+    named = {name for program in solver.PROGRAMS for name in solver.rules(program)}
+    assert named == {f.name for f in rules_path().glob("*.lp")}

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from plugnproduce.statechart.clock import ManualClock
-from plugnproduce.statechart.interpreter import Interpreter
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 MAX_STEPS = 1_000
 

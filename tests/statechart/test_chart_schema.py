@@ -12,7 +12,7 @@ HEAD = b'<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="a
 
 
 def test_the_schema_and_its_licence_ship_in_the_package() -> None:
-    folder = package_file("statechart", "w3c")
+    folder = package_file("statechart", "io", "w3c")
     assert (folder / "scxml.xsd").is_file() and (folder / "xml.xsd").is_file()
     assert "Copyright" in (folder / "scxml-copyright.xsd").read_text()
 

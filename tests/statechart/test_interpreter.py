@@ -8,9 +8,9 @@ import pytest
 
 from plugnproduce.errors import ExecutionError
 from plugnproduce.statechart import SCXML_NS, parse_chart
-from plugnproduce.statechart.clock import ManualClock
-from plugnproduce.statechart.events import ERROR, LOG, Event, MetaEvent
-from plugnproduce.statechart.interpreter import Interpreter
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.events import ERROR, LOG, Event, MetaEvent
+from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 
 def session(body: str, initial: str | None = None, **options: object) -> Interpreter:

@@ -9,9 +9,9 @@ from statemachine.io.scxml.processor import SCXMLProcessor
 from plugnproduce import service
 from plugnproduce.codegen.closed_world import closed_world_chart
 from plugnproduce.statechart import parse_chart
-from plugnproduce.statechart.clock import ManualClock
-from plugnproduce.statechart.events import EVENT_CONSUMED, TRANSITION_TAKEN, MetaEvent
-from plugnproduce.statechart.interpreter import Interpreter
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.events import EVENT_CONSUMED, TRANSITION_TAKEN, MetaEvent
+from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 CELL = service.builtin("cells", "bin-picking.yaml")
 

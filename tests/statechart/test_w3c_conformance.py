@@ -14,9 +14,9 @@ from pathlib import Path
 import pytest
 from statechart_support import run_to_end
 
-from plugnproduce.statechart.clock import ManualClock
-from plugnproduce.statechart.interpreter import Interpreter
-from plugnproduce.statechart.reader import parse_chart
+from plugnproduce.statechart.io.reader import parse_chart
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 IRP = Path(__file__).parent / "w3c" / "irp"
 SCXML_NS = b'xmlns="http://www.w3.org/2005/07/scxml"'

@@ -14,68 +14,52 @@ from __future__ import annotations
 
 import copy
 
-from lxml import etree
-
-from plugnproduce.codegen.emit import SCXML_NS, el, to_bytes
 from plugnproduce.codegen.task import DONE, FAILED, GeneratedTask
-from plugnproduce.description.model import Cell
-from plugnproduce.safeio import parse_xml
+from plugnproduce.description.model import Cell, DeviceDescription
+from plugnproduce.statechart.io.writer import write_chart
+from plugnproduce.statechart.model import Cancel, Chart, Final, History, Parallel, Send, State, Transition, walk
 
-S = f"{{{SCXML_NS}}}"
+_TARGETS = {DONE: f"controller_{DONE}", FAILED: f"controller_{FAILED}"}
 
 
 def closed_world_chart(generated: GeneratedTask, cell: Cell) -> bytes:
     """The closed-world simulation chart of a generated task on the devices of ``cell``."""
-    root = el("scxml", version="1.0", datamodel="python", initial="world", name=f"closed-world-{generated.task.name}")
-    world = el("parallel", id="world")
-    controller = copy.deepcopy(generated.chart.find(f"{S}state[@id='task']"))
-    assert controller is not None  # generate_task always writes it
-    controller.set("id", "controller")
-    for send in controller.iter(f"{S}send"):
-        if send.get("type") in ("xirp", "upnp"):
-            send.set("event", f"{send.get('target')}.{send.get('event')}")
-            del send.attrib["type"], send.attrib["target"]
-    for t in controller.iter(f"{S}transition"):
-        if t.get("target") in (DONE, FAILED):
-            t.set("target", f"controller_{t.get('target')}")
-    controller.append(el("final", id=f"controller_{DONE}"))
-    controller.append(el("final", id=f"controller_{FAILED}"))
-    world.append(controller)
-    for device in sorted(cell.devices, key=lambda d: d.id):
-        world.append(_device_region(device.id, device.chart_file, device.initial))
-    world.append(el("transition", event="done.state.controller", cond=f"In('controller_{DONE}')", target=DONE))
-    world.append(el("transition", event="done.state.controller", target=FAILED))
-    root.append(world)
-    root.append(el("final", id=DONE))
-    root.append(el("final", id=FAILED))
-    return to_bytes(root)
+    task = generated.chart
+    controller = copy.deepcopy(next(c for c in task.children if isinstance(c, State) and c.id == "task"))
+    controller.id = "controller"
+    for node in walk(controller, into_charts=False):
+        if isinstance(node, Send) and node.type in ("xirp", "upnp"):
+            node.event, node.type, node.target = f"{node.target}.{node.event}", None, None
+        elif isinstance(node, Transition):
+            node.targets = [_TARGETS.get(t, t) for t in node.targets]
+    controller.children += [Final(id=_TARGETS[DONE]), Final(id=_TARGETS[FAILED])]
+    world = Parallel(id="world", children=[controller])
+    world.children += [_device_region(device) for device in sorted(cell.devices, key=lambda d: d.id)]
+    world.transitions = [Transition(event="done.state.controller", cond=f"In('controller_{DONE}')", targets=[DONE]),
+                         Transition(event="done.state.controller", targets=[FAILED])]
+    root = Chart(name=f"closed-world-{generated.task.name}", initial=["world"], datamodel="python",
+                 data=copy.deepcopy(task.data), children=[world, Final(id=DONE), Final(id=FAILED)])
+    return write_chart(root)
 
 
-def _device_region(device: str, chart_file: str, initial: str) -> etree._Element:
+def _device_region(device: DeviceDescription) -> State:
     """A device's own chart as a region: ids and events prefixed with the device id."""
-    chart = parse_xml(chart_file).getroot()
-    prefix = device.replace("-", "_")
-    region = el("state", id=f"device_{prefix}", initial=f"{prefix}__{initial}")
-    for state in chart:
-        if not isinstance(state.tag, str) or state.tag not in (f"{S}state", f"{S}final"):
+    prefix = device.id.replace("-", "_")
+    region = State(id=f"device_{prefix}", initial=[f"{prefix}__{device.initial}"])
+    for state in device.chart.children:
+        if not isinstance(state, State | Final):
             continue
         s = copy.deepcopy(state)
-        for node in s.iter():
-            if node.get("id"):
-                node.set("id", f"{prefix}__{node.get('id')}")
-            if node.tag == f"{S}transition":
-                if node.get("target"):
-                    node.set("target", " ".join(f"{prefix}__{t}" for t in node.get("target", "").split()))
-                if node.get("event"):
-                    node.set("event", " ".join(f"{device}.{e}" for e in node.get("event", "").split()))
-            if node.tag == f"{S}send":
-                _localise_send(node, device)
-        region.append(s)
+        for node in walk(s, into_charts=False):
+            if isinstance(node, State | Final | Parallel | History | Send) and node.id:
+                node.id = f"{prefix}__{node.id}"
+            if isinstance(node, Transition):
+                node.targets = [f"{prefix}__{t}" for t in node.targets]
+                node.event = " ".join(f"{device.id}.{e}" for e in node.events) or None
+            elif isinstance(node, Send):
+                node.event = f"{device.id}.{node.event or ''}"
+                node.type = node.target = node.delay = node.delayexpr = None
+            elif isinstance(node, Cancel) and node.sendid:
+                node.sendid = f"{prefix}__{node.sendid}"
+        region.children.append(s)
     return region
-
-
-def _localise_send(send: etree._Element, device: str) -> None:
-    event = send.get("event", "")
-    send.set("event", f"{device}.{event}")
-    for attr in ("type", "target", "delay", "delayexpr"):
-        send.attrib.pop(attr, None)

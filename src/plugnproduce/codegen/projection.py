@@ -1,55 +1,79 @@
 """Per-device programs (the paper's outlook, section 8): the task projected onto one device.
 
-The device's own chart is unrolled along the path the task takes through it: one
-state per visit, each with the device state's ``<onentry>`` and the transition's own
-content copied verbatim, so the program receives exactly the requests the task sends
-it, in order, and sends the events the controller waits for. It could be downloaded
-to the device's controller and run there instead of receiving single commands.
+The device's own chart is followed along the paths the task takes through it: each
+distinct path (one step's worth) is written once as a segment, one state per visit,
+each with the device state's ``<onentry>`` and the transition's own content copied
+verbatim, and the plan in the datamodel says which segment runs at each step that uses
+the device. So the program receives exactly the requests the task sends it, in order,
+and sends the events the controller waits for. It could be downloaded to the device's
+controller and run there instead of receiving single commands.
 """
 
 from __future__ import annotations
 
 import copy
 
-from lxml import etree
-
-from plugnproduce.codegen.emit import SCXML_NS, el, pnp_attr, to_bytes
-from plugnproduce.codegen.task import GeneratedTask
+from plugnproduce.codegen.task import NEXT, PLAN, STEP, GeneratedTask
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
-from plugnproduce.safeio import parse_xml
+from plugnproduce.statechart.io.writer import write_chart
+from plugnproduce.statechart.model import Assign, Chart, Data, Final, State, Transition, pnp
 
-S = f"{{{SCXML_NS}}}"
+END = "end"
 
 
 def device_program(generated: GeneratedTask, device: DeviceDescription) -> bytes:
     """The SCXML program of ``device`` for the generated task."""
-    chart = parse_xml(device.chart_file).getroot()
-    states = {s.get("id"): s for s in chart if isinstance(s.tag, str) and s.tag in (f"{S}state", f"{S}final")}
-    path = [t for _, steps in generated.device_paths(device.id) for t in steps]
-    visits = [device.initial] + [t.target for t in path]
-    ids = [f"p{n}_{state_id}" for n, state_id in enumerate(visits)]
-    root = el("scxml", version="1.0", name=f"{device.id}-program", initial=ids[0])
-    root.set(pnp_attr("device"), device.id)
-    for n, state_id in enumerate(visits):
-        last = n == len(visits) - 1
-        state = el("final" if last else "state", id=ids[n])
-        state.set(pnp_attr("deviceState"), state_id)
-        concept = device.state(state_id).concept
-        if concept:
-            state.set(pnp_attr("concept"), local_name(concept))
-        onentry = states[state_id].find(f"{S}onentry")
-        if onentry is not None:
-            state.append(copy.deepcopy(onentry))
-        if not last:
-            state.append(_step(states[state_id], path[n], ids[n + 1]))
-        root.append(state)
-    return to_bytes(root)
+    segments: dict[tuple[ChartTransition, ...], int] = {}
+    plan = [segments.setdefault(path, len(segments) + 1) for _, path in generated.device_paths(device.id) if path]
+    last = generated.final_states.get(device.id, device.initial)
+    start = _visit(device, "p0", device.initial, entry=True)
+    start.transitions.append(Transition(targets=[NEXT]))
+    pick = State(id=NEXT, transitions=[Transition(cond=f"{PLAN}[{STEP}] == {k}", targets=[f"q{k}_0"])
+                                       for k in segments.values()])
+    pick.transitions.append(Transition(cond=f"{PLAN}[{STEP}] == 0", targets=[END]))
+    end = Final(id=END, extra_attrs=_visit(device, END, last, entry=False).extra_attrs)
+    root = Chart(name=f"{device.id}-program", initial=["p0"], datamodel="python",
+                 data=[Data(id=PLAN, expr="[" + ", ".join(map(str, [*plan, 0])) + "]"), Data(id=STEP, expr="0")],
+                 extra_attrs={pnp("device"): device.id}, children=[start, pick])
+    for path, k in segments.items():
+        root.children.extend(_segment(device, k, path))
+    root.children.append(end)
+    return write_chart(root)
 
 
-def _step(source: etree._Element, transition: ChartTransition, target: str) -> etree._Element:
+def _segment(device: DeviceDescription, k: int, path: tuple[ChartTransition, ...]) -> list[State]:
+    """One step's path through the device's chart: a state per visit, the last one back to the plan."""
+    visits = [path[0].source] + [t.target for t in path]
+    ids = [f"q{k}_{n}" for n in range(len(visits))]
+    states = [_visit(device, ids[n], state_id, entry=n > 0) for n, state_id in enumerate(visits)]
+    for n, t in enumerate(path):
+        states[n].transitions.append(_step(device, t, ids[n + 1]))
+    states[-1].transitions.append(Transition(targets=[NEXT], actions=[Assign(location=STEP, expr=f"{STEP} + 1")]))
+    return states
+
+
+def _visit(device: DeviceDescription, sid: str, state_id: str, *, entry: bool) -> State:
+    """A visit of a device state: its annotations, and (when ``entry``) the state's first ``<onentry>``."""
+    state = State(id=sid, extra_attrs={pnp("deviceState"): state_id})
+    concept = device.state(state_id).concept
+    if concept:
+        state.extra_attrs[pnp("concept")] = local_name(concept)
+    original = _chart_state(device, state_id)
+    if entry and original is not None:
+        state.onentry = copy.deepcopy(original.onentry[:1])
+    return state
+
+
+def _chart_state(device: DeviceDescription, state_id: str) -> State | Final | None:
+    return next((s for s in device.chart.children if isinstance(s, State | Final) and s.id == state_id), None)
+
+
+def _step(device: DeviceDescription, transition: ChartTransition, target: str) -> Transition:
     """The chart's transition taken at this point, copied with a new target."""
-    original = next(t for t in source.findall(f"{S}transition") if t.sourceline == transition.line)
+    source = _chart_state(device, transition.source)
+    taken = source.transitions if isinstance(source, State) else []
+    original = next(t for t in taken if t.line == transition.line)
     t = copy.deepcopy(original)
-    t.set("target", target)
+    t.targets = [target]
     return t

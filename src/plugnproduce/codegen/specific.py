@@ -13,13 +13,27 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from lxml import etree
-
-from plugnproduce.codegen.emit import el, pnp_attr
-from plugnproduce.codegen.paths import find_path
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
+from plugnproduce.description.paths import find_path
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
+
+PLAN, STEP, VALUES = "pnp_plan", "pnp_step", "pnp_values"
+"""Task chart datamodel: the chart each step runs (then 0), how many steps have ended, and each
+step's parameter values that differ between the steps sharing a chart."""
+
+
+@dataclass(frozen=True)
+class Varying:
+    """A parameter value that differs between the steps sharing a chart: read from the step's values."""
+
+    name: str
+
+    @property
+    def expr(self) -> str:
+        """The expression that reads it at run time."""
+        return f"{VALUES}[{STEP}][{self.name!r}]"
 
 
 @dataclass
@@ -28,7 +42,7 @@ class RegionResult:
 
     role: str
     device: DeviceDescription
-    element: etree._Element
+    element: State
     start_state: str
     end_state: str
     commands: list[tuple[str, Command]] = field(default_factory=list)
@@ -59,14 +73,12 @@ def specific_region(
     taxonomy: Taxonomy,
 ) -> RegionResult:
     """Build the controller's region for ``role`` played by ``device``, from the device state ``start_state``."""
-    region = el("state", id=f"s{step}_{device.id}".replace("-", "_"), initial=ids[role.region[0].id])
-    region.set(pnp_attr("role"), role.name)
-    region.set(pnp_attr("device"), device.id)
+    region = State(id=f"s{step}_{device.id}".replace("-", "_"), initial=[ids[role.region[0].id]],
+                   extra_attrs={pnp("role"): role.name, pnp("device"): device.id})
     result = RegionResult(role.name, device, region, start_state, start_state)
     current = start_state
-    head = el("state", id=ids[role.region[0].id])
-    _annotate(head, role.region[0].concept, current)
-    states = [head]
+    states: list[State | Final] = [State(id=ids[role.region[0].id], extra_attrs=_annotation(role.region[0].concept,
+                                                                                            current))]
     for general in role.region[1:]:
         wanted = frozenset(process.parameter(p).quantity for p in general.params)
         path = find_path(device, current, general.concept, taxonomy, wanted)
@@ -75,22 +87,19 @@ def specific_region(
         _insert_path(states, path.steps, ids[general.id], device, values, process, cond, result)
         result.path.extend(path.steps)
         current = path.target
-        target = el("final" if general is role.region[-1] else "state", id=ids[general.id])
-        _annotate(target, general.concept, current)
-        states.append(target)
-    for s in states:
-        region.append(s)
+        kind = Final if general is role.region[-1] else State
+        states.append(kind(id=ids[general.id], extra_attrs=_annotation(general.concept, current)))
+    region.children.extend(states)
     result.end_state = current
     return result
 
 
-def _annotate(state: etree._Element, concept: str, device_state: str) -> None:
-    state.set(pnp_attr("concept"), local_name(concept))
-    state.set(pnp_attr("deviceState"), device_state)
+def _annotation(concept: str, device_state: str) -> dict[str, str]:
+    return {pnp("concept"): local_name(concept), pnp("deviceState"): device_state}
 
 
 def _insert_path(
-    states: list[etree._Element],
+    states: list[State | Final],
     steps: tuple[ChartTransition, ...],
     target_id: str,
     device: DeviceDescription,
@@ -101,11 +110,9 @@ def _insert_path(
 ) -> None:
     """Append the mirrored transitions of a path, with the intermediate states it passes."""
     source = states[-1]
+    assert isinstance(source, State)  # only the last region state is a <final>, and it is not appended yet
     if not steps:
-        t = el("transition", target=target_id)
-        if cond:
-            t.set("cond", cond)
-        source.append(t)
+        source.transitions.append(Transition(targets=[target_id], cond=cond))
         return
     for i, edge in enumerate(steps):
         last = i == len(steps) - 1
@@ -118,19 +125,16 @@ def _insert_path(
         for j, (kind, command) in enumerate(moves):
             final_move = last and j == len(moves) - 1
             nxt = target_id if final_move else f"{target_id}_{i + 1}{'abcdefghij'[j]}"
-            t = el("transition", target=nxt)
-            if cond and i == 0 and j == 0:
-                t.set("cond", cond)
+            t = Transition(targets=[nxt], cond=cond if i == 0 and j == 0 else None)
             if kind == "send" and command is not None:
-                t.append(_request(device, command, edge.accepts, values, process))
-                result.commands.append((source.get("id", ""), command))
+                t.actions.append(_request(device, command, edge.accepts, values, process))
+                result.commands.append((source.id or "", command))
             elif kind == "wait" and command is not None:
-                t.set("event", f"{device.id}.{command.event}")
-                result.commands.append((source.get("id", ""), command))
-            source.append(t)
+                t.event = f"{device.id}.{command.event}"
+                result.commands.append((source.id or "", command))
+            source.transitions.append(t)
             if not final_move:
-                source = el("state", id=nxt)
-                source.set(pnp_attr("deviceState"), edge.target)
+                source = State(id=nxt, extra_attrs={pnp("deviceState"): edge.target})
                 states.append(source)
 
 
@@ -140,16 +144,17 @@ def _request(
     accepts: tuple[str, ...],
     values: dict[str, object],
     process: ProcessDescription,
-) -> etree._Element:
-    send = el("send", type=command.protocol, target=device.id, event=command.event)
+) -> Send:
+    send = Send(type=command.protocol, target=device.id, event=command.event)
     for name, value in sorted(values.items()):
         quantity = process.parameter(name).quantity
         if quantity in accepts:
-            send.append(el("param", name=local_name(quantity), expr=_literal(value)))
+            expr = value.expr if isinstance(value, Varying) else literal(value)
+            send.params.append(Param(name=local_name(quantity), expr=expr))
     return send
 
 
-def _literal(value: object) -> str:
+def literal(value: object) -> str:
     """A Python-datamodel expression for a parameter value."""
     if isinstance(value, str) and not _is_pose(value):
         return repr(value)

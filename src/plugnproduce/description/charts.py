@@ -2,129 +2,131 @@
 
 Lifts the parts of a chart the descriptions give meaning to (``pnp:concept``,
 ``pnp:accepts``, ``pnp:role``, ``pnp:params``, protocol-prefixed events), with their
-lines. The chart is parsed with the hardened parser; schema validity is checked
-separately (:mod:`plugnproduce.statechart.schema`).
+lines, from a chart the one SCXML reader (:mod:`plugnproduce.statechart.io.reader`)
+has parsed. Schema validity is checked separately (:mod:`plugnproduce.statechart.io.schema`).
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from pathlib import Path
-
-from lxml import etree
 
 from plugnproduce.description.model import ChartState, ChartTransition, Command, RegionState
 from plugnproduce.errors import DescriptionError
-from plugnproduce.ontology.vocabulary import PNP_IRI, concept_iri
-from plugnproduce.safeio import parse_xml
+from plugnproduce.ontology.vocabulary import concept_iri
+from plugnproduce.statechart.model import (
+    CONCEPT,
+    Chart,
+    Final,
+    Node,
+    Parallel,
+    Send,
+    State,
+    StateNode,
+    Transition,
+    pnp,
+    walk,
+)
 
-SCXML = "{http://www.w3.org/2005/07/scxml}"
-CONCEPT = "{" + PNP_IRI + "}concept"
-ACCEPTS = "{" + PNP_IRI + "}accepts"
-ROLE = "{" + PNP_IRI + "}role"
-PARAMS = "{" + PNP_IRI + "}params"
+ACCEPTS, ROLE, PARAMS = pnp("accepts"), pnp("role"), pnp("params")
 _IN = re.compile(r"""In\(\s*['"]([^'"]+)['"]\s*\)""")
-_STATES = (SCXML + "state", SCXML + "final")
 
 
-def _root(path: str | Path) -> etree._Element:
-    root = parse_xml(path).getroot()
-    if root.tag != SCXML + "scxml":
-        raise DescriptionError(f"expected an <scxml> document in the SCXML namespace; found <{root.tag}>", path,
-                               root.sourceline)
-    return root
-
-
-def _sends(parent: etree._Element | None) -> list[Command]:
+def _sends(nodes: Iterable[Node]) -> list[Command]:
+    """The protocol events sent anywhere below ``nodes``, in document order."""
     out: list[Command] = []
-    if parent is None:
-        return out
-    for send in parent.iter(SCXML + "send"):
-        cmd = Command.parse(send.get("event", ""))
-        if cmd is not None and cmd.kind == "event":
-            out.append(cmd)
+    for top in nodes:
+        for node in walk(top, into_charts=False):
+            if isinstance(node, Send):
+                cmd = Command.parse(node.event or "")
+                if cmd is not None and cmd.kind == "event":
+                    out.append(cmd)
     return out
 
 
-def _concept(el: etree._Element) -> str | None:
-    value = el.get(CONCEPT)
+def _concept(node: Node) -> str | None:
+    value = node.extra_attrs.get(CONCEPT)
     return concept_iri(value) if value else None
 
 
-def device_chart(path: str | Path) -> tuple[str, tuple[ChartState, ...], tuple[ChartTransition, ...]]:
-    """The initial state, states and transitions of a (flat) Device State Chart."""
-    root = _root(path)
-    states = [c for c in root if c.tag in _STATES]
-    for c in root:
-        if c.tag in (SCXML + "parallel",) or (c.tag == SCXML + "state" and c.find(SCXML + "state") is not None):
+def _flat_states(chart: Chart, path: str | Path) -> list[State | Final]:
+    """The top-level states of a Device State Chart, refusing compound and parallel ones."""
+    states: list[State | Final] = []
+    for c in chart.children:
+        if isinstance(c, Parallel) or (isinstance(c, State) and not c.is_atomic):
             raise DescriptionError("a Device State Chart must be flat: found a compound or parallel state; "
-                                   "expected only <state> and <final> at the top", path, c.sourceline)
-    initial = (root.get("initial") or (states[0].get("id", "") if states else "")).split()[0] if states else ""
-    entry = {s.get("id"): _sends(s.find(SCXML + "onentry")) for s in states}
-    chart_states = tuple(ChartState(s.get("id", ""), _concept(s), s.sourceline) for s in states)
+                                   "expected only <state> and <final> at the top", path, c.line)
+        if isinstance(c, State | Final):
+            states.append(c)
+    return states
+
+
+def device_chart(chart: Chart, path: str | Path) -> tuple[str, tuple[ChartState, ...], tuple[ChartTransition, ...]]:
+    """The initial state, states and transitions of a (flat) Device State Chart read from ``path``."""
+    states = _flat_states(chart, path)
+    initial = (chart.initial[0] if chart.initial else (states[0].id or "")) if states else ""
+    entry = {s.id: _sends(s.onentry) for s in states}
+    chart_states = tuple(ChartState(s.id or "", _concept(s), s.line) for s in states)
     transitions: list[ChartTransition] = []
     for s in states:
-        for t in s.findall(SCXML + "transition"):
-            for target in (t.get("target") or s.get("id", "")).split():
-                sends = tuple(_sends(t)) + tuple(entry.get(target, ()))
-                accepts = tuple(concept_iri(a) for a in (t.get(ACCEPTS) or "").split())
-                transitions.append(ChartTransition(s.get("id", ""), target, t.get("event"), sends, accepts,
-                                                   t.sourceline))
+        for t in s.transitions if isinstance(s, State) else ():
+            for target in t.targets or [s.id or ""]:
+                sends = tuple(_sends([t])) + tuple(entry.get(target, ()))
+                accepts = tuple(concept_iri(a) for a in t.extra_attrs.get(ACCEPTS, "").split())
+                transitions.append(ChartTransition(s.id or "", target, t.event, sends, accepts, t.line))
     return initial, chart_states, tuple(transitions)
 
 
-def process_regions(path: str | Path) -> dict[str, tuple[RegionState, ...]]:
+def process_regions(chart: Chart, path: str | Path) -> dict[str, tuple[RegionState, ...]]:
     """Role name → its region's states in visiting order, from a General Process State Chart."""
-    root = _root(path)
-    parallels = root.findall(SCXML + "parallel")
+    parallels = [c for c in chart.children if isinstance(c, Parallel)]
     if len(parallels) != 1:
         raise DescriptionError(
-            f"a General Process State Chart has one top-level <parallel>; found {len(parallels)}", path,
-            root.sourceline)
+            f"a General Process State Chart has one top-level <parallel>; found {len(parallels)}", path, chart.line)
     regions: dict[str, tuple[RegionState, ...]] = {}
-    for region in parallels[0]:
-        if not isinstance(region.tag, str) or not region.tag.startswith(SCXML):
-            continue
-        role = region.get(ROLE)
-        if region.tag != SCXML + "state" or not role:
+    for region in parallels[0].children:
+        role = region.extra_attrs.get(ROLE)
+        if not isinstance(region, State) or not role:
             raise DescriptionError("each region of the <parallel> must be a <state> with a pnp:role attribute",
-                                   path, region.sourceline)
+                                   path, region.line)
         regions[role] = _region_sequence(region, path)
     return regions
 
 
-def _region_sequence(region: etree._Element, path: str | Path) -> tuple[RegionState, ...]:
-    children = [c for c in region if c.tag in _STATES]
-    by_id = {c.get("id"): c for c in children}
-    first = region.get("initial")
-    current = by_id.get(first.split()[0]) if first else (children[0] if children else None)
+def _region_sequence(region: State, path: str | Path) -> tuple[RegionState, ...]:
+    children = [c for c in region.children if isinstance(c, State | Final)]
+    by_id: dict[str | None, State | Final] = {c.id: c for c in children}
+    current = by_id.get(region.initial[0]) if region.initial else (children[0] if children else None)
     seq: list[RegionState] = []
     params: tuple[str, ...] = ()
     waits: str | None = None
-    name = region.get("id")
     while current is not None:
-        sid = current.get("id", "")
+        sid = current.id or ""
         if any(s.id == sid for s in seq):
-            raise DescriptionError(f"region {name!r} loops back to {sid!r}; expected a sequence", path,
-                                   current.sourceline)
+            raise DescriptionError(f"region {region.id!r} loops back to {sid!r}; expected a sequence", path,
+                                   current.line)
         concept = _concept(current)
         if concept is None:
-            raise DescriptionError(f"state {sid!r} has no pnp:concept; expected a state concept", path,
-                                   current.sourceline)
-        seq.append(RegionState(sid, concept, current.sourceline, params, waits))
-        transitions = current.findall(SCXML + "transition")
-        if current.tag == SCXML + "final" or not transitions:
+            raise DescriptionError(f"state {sid!r} has no pnp:concept; expected a state concept", path, current.line)
+        seq.append(RegionState(sid, concept, current.line, params, waits))
+        transitions = current.transitions if isinstance(current, State) else []
+        if isinstance(current, Final) or not transitions:
             break
-        if len(transitions) != 1 or len((transitions[0].get("target") or "").split()) != 1:
-            raise DescriptionError(f"state {sid!r} must have exactly one transition with one target", path,
-                                   current.sourceline)
-        t = transitions[0]
-        params = tuple((t.get(PARAMS) or "").split())
-        m = _IN.search(t.get("cond") or "")
+        t = _only_transition(current, transitions, path)
+        params = tuple(t.extra_attrs.get(PARAMS, "").split())
+        m = _IN.search(t.cond or "")
         waits = m.group(1) if m else None
-        current = by_id.get(t.get("target"))
+        current = by_id.get(t.targets[0])
         if current is None:
-            raise DescriptionError(f"transition leaves region {name!r}", path, t.sourceline)
-    if not seq or by_id[seq[-1].id].tag != SCXML + "final":
-        raise DescriptionError(f"region {name!r} must end in a <final> state", path, region.sourceline)
+            raise DescriptionError(f"transition leaves region {region.id!r}", path, t.line)
+    if not seq or not isinstance(by_id[seq[-1].id], Final):
+        raise DescriptionError(f"region {region.id!r} must end in a <final> state", path, region.line)
     return tuple(seq)
+
+
+def _only_transition(state: StateNode, transitions: list[Transition], path: str | Path) -> Transition:
+    if len(transitions) != 1 or len(transitions[0].targets) != 1:
+        raise DescriptionError(f"state {state.id!r} must have exactly one transition with one target", path,
+                               state.line)
+    return transitions[0]

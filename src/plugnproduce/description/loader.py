@@ -30,6 +30,7 @@ from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.safeio import parse_turtle, parse_yaml_node
+from plugnproduce.statechart.io.reader import read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 
@@ -106,7 +107,8 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
             f"unknown protocol {local_name(protocol)}; expected pnp:XIRP or pnp:UPnP", loaded.path, loaded.line(str(s))
         )
     chart_file = file_of(_one(loaded, s, PNP.stateChart, "state chart"))
-    initial, states, transitions = device_chart(chart_file)
+    chart = read_chart(chart_file)
+    initial, states, transitions = device_chart(chart, chart_file)
     timeout = _opt(loaded, s, PNP.commandTimeout)
     cost = _opt(loaded, s, PNP.cost)
     label = _opt(loaded, s, RDFS.label)
@@ -126,6 +128,7 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
         command_timeout=float(timeout.toPython()) if isinstance(timeout, rdflib.Literal) else 10.0,
         cost=float(cost.toPython()) if isinstance(cost, rdflib.Literal) else 0.0,
         skills=tuple(sorted(taxonomy.device_skills(classes, declared))),
+        chart=chart,
     )
 
 
@@ -145,7 +148,8 @@ def process_from(loaded: Loaded) -> ProcessDescription:
         )
     s = subjects[0]
     chart_file = file_of(_one(loaded, s, PNP.generalChart, "general process state chart"))
-    regions = process_regions(chart_file)
+    chart = read_chart(chart_file)
+    regions = process_regions(chart, chart_file)
     roles: list[Role] = []
     for r in sorted(loaded.graph.objects(s, PNP.hasRole), key=str):
         name = str(_one(loaded, r, PNP.roleName, "role name"))
@@ -177,6 +181,7 @@ def process_from(loaded: Loaded) -> ProcessDescription:
         parameters=params,
         chart_file=str(chart_file),
         where=loaded.where(str(s)),
+        chart=chart,
     )
 
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
+from plugnproduce.statechart.model import Chart
+
 Protocol = Literal["xirp", "upnp"]
 PROTOCOLS: tuple[Protocol, ...] = ("xirp", "upnp")
 
@@ -97,6 +99,8 @@ class DeviceDescription:
     cost: float = 0.0
     skills: tuple[str, ...] = ()
     """Every skill of the device after reasoning (declared, implied by class, super-skills)."""
+    chart: Chart = field(default_factory=Chart, compare=False, repr=False)
+    """The parsed Device State Chart (``chart_file`` as read by the one SCXML reader)."""
 
     def state(self, state_id: str) -> ChartState:
         """The chart state called ``state_id``."""
@@ -169,6 +173,8 @@ class ProcessDescription:
     parameters: tuple[Parameter, ...]
     chart_file: str
     where: Where
+    chart: Chart = field(default_factory=Chart, compare=False, repr=False)
+    """The parsed General Process State Chart."""
 
     def role(self, name: str) -> Role:
         """The role called ``name``."""

@@ -23,22 +23,23 @@ from pathlib import Path
 from typing import Any
 
 from plugnproduce.codegen import DONE, GeneratedTask
+from plugnproduce.codegen.task import STEP
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
-from plugnproduce.statechart.events import STATE_ENTERED, Event, MacroStep, MetaEvent
-from plugnproduce.statechart.interpreter import Interpreter
-from plugnproduce.statechart.loop import ChartLoop
 from plugnproduce.statechart.model import StateNode
+from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, MacroStep, MetaEvent
+from plugnproduce.statechart.runtime.interpreter import Interpreter
+from plugnproduce.statechart.runtime.loop import ChartLoop
 
 RecordObserver = Callable[[dict[str, Any]], None]
 """Called with each journal record as soon as it is written."""
 
 FAULT_EVENT = "error.fault"
 
-_STEP, _COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("step", "command", "device", "deviceState"))
+_COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("command", "device", "deviceState"))
 
 
 @dataclass(frozen=True)
@@ -87,26 +88,27 @@ class RunReport:
 class _StateInfo:
     device: str | None
     device_state: str | None
-    step: int | None
     command: str | None
+    starts_step: bool
+    """The state is a step's chart: entering it starts the step the plan's counter names."""
 
 
 def _chart_map(chart: Chart) -> dict[str, _StateInfo]:
-    """Per controller state: the device region it belongs to, the device state it stands for, its step."""
+    """Per controller state: the device region it belongs to, the device state it stands for, its process."""
     out: dict[str, _StateInfo] = {}
 
-    def walk(node: StateNode, device: str | None, step: int | None, command: str | None) -> None:
+    def walk(node: StateNode, device: str | None, command: str | None) -> None:
         attrs = node.extra_attrs
-        if isinstance(node, Parallel) and _STEP in attrs:
-            step, command = int(attrs[_STEP]), attrs.get(_COMMAND)
+        starts = isinstance(node, Parallel) and _COMMAND in attrs
+        command = attrs[_COMMAND] if starts else command
         device = attrs.get(_DEVICE, device)
         if node.id:
-            out[node.id] = _StateInfo(device, attrs.get(_DEVICE_STATE), step, command)
+            out[node.id] = _StateInfo(device, attrs.get(_DEVICE_STATE), command, starts)
         for child in getattr(node, "children", ()):
-            walk(child, device, step, command)
+            walk(child, device, command)
 
     for top in chart.children:
-        walk(top, None, None, None)
+        walk(top, None, None)
     return out
 
 
@@ -229,9 +231,9 @@ class TaskRun:
         info = self._states.get(meta.data["state"])
         if info is None:
             return
-        if info.step is not None and info.step != self.step:
-            self.step, self.command = info.step, info.command
-            self._record("step", step=info.step, command=info.command, bindings=self._bindings.get(info.step, {}))
+        if info.starts_step:
+            self.step, self.command = int(self.interpreter.dm[STEP]) + 1, info.command
+            self._record("step", step=self.step, command=info.command, bindings=self._bindings.get(self.step, {}))
         if info.device is not None and info.device_state is not None:
             if self.device_states.get(info.device) != info.device_state:
                 self.device_states[info.device] = info.device_state

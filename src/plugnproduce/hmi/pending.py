@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from plugnproduce import reasoning, service
 from plugnproduce.codegen import GeneratedTask, generate_task
-from plugnproduce.codegen.outputs import Chart, all_charts
+from plugnproduce.codegen.outputs import GeneratedChart, all_charts
 from plugnproduce.description.model import Cell, Task
 
 
@@ -21,7 +21,7 @@ class Generation:
 
     check: reasoning.CheckResult
     generated: GeneratedTask | None
-    charts: tuple[Chart, ...]
+    charts: tuple[GeneratedChart, ...]
 
 
 def generate(task: Task, cell: Cell, per_device: bool = False) -> Generation:

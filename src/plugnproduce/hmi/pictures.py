@@ -10,7 +10,7 @@ from collections import OrderedDict
 from collections.abc import Callable
 from pathlib import Path
 
-from plugnproduce.codegen.outputs import Chart
+from plugnproduce.codegen.outputs import GeneratedChart
 from plugnproduce.drawing import draw_chart
 
 
@@ -39,7 +39,7 @@ class Pictures:
         key = f"file:{p}:{p.stat().st_mtime_ns}"
         return self._cached(key, lambda: self._draw(p))
 
-    def of_chart(self, chart: Chart) -> bytes:
+    def of_chart(self, chart: GeneratedChart) -> bytes:
         """The picture of a generated chart."""
         key = "chart:" + hashlib.sha256(chart.data).hexdigest()
 
@@ -74,14 +74,14 @@ class GeneratedCharts:
         self._store = _Bounded(limit)
         self._lock = threading.Lock()
 
-    def add(self, charts: tuple[Chart, ...]) -> str:
+    def add(self, charts: tuple[GeneratedChart, ...]) -> str:
         """Keep a generation's charts; its id is a digest of their content."""
         digest = hashlib.sha256(b"".join(c.name.encode() + b"\0" + c.data for c in charts)).hexdigest()[:16]
         with self._lock:
             self._store.keep(digest, {c.name: c for c in charts})
         return digest
 
-    def chart(self, generation: str, name: str) -> Chart:
+    def chart(self, generation: str, name: str) -> GeneratedChart:
         """One chart of a generation (KeyError if either is unknown)."""
         with self._lock:
             charts = self._store.get(generation)
@@ -89,5 +89,5 @@ class GeneratedCharts:
             raise KeyError(f"generation {generation!r} (generate the task again)")
         if name not in charts:
             raise KeyError(f"chart {name!r} of generation {generation} (it has: {', '.join(charts)})")
-        chart: Chart = charts[name]
+        chart: GeneratedChart = charts[name]
         return chart

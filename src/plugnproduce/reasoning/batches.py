@@ -29,7 +29,6 @@ from plugnproduce.reasoning.terms import Atom, program
 
 CHUNK = 400
 """Configurations grounded together in one Control."""
-STAGE2 = ("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp", "show_cheapest.lp")
 
 
 @dataclass(frozen=True)
@@ -159,7 +158,7 @@ def _stage2(devices: dict[str, tuple[str, ...]], addable: list[s.Addable]) -> di
         v = f"v{n}"
         facts += config_facts(v, (*devices[a.c], a.a))
         facts += [s.Variant(v, a.c, a.a), s.Check(v, a.t)]
-    model = solver.solve(STAGE2, _STATIC + program(facts))
+    model = solver.solve(solver.CHEAPEST, _STATIC + program(facts))
     best: dict[tuple[str, str], str] = {}
     for c in sorted(model[s.Cheapest], key=lambda x: x.a, reverse=True):
         best[(c.c, c.t)] = c.a  # ties: the first id wins

@@ -5,7 +5,7 @@ are turned into facts once and reused for every configuration they appear in. Ch
 reachability (``reach/3``) is left to ASP, as the transitive closure of ``edge/3``; the
 one thing computed here is where a role's region *leaves* a device (``leaves/5``),
 because that is code generation's own shortest-path choice
-(:func:`plugnproduce.codegen.paths.find_path`, networkx) and the plausibility check must
+(:func:`plugnproduce.description.paths.find_path`, networkx) and the plausibility check must
 agree with the code that will run.
 """
 
@@ -15,8 +15,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
-from plugnproduce.codegen.paths import NoPath, find_path
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
+from plugnproduce.description.paths import NoPath, find_path
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP_IRI
 from plugnproduce.reasoning import schema as s

@@ -17,11 +17,25 @@ from plugnproduce.errors import EncodingError
 from plugnproduce.reasoning.terms import Model, decode
 from plugnproduce.resources import rules_path
 
-CAPABILITIES = ("roles.lp", "offered.lp", "bindings.lp", "explain.lp", "show_capabilities.lp")
-OFFERED = ("roles.lp", "offered.lp", "show_capabilities.lp")
-CHECK = ("roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp", "show_check.lp")
-BATCH = ("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp", "show_batch.lp")
-REPAIR = ("roles.lp", "chain.lp", "params.lp", "repair.lp", "show_repair.lp")
+PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
+    "capabilities": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
+    "offered": (("roles.lp", "offered.lp"), "show_capabilities.lp"),
+    "check": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"), "show_check.lp"),
+    "batch": (("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_batch.lp"),
+    "cheapest": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_cheapest.lp"),
+    "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
+}
+"""The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
+
+
+def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
+    """The encodings of a program of :data:`PROGRAMS`, with its ``#show`` file unless ``show`` is False."""
+    concerns, shown = PROGRAMS[program]
+    return concerns + (shown,) if show else concerns
+
+
+CAPABILITIES, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR = (
+    rules(p) for p in ("capabilities", "offered", "check", "batch", "cheapest", "repair"))
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""

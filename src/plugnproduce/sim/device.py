@@ -21,10 +21,10 @@ from typing import Any
 from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols import upnp, xirp
-from plugnproduce.statechart import read_chart
-from plugnproduce.statechart.events import Event
-from plugnproduce.statechart.interpreter import Interpreter
-from plugnproduce.statechart.loop import ChartLoop
+from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.statechart.runtime.events import Event
+from plugnproduce.statechart.runtime.interpreter import Interpreter
+from plugnproduce.statechart.runtime.loop import ChartLoop
 
 _ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
 
@@ -60,8 +60,7 @@ class SimulatedDevice:
         self.description = device
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
-        chart = read_chart(device.chart_file)
-        self.interpreter = Interpreter(chart, io_processors={device.protocol: self},
+        self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
         self._loop = ChartLoop(self.interpreter)
         self._task: asyncio.Task[None] | None = None
@@ -104,14 +103,13 @@ class SimulatedDevice:
         requests, events = requests_and_events(d)
         if d.protocol == "xirp":
             self._xirp = xirp.XirpServer(d.id, device_class, self._on_xirp_request, label=d.label,
-                                         files=self._files(xirp.DeviceFiles, d.endpoint), faults=self.faults)
+                                         files=self._files(d.endpoint), faults=self.faults)
             await self._xirp.start()
             spec = upnp.service_spec_from_chart_events({}, [])
-            files = self._files(upnp.DeviceFiles, self._xirp.endpoint)
-            self._xirp.files = self._files(xirp.DeviceFiles, self._xirp.endpoint)
+            files = self._xirp.files = self._files(self._xirp.endpoint)
         else:
             spec = upnp.service_spec_from_chart_events(requests, events)
-            files = self._files(upnp.DeviceFiles, d.endpoint)
+            files = self._files(d.endpoint)
         self._upnp = upnp.UpnpDeviceServer(d.id, d.label, upnp.device_type_for(device_class), spec,
                                            self._on_upnp_action, files=files, network=self.network)
         await self._upnp.start()
@@ -136,10 +134,10 @@ class SimulatedDevice:
         """Abort every XIRP connection (a cable pulled); the device stays announced."""
         return await self._xirp.disconnect_all() if self._xirp is not None else 0
 
-    def _files(self, kind: type, endpoint: str) -> Any:
+    def _files(self, endpoint: str) -> DeviceFiles:
         d = self.description
         turtle, chart = served_description(d, endpoint)
-        return kind(Path(d.where.file).name, turtle, Path(d.chart_file).name, chart)
+        return DeviceFiles(Path(d.where.file).name, turtle, Path(d.chart_file).name, chart)
 
     # --- requests in ----------------------------------------------------------------
 

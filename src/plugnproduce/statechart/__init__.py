@@ -8,6 +8,9 @@
 
 from __future__ import annotations
 
+from plugnproduce.statechart.io.reader import parse_chart, read_chart
+from plugnproduce.statechart.io.schema import schema_problems
+from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (
     CONCEPT,
     PNP_NS,
@@ -21,9 +24,6 @@ from plugnproduce.statechart.model import (
     concept,
     iter_states,
 )
-from plugnproduce.statechart.reader import parse_chart, read_chart
-from plugnproduce.statechart.schema import schema_problems
-from plugnproduce.statechart.writer import write_chart
 
 __all__ = [
     "CONCEPT",

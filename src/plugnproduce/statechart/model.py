@@ -1,8 +1,8 @@
 """A neutral model of a W3C SCXML 1.0 document, as plain dataclasses.
 
-The reader (:mod:`plugnproduce.statechart.reader`) turns a document into a :class:`Chart`,
-the writer (:mod:`plugnproduce.statechart.writer`) turns one back into XML, and the
-interpreter (:mod:`plugnproduce.statechart.interpreter`) runs one. Expressions stay
+The reader (:mod:`plugnproduce.statechart.io.reader`) turns a document into a :class:`Chart`,
+the writer (:mod:`plugnproduce.statechart.io.writer`) turns one back into XML, and the
+interpreter (:mod:`plugnproduce.statechart.runtime.interpreter`) runs one. Expressions stay
 strings here; nothing is evaluated.
 
 Every node keeps its source ``line`` (ignored when nodes are compared) and
@@ -26,6 +26,11 @@ PNP_NS = "http://plugnproduce.org/ontology#"
 
 CONCEPT = "{" + PNP_NS + "}concept"
 """Clark name of the ``pnp:concept`` annotation on states."""
+
+
+def pnp(name: str) -> str:
+    """The Clark name of a ``pnp:`` annotation attribute (``pnp("device")``)."""
+    return "{" + PNP_NS + "}" + name
 
 
 @dataclass(kw_only=True)

@@ -25,7 +25,8 @@ from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_fil
 from plugnproduce.ontology.vocabulary import PNP
 from plugnproduce.resources import descriptions_path
 from plugnproduce.safeio import read_bytes
-from plugnproduce.statechart.schema import schema_problems
+from plugnproduce.statechart.io.reader import read_chart
+from plugnproduce.statechart.io.schema import schema_problems
 from plugnproduce.validation.findings import Problem, Report
 from plugnproduce.validation.shapes import shape_problems
 from plugnproduce.validation.structure import device_problems, process_problems, task_problems
@@ -114,7 +115,7 @@ def _turtle(
         # complete device gets the structure checks.
         subject = device_subject(loaded, taxonomy)
         chart = g.value(subject, PNP.stateChart)
-        states = device_chart(file_of(chart))[1] if chart is not None else ()
+        states = device_chart(read_chart(file_of(chart)), file_of(chart))[1] if chart is not None else ()
         classes = [str(c) for c in g.objects(subject, RDF.type)]
         skills = taxonomy.device_skills(classes, [str(k) for k in g.objects(subject, PNP.hasSkill)])
         kg.add_device_facts(str(subject), skills, str(file_of(chart)) if chart is not None else "", states)

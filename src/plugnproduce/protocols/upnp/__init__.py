@@ -12,6 +12,7 @@ See ``docs/upnp.md``.
 
 from __future__ import annotations
 
+from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.upnp.boundary import (
     LOOPBACK,
     SsdpNetwork,
@@ -38,7 +39,6 @@ from plugnproduce.protocols.upnp.spec import (
     SERVICE_TYPE,
     ActionSpec,
     ArgumentSpec,
-    DeviceFiles,
     RemoteFiles,
     ServiceSpec,
     VariableSpec,

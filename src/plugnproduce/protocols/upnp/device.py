@@ -45,6 +45,7 @@ from async_upnp_client.server import (
 )
 
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
+from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.upnp.boundary import LOOPBACK, SsdpNetwork, reason
 from plugnproduce.protocols.upnp.spec import (
     ARG_TYPE_PREFIX,
@@ -53,7 +54,6 @@ from plugnproduce.protocols.upnp.spec import (
     SERVICE_TYPE,
     ActionSpec,
     ArgumentSpec,
-    DeviceFiles,
     ServiceSpec,
     udn_for,
 )

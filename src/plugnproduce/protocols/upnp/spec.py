@@ -203,28 +203,6 @@ def _unique(items: Sequence[str]) -> list[str]:
 
 
 @dataclass(frozen=True)
-class DeviceFiles:
-    """The device's own description, served next to its UPnP description.
-
-    ``description_name`` and ``chart_name`` are the file names (``gripper.ttl``,
-    ``gripper.scxml``); the files are served under ``/pnp/`` by those names, so a
-    relative ``pnp:stateChart <gripper.scxml>`` in the Turtle still resolves.
-    """
-
-    description_name: str
-    description: str
-    chart_name: str
-    chart: str
-
-    def __post_init__(self) -> None:
-        for name in (self.description_name, self.chart_name):
-            if not re.match(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$", name):
-                raise DescriptionError(f"file name {name!r} cannot be served; expected a plain file name")
-        if self.description_name == self.chart_name:
-            raise DescriptionError(f"description and chart share the file name {self.chart_name!r}")
-
-
-@dataclass(frozen=True)
 class RemoteFiles:
     """A device's description files as fetched from it, with the URLs they came from.
 

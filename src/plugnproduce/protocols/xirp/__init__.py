@@ -41,6 +41,8 @@ from plugnproduce.protocols.xirp.messages import (
     Request,
     Response,
     Value,
+    documents_of,
+    files_from_documents,
     format_endpoint,
     parse_endpoint,
 )
@@ -59,6 +61,8 @@ __all__ = [
     "UNKNOWN_REQUEST",
     "Bye",
     "DeviceFiles",
+    "documents_of",
+    "files_from_documents",
     "Document",
     "ErrorMessage",
     "Event",

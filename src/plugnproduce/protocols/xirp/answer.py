@@ -35,6 +35,7 @@ from plugnproduce.protocols.xirp.messages import (
     Request,
     Response,
     Value,
+    documents_of,
 )
 from plugnproduce.protocols.xirp.stream import FrameLink
 
@@ -142,7 +143,7 @@ class Responder:
             return _failed(request, UNKNOWN_REQUEST, f"device {self.device!r} serves no description")
         if request.params:
             return _failed(request, BAD_PARAMETER, f"describe takes no parameters; got {', '.join(request.params)}")
-        return Response(request.id, documents=self.files.documents())
+        return Response(request.id, documents=documents_of(self.files))
 
     def _send(self, link: FrameLink, response: Response, fault: Fault | None) -> None:
         """Send the response, unless a fault drops it or sends garbage instead."""

@@ -37,6 +37,7 @@ from plugnproduce.protocols.xirp.messages import (
     Request,
     Response,
     Value,
+    files_from_documents,
     format_endpoint,
     parse_endpoint,
 )
@@ -205,7 +206,7 @@ class XirpClient:
         if response.failure is not None:
             code, text = response.failure.code, response.failure.text
             raise RemoteFailure(f"{DESCRIBE} of {self._what} failed: {code}: {text}", code, text, DESCRIBE)
-        return DeviceFiles.from_documents(response.documents, f"{DESCRIBE} of {self._what}")
+        return files_from_documents(response.documents, f"{DESCRIBE} of {self._what}")
 
     async def _exchange(self, name: str, params: Params, timeout: float | None) -> Response:
         if self._lost is not None or self._closing:

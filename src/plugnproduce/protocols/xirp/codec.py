@@ -16,9 +16,9 @@ from datetime import datetime
 from decimal import Decimal
 from typing import Any
 
+from plugnproduce.protocols.files import FILE_NAME_PATTERN
 from plugnproduce.protocols.xirp.messages import (
     CODE_PATTERN,
-    FILE_NAME_PATTERN,
     ID_PATTERN,
     INVALID_VALUE,
     NAME_PATTERN,

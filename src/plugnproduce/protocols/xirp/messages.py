@@ -17,7 +17,8 @@ from datetime import datetime
 from decimal import Decimal
 from typing import NamedTuple, TypeAlias
 
-from plugnproduce.errors import ProtocolError
+from plugnproduce.errors import DescriptionError, ProtocolError
+from plugnproduce.protocols.files import DeviceFiles
 
 NAMESPACE = "urn:plugnproduce-org:xirp:1"
 """XML namespace of every XIRP message (version 1)."""
@@ -56,7 +57,6 @@ INVALID_VALUE = "invalid-value"
 NAME_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]{0,127}")
 ID_PATTERN = re.compile(r"[A-Za-z0-9_.\-]{1,64}")
 CODE_PATTERN = re.compile(r"[a-z][a-z0-9\-]{0,63}")
-FILE_NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]{0,127}")
 
 
 class MessageError(ProtocolError):
@@ -176,42 +176,26 @@ class Bye:
 Message: TypeAlias = Hello | Request | Response | Event | ErrorMessage | Bye
 
 
-@dataclass(frozen=True)
-class DeviceFiles:
-    """A device's own description: Turtle metadata and SCXML chart, with their file names.
+def documents_of(files: DeviceFiles) -> tuple[Document, Document]:
+    """The two documents of a ``describe`` response."""
+    return (Document(files.description_name, TURTLE, files.description),
+            Document(files.chart_name, SCXML, files.chart))
 
-    The names let a relative ``pnp:stateChart <gripper.scxml>`` in the Turtle resolve
-    (the same fields as the UPnP side's ``DeviceFiles``).
-    """
 
-    description_name: str
-    description: str
-    chart_name: str
-    chart: str
-
-    def __post_init__(self) -> None:
-        for name in (self.description_name, self.chart_name):
-            if not FILE_NAME_PATTERN.fullmatch(name):
-                raise MessageError(f"file name {name!r} cannot be served; expected a plain file name", INVALID_VALUE)
-        if self.description_name == self.chart_name:
-            raise MessageError(f"description and chart share the file name {self.chart_name!r}", INVALID_VALUE)
-
-    def documents(self) -> tuple[Document, Document]:
-        """The two documents of a ``describe`` response."""
-        return (Document(self.description_name, TURTLE, self.description), Document(self.chart_name, SCXML, self.chart))
-
-    @classmethod
-    def from_documents(cls, documents: tuple[Document, ...], what: str) -> DeviceFiles:
-        """Pick the Turtle description and the SCXML chart out of a ``describe`` response."""
-        by_type: dict[str, Document] = {}
-        for document in documents:
-            by_type.setdefault(document.media_type, document)
-        missing = [t for t in (TURTLE, SCXML) if t not in by_type]
-        if missing:
-            found = ", ".join(f"{d.name} ({d.media_type})" for d in documents) or "no documents"
-            raise MessageError(f"{what}: expected a {' and a '.join(missing)} document; found {found}")
-        ttl, chart = by_type[TURTLE], by_type[SCXML]
-        return cls(ttl.name, ttl.text, chart.name, chart.text)
+def files_from_documents(documents: tuple[Document, ...], what: str) -> DeviceFiles:
+    """Pick the Turtle description and the SCXML chart out of a ``describe`` response."""
+    by_type: dict[str, Document] = {}
+    for document in documents:
+        by_type.setdefault(document.media_type, document)
+    missing = [t for t in (TURTLE, SCXML) if t not in by_type]
+    if missing:
+        found = ", ".join(f"{d.name} ({d.media_type})" for d in documents) or "no documents"
+        raise MessageError(f"{what}: expected a {' and a '.join(missing)} document; found {found}")
+    ttl, chart = by_type[TURTLE], by_type[SCXML]
+    try:
+        return DeviceFiles(ttl.name, ttl.text, chart.name, chart.text)
+    except DescriptionError as exc:
+        raise MessageError(f"{what}: {exc}", INVALID_VALUE) from exc
 
 
 def parse_endpoint(endpoint: str) -> tuple[str, int]:

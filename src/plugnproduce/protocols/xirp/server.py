@@ -30,6 +30,7 @@ from plugnproduce.protocols.xirp.messages import (
     MessageError,
     Params,
     Response,
+    documents_of,
     format_endpoint,
 )
 from plugnproduce.protocols.xirp.stream import ConnectionLost, FrameLink
@@ -125,7 +126,7 @@ class XirpServer:
             raise ProtocolError(f"device {self.device!r} is already started, at {self.endpoint}")
         self._hello_frame = encode_frame(self.hello)
         if self.files is not None:
-            size = len(encode_frame(Response("x" * 64, documents=self.files.documents())))
+            size = len(encode_frame(Response("x" * 64, documents=documents_of(self.files))))
             if size > self.max_frame:
                 raise MessageError(
                     f"device {self.device!r}: its description and chart take {size} bytes in a describe "

@@ -16,14 +16,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from plugnproduce.statechart.actions import ActionError, Block, literal, markup_value, run_actions
-from plugnproduce.statechart.evaluator import EvaluationError
-from plugnproduce.statechart.events import ERROR, LOG, Event, MetaEvent
-from plugnproduce.statechart.invoke import resolve_src, value_from_file
+from plugnproduce.statechart.runtime.actions import ActionError, Block, literal, markup_value, run_actions
+from plugnproduce.statechart.runtime.evaluator import EvaluationError
+from plugnproduce.statechart.runtime.events import ERROR, LOG, Event, MetaEvent
+from plugnproduce.statechart.runtime.invoke import resolve_src, value_from_file
 
 if TYPE_CHECKING:
-    from plugnproduce.statechart.compiled import CompiledChart, CState
     from plugnproduce.statechart.model import Chart, Data
+    from plugnproduce.statechart.runtime.compiled import CompiledChart, CState
 
 log = logging.getLogger("plugnproduce.statechart")
 

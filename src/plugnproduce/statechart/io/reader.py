@@ -19,7 +19,7 @@ from lxml import etree
 
 from plugnproduce.errors import DescriptionError
 from plugnproduce.safeio import parse_xml_bytes, read_bytes
-from plugnproduce.statechart.checks import check_structure
+from plugnproduce.statechart.io.checks import check_structure
 from plugnproduce.statechart.model import (
     SCXML_NS,
     Assign,

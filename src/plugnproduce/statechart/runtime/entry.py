@@ -9,8 +9,8 @@ entered by default (whose ``<initial>`` content runs) and the content of history
 
 from __future__ import annotations
 
-from plugnproduce.statechart.actions import Block
-from plugnproduce.statechart.compiled import ROOT, CState, CTransition, transition_domain
+from plugnproduce.statechart.runtime.actions import Block
+from plugnproduce.statechart.runtime.compiled import ROOT, CState, CTransition, transition_domain
 
 History = dict[CState, list[CState]]
 """The recorded history: history pseudo-state → the states it remembers."""

@@ -10,9 +10,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from plugnproduce.statechart.actions import ActionError
-from plugnproduce.statechart.clock import Clock
-from plugnproduce.statechart.events import (
+from plugnproduce.statechart.runtime.actions import ActionError
+from plugnproduce.statechart.runtime.clock import Clock
+from plugnproduce.statechart.runtime.events import (
     EVENT_SENT,
     SCXML_IO,
     SCXML_TYPES,
@@ -23,8 +23,8 @@ from plugnproduce.statechart.events import (
 )
 
 if TYPE_CHECKING:
-    from plugnproduce.statechart.events import MacroStep
-    from plugnproduce.statechart.interpreter import Interpreter
+    from plugnproduce.statechart.runtime.events import MacroStep
+    from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 _SCXML_PREFIX = "#_scxml_"
 

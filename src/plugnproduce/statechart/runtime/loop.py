@@ -12,8 +12,8 @@ import contextlib
 from collections.abc import Callable
 from typing import Any
 
-from plugnproduce.statechart.events import MacroStep
-from plugnproduce.statechart.interpreter import Interpreter
+from plugnproduce.statechart.runtime.events import MacroStep
+from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 StepCallback = Callable[[MacroStep], None]
 """Called with every macrostep as soon as it is done."""

@@ -8,8 +8,6 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from plugnproduce.statechart.actions import Block, compile_block, compile_donedata, compile_invoke
-from plugnproduce.statechart.evaluator import Evaluator, Expr
 from plugnproduce.statechart.model import (
     Chart,
     Data,
@@ -20,6 +18,8 @@ from plugnproduce.statechart.model import (
     StateNode,
     Transition,
 )
+from plugnproduce.statechart.runtime.actions import Block, compile_block, compile_donedata, compile_invoke
+from plugnproduce.statechart.runtime.evaluator import Evaluator, Expr
 
 log = logging.getLogger(__name__)
 

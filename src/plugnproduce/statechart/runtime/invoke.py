@@ -1,7 +1,7 @@
 """``<invoke>`` of child SCXML sessions, and files named by ``src`` (``<data src>``, ``<invoke src>``).
 
 A child session shares the parent's clock, trust and I/O processors and runs inside the
-parent's :meth:`~plugnproduce.statechart.interpreter.Interpreter.execute_once`. It talks to
+parent's :meth:`~plugnproduce.statechart.runtime.interpreter.Interpreter.execute_once`. It talks to
 the parent through ``#_parent`` and ``#_<invokeid>``; its top-level final state gives the
 parent ``done.invoke.<invokeid>``. Files are read only inside the chart's folder unless
 the interpreter is trusted.
@@ -18,13 +18,13 @@ from lxml import etree
 
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.safeio import parse_xml_bytes, read_bytes
-from plugnproduce.statechart.actions import ActionError, Block, CInvoke, literal, value_of
-from plugnproduce.statechart.events import SCXML_TYPES, Event, EventData
 from plugnproduce.statechart.model import Chart
+from plugnproduce.statechart.runtime.actions import ActionError, Block, CInvoke, literal, value_of
+from plugnproduce.statechart.runtime.events import SCXML_TYPES, Event, EventData
 
 if TYPE_CHECKING:
-    from plugnproduce.statechart.compiled import CState
-    from plugnproduce.statechart.interpreter import Interpreter
+    from plugnproduce.statechart.runtime.compiled import CState
+    from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 MAX_CHILD_STEPS = 10_000
 """Most macrosteps an invoked session makes before its parent takes its next event."""
@@ -103,7 +103,7 @@ class Invoker:
         child.start()
 
     def _child_chart(self, inv: CInvoke) -> tuple[Chart, Path | None]:
-        from plugnproduce.statechart.reader import parse_chart, read_chart
+        from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
         rt: Any = self
         if inv.content is not None:

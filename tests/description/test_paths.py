@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from plugnproduce import service
-from plugnproduce.codegen.paths import NoPath, find_path
 from plugnproduce.description.model import Command
+from plugnproduce.description.paths import NoPath, find_path
 
 P = "http://plugnproduce.org/ontology#"
 

@@ -3,17 +3,17 @@
 One synchronous step at a time: :meth:`Interpreter.execute_once` takes the next external
 event and runs the whole macrostep (the event's microstep, then eventless transitions and
 internal events until the configuration is stable) and returns a
-:class:`~plugnproduce.statechart.events.MacroStep`. Time comes from an injected clock;
+:class:`~plugnproduce.statechart.runtime.events.MacroStep`. Time comes from an injected clock;
 delayed sends wait in the session until the clock reaches them. Observers receive meta
-events. asyncio lives apart (:class:`plugnproduce.statechart.loop.ChartLoop`).
+events. asyncio lives apart (:class:`plugnproduce.statechart.runtime.loop.ChartLoop`).
 
 The public API (kept stable: the executor and the simulated devices use it):
 
 ``Interpreter(chart, *, clock=None, trusted=False, io_processors=None, base_dir=None, session_id=None)``
     A session of a read :class:`~plugnproduce.statechart.model.Chart`, checked first (a
     :class:`~plugnproduce.errors.DescriptionError` names what is broken). ``clock``: where
-    time comes from (default :class:`~plugnproduce.statechart.clock.MonotonicClock`; tests
-    use :class:`~plugnproduce.statechart.clock.ManualClock`). ``trusted``: expressions are
+    time comes from (default :class:`~plugnproduce.statechart.runtime.clock.MonotonicClock`; tests
+    use :class:`~plugnproduce.statechart.runtime.clock.ManualClock`). ``trusted``: expressions are
     plain Python and ``<script>`` runs; by default expressions go through the restricted
     evaluator and a ``<script>`` is refused with an :class:`~plugnproduce.errors.ExecutionError`.
     ``io_processors``: ``<send type>`` → an object with ``send(event, target, type)``.
@@ -37,7 +37,7 @@ The public API (kept stable: the executor and the simulated devices use it):
 ``configuration``, ``is_active(state_id)``
     Ids of the active states in document order (empty once stopped); whether one is active.
 ``attach(observer)`` / ``detach(observer)``
-    Meta events (:class:`~plugnproduce.statechart.events.MetaEvent`): states entered and
+    Meta events (:class:`~plugnproduce.statechart.runtime.events.MetaEvent`): states entered and
     exited, events consumed and sent, transitions taken, logs and errors.
 ``datamodel``
     The datamodel's variables, system variables included.
@@ -57,15 +57,17 @@ from typing import Any
 
 from plugnproduce.errors import ExecutionError
 from plugnproduce.safeio import read_bytes
-from plugnproduce.statechart.actions import Block
-from plugnproduce.statechart.checks import check_structure
-from plugnproduce.statechart.clock import Clock, MonotonicClock
-from plugnproduce.statechart.compiled import ROOT, CompiledChart, CState, CTransition
-from plugnproduce.statechart.datamodel import Datamodel
-from plugnproduce.statechart.dispatch import Dispatcher
-from plugnproduce.statechart.entry import EntryBuilder, domain_of
-from plugnproduce.statechart.evaluator import EvaluationError, Evaluator, Expr
-from plugnproduce.statechart.events import (
+from plugnproduce.statechart.io.checks import check_structure
+from plugnproduce.statechart.io.reader import parse_chart
+from plugnproduce.statechart.model import Chart
+from plugnproduce.statechart.runtime.actions import Block
+from plugnproduce.statechart.runtime.clock import Clock, MonotonicClock
+from plugnproduce.statechart.runtime.compiled import ROOT, CompiledChart, CState, CTransition
+from plugnproduce.statechart.runtime.datamodel import Datamodel
+from plugnproduce.statechart.runtime.dispatch import Dispatcher
+from plugnproduce.statechart.runtime.entry import EntryBuilder, domain_of
+from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator, Expr
+from plugnproduce.statechart.runtime.events import (
     EVENT_CONSUMED,
     STATE_ENTERED,
     STATE_EXITED,
@@ -76,9 +78,7 @@ from plugnproduce.statechart.events import (
     MetaEvent,
     TakenTransition,
 )
-from plugnproduce.statechart.invoke import Invocation, Invoker
-from plugnproduce.statechart.model import Chart
-from plugnproduce.statechart.reader import parse_chart
+from plugnproduce.statechart.runtime.invoke import Invocation, Invoker
 
 log = logging.getLogger("plugnproduce.statechart")
 

@@ -1,6 +1,6 @@
 """Executable content compiled to actions: small objects whose ``run(rt)`` does the work.
 
-``rt`` is the running session (:class:`~plugnproduce.statechart.interpreter.Interpreter`);
+``rt`` is the running session (:class:`~plugnproduce.statechart.runtime.interpreter.Interpreter`);
 actions use only its datamodel namespace ``rt.dm`` and a few methods (``raise_internal``,
 ``send``, ``cancel``, ``log``). A failing action raises :class:`EvaluationError` or
 :class:`ActionError`; the interpreter then stops the block and raises the error event.
@@ -17,8 +17,6 @@ from typing import TYPE_CHECKING, Any
 
 from plugnproduce.errors import ExecutionError, PlugNProduceError
 from plugnproduce.safeio import parse_xml_bytes
-from plugnproduce.statechart.evaluator import EvaluationError, Evaluator, Expr, Location
-from plugnproduce.statechart.events import EventData
 from plugnproduce.statechart.model import (
     Assign,
     Cancel,
@@ -35,9 +33,11 @@ from plugnproduce.statechart.model import (
     Script,
     Send,
 )
+from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator, Expr, Location
+from plugnproduce.statechart.runtime.events import EventData
 
 if TYPE_CHECKING:
-    from plugnproduce.statechart.interpreter import Interpreter
+    from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 
 class ActionError(Exception):

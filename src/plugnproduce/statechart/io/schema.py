@@ -21,7 +21,7 @@ from plugnproduce.safeio import parse_xml_bytes
 @lru_cache(maxsize=1)
 def scxml_schema() -> xmlschema.XMLSchema:
     """The W3C SCXML schema, loaded once (from package data; nothing is fetched)."""
-    return xmlschema.XMLSchema(str(package_file("statechart", "w3c", "scxml.xsd")))
+    return xmlschema.XMLSchema(str(package_file("statechart", "io", "w3c", "scxml.xsd")))
 
 
 def schema_problems(data: bytes, source: str | Path) -> list[DescriptionError]:

@@ -1,0 +1,81 @@
+"""The layers of ``docs/architecture.md``, checked on the source: imports point one way, and SCXML
+is read, written and named only in ``statechart/``."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).parent.parent / "src" / "plugnproduce"
+
+LAYERS = {
+    "cli": 7,  # the command line may also start the web HMI (pnp serve)
+    "hmi": 6,
+    "service": 5,
+    "executor": 4, "sim": 4, "discovery": 4,
+    "codegen": 3, "reasoning": 3, "validation": 3, "drawing": 3,
+    "description": 2,
+    "ontology": 1, "statechart": 1, "protocols": 1,
+    "resources": 0, "safeio": 0,
+    "errors": -1,
+}
+"""Rank of each subpackage or top-level module: a module imports only from lower ranks or its own part."""
+
+SCXML_NAMESPACE = "http://www.w3.org/2005/07/scxml"
+
+
+def _modules() -> list[Path]:
+    return sorted(p for p in SRC.rglob("*.py")
+                  if (p.parent != SRC and p.name != "__main__.py") or (p.parent == SRC and p.stem in LAYERS))
+
+
+def _part(module: str) -> str | None:
+    """``plugnproduce.codegen.task`` → ``codegen``; None for modules outside the package."""
+    parts = module.split(".")
+    return parts[1] if parts[0] == "plugnproduce" and len(parts) > 1 else None
+
+
+def _imports(path: Path) -> set[str]:
+    """Every module ``path`` imports (``from plugnproduce import service`` counts as ``plugnproduce.service``)."""
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            out.add(node.module)
+            if node.module == "plugnproduce":
+                out |= {f"plugnproduce.{a.name}" for a in node.names}
+    return out
+
+
+def _own_part(path: Path) -> str:
+    rel = path.relative_to(SRC)
+    return rel.parts[0] if len(rel.parts) > 1 else rel.stem
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
+def test_imports_point_down_the_layers(path: Path) -> None:
+    own = _own_part(path)
+    upward = sorted(m for m in _imports(path) if (part := _part(m)) in LAYERS and part != own
+                    and LAYERS[part] >= LAYERS[own])
+    assert upward == [], f"{own} (rank {LAYERS[own]}) imports {upward}"
+
+
+def test_scxml_is_parsed_written_and_named_only_in_statechart() -> None:
+    offenders = [str(p.relative_to(SRC)) for p in SRC.rglob("*.py") if _own_part(p) != "statechart"
+                 and SCXML_NAMESPACE in p.read_text(encoding="utf-8")]
+    assert offenders == []
+
+
+def test_codegen_builds_model_objects_not_xml() -> None:
+    offenders = [str(p.relative_to(SRC)) for p in (SRC / "codegen").rglob("*.py")
+                 if any(m.split(".")[0] == "lxml" or m.startswith("xml.") for m in _imports(p))]
+    assert offenders == []
+
+
+def test_no_reasoning_module_imports_codegen() -> None:
+    offenders = [str(p.relative_to(SRC)) for p in (SRC / "reasoning").rglob("*.py")
+                 if any(_part(m) == "codegen" for m in _imports(p))]
+    assert offenders == []
