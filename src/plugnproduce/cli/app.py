@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import sys
 from collections.abc import Callable
 from functools import wraps
@@ -20,6 +21,29 @@ app = typer.Typer(
 )
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+LIBRARIES: dict[str, Any] = {"folders": [], "builtin": True}
+"""The libraries every command loads: ``--library`` options, then ``PNP_LIBRARY``; see :func:`knowledge`."""
+
+
+@app.callback()
+def _options(
+    library: list[str] = typer.Option([], "--library", metavar="DIR",
+                                      help="A library folder (ontology/, devices/, processes/, cells/, tasks/); "
+                                           "repeatable. PNP_LIBRARY adds folders separated by ':'."),
+    no_builtin: bool = typer.Option(False, "--no-builtin", help="Leave the built-in library out."),
+) -> None:
+    """Options that hold for every command."""
+    LIBRARIES["folders"] = [*library, *[p for p in os.environ.get("PNP_LIBRARY", "").split(":") if p.strip()]]
+    LIBRARIES["builtin"] = not no_builtin
+
+
+def knowledge(cell: Any = None) -> Any:
+    """The knowledge the command line's libraries give (plus those a cell file lists), a service argument."""
+    from plugnproduce import service
+
+    k = service.knowledge(tuple(LIBRARIES["folders"]), builtin=LIBRARIES["builtin"])
+    return service.knowledge_for_cell(cell, k) if cell is not None else k
 
 JSON_OPTION = typer.Option(False, "--json", help="Machine-readable output.")
 

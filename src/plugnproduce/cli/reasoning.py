@@ -17,7 +17,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from plugnproduce import reasoning, service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
 from plugnproduce.description.loader import task_to_yaml
 
 CELL_OPTION = typer.Option(..., "--cell", help="The cell file (YAML).")
@@ -38,7 +38,7 @@ def _reasons(reasons: tuple[reasoning.Reason, ...], indent: str = "    ") -> Non
 @boundary
 def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Show the process commands a cell offers (with every role binding) and why the others are not offered."""
-    caps = service.capabilities(cell)
+    caps = service.capabilities(cell, knowledge(cell))
     if json_out:
         emit_json(caps.to_json())
         return
@@ -68,7 +68,7 @@ def check(task: Path = typer.Argument(..., help="The task file (YAML)."), cell: 
 
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
     """
-    result = service.check(task, cell)
+    result = service.check(task, cell, knowledge(cell))
     if json_out:
         emit_json(result.to_json())
     else:
@@ -92,8 +92,8 @@ def repair(
 
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
-    result = service.check(task, cell)
-    repairs = [] if result.plausible else service.repair(task, cell, catalogue, top)
+    result = service.check(task, cell, knowledge(cell))
+    repairs = [] if result.plausible else service.repair(task, cell, catalogue, top, knowledge=knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
                    "repairs": [r.to_json() for r in repairs]})
@@ -122,17 +122,18 @@ def explain(
 ) -> None:
     """Why a process command is (not) offered, or why a task's step is (not) plausible. Exit 1 when it is not."""
     if step is None:
-        ex = service.explain_process(cell, target)
+        ex = service.explain_process(cell, target, knowledge(cell))
+        name = service.cell(cell, knowledge()).name
         if json_out:
             emit_json(ex.to_json())
         elif ex.offered:
-            typer.echo(f"{ex.command} is offered in cell {service.cell(cell).name}: {_bindings(ex.bindings)}")
+            typer.echo(f"{ex.command} is offered in cell {name}: {_bindings(ex.bindings)}")
         else:
-            typer.echo(f"{ex.command} is not offered in cell {service.cell(cell).name}:")
+            typer.echo(f"{ex.command} is not offered in cell {name}:")
             _reasons(ex.reasons, "  ")
         ok = ex.offered
     else:
-        st = service.explain_step(Path(target), cell, step)
+        st = service.explain_step(Path(target), cell, step, knowledge(cell))
         if json_out:
             emit_json(st.to_json())
         else:
@@ -168,7 +169,7 @@ def batch(
     """Feasibility of many cell configurations: offered processes, plausible tasks, cheapest device to add."""
     if (configs is None) == (generate is None):
         fail("give either CONFIGS (a JSONL or CSV file) or --generate N")
-    devices = service.catalogue(catalogue)
+    devices = service.catalogue(catalogue, knowledge())
     if generate is not None:
         try:
             configurations = service.generate_configurations(generate, _sizes(sizes), seed, devices)

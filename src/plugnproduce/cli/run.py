@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from plugnproduce import service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.cli.generate import refuse
 from plugnproduce.executor.journal import describe
 
@@ -47,7 +47,7 @@ def run(
 
     try:
         report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
-                                              observer=show, started=started))
+                                              observer=show, started=started, knowledge=knowledge(cell)))
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)
     if json_out:

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from plugnproduce import service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
 
 
 @app.command()
@@ -20,7 +20,7 @@ def validate(
 
     Exit 0 valid, 1 invalid, 2 unreadable or hostile input.
     """
-    report = service.validate(list(paths))
+    report = service.validate(list(paths), knowledge())
     problems = report.sorted()
     if json_out:
         emit_json({"valid": report.valid, "files": len(report.files), "problems": [p.to_json() for p in problems]})

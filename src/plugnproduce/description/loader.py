@@ -27,6 +27,7 @@ from plugnproduce.description.model import (
 )
 from plugnproduce.description.rdf import term_line
 from plugnproduce.errors import DescriptionError
+from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.safeio import parse_turtle, parse_yaml_node
@@ -85,6 +86,8 @@ def device_subject(loaded: Loaded, taxonomy: Taxonomy) -> rdflib.URIRef:
         {s for s, c in loaded.graph.subject_objects(RDF.type) if isinstance(s, rdflib.URIRef)
          and taxonomy.is_kind(str(c), "Device")}
     )
+    if not devices:
+        _unknown_device_class(loaded, taxonomy)
     if len(devices) != 1:
         raise DescriptionError(
             f"a device description describes exactly one device (an individual of a pnp:Device class); "
@@ -93,6 +96,14 @@ def device_subject(loaded: Loaded, taxonomy: Taxonomy) -> rdflib.URIRef:
             1,
         )
     return devices[0]
+
+
+def _unknown_device_class(loaded: Loaded, taxonomy: Taxonomy) -> None:
+    """A would-be device (it has a state chart) whose class is unknown: say so at its line."""
+    for s in sorted(set(loaded.graph.subjects(PNP.stateChart)), key=str):
+        for c in sorted(loaded.graph.objects(s, RDF.type), key=str):
+            if not taxonomy.knows(str(c)):
+                raise DescriptionError(unknown_class(str(s), str(c), taxonomy), loaded.path, loaded.line(str(s)))
 
 
 def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
@@ -304,7 +315,7 @@ def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
     """A cell file's name and its device description files with the lines that list them."""
     p = Path(path)
     top = _mapping(parse_yaml_node(p), p, "cell")
-    _unknown_keys(top, {"cell", "devices"}, p, "cell")
+    _unknown_keys(top, {"cell", "devices", "libraries"}, p, "cell")
     if "cell" not in top or "devices" not in top or not isinstance(top["devices"], yaml.SequenceNode):
         raise DescriptionError("a cell needs 'cell' (its name) and 'devices' (a list of files)", p, 1)
     files = []
@@ -313,6 +324,25 @@ def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
             raise DescriptionError("each device is a path to a device description", p, node.start_mark.line + 1)
         files.append(((p.parent / node.value).resolve(), node.start_mark.line + 1))
     return str(_plain(top["cell"])), files
+
+
+def cell_libraries(path: str | Path) -> list[Path]:
+    """The library folders a cell file lists under ``libraries:`` (relative to the cell file)."""
+    p = Path(path)
+    top = _mapping(parse_yaml_node(p), p, "cell")
+    node = top.get("libraries")
+    if node is None:
+        return []
+    if not isinstance(node, yaml.SequenceNode) or not all(isinstance(n, yaml.ScalarNode) for n in node.value):
+        raise DescriptionError("libraries must be a list of folders (relative to the cell file)", p,
+                               node.start_mark.line + 1)
+    out = []
+    for n in node.value:
+        folder = (p.parent / n.value).resolve()
+        if not folder.is_dir():
+            raise DescriptionError(f"library folder {n.value} not found", p, n.start_mark.line + 1)
+        out.append(folder)
+    return out
 
 
 def load_cell(path: str | Path, taxonomy: Taxonomy) -> Cell:
