@@ -16,7 +16,7 @@ from lxml import etree
 from plugnproduce.codegen.emit import SCXML_NS, el, pnp_attr, to_bytes
 from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import ChartTransition, DeviceDescription
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_value
 from plugnproduce.safeio import parse_xml
 
 S = f"{{{SCXML_NS}}}"
@@ -37,7 +37,7 @@ def device_program(generated: GeneratedTask, device: DeviceDescription) -> bytes
         state.set(pnp_attr("deviceState"), state_id)
         concept = device.state(state_id).concept
         if concept:
-            state.set(pnp_attr("concept"), local_name(concept))
+            state.set(pnp_attr("concept"), concept_value(concept))
         onentry = states[state_id].find(f"{S}onentry")
         if onentry is not None:
             state.append(copy.deepcopy(onentry))

@@ -19,7 +19,7 @@ from plugnproduce.codegen.emit import el, pnp_attr
 from plugnproduce.codegen.paths import find_path
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_value, local_name
 
 
 @dataclass
@@ -64,7 +64,7 @@ def specific_region(
     region.set(pnp_attr("device"), device.id)
     result = RegionResult(role.name, device, region, start_state, start_state)
     current = start_state
-    head = el("state", id=ids[role.region[0].id])
+    head = el("final" if len(role.region) == 1 else "state", id=ids[role.region[0].id])  # a one-state role is done
     _annotate(head, role.region[0].concept, current)
     states = [head]
     for general in role.region[1:]:
@@ -85,7 +85,7 @@ def specific_region(
 
 
 def _annotate(state: etree._Element, concept: str, device_state: str) -> None:
-    state.set(pnp_attr("concept"), local_name(concept))
+    state.set(pnp_attr("concept"), concept_value(concept))
     state.set(pnp_attr("deviceState"), device_state)
 
 

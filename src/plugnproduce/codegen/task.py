@@ -19,7 +19,7 @@ from plugnproduce.codegen.specific import RegionResult, controller_ids, specific
 from plugnproduce.description.model import Cell, ChartTransition, Command, ProcessDescription, Step, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_value, local_name
 
 DONE, FAILED = "done", "failed"
 
@@ -141,7 +141,7 @@ def _idle_region(index: int, device: str, state: str, cell: Cell, taxonomy: Taxo
     final = el("final", id=f"{sid}_stays")
     concept = cell.device(device).state(state).concept
     if concept:
-        final.set(pnp_attr("concept"), local_name(concept))
+        final.set(pnp_attr("concept"), concept_value(concept))
     final.set(pnp_attr("deviceState"), state)
     region.append(final)
     return region

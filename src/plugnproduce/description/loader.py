@@ -7,6 +7,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from decimal import Decimal
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
@@ -195,6 +196,14 @@ def _number(node: rdflib.term.Node | None) -> float | None:
     return float(node.toPython()) if isinstance(node, rdflib.Literal) else None
 
 
+def _default(node: rdflib.term.Node | None) -> object:
+    """A default value as a plain Python value (a decimal as a float, never ``Decimal``)."""
+    if not isinstance(node, rdflib.Literal):
+        return None
+    value = node.toPython()
+    return float(value) if isinstance(value, Decimal) else value
+
+
 def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
     role = _one(loaded, p, PNP.forRole, "role")
     role_name = _opt(loaded, role, PNP.roleName)
@@ -208,7 +217,7 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
         unit=str(_opt(loaded, p, PNP.unit) or ""),
         minimum=_number(_opt(loaded, p, PNP.minValue)),
         maximum=_number(_opt(loaded, p, PNP.maxValue)),
-        default=default.toPython() if isinstance(default, rdflib.Literal) else None,
+        default=_default(default),
         where=loaded.where(str(p)),
     )
 
