@@ -35,8 +35,8 @@ class Library:
 
     def files(self, kind: str, pattern: str = "*.ttl") -> list[Path]:
         """The files of one kind (``"devices"``, ``"processes"``...) in this library, sorted."""
-        if kind == "ontology":
-            return ontology_files(ontology_path()) if self.builtin else _glob(self.root / "ontology", pattern)
+        if kind == "ontology" and self.builtin:
+            return ontology_files(ontology_path())
         return _glob(self.root / kind, pattern)
 
     @property
@@ -94,8 +94,8 @@ class Knowledge:
         return tuple(sorted(found, key=lambda d: d.id))
 
     def ontology_files(self) -> list[Path]:
-        """The TBox files of every library, built-in first."""
-        return [f for lib in self.libraries for f in lib.files("ontology")]
+        """The TBox files: the ``pnp`` ontology, then every user library's extensions."""
+        return tbox_files(self.libraries)
 
     def tbox(self) -> rdflib.Graph:
         """The combined TBox as written (without the reasoner's closure)."""
@@ -126,6 +126,12 @@ def refuse_duplicates(items: Sequence[DeviceDescription | ProcessDescription], w
                 "ids must be unique across libraries", item.where.file, item.where.line)
 
 
+def tbox_files(libraries: Sequence[Library]) -> list[Path]:
+    """The ``pnp`` ontology (always: libraries extend it, even without the built-in library) and the
+    ``ontology/`` files of the user libraries, in library order."""
+    return ontology_files(ontology_path()) + [f for lib in libraries if not lib.builtin for f in lib.files("ontology")]
+
+
 def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Sequence[Path] = ()) -> Knowledge:
     """Load the knowledge of ``libraries`` (default: the built-in one alone).
 
@@ -133,7 +139,7 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
     is cached by the combined content. Processes are read from every library's ``processes/``.
     """
     libs = tuple(libraries) if libraries is not None else (builtin_library(),)
-    tbox = [f for lib in libs for f in lib.files("ontology")] + list(extra_tbox)
+    tbox = tbox_files(libs) + [f for f in extra_tbox if f not in tbox_files(libs)]
     taxonomy = load_taxonomy(tbox)
     processes = [load_process(f) for lib in libs for f in lib.files("processes")]
     refuse_duplicates(processes, "process")
