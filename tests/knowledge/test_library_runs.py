@@ -32,7 +32,7 @@ def test_the_bin_picking_task_runs_with_a_user_gripper(tmp_path: Path) -> None:
 
 
 def test_a_one_state_role_region_completes_and_a_fractional_default_is_sent(tmp_path: Path) -> None:
-    cell = bin_picking_cell(tmp_path, [THREE_FINGER], GRIPPER_3F)
+    cell = bin_picking_cell(tmp_path, [THREE_FINGER])  # the built-in gripper: its chart sits beside its Turtle
     result = pnp("run", str(THREE_FINGER / "tasks" / "squeeze-and-open.yaml"), "--cell", str(cell), "--sim",
                  "--journal", str(tmp_path / "run.jsonl"))
     assert result.returncode == 0, result.stdout + result.stderr
