@@ -317,7 +317,14 @@ def task_to_yaml(task: Task) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = steps
-    return yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
+    return yaml.dump(doc, Dumper=_NoAliases, sort_keys=False, default_flow_style=None)
+
+
+class _NoAliases(yaml.SafeDumper):
+    """Writes a value shared by several steps out each time: task files refuse anchors and aliases."""
+
+    def ignore_aliases(self, data: object) -> bool:
+        return True
 
 
 def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
