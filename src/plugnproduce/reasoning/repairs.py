@@ -145,9 +145,9 @@ def folded_repeat(steps: list[Step], most: int) -> int:
     """The largest ``repeat`` (at most ``most``) such that the steps are that many equal rounds."""
     for r in range(most, 1, -1):
         n = len(steps) // r
-        if n * r == len(steps) and all(
-            (a.command, a.bind, a.params) == (b.command, b.bind, b.params) for a, b in zip(steps, steps[n:])
-        ):
+        shifted = zip(steps, steps[n:], strict=False)
+        if n * r == len(steps) and all((a.command, a.bind, a.params) == (b.command, b.bind, b.params)
+                                       for a, b in shifted):
             return r
     return 1
 
