@@ -11,7 +11,7 @@ from lxml import etree
 
 from plugnproduce import service
 from plugnproduce.ontology.vocabulary import PNP_IRI, concept_iri
-from tests.knowledge.test_libraries import THREE_FINGER, TF, bin_picking_cell
+from tests.knowledge.test_libraries import TF, THREE_FINGER, bin_picking_cell
 
 BUILTIN = service.builtin()
 GRIPPER_3F = THREE_FINGER / "devices" / "gripper-3f.ttl"

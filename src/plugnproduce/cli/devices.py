@@ -105,6 +105,11 @@ CONTROL = typer.Option(None, "--control", help="HOST:PORT of the running simulat
 def sim_plug(device: str = typer.Argument(..., help="A catalogue device id or a device description file."),
              control_address: str | None = CONTROL) -> None:
     """Plug a simulated device into the running cell."""
+    path = Path(device)
+    if device.endswith(".ttl") or path.is_file():
+        if not path.is_file():
+            fail(f"{device}: device description file not found")
+        device = str(path.resolve())
     _control("plug", device, control_address)
 
 
@@ -134,14 +139,16 @@ def sim_up(
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
 
-    Plug in more with 'pnp sim plug DEVICE' (any built-in device). PNP_SSDP_PORT chooses a private SSDP port.
+    Plug in more with 'pnp sim plug DEVICE' (a device of the libraries, or a device description file).
+    PNP_SSDP_PORT chooses a private SSDP port.
     """
     from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.cell import SimulatedCell, parse_faults, run_simulated_cell
 
     the_cell = service.cell(cell, knowledge())
-    sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=knowledge(cell)), network=network_from_env(),
-                        faults=parse_faults(faults, the_cell.devices))
+    k = knowledge(cell)
+    sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=k), network=network_from_env(),
+                        faults=parse_faults(faults, the_cell.devices), taxonomy=k.taxonomy)
     try:
         asyncio.run(run_simulated_cell(sim, state_file or control.default_state_file(), echo=typer.echo))
     except KeyboardInterrupt:
