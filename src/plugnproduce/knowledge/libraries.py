@@ -78,6 +78,8 @@ class Knowledge:
     libraries: tuple[Library, ...]
     taxonomy: Taxonomy
     processes: tuple[ProcessDescription, ...]
+    extra_tbox: tuple[Path, ...] = ()
+    """TBox files given beside the libraries (an extension being tried out)."""
 
     def process(self, command: str) -> ProcessDescription:
         """The process a command names."""
@@ -95,7 +97,7 @@ class Knowledge:
 
     def ontology_files(self) -> list[Path]:
         """The TBox files: the ``pnp`` ontology, then every user library's extensions."""
-        return tbox_files(self.libraries)
+        return tbox_files(self.libraries) + [f for f in self.extra_tbox if f not in tbox_files(self.libraries)]
 
     def tbox(self) -> rdflib.Graph:
         """The combined TBox as written (without the reasoner's closure)."""
@@ -112,7 +114,7 @@ class Knowledge:
     def with_libraries(self, extra: Sequence[Library]) -> Knowledge:
         """This knowledge with more libraries (those already loaded are not repeated)."""
         new = [lib for lib in extra if lib not in self.libraries]
-        return load_knowledge(self.libraries + tuple(new)) if new else self
+        return load_knowledge(self.libraries + tuple(new), self.extra_tbox) if new else self
 
 
 def refuse_duplicates(items: Sequence[DeviceDescription | ProcessDescription], what: str) -> None:
@@ -143,4 +145,4 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
     taxonomy = load_taxonomy(tbox)
     processes = [load_process(f) for lib in libs for f in lib.files("processes")]
     refuse_duplicates(processes, "process")
-    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)))
+    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(extra_tbox))
