@@ -139,6 +139,19 @@ def repair(
                             catalogue=devices, top=top, costs=costs)
 
 
+def catalogue_players(result: reasoning.CheckResult,
+                      knowledge: Knowledge | None = None) -> dict[tuple[int, str], list[str]]:
+    """For each step role no device of the cell can play: the catalogue devices (built-in and library) that could."""
+    k = _k(knowledge)
+    out: dict[tuple[int, str], list[str]] = {}
+    for p in result.problems:
+        if p.kind != "no_device" or p.role is None:
+            continue
+        needed = k.process(p.command).role(p.role).required_skill
+        out[(p.step, p.role)] = [d.id for d in k.devices if any(k.taxonomy.is_a(s, needed) for s in d.skills)]
+    return out
+
+
 def explain_process(cell_or_path: CellArg, command: str,
                     knowledge: Knowledge | None = None) -> reasoning.ProcessExplanation:
     """Why a process command is (not) offered in a cell."""

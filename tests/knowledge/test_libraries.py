@@ -143,3 +143,23 @@ def test_a_library_ontology_is_classified_and_cached_by_content(tmp_path: Path) 
     first = load_knowledge((builtin_library(), Library(THREE_FINGER)))
     again = load_knowledge((builtin_library(), Library(THREE_FINGER)))
     assert first.taxonomy.digest == again.taxonomy.digest != service.knowledge().taxonomy.digest
+
+
+def test_repair_says_which_catalogue_device_could_serve_a_role_no_device_plays(tmp_path: Path) -> None:
+    task = tmp_path / "squeeze.yaml"
+    task.write_text("task: s\nsteps:\n  - command: squeeze\n")
+    robot_only = tmp_path / "robot.yaml"
+    robot_only.write_text(f"cell: robot-only\ndevices:\n  - {BUILTIN / 'devices' / 'robot.ttl'}\n")
+    result = runner.invoke(app, ["--library", str(THREE_FINGER), "repair", str(task), "--cell", str(robot_only)])
+    line = next(x for x in result.stdout.splitlines() if x.startswith("step 1, role 'gripper'"))
+    assert "could play it: gripper, gripper-3f, magnetic-gripper, vacuum-gripper" in line
+
+
+def test_repair_says_when_no_catalogue_device_could_serve(tmp_path: Path) -> None:
+    task = tmp_path / "squeeze.yaml"
+    task.write_text("task: s\nsteps:\n  - command: squeeze\n")
+    gripper_only = tmp_path / "gripper.yaml"
+    gripper_only.write_text(f"cell: gripper-only\ndevices:\n  - {THREE_FINGER / 'devices' / 'gripper-3f.ttl'}\n")
+    result = runner.invoke(app, ["--no-builtin", "--library", str(THREE_FINGER), "repair", str(task), "--cell",
+                                 str(gripper_only)])
+    assert "step 1, role 'robot': no catalogue device (built-in or library) can play it" in result.stdout

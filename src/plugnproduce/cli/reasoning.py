@@ -94,14 +94,21 @@ def repair(
     """
     result = service.check(task, cell, knowledge(cell))
     repairs = [] if result.plausible else service.repair(task, cell, catalogue, top, knowledge=knowledge(cell))
+    players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
-                   "repairs": [r.to_json() for r in repairs]})
+                   "repairs": [r.to_json() for r in repairs],
+                   "catalogue_players": [{"step": i, "role": r, "devices": ds} for (i, r), ds in players.items()]})
     elif result.plausible:
         typer.echo(f"task {result.task} in cell {result.cell}: plausible; nothing to repair")
     else:
         typer.echo(f"task {result.task} in cell {result.cell}: implausible; {len(repairs)} repair(s)")
         _print_problems(result)
+        for (i, role), devices in players.items():
+            typer.echo(f"step {i}, role '{role}': " + (f"catalogue device(s) that could play it: {', '.join(devices)}"
+                                                       + ("" if catalogue else " (repair with --catalogue to add one)")
+                                                       if devices else "no catalogue device (built-in or library) "
+                                                       "can play it"))
         for r in repairs:
             typer.echo(f"\nrepair {r.rank} (cost {r.cost:g}):")
             for e in r.edits:
