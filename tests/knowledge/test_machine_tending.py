@@ -69,3 +69,18 @@ def test_a_user_gripper_subclass_in_the_bin_picking_cell_runs_the_bin_picking_ta
                  library=ADAPTIVE)
     assert result.returncode == 0, result.stdout + result.stderr
     assert "adaptive-gripper: Close" in result.stdout
+
+
+def test_a_library_skill_s_mandatory_state_is_enforced(tmp_path: Path) -> None:
+    import shutil
+
+    shutil.copytree(MT, tmp_path / "mt")
+    chart = tmp_path / "mt" / "devices" / "mt-cnc.scxml"
+    text = chart.read_text()
+    for kind in ("Open", "Closed"):
+        text = text.replace(f'"http://example.org/machine-tending#Door{kind}WithRawPart"', f'"Door{kind}"')
+    chart.write_text(text)
+    result = pnp("validate", str(tmp_path / "mt"))
+    assert result.returncode == 1
+    assert ("lacks the mandatory state 'RawPartLoaded'; expected a state annotated "
+            "http://example.org/machine-tending#RawPartLoaded") in result.stdout
