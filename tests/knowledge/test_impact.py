@@ -50,3 +50,15 @@ def test_a_catalogue_device_gaining_a_role_is_reported(tmp_path: Path) -> None:
     result = runner.invoke(app, ["impact", str(ext)])
     assert result.exit_code == 1
     assert "catalogue device vacuum-gripper: roles +screw.screwdriver" in result.stdout
+
+
+def test_the_impact_of_a_loaded_library_s_own_ontology_file(tmp_path: Path) -> None:
+    # The library is loaded (and its cell lists it): "before" is the knowledge without the file.
+    cell = tmp_path / "robot-3f.yaml"
+    cell.write_text(f"cell: robot-3f\nlibraries: [{THREE_FINGER}]\ndevices:\n  - {BUILTIN / 'devices' / 'robot.ttl'}\n"
+                    f"  - {THREE_FINGER / 'devices' / 'gripper-3f.ttl'}\n")
+    result = runner.invoke(app, ["--library", str(THREE_FINGER), "impact",
+                                 str(THREE_FINGER / "ontology" / "three-finger.ttl"), "--cells", str(cell)])
+    assert result.exit_code == 1, result.output
+    assert "+ pick             gripper=gripper-3f robot=robot" in result.stdout
+    assert "catalogue device gripper-3f: roles +" in result.stdout

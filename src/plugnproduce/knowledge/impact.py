@@ -45,7 +45,9 @@ class Impact:
 def impact(before: Knowledge, extensions: Sequence[Path], cell_files: Iterable[Path] | None = None) -> Impact:
     """The impact of adding ``extensions`` (TBox files) to ``before``, on ``cell_files`` (default: the
     libraries' cells), the catalogue and the libraries' tasks."""
+    extensions = [p.resolve() for p in extensions]
     after = load_knowledge(before.libraries, tuple(before.extra_tbox) + tuple(extensions))
+    before = load_knowledge(before.libraries, before.extra_tbox, tuple(before.left_out) + tuple(extensions))
     result = Impact([str(p) for p in extensions])
     cells = sorted(set(cell_files)) if cell_files is not None else before.cell_files()
     pairs = [(f, _cell(f, before), _cell(f, after)) for f in cells]
@@ -92,7 +94,7 @@ def _roles(device: DeviceDescription, k: Knowledge) -> set[str]:
 
 def _catalogue_change(before: Knowledge, after: Knowledge) -> list[dict[str, object]]:
     out: list[dict[str, object]] = []
-    for d in before.devices:
+    for d in after.devices:  # read with the extension: a device of a class only it defines is read too
         old, new = _roles(d, before), _roles(d, after)
         if old != new:
             out.append({"device": d.id, "file": d.where.file, "roles_added": sorted(new - old),

@@ -80,6 +80,8 @@ class Knowledge:
     processes: tuple[ProcessDescription, ...]
     extra_tbox: tuple[Path, ...] = ()
     """TBox files given beside the libraries (an extension being tried out)."""
+    left_out: tuple[Path, ...] = ()
+    """TBox files of the libraries left out (the state before an extension, for ``pnp impact``)."""
 
     def process(self, command: str) -> ProcessDescription:
         """The process a command names."""
@@ -97,7 +99,8 @@ class Knowledge:
 
     def ontology_files(self) -> list[Path]:
         """The TBox files: the ``pnp`` ontology, then every user library's extensions."""
-        return tbox_files(self.libraries) + [f for f in self.extra_tbox if f not in tbox_files(self.libraries)]
+        files = tbox_files(self.libraries) + [f for f in self.extra_tbox if f not in tbox_files(self.libraries)]
+        return [f for f in files if f not in self.left_out]
 
     def tbox(self) -> rdflib.Graph:
         """The combined TBox as written (without the reasoner's closure)."""
@@ -114,7 +117,7 @@ class Knowledge:
     def with_libraries(self, extra: Sequence[Library]) -> Knowledge:
         """This knowledge with more libraries (those already loaded are not repeated)."""
         new = [lib for lib in extra if lib not in self.libraries]
-        return load_knowledge(self.libraries + tuple(new), self.extra_tbox) if new else self
+        return load_knowledge(self.libraries + tuple(new), self.extra_tbox, self.left_out) if new else self
 
 
 def refuse_duplicates(items: Sequence[DeviceDescription | ProcessDescription], what: str) -> None:
@@ -134,15 +137,17 @@ def tbox_files(libraries: Sequence[Library]) -> list[Path]:
     return ontology_files(ontology_path()) + [f for lib in libraries if not lib.builtin for f in lib.files("ontology")]
 
 
-def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Sequence[Path] = ()) -> Knowledge:
+def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Sequence[Path] = (),
+                   left_out: Sequence[Path] = ()) -> Knowledge:
     """Load the knowledge of ``libraries`` (default: the built-in one alone).
 
-    The TBox of every library (and ``extra_tbox`` files) is classified together; the closure
-    is cached by the combined content. Processes are read from every library's ``processes/``.
+    The TBox of every library (and ``extra_tbox`` files, but not ``left_out`` ones) is classified
+    together; the closure is cached by the combined content. Processes are read from every
+    library's ``processes/``.
     """
     libs = tuple(libraries) if libraries is not None else (builtin_library(),)
-    tbox = tbox_files(libs) + [f for f in extra_tbox if f not in tbox_files(libs)]
+    tbox = [f for f in tbox_files(libs) + [f for f in extra_tbox if f not in tbox_files(libs)] if f not in left_out]
     taxonomy = load_taxonomy(tbox)
     processes = [load_process(f) for lib in libs for f in lib.files("processes")]
     refuse_duplicates(processes, "process")
-    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(extra_tbox))
+    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(extra_tbox), tuple(left_out))
