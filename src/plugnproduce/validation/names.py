@@ -11,7 +11,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import rdflib
-from rdflib.namespace import RDF
+from rdflib.namespace import OWL, RDF, RDFS
 
 from plugnproduce.description.loader import Loaded
 from plugnproduce.ontology.names import unknown_class, unknown_term
@@ -50,8 +50,13 @@ def turtle_name_problems(loaded: Loaded, taxonomy: Taxonomy) -> Iterator[Problem
     """Unknown classes, skills, quantities and state concepts in a Turtle description."""
     g = loaded.graph
     for s, c in sorted(g.subject_objects(RDF.type)):
-        if isinstance(c, rdflib.URIRef) and str(c) not in DESCRIPTION_CLASSES and not taxonomy.knows(str(c)):
-            line = loaded.line(str(s)) or 0
+        if not isinstance(c, rdflib.URIRef) or str(c) in DESCRIPTION_CLASSES or taxonomy.knows(str(c)):
+            continue
+        line = loaded.line(str(s)) or 0
+        if str(c).startswith((str(OWL), str(RDFS))):
+            yield Problem(str(loaded.path), line, f"{local_name(str(s))} is an ontology term ({local_name(str(c))}); "
+                          "a description's class axioms are not read: put them in a library's ontology/ folder")
+        else:
             yield Problem(str(loaded.path), line, unknown_class(str(s), str(c), taxonomy))
     for prop, kind in TERM_PROPERTIES.items():
         for s, o in sorted(g.subject_objects(prop)):
