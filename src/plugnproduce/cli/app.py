@@ -7,11 +7,15 @@ import os
 import sys
 from collections.abc import Callable
 from functools import wraps
-from typing import Any, NoReturn, TypeVar
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 import typer
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
+
+if TYPE_CHECKING:  # the knowledge is loaded by the commands that need it
+    from plugnproduce.knowledge import Knowledge
 
 app = typer.Typer(
     no_args_is_help=True,
@@ -38,7 +42,7 @@ def _options(
     LIBRARIES["builtin"] = not no_builtin
 
 
-def knowledge(cell: Any = None) -> Any:
+def knowledge(cell: str | Path | None = None) -> Knowledge:
     """The knowledge the command line's libraries give (plus those a cell file lists), a service argument."""
     from plugnproduce import service
 
