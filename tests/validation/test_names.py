@@ -84,3 +84,12 @@ def test_class_axioms_in_a_device_file_say_where_they_belong(device_copy) -> Non
     found = [m for m in _messages(ttl) if "SoftGripper" in m]
     assert found == [f"{ttl}:15: SoftGripper is an ontology term (Class); a description's class axioms are not "
                      "read: put them in a library's ontology/ folder"]
+
+
+def test_a_misspelt_concept_in_a_process_chart_is_one_finding_with_did_you_mean(process_copy) -> None:
+    ttl, scxml = process_copy("pick")
+    edit(scxml, 'id="robot_lifted" pnp:concept="AtPose"', 'id="robot_lifted" pnp:concept="AtPsoe"')
+    found = [m for m in _messages(ttl.parent) if "AtPsoe" in m]
+    assert found == [f"{scxml}:18: state 'robot_lifted' is annotated with AtPsoe, which is not a state concept of "
+                     "the ontology; did you mean AtPose or AtHome?"]
+    assert not [m for m in _messages(ttl.parent) if m.startswith("<knowledge graph>")]

@@ -22,6 +22,7 @@ from plugnproduce.validation.findings import Problem
 
 CONCEPT = "{" + PNP_IRI + "}concept"
 ACCEPTS = "{" + PNP_IRI + "}accepts"
+ROLE = "{" + PNP_IRI + "}role"
 
 TERM_PROPERTIES = {PNP.hasSkill: "Skill", PNP.requiresSkill: "Skill", PNP.quantity: "Quantity",
                    PNP.mandatoryState: "StateConcept"}
@@ -32,11 +33,13 @@ DESCRIPTION_CLASSES = {str(PNP.Process), str(PNP.Role), str(PNP.Parameter)}
 
 def chart_name_problems(path: Path, taxonomy: Taxonomy) -> Iterator[Problem]:
     """Unknown state concepts (``pnp:concept``) and quantities (``pnp:accepts``) in a chart."""
-    for el in parse_xml(path).getroot().iter():
+    root = parse_xml(path).getroot()
+    process_chart = any(el.get(ROLE) for el in root.iter() if isinstance(el.tag, str))
+    for el in root.iter():
         if not isinstance(el.tag, str):
             continue
         concept = el.get(CONCEPT)
-        if concept:
+        if concept and not process_chart:  # a process chart's concepts: see structure.process_problems
             message = unknown_term(concept_iri(concept), "StateConcept", taxonomy)
             if message:
                 yield Problem(str(path), el.sourceline or 0, f"pnp:concept: {message}")

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 from plugnproduce.description.model import Command, DeviceDescription, ProcessDescription, Task
+from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.validation.findings import Problem
@@ -47,7 +48,8 @@ def process_problems(process: ProcessDescription, taxonomy: Taxonomy) -> Iterato
         for s in role.region:
             if not taxonomy.is_kind(s.concept, "StateConcept"):
                 yield Problem(file, s.line or 0, f"state {s.id!r} is annotated with {local_name(s.concept)}, "
-                              "which is not a state concept of the ontology")
+                              "which is not a state concept of the ontology"
+                              + did_you_mean(s.concept, taxonomy.classes_of_kind("StateConcept")))
             for name in s.params:
                 if name not in params:
                     yield Problem(file, s.line or 0, f"transition into {s.id!r} consumes parameter {name!r}, "
