@@ -65,7 +65,8 @@ def validate(paths: list[str | Path], knowledge: Knowledge | None = None) -> Rep
 
 def cell(path: str | Path, knowledge: Knowledge | None = None) -> Cell:
     """Read a cell file (with the libraries it lists, added to ``knowledge``)."""
-    return load_cell(path, knowledge_for_cell(path, knowledge).taxonomy)
+    k = knowledge_for_cell(path, knowledge)
+    return load_cell(path, k.taxonomy, k.device)
 
 
 def catalogue(folder: str | Path | None = None, knowledge: Knowledge | None = None) -> list[DeviceDescription]:
@@ -96,7 +97,7 @@ def _context(cell_or_path: CellArg, knowledge: Knowledge | None) -> tuple[Cell, 
             return cell_or_path, knowledge_for_cell(cell_or_path.file, knowledge)
         return cell_or_path, _k(knowledge)
     k = knowledge_for_cell(cell_or_path, knowledge)
-    return load_cell(cell_or_path, k.taxonomy), k
+    return load_cell(cell_or_path, k.taxonomy, k.device), k
 
 
 def _as_task(task_or_path: TaskArg) -> Task:

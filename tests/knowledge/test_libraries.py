@@ -163,3 +163,19 @@ def test_repair_says_when_no_catalogue_device_could_serve(tmp_path: Path) -> Non
     result = runner.invoke(app, ["--no-builtin", "--library", str(THREE_FINGER), "repair", str(task), "--cell",
                                  str(gripper_only)])
     assert "step 1, role 'robot': no catalogue device (built-in or library) can play it" in result.stdout
+
+
+def test_a_cell_names_library_devices_by_id(tmp_path: Path) -> None:
+    cell = tmp_path / "by-id.yaml"
+    cell.write_text(f"cell: by-id\nlibraries: [{THREE_FINGER}]\ndevices:\n  - robot\n  - gripper-3f\n")
+    assert "pick" in service.capabilities(cell).commands()
+    assert [d.id for d in service.cell(cell).devices] == ["robot", "gripper-3f"]
+    assert runner.invoke(app, ["validate", str(cell)]).exit_code == 0
+
+
+def test_an_unknown_device_id_in_a_cell_is_bad_input(tmp_path: Path) -> None:
+    cell = tmp_path / "by-id.yaml"
+    cell.write_text("cell: by-id\ndevices:\n  - robot\n  - robott\n")
+    result = runner.invoke(app, ["capabilities", "--cell", str(cell)])
+    assert result.exit_code == 2
+    assert result.output.startswith(f"{cell}:4: device description robott not found")

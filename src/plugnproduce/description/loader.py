@@ -6,6 +6,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
@@ -361,14 +362,23 @@ def cell_libraries(path: str | Path) -> list[Path]:
     return out
 
 
-def load_cell(path: str | Path, taxonomy: Taxonomy) -> Cell:
-    """Read a cell (YAML) and all its device descriptions."""
+def load_cell(path: str | Path, taxonomy: Taxonomy,
+              by_id: Callable[[str], DeviceDescription | None] | None = None) -> Cell:
+    """Read a cell (YAML) and all its device descriptions.
+
+    An entry that is no file but a plain id (``robot``) names a catalogue device, found by ``by_id``.
+    """
     name, files = cell_device_files(path)
     devices = []
     for f, line in files:
-        if not f.is_file():
-            raise DescriptionError(f"device description {f.name} not found", path, line)
-        devices.append(load_device(f, taxonomy))
+        if f.is_file():
+            devices.append(load_device(f, taxonomy))
+            continue
+        known = by_id(f.name) if by_id is not None and f.suffix != ".ttl" else None
+        if known is None:
+            raise DescriptionError(f"device description {f.name} not found; expected a device description file "
+                                   "(relative to the cell file) or the id of a device of a loaded library", path, line)
+        devices.append(known)
     ids = [d.id for d in devices]
     for d in devices:
         if ids.count(d.id) > 1:

@@ -64,7 +64,7 @@ def impact(before: Knowledge, extensions: Sequence[Path], cell_files: Iterable[P
 def _cell(path: Path, k: Knowledge) -> tuple[Cell | None, Knowledge]:
     try:
         k = k.with_libraries(library_folders(cell_libraries(path)))
-        return load_cell(path, k.taxonomy), k
+        return load_cell(path, k.taxonomy, k.device), k
     except DescriptionError:
         return None, k  # e.g. a device of a class only the extension defines: the cell cannot be read before
 

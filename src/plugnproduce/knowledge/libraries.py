@@ -97,6 +97,10 @@ class Knowledge:
         refuse_duplicates(found, "device")
         return tuple(sorted(found, key=lambda d: d.id))
 
+    def device(self, device_id: str) -> DeviceDescription | None:
+        """The catalogue device with this id, if any."""
+        return next((d for d in self.devices if d.id == device_id), None)
+
     def ontology_files(self) -> list[Path]:
         """The TBox files: the ``pnp`` ontology, then every user library's extensions."""
         files = tbox_files(self.libraries) + [f for f in self.extra_tbox if f not in tbox_files(self.libraries)]

@@ -13,6 +13,7 @@ from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.description.loader import (
     Loaded,
     cell_device_files,
+    cell_libraries,
     device_from,
     device_subject,
     file_of,
@@ -22,7 +23,7 @@ from plugnproduce.description.loader import (
 )
 from plugnproduce.description.model import ProcessDescription, Task, Where
 from plugnproduce.errors import DescriptionError, UnreadableError
-from plugnproduce.knowledge import Knowledge, load_knowledge
+from plugnproduce.knowledge import Knowledge, library_folders, load_knowledge
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.safeio import read_bytes
@@ -78,7 +79,7 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
             elif _yaml_kind(f) == "task":
                 tasks.append(load_task(f))
             else:
-                _cell(f, report)
+                _cell(f, report, knowledge)
         except DescriptionError as exc:
             report.add(Problem.from_error(exc))
     _tasks(tasks, knowledge, processes, kg, report)
@@ -176,8 +177,9 @@ def _yaml_kind(path: Path) -> str:
     return "task"
 
 
-def _cell(path: Path, report: Report) -> None:
+def _cell(path: Path, report: Report, knowledge: Knowledge) -> None:
     _, files = cell_device_files(path)
+    knowledge = knowledge.with_libraries(library_folders(cell_libraries(path)))
     for f, line in files:
-        if not f.is_file():
+        if not f.is_file() and (f.suffix == ".ttl" or knowledge.device(f.name) is None):
             report.add(Problem(str(path), line, f"device description {f} not found"))
