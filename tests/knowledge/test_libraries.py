@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -179,3 +180,15 @@ def test_an_unknown_device_id_in_a_cell_is_bad_input(tmp_path: Path) -> None:
     result = runner.invoke(app, ["capabilities", "--cell", str(cell)])
     assert result.exit_code == 2
     assert result.output.startswith(f"{cell}:4: device description robott not found")
+
+
+def test_batch_takes_library_devices_processes_and_tasks(tmp_path: Path) -> None:
+    configs = tmp_path / "configs.jsonl"
+    configs.write_text('{"config": "3f", "devices": ["robot", "gripper-3f"]}\n'
+                       '{"config": "robot-only", "devices": ["robot"]}\n')
+    result = runner.invoke(app, ["--library", str(THREE_FINGER), "batch", str(configs), "--workers", "1",
+                                 "--task", str(THREE_FINGER / "tasks" / "squeeze-and-open.yaml")])
+    assert result.exit_code == 0, result.output
+    rows = {r["config"]: r for r in map(json.loads, result.stdout.splitlines())}
+    assert "squeeze" in rows["3f"]["offered"] and rows["3f"]["plausible"] == ["squeeze-and-open"]
+    assert rows["robot-only"]["cheapest_device"]["squeeze-and-open"] is not None

@@ -168,7 +168,7 @@ def batch(
     generate: int | None = typer.Option(None, "--generate", help="Generate this many random configurations."),
     sizes: str = typer.Option("2-6", "--sizes", help="Devices per generated configuration, MIN-MAX."),
     seed: int = typer.Option(1, "--seed", help="Seed of the generator."),
-    catalogue: Path | None = typer.Option(None, "--catalogue", help="Device folder (default: built-in devices)."),
+    catalogue: Path | None = typer.Option(None, "--catalogue", help="Device folder (default: the libraries' devices)."),
     tasks: list[Path] = typer.Option([], "--task", help="A task to check in every configuration (repeatable)."),
     output: Path | None = typer.Option(None, "-o", "--output", help="Report file: .jsonl or .csv (default: stdout)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Worker processes."),
@@ -189,7 +189,7 @@ def batch(
     with Progress(*columns, console=err, transient=True) as bar:
         job = bar.add_task("batch", total=len(configurations))
         rows = list(service.batch(configurations, devices, list(tasks), workers,
-                                  progress=lambda n: bar.advance(job, n)))
+                                  progress=lambda n: bar.advance(job, n), knowledge=knowledge()))
     text = _report(rows, output.suffix.lower() == ".csv" if output else False)
     if output is None:
         sys.stdout.write(text)
