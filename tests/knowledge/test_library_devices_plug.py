@@ -32,5 +32,8 @@ async def test_issue_11_the_hmi_plug_list_shows_library_devices(tmp_path) -> Non
         async with httpx.AsyncClient(transport=transport, base_url="http://127.0.0.1") as client:
             listed = (await client.get("/api/catalogue")).json()
             processes = (await client.get("/api/processes")).json()
+            task = {"task": "s", "steps": [{"command": "squeeze", "bind": {}, "params": {}}]}
+            validated = (await client.post("/api/task/validate", json=task)).json()
     assert "gripper-3f" in [d["id"] for d in listed]
     assert "squeeze" in [p["command"] for p in processes]
+    assert validated["valid"], validated

@@ -36,9 +36,9 @@ def _rows(problems: list[dict[str, Any]], task: TaskIn) -> list[dict[str, Any]]:
 
 
 @router.post("/validate", summary="Validate the task like a task file: types, ranges, known commands")
-def validate(task: TaskIn) -> dict[str, Any]:
+def validate(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """Schema, SHACL shapes and structure, as ``pnp validate`` does; each problem names its editor field."""
-    return taskfiles.validate_task(task)
+    return taskfiles.validate_task(task, hub.knowledge)
 
 
 @router.post("/check", dependencies=reasoner, summary="Is the task plausible in the cell as it is now?")
