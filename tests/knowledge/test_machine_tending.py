@@ -84,3 +84,12 @@ def test_a_library_skill_s_mandatory_state_is_enforced(tmp_path: Path) -> None:
     assert result.returncode == 1
     assert ("lacks the mandatory state 'RawPartLoaded'; expected a state annotated "
             "http://example.org/machine-tending#RawPartLoaded") in result.stdout
+
+
+def test_one_file_of_a_library_validates_with_the_library_s_ontology() -> None:
+    result = pnp("validate", str(MT / "devices" / "mt-cnc.ttl"), library=Path("/nonexistent-is-not-used"))
+    assert result.returncode == 2  # a missing library folder is bad input...
+    env = {k: v for k, v in os.environ.items() if k != "PNP_LIBRARY"}
+    alone = subprocess.run([sys.executable, "-m", "plugnproduce", "validate", str(MT / "devices" / "mt-cnc.ttl")],
+                           capture_output=True, text=True, timeout=120, env=env)
+    assert alone.returncode == 0, alone.stdout  # ...but none is needed: the file's own library is found

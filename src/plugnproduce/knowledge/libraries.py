@@ -35,8 +35,9 @@ class Library:
 
     def files(self, kind: str, pattern: str = "*.ttl") -> list[Path]:
         """The files of one kind (``"devices"``, ``"processes"``...) in this library, sorted."""
-        if kind == "ontology" and self.builtin:
-            return ontology_files(ontology_path())
+        if kind == "ontology":  # every Turtle file but SHACL shapes
+            folder = ontology_path() if self.builtin else self.root / "ontology"
+            return ontology_files(folder) if folder.is_dir() else []
         return _glob(self.root / kind, pattern)
 
     @property

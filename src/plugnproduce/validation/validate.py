@@ -23,9 +23,10 @@ from plugnproduce.description.loader import (
 )
 from plugnproduce.description.model import ProcessDescription, Task, Where
 from plugnproduce.errors import DescriptionError, UnreadableError
-from plugnproduce.knowledge import Knowledge, library_folders, load_knowledge
+from plugnproduce.knowledge import Knowledge, Library, library_folders, load_knowledge
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
+from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import read_bytes
 from plugnproduce.statechart.schema import schema_problems
 from plugnproduce.validation.findings import Problem, Report
@@ -90,12 +91,18 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
 
 
 def _with_extensions(knowledge: Knowledge, files: list[Path], report: Report) -> Knowledge:
+    """The knowledge with the TBox files among ``files`` and those of the libraries the files sit in."""
     known = set(knowledge.ontology_files())
-    extra = [f for f in files if f.suffix == ".ttl" and f not in known and _is_tbox(f)]
+    extra = {f.resolve() for f in files if f.suffix == ".ttl" and f not in known and _is_tbox(f)}
+    builtin = ontology_path().resolve()
+    for root in {p.resolve() for f in files for p in f.resolve().parents[:3] if (p / "ontology").is_dir()}:
+        if (root / "ontology").resolve() == builtin:
+            continue
+        extra |= {t for t in Library(root).files("ontology") if t not in known}
     if not extra:
         return knowledge
     try:
-        return load_knowledge(knowledge.libraries, extra_tbox=extra)
+        return load_knowledge(knowledge.libraries, extra_tbox=sorted(extra), left_out=knowledge.left_out)
     except DescriptionError as exc:
         report.add(Problem.from_error(exc))
         return knowledge
