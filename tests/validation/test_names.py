@@ -93,3 +93,12 @@ def test_a_misspelt_concept_in_a_process_chart_is_one_finding_with_did_you_mean(
     assert found == [f"{scxml}:18: state 'robot_lifted' is annotated with AtPsoe, which is not a state concept of "
                      "the ontology; did you mean AtPose or AtHome?"]
     assert not [m for m in _messages(ttl.parent) if m.startswith("<knowledge graph>")]
+
+
+def test_a_misspelt_process_command_in_a_task_suggests_the_nearest(tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text("task: t\nsteps:\n  - command: pik\n")
+    assert _messages(task) == [f"{task}:3: step 1: unknown process command 'pik'; did you mean pick?"]
+    result = runner.invoke(app, ["check", str(task), "--cell", str(Path(__file__).parents[2] / "descriptions" /
+                                                                 "cells" / "bin-picking.yaml")])
+    assert "unknown process command 'pik'; did you mean pick?" in result.stdout

@@ -8,6 +8,7 @@ roles and parameters.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Iterator
 
 from plugnproduce.description.model import Command, DeviceDescription, ProcessDescription, Task
@@ -69,9 +70,9 @@ def task_problems(task: Task, processes: dict[str, ProcessDescription]) -> Itera
         line = step.line or 0
         process = processes.get(step.command)
         if process is None:
-            known = ", ".join(sorted(processes))
-            yield Problem(task.file, line, f"step {step.index}: unknown process command {step.command!r}; "
-                          f"expected one of {known}")
+            close = difflib.get_close_matches(step.command, sorted(processes), n=2)
+            hint = f"did you mean {' or '.join(close)}?" if close else f"expected one of {', '.join(sorted(processes))}"
+            yield Problem(task.file, line, f"step {step.index}: unknown process command {step.command!r}; {hint}")
             continue
         roles = {r.name for r in process.roles}
         for role in step.bind:
