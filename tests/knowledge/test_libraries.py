@@ -192,3 +192,13 @@ def test_batch_takes_library_devices_processes_and_tasks(tmp_path: Path) -> None
     rows = {r["config"]: r for r in map(json.loads, result.stdout.splitlines())}
     assert "squeeze" in rows["3f"]["offered"] and rows["3f"]["plausible"] == ["squeeze-and-open"]
     assert rows["robot-only"]["cheapest_device"]["squeeze-and-open"] is not None
+
+
+def test_an_inconsistent_extension_is_named(tmp_path: Path) -> None:
+    (tmp_path / "bad" / "ontology").mkdir(parents=True)
+    bad = tmp_path / "bad" / "ontology" / "bad.ttl"
+    bad.write_text("@prefix pnp: <http://plugnproduce.org/ontology#> .\n@prefix owl: <http://www.w3.org/2002/07/owl#> .\n"
+                   "<http://example.org/x> a pnp:Robot , pnp:Skill .\npnp:Device owl:disjointWith pnp:Skill .\n")
+    result = runner.invoke(app, ["--library", str(tmp_path / "bad"), "vocab"])
+    assert result.exit_code == 2
+    assert result.output == f"error: the ontology is inconsistent (HermiT) with the extension(s) {bad}\n"

@@ -18,7 +18,7 @@ import rdflib
 
 from plugnproduce.description.loader import load_device, load_process
 from plugnproduce.description.model import DeviceDescription, ProcessDescription
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, OntologyError
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
 from plugnproduce.resources import descriptions_path, ontology_path
 
@@ -152,7 +152,13 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
     """
     libs = tuple(libraries) if libraries is not None else (builtin_library(),)
     tbox = [f for f in tbox_files(libs) + [f for f in extra_tbox if f not in tbox_files(libs)] if f not in left_out]
-    taxonomy = load_taxonomy(tbox)
+    try:
+        taxonomy = load_taxonomy(tbox)
+    except OntologyError as exc:
+        own = [str(f) for f in tbox if f not in tbox_files((builtin_library(),))]
+        if not own:
+            raise
+        raise OntologyError(f"{exc} with the extension(s) {', '.join(own)}") from exc
     processes = [load_process(f) for lib in libs for f in lib.files("processes")]
     refuse_duplicates(processes, "process")
     return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(extra_tbox), tuple(left_out))
