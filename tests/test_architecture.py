@@ -16,6 +16,7 @@ LAYERS = {
     "service": 5,
     "executor": 4, "sim": 4, "discovery": 4,
     "codegen": 3, "reasoning": 3, "validation": 3, "drawing": 3,
+    "knowledge": 2.5,  # the loaded libraries: their taxonomy, descriptions and catalogue
     "description": 2,
     "ontology": 1, "statechart": 1, "protocols": 1,
     "resources": 0, "safeio": 0,

@@ -29,6 +29,7 @@ def test_wheel_ships_the_data_folders(tmp_path: Path) -> None:
     names = set(zipfile.ZipFile(wheel).namelist())
     for needed in (
         "plugnproduce/data/ontology/pnp.ttl",
+        "plugnproduce/data/ontology/closure.json",
         "plugnproduce/data/ontology/shapes.ttl",
         "plugnproduce/data/descriptions/cells/bin-picking.yaml",
         "plugnproduce/data/descriptions/devices/gripper.scxml",

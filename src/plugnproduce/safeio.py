@@ -255,7 +255,8 @@ def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
     try:
         g.parse(data=text, format="turtle", publicID=p.resolve().as_uri())
     except BadSyntax as exc:
-        raise UnreadableError(f"malformed Turtle: {exc.message}", p, exc.lines + 1) from exc
+        why = str(getattr(exc, "_why", "") or "syntax error").strip()
+        raise UnreadableError(f"malformed Turtle: {why}", p, exc.lines + 1) from exc
     except Exception as exc:  # rdflib raises assorted types for bad literals and IRIs
         raise UnreadableError(f"malformed Turtle: {exc}", p) from exc
     if len(g) > MAX_TRIPLES:

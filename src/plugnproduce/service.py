@@ -20,10 +20,10 @@ from typing import TYPE_CHECKING
 from plugnproduce import reasoning
 from plugnproduce.codegen import GeneratedTask, generate_task
 from plugnproduce.codegen.outputs import GeneratedChart, all_charts
-from plugnproduce.description.loader import load_cell, load_devices, load_processes, load_task
-from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.description.loader import cell_libraries, load_cell, load_devices, load_task
+from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
-from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy
+from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
 from plugnproduce.resources import descriptions_path
 from plugnproduce.validation import Report, validate_paths
 
@@ -32,44 +32,50 @@ if TYPE_CHECKING:  # execution pulls in the network stack: imported when a run n
     from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
     from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
-
-
-@dataclass(frozen=True)
-class Knowledge:
-    """What every use case needs: the taxonomy closure and the known processes."""
-
-    taxonomy: Taxonomy
-    processes: tuple[ProcessDescription, ...]
-
-    def process(self, command: str) -> ProcessDescription:
-        """The process a command names."""
-        for p in self.processes:
-            if p.id == command:
-                return p
-        raise KeyError(command)
+    from plugnproduce.reasoning.impact import Impact
 
 
 @lru_cache(maxsize=8)
-def knowledge(processes_dir: Path | None = None) -> Knowledge:
-    """The taxonomy (cached by content) and the processes of ``processes_dir`` (default: built-in)."""
-    taxonomy = load_taxonomy()
-    folder = processes_dir or descriptions_path() / "processes"
-    return Knowledge(taxonomy, tuple(load_processes(folder)))
+def _loaded(libraries: tuple[Library, ...]) -> Knowledge:
+    return load_knowledge(libraries)
 
 
-def validate(paths: list[str | Path], progress: Callable[[str], None] | None = None) -> Report:
+def knowledge(libraries: tuple[str | Path, ...] = (), builtin: bool = True) -> Knowledge:
+    """Load the knowledge of the built-in library (unless ``builtin`` is false) and ``libraries``.
+
+    Loading the same libraries again returns the same object; every use case takes the result as
+    its ``knowledge`` argument (default: the built-in library alone).
+    """
+    libs = ((builtin_library(),) if builtin else ()) + library_folders(libraries)
+    return _loaded(libs)
+
+
+def knowledge_for_cell(path: str | Path, base: Knowledge | None = None) -> Knowledge:
+    """``base`` (default: built-in) with the libraries a cell file lists under ``libraries:``."""
+    base = base or knowledge()
+    return base.with_libraries(library_folders(cell_libraries(path)))
+
+
+def _k(k: Knowledge | None) -> Knowledge:
+    return k if k is not None else knowledge()
+
+
+def validate(paths: list[str | Path], knowledge: Knowledge | None = None,
+             progress: Callable[[str], None] | None = None) -> Report:
     """Validate description files and folders; ``progress`` is told each phase as it begins."""
-    return validate_paths(paths, knowledge().taxonomy, progress=progress)
+    return validate_paths(paths, _k(knowledge), progress=progress)
 
 
-def cell(path: str | Path) -> Cell:
-    """Read a cell file."""
-    return load_cell(path, knowledge().taxonomy)
+def cell(path: str | Path, knowledge: Knowledge | None = None) -> Cell:
+    """Read a cell file (with the libraries it lists, added to ``knowledge``)."""
+    k = knowledge_for_cell(path, knowledge)
+    return load_cell(path, k.taxonomy, k.device)
 
 
-def catalogue(folder: str | Path | None = None) -> list[DeviceDescription]:
-    """Read a catalogue of device descriptions (default: the built-in devices)."""
-    return load_devices(folder or descriptions_path() / "devices", knowledge().taxonomy)
+def catalogue(folder: str | Path | None = None, knowledge: Knowledge | None = None) -> list[DeviceDescription]:
+    """Read a catalogue of device descriptions (default: every device of the loaded libraries)."""
+    k = _k(knowledge)
+    return list(k.devices) if folder is None else load_devices(folder, k.taxonomy)
 
 
 def task(path: str | Path) -> Task:
@@ -83,54 +89,85 @@ def builtin(*parts: str) -> Path:
 
 
 
-def _as_cell(cell_or_path: Cell | str | Path) -> Cell:
-    return cell_or_path if isinstance(cell_or_path, Cell) else cell(cell_or_path)
+CellArg = Cell | str | Path
+TaskArg = Task | str | Path
 
 
-def _as_task(task_or_path: Task | str | Path) -> Task:
+def _context(cell_or_path: CellArg, knowledge: Knowledge | None) -> tuple[Cell, Knowledge]:
+    """The cell and the knowledge to reason with: ``knowledge`` plus the cell file's libraries."""
+    if isinstance(cell_or_path, Cell):
+        if cell_or_path.file and Path(cell_or_path.file).is_file():
+            return cell_or_path, knowledge_for_cell(cell_or_path.file, knowledge)
+        return cell_or_path, _k(knowledge)
+    k = knowledge_for_cell(cell_or_path, knowledge)
+    return load_cell(cell_or_path, k.taxonomy, k.device), k
+
+
+def _as_task(task_or_path: TaskArg) -> Task:
     return task_or_path if isinstance(task_or_path, Task) else task(task_or_path)
 
 
-def capabilities(cell_or_path: Cell | str | Path) -> reasoning.Capabilities:
+def _devices(catalogue_or_folder: list[DeviceDescription] | str | Path | None, k: Knowledge) -> list[DeviceDescription]:
+    if isinstance(catalogue_or_folder, list):
+        return catalogue_or_folder
+    return catalogue(catalogue_or_folder, k)
+
+
+def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.Capabilities:
     """The process commands a cell offers, with every valid role binding; the others with reasons."""
-    k = knowledge()
-    return reasoning.capabilities(_as_cell(cell_or_path), k.taxonomy, k.processes)
+    the_cell, k = _context(cell_or_path, knowledge)
+    return reasoning.capabilities(the_cell, k.taxonomy, k.processes)
 
 
-def check(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path) -> reasoning.CheckResult:
+def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.CheckResult:
     """Whether a task is plausible in a cell: per step its bindings, device states and problems."""
-    k = knowledge()
-    return reasoning.check(_as_task(task_or_path), _as_cell(cell_or_path), k.taxonomy, k.processes)
+    the_cell, k = _context(cell_or_path, knowledge)
+    return reasoning.check(_as_task(task_or_path), the_cell, k.taxonomy, k.processes)
 
 
 def repair(
-    task_or_path: Task | str | Path,
-    cell_or_path: Cell | str | Path,
+    task_or_path: TaskArg,
+    cell_or_path: CellArg,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     top: int = 3,
     costs: reasoning.RepairCosts | None = None,
+    knowledge: Knowledge | None = None,
 ) -> list[reasoning.Repair]:
     """The ``top`` cheapest distinct repairs of an implausible task (none if it is plausible).
 
     With a catalogue (device descriptions, or a folder of them) a repair may add a device.
     """
-    k = knowledge()
-    devices = catalogue(catalogue_or_folder) if isinstance(catalogue_or_folder, str | Path) else catalogue_or_folder
-    return reasoning.repair(_as_task(task_or_path), _as_cell(cell_or_path), k.taxonomy, k.processes,
+    the_cell, k = _context(cell_or_path, knowledge)
+    devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
+    return reasoning.repair(_as_task(task_or_path), the_cell, k.taxonomy, k.processes,
                             catalogue=devices, top=top, costs=costs)
 
 
-def explain_process(cell_or_path: Cell | str | Path, command: str) -> reasoning.ProcessExplanation:
+def catalogue_players(result: reasoning.CheckResult,
+                      knowledge: Knowledge | None = None) -> dict[tuple[int, str], list[str]]:
+    """For each step role no device of the cell can play: the catalogue devices (built-in and library) that could."""
+    k = _k(knowledge)
+    out: dict[tuple[int, str], list[str]] = {}
+    for p in result.problems:
+        if p.kind != "no_device" or p.role is None:
+            continue
+        needed = k.process(p.command).role(p.role).required_skill
+        out[(p.step, p.role)] = [d.id for d in k.devices if any(k.taxonomy.is_a(s, needed) for s in d.skills)]
+    return out
+
+
+def explain_process(cell_or_path: CellArg, command: str,
+                    knowledge: Knowledge | None = None) -> reasoning.ProcessExplanation:
     """Why a process command is (not) offered in a cell."""
-    k = knowledge()
-    return reasoning.explain_process(_as_cell(cell_or_path), command, k.taxonomy, k.processes)
+    the_cell, k = _context(cell_or_path, knowledge)
+    return reasoning.explain_process(the_cell, command, k.taxonomy, k.processes)
 
 
-def explain_step(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path,
-                 n: int) -> reasoning.StepExplanation:
+def explain_step(task_or_path: TaskArg, cell_or_path: CellArg, n: int,
+                 knowledge: Knowledge | None = None) -> reasoning.StepExplanation:
     """Why step ``n`` (1-based) of a task is (not) plausible in a cell."""
-    k = knowledge()
-    return reasoning.explain_step(_as_task(task_or_path), _as_cell(cell_or_path), n, k.taxonomy, k.processes)
+    the_cell, k = _context(cell_or_path, knowledge)
+    return reasoning.explain_step(_as_task(task_or_path), the_cell, n, k.taxonomy, k.processes)
 
 
 def batch(
@@ -139,11 +176,12 @@ def batch(
     tasks: list[Task | str | Path] | None = None,
     workers: int = 2,
     progress: Callable[[int], None] | None = None,
+    knowledge: Knowledge | None = None,
 ) -> Iterator[reasoning.BatchRow]:
     """Feasibility of many configurations (a list, or a JSONL/CSV file of device lists) of catalogue devices:
     per configuration the offered processes, the plausible tasks, and for the others the cheapest device to add."""
-    k = knowledge()
-    devices = catalogue_or_folder if isinstance(catalogue_or_folder, list) else catalogue(catalogue_or_folder)
+    k = _k(knowledge)
+    devices = _devices(catalogue_or_folder, k)
     configs = (configurations if isinstance(configurations, list)
                else reasoning.read_configurations(configurations))
     return reasoning.batch(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
@@ -155,10 +193,10 @@ def generate_configurations(
     sizes: tuple[int, int],
     seed: int,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+    knowledge: Knowledge | None = None,
 ) -> list[reasoning.Configuration]:
     """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices."""
-    devices = catalogue_or_folder if isinstance(catalogue_or_folder, list) else catalogue(catalogue_or_folder)
-    return reasoning.generate(devices, count, sizes, seed)
+    return reasoning.generate(_devices(catalogue_or_folder, _k(knowledge)), count, sizes, seed)
 
 
 # ------------------------------------------------------------------ code generation
@@ -181,14 +219,14 @@ class Generated:
     charts: list[GeneratedChart]
 
 
-def generate(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path, per_device: bool = False) -> Generated:
+def generate(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,
+             knowledge: Knowledge | None = None) -> Generated:
     """Check a task, then generate its specific process charts, task chart, closed-world chart and,
     with ``per_device``, each device's program. Raises :class:`ImplausibleTask` for an implausible task."""
-    the_task, the_cell = _as_task(task_or_path), _as_cell(cell_or_path)
-    result = check(the_task, the_cell)
+    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    result = check(the_task, the_cell, k)
     if not result.plausible:
         raise ImplausibleTask(result)
-    k = knowledge()
     generated = generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
     return Generated(generated, all_charts(generated, the_cell, per_device))
 
@@ -234,6 +272,7 @@ async def run_task(
     started: Callable[[TaskRun], None] | None = None,
     discovery_timeout: float = 10.0,
     progress: Callable[[str], None] | None = None,
+    knowledge: Knowledge | None = None,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
@@ -250,11 +289,11 @@ async def run_task(
 
     say = progress or (lambda _: None)
     say("checking the task in the cell")
-    the_task, the_cell = _as_task(task_or_path), _as_cell(cell_or_path)
-    if not (result := check(the_task, the_cell)).plausible:
+    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    if not (result := check(the_task, the_cell, k)).plausible:
         raise ImplausibleTask(result)
     say(f"generating the charts of {len(the_task.steps)} step(s)")
-    generated = generate(the_task, the_cell).task
+    generated = generate(the_task, the_cell, knowledge=k).task
     journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
     network = private_network() if simulate else network_from_env()
     async with contextlib.AsyncExitStack() as stack:
@@ -263,7 +302,7 @@ async def run_task(
             sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices))
             await stack.enter_async_context(sim)
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
-        live = await stack.enter_async_context(LiveCell(knowledge().taxonomy, network=network, name=the_cell.name))
+        live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name))
         devices = await find_devices(live, [d.id for d in the_cell.devices], discovery_timeout)
         say("running")
         run = TaskRun(generated, devices, journal, observer)
@@ -302,3 +341,12 @@ def runs() -> list[RunSummary]:
     from plugnproduce.executor.history import list_runs
 
     return list_runs(runs_folder())
+
+
+def impact(extensions: list[Path], cell_files: list[Path] | None = None,
+           knowledge: Knowledge | None = None) -> Impact:
+    """What adding the TBox files ``extensions`` to ``knowledge`` changes: offered commands per cell
+    (default: every cell of the loaded libraries), catalogue roles, and the libraries' tasks."""
+    from plugnproduce.reasoning.impact import impact as compute
+
+    return compute(_k(knowledge), extensions, cell_files)

@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import json
+import os
 import sys
 from collections.abc import Callable
 from functools import wraps
-from typing import Any, NoReturn, TypeVar
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 import typer
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
+
+if TYPE_CHECKING:  # the knowledge is loaded by the commands that need it
+    from plugnproduce.knowledge import Knowledge
 
 app = typer.Typer(
     no_args_is_help=True,
@@ -21,6 +26,18 @@ app = typer.Typer(
 )
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+LIBRARIES: dict[str, Any] = {"folders": [], "builtin": True}
+"""The libraries every command loads: ``--library`` options, then ``PNP_LIBRARY``; see :func:`knowledge`."""
+
+
+def knowledge(cell: str | Path | None = None) -> Knowledge:
+    """The knowledge the command line's libraries give (plus those a cell file lists), a service argument."""
+    from plugnproduce import service
+
+    k = service.knowledge(tuple(LIBRARIES["folders"]), builtin=LIBRARIES["builtin"])
+    return service.knowledge_for_cell(cell, k) if cell is not None else k
+
 
 JSON_OPTION = typer.Option(False, "--json", help="Machine-readable output.")
 
@@ -37,8 +54,14 @@ def _print_version(wanted: bool) -> None:
 def _options(
     version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
                                  help="Print the version and exit."),
+    library: list[str] = typer.Option([], "--library", metavar="DIR",
+                                      help="A library folder (ontology/, devices/, processes/, cells/, tasks/); "
+                                           "repeatable. PNP_LIBRARY adds folders separated by ':'."),
+    no_builtin: bool = typer.Option(False, "--no-builtin", help="Leave the built-in library out."),
 ) -> None:
     """Plug'n'Produce cell controller: from device and process descriptions to executable SCXML."""
+    LIBRARIES["folders"] = [*library, *[p for p in os.environ.get("PNP_LIBRARY", "").split(":") if p.strip()]]
+    LIBRARIES["builtin"] = not no_builtin
 
 
 def fail(message: str, code: int = 2) -> NoReturn:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from plugnproduce import service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
 from plugnproduce.description.model import Cell
 from plugnproduce.errors import ProtocolError
 from plugnproduce.sim import control
@@ -23,7 +23,7 @@ app.add_typer(sim_app, name="sim")
 
 
 def _device_json(cell: Cell) -> list[dict[str, object]]:
-    taxonomy = service.knowledge().taxonomy
+    taxonomy = knowledge().taxonomy
     return [
         {
             "id": d.id,
@@ -38,7 +38,7 @@ def _device_json(cell: Cell) -> list[dict[str, object]]:
 
 
 def _offered(cell: Cell) -> list[str]:
-    return service.capabilities(cell).commands() if cell.devices else []
+    return service.capabilities(cell, knowledge()).commands() if cell.devices else []
 
 
 def _change_json(change: CellChange) -> dict[str, object]:
@@ -64,7 +64,7 @@ async def _discover(json_out: bool, watch: bool, timeout: float) -> None:
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env
 
-    async with LiveCell(service.knowledge().taxonomy, network=network_from_env(), search_timeout=timeout) as live:
+    async with LiveCell(knowledge().taxonomy, network=network_from_env(), search_timeout=timeout) as live:
         cell = live.cell
         if json_out and watch:  # one JSON object per line from the first on
             typer.echo(json.dumps({"devices": _device_json(cell), "offered": _offered(cell)}))
@@ -107,6 +107,11 @@ def sim_plug(device: str = typer.Argument(..., metavar="DEVICE",
                                           help="A catalogue device id or a device description file."),
              control_address: str | None = CONTROL) -> None:
     """Plug a simulated device into the running cell."""
+    path = Path(device)
+    if device.endswith(".ttl") or path.is_file():
+        if not path.is_file():
+            fail(f"{device}: device description file not found")
+        device = str(path.resolve())
     _control("plug", device, control_address)
 
 
@@ -137,14 +142,16 @@ def sim_up(
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
 
-    Plug in more with 'pnp sim plug DEVICE' (any built-in device). PNP_SSDP_PORT chooses a private SSDP port.
+    Plug in more with 'pnp sim plug DEVICE' (a device of the libraries, or a device description file).
+    PNP_SSDP_PORT chooses a private SSDP port.
     """
     from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.cell import SimulatedCell, parse_faults, run_simulated_cell
 
-    the_cell = service.cell(cell)
-    sim = SimulatedCell(the_cell, catalogue=service.catalogue(), network=network_from_env(),
-                        faults=parse_faults(faults, the_cell.devices))
+    the_cell = service.cell(cell, knowledge())
+    k = knowledge(cell)
+    sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=k), network=network_from_env(),
+                        faults=parse_faults(faults, the_cell.devices), taxonomy=k.taxonomy)
     try:
         asyncio.run(run_simulated_cell(sim, state_file or control.default_state_file(), echo=typer.echo))
     except KeyboardInterrupt:

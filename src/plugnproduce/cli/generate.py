@@ -8,7 +8,7 @@ from typing import NoReturn
 import typer
 
 from plugnproduce import service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
 
 CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
 
@@ -39,7 +39,7 @@ def generate(
     Exit 0 written, 1 the task is implausible (nothing is written), 2 bad input.
     """
     try:
-        generated = service.generate(task, cell, per_device)
+        generated = service.generate(task, cell, per_device, knowledge(cell))
     except service.ImplausibleTask as exc:
         refuse(exc, "nothing written", json_out)
     out.mkdir(parents=True, exist_ok=True)

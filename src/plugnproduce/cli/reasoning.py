@@ -17,7 +17,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from plugnproduce import reasoning, service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
 from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.description.loader import task_to_yaml
 
@@ -39,7 +39,7 @@ def _reasons(reasons: tuple[reasoning.Reason, ...], indent: str = "    ") -> Non
 @boundary
 def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Show the process commands a cell offers (with every role binding) and why the others are not offered."""
-    caps = service.capabilities(cell)
+    caps = service.capabilities(cell, knowledge(cell))
     if json_out:
         emit_json(caps.to_json())
         return
@@ -69,7 +69,7 @@ def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (
 
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
     """
-    result = service.check(task, cell)
+    result = service.check(task, cell, knowledge(cell))
     if json_out:
         emit_json(result.to_json())
     else:
@@ -94,16 +94,23 @@ def repair(
 
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
-    result = service.check(task, cell)
-    repairs = [] if result.plausible else service.repair(task, cell, catalogue, top)
+    result = service.check(task, cell, knowledge(cell))
+    repairs = [] if result.plausible else service.repair(task, cell, catalogue, top, knowledge=knowledge(cell))
+    players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
-                   "repairs": [r.to_json() for r in repairs]})
+                   "repairs": [r.to_json() for r in repairs],
+                   "catalogue_players": [{"step": i, "role": r, "devices": ds} for (i, r), ds in players.items()]})
     elif result.plausible:
         typer.echo(f"task {result.task} in cell {result.cell}: plausible; nothing to repair")
     else:
         typer.echo(f"task {result.task} in cell {result.cell}: implausible; {len(repairs)} repair(s)")
         _print_problems(result)
+        for (i, role), devices in players.items():
+            typer.echo(f"step {i}, role '{role}': " + (f"catalogue device(s) that could play it: {', '.join(devices)}"
+                                                       + ("" if catalogue else " (repair with --catalogue to add one)")
+                                                       if devices else "no catalogue device (built-in or library) "
+                                                       "can play it"))
         for r in repairs:
             typer.echo(f"\nrepair {r.rank} (cost {r.cost:g}):")
             for e in r.edits:
@@ -125,17 +132,18 @@ def explain(
 ) -> None:
     """Why a process command is (not) offered, or why a task's step is (not) plausible. Exit 1 when it is not."""
     if step is None:
-        ex = service.explain_process(cell, target)
+        ex = service.explain_process(cell, target, knowledge(cell))
+        name = service.cell(cell, knowledge()).name
         if json_out:
             emit_json(ex.to_json())
         elif ex.offered:
-            typer.echo(f"{ex.command} is offered in cell {service.cell(cell).name}: {_bindings(ex.bindings)}")
+            typer.echo(f"{ex.command} is offered in cell {name}: {_bindings(ex.bindings)}")
         else:
-            typer.echo(f"{ex.command} is not offered in cell {service.cell(cell).name}:")
+            typer.echo(f"{ex.command} is not offered in cell {name}:")
             _reasons(ex.reasons, "  ")
         ok = ex.offered
     else:
-        st = service.explain_step(Path(target), cell, step)
+        st = service.explain_step(Path(target), cell, step, knowledge(cell))
         if json_out:
             emit_json(st.to_json())
         else:
@@ -167,7 +175,7 @@ def batch(
                               help="Devices per generated configuration, MIN-MAX."),
     seed: int = typer.Option(1, "--seed", metavar="N", help="Seed of the generator."),
     catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
-                                          help="Device folder (default: built-in devices)."),
+                                          help="Device folder (default: the libraries' devices)."),
     tasks: list[Path] = typer.Option([], "--task", metavar="TASK",
                                      help="A task to check in every configuration (repeatable)."),
     output: Path | None = typer.Option(None, "-o", "--output", metavar="FILE",
@@ -177,7 +185,7 @@ def batch(
     """Feasibility of many cell configurations: offered processes, plausible tasks, cheapest device to add."""
     if (configs is None) == (generate is None):
         fail("give either CONFIGS (a JSONL or CSV file) or --generate N")
-    devices = service.catalogue(catalogue)
+    devices = service.catalogue(catalogue, knowledge())
     if generate is not None:
         try:
             configurations = service.generate_configurations(generate, _sizes(sizes), seed, devices)
@@ -190,7 +198,7 @@ def batch(
     with Progress(*columns, console=err, transient=True, disable=not on_a_terminal()) as bar:
         job = bar.add_task("batch", total=len(configurations))
         rows = list(service.batch(configurations, devices, list(tasks), workers,
-                                  progress=lambda n: bar.advance(job, n)))
+                                  progress=lambda n: bar.advance(job, n), knowledge=knowledge()))
     text = _report(rows, output.suffix.lower() == ".csv" if output else False)
     if output is None:
         sys.stdout.write(text)

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from plugnproduce import service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.cli.generate import refuse
 from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.executor.journal import describe
@@ -58,7 +58,8 @@ def run(
     try:
         with phases:
             report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
-                                                  observer=show, started=started, progress=phases))
+                                                  observer=show, started=started, progress=phases,
+                                                  knowledge=knowledge(cell)))
             phases.close(last_done=True)
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)

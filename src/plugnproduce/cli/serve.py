@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from plugnproduce import service
-from plugnproduce.cli.app import app, boundary, fail
+from plugnproduce.cli.app import app, boundary, fail, knowledge
 
 if TYPE_CHECKING:
     from plugnproduce.hmi import CellSource, Runner
@@ -28,18 +28,20 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "") -> CellSource:
         from plugnproduce.hmi.livecell import LiveCellSource
         from plugnproduce.protocols.upnp import network_from_env
 
-        return LiveCellSource(network_from_env(), name=service.cell(cell).name if cell else "live")
+        return LiveCellSource(network_from_env(), name=service.cell(cell, knowledge()).name if cell else "live",
+                              knowledge=knowledge(cell))
     from plugnproduce.hmi.simcell import SimulatedCellSource
 
-    the_cell = service.cell(cell or service.builtin("cells", "bin-picking.yaml"))
-    return SimulatedCellSource(the_cell, service.catalogue(), faults=faults)
+    cell = cell or service.builtin("cells", "bin-picking.yaml")
+    k = knowledge(cell)
+    return SimulatedCellSource(service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k)
 
 
-def runner_for(source: CellSource) -> Runner:
+def runner_for(source: CellSource, cell: Path | None = None) -> Runner:
     """Who runs tasks: the executor, on the devices of the source's cell, journalling into the runs folder."""
     from plugnproduce.hmi.executorrunner import ExecutorRunner
 
-    return ExecutorRunner(source, service.runs_folder())
+    return ExecutorRunner(source, service.runs_folder(), knowledge(cell))
 
 
 def _listen(host: str, port: int) -> socket.socket:
@@ -78,9 +80,10 @@ def serve(
     if faults and not sim:
         fail("--faults needs --sim: faults are injected into simulated devices")
     source = cell_source(cell, sim, faults)
-    service.knowledge()  # the taxonomy and processes, loaded once before the first request
+    the_cell = cell or (service.builtin("cells", "bin-picking.yaml") if sim else None)
     allowed = list(LOOPBACK_NAMES) if host in LOOPBACK_NAMES else None
-    application = create_app(source, runner_for(source), token, allowed_hosts=allowed)
+    application = create_app(source, runner_for(source, the_cell), token, allowed_hosts=allowed,
+                             knowledge=knowledge(the_cell))
     sock = _listen(host, port)
     bound = sock.getsockname()[1]
     shown = f"[{host}]" if ":" in host else host

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from plugnproduce import service
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.cli.progress import Phases, on_a_terminal
 
 
@@ -22,7 +22,7 @@ def validate(
     Exit 0 valid, 1 invalid, 2 unreadable or hostile input.
     """
     with Phases(on_a_terminal(json_out)) as phases:
-        report = service.validate(list(paths), progress=phases)
+        report = service.validate(list(paths), knowledge(), progress=phases)
         phases.close(last_done=True)
     problems = report.sorted()
     if json_out:

@@ -15,7 +15,7 @@ import copy
 
 from plugnproduce.codegen.task import NEXT, PLAN, STEP, GeneratedTask
 from plugnproduce.description.model import ChartTransition, DeviceDescription
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_value
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import Assign, Chart, Data, Final, State, Transition, pnp
 
@@ -58,7 +58,7 @@ def _visit(device: DeviceDescription, sid: str, state_id: str, *, entry: bool) -
     state = State(id=sid, extra_attrs={pnp("deviceState"): state_id})
     concept = device.state(state_id).concept
     if concept:
-        state.extra_attrs[pnp("concept")] = local_name(concept)
+        state.extra_attrs[pnp("concept")] = concept_value(concept)
     original = _chart_state(device, state_id)
     if entry and original is not None:
         state.onentry = copy.deepcopy(original.onentry[:1])

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.description.paths import find_path
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
 
 PLAN, STEP, VALUES = "pnp_plan", "pnp_step", "pnp_values"
@@ -77,8 +77,9 @@ def specific_region(
                    extra_attrs={pnp("role"): role.name, pnp("device"): device.id})
     result = RegionResult(role.name, device, region, start_state, start_state)
     current = start_state
-    states: list[State | Final] = [State(id=ids[role.region[0].id], extra_attrs=_annotation(role.region[0].concept,
-                                                                                            current))]
+    head_kind = Final if len(role.region) == 1 else State  # a one-state role is done at once
+    states: list[State | Final] = [head_kind(id=ids[role.region[0].id],
+                                             extra_attrs=_annotation(role.region[0].concept, current))]
     for general in role.region[1:]:
         wanted = frozenset(process.parameter(p).quantity for p in general.params)
         path = find_path(device, current, general.concept, taxonomy, wanted)
@@ -95,7 +96,7 @@ def specific_region(
 
 
 def _annotation(concept: str, device_state: str) -> dict[str, str]:
-    return {pnp("concept"): local_name(concept), pnp("deviceState"): device_state}
+    return {pnp("concept"): concept_value(concept), pnp("deviceState"): device_state}
 
 
 def _insert_path(

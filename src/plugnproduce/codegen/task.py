@@ -25,7 +25,7 @@ from plugnproduce.codegen.specific import (
 from plugnproduce.description.model import Cell, ChartTransition, Command, ProcessDescription, Step, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (
     Assign,
@@ -244,7 +244,7 @@ def _idle_region(index: int, device: str, state: str, cell: Cell) -> State:
     final = Final(id=f"{sid}_stays", extra_attrs={pnp("deviceState"): state})
     concept = cell.device(device).state(state).concept
     if concept:
-        final.extra_attrs[pnp("concept")] = local_name(concept)
+        final.extra_attrs[pnp("concept")] = concept_value(concept)
     return State(id=sid, initial=[final.id or ""], children=[final], extra_attrs={pnp("device"): device})
 
 

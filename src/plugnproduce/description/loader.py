@@ -6,7 +6,9 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from decimal import Decimal
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
@@ -27,6 +29,7 @@ from plugnproduce.description.model import (
 )
 from plugnproduce.description.rdf import term_line
 from plugnproduce.errors import DescriptionError
+from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.safeio import parse_turtle, parse_yaml_node
@@ -86,6 +89,8 @@ def device_subject(loaded: Loaded, taxonomy: Taxonomy) -> rdflib.URIRef:
         {s for s, c in loaded.graph.subject_objects(RDF.type) if isinstance(s, rdflib.URIRef)
          and taxonomy.is_kind(str(c), "Device")}
     )
+    if not devices:
+        _unknown_device_class(loaded, taxonomy)
     if len(devices) != 1:
         raise DescriptionError(
             f"a device description describes exactly one device (an individual of a pnp:Device class); "
@@ -94,6 +99,14 @@ def device_subject(loaded: Loaded, taxonomy: Taxonomy) -> rdflib.URIRef:
             1,
         )
     return devices[0]
+
+
+def _unknown_device_class(loaded: Loaded, taxonomy: Taxonomy) -> None:
+    """A would-be device (it has a state chart) whose class is unknown: say so at its line."""
+    for s in sorted(set(loaded.graph.subjects(PNP.stateChart)), key=str):
+        for c in sorted(loaded.graph.objects(s, RDF.type), key=str):
+            if not taxonomy.knows(str(c)):
+                raise DescriptionError(unknown_class(str(s), str(c), taxonomy), loaded.path, loaded.line(str(s)))
 
 
 def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
@@ -189,6 +202,14 @@ def _number(node: rdflib.term.Node | None) -> float | None:
     return float(node.toPython()) if isinstance(node, rdflib.Literal) else None
 
 
+def _default(node: rdflib.term.Node | None) -> object:
+    """A default value as a plain Python value (a decimal as a float, never ``Decimal``)."""
+    if not isinstance(node, rdflib.Literal):
+        return None
+    value = node.toPython()
+    return float(value) if isinstance(value, Decimal) else value
+
+
 def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
     role = _one(loaded, p, PNP.forRole, "role")
     role_name = _opt(loaded, role, PNP.roleName)
@@ -202,7 +223,7 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
         unit=str(_opt(loaded, p, PNP.unit) or ""),
         minimum=_number(_opt(loaded, p, PNP.minValue)),
         maximum=_number(_opt(loaded, p, PNP.maxValue)),
-        default=default.toPython() if isinstance(default, rdflib.Literal) else None,
+        default=_default(default),
         where=loaded.where(str(p)),
     )
 
@@ -306,14 +327,21 @@ def task_to_yaml(task: Task) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = steps
-    return yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
+    return yaml.dump(doc, Dumper=_NoAliases, sort_keys=False, default_flow_style=None)
+
+
+class _NoAliases(yaml.SafeDumper):
+    """Writes a value shared by several steps out each time: task files refuse anchors and aliases."""
+
+    def ignore_aliases(self, data: object) -> bool:
+        return True
 
 
 def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
     """A cell file's name and its device description files with the lines that list them."""
     p = Path(path)
     top = _mapping(parse_yaml_node(p), p, "cell")
-    _unknown_keys(top, {"cell", "devices"}, p, "cell")
+    _unknown_keys(top, {"cell", "devices", "libraries"}, p, "cell")
     if "cell" not in top or "devices" not in top or not isinstance(top["devices"], yaml.SequenceNode):
         raise DescriptionError("a cell needs 'cell' (its name) and 'devices' (a list of files)", p, 1)
     files = []
@@ -324,14 +352,42 @@ def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
     return str(_plain(top["cell"])), files
 
 
-def load_cell(path: str | Path, taxonomy: Taxonomy) -> Cell:
-    """Read a cell (YAML) and all its device descriptions."""
+def cell_libraries(path: str | Path) -> list[Path]:
+    """The library folders a cell file lists under ``libraries:`` (relative to the cell file)."""
+    p = Path(path)
+    top = _mapping(parse_yaml_node(p), p, "cell")
+    node = top.get("libraries")
+    if node is None:
+        return []
+    if not isinstance(node, yaml.SequenceNode) or not all(isinstance(n, yaml.ScalarNode) for n in node.value):
+        raise DescriptionError("libraries must be a list of folders (relative to the cell file)", p,
+                               node.start_mark.line + 1)
+    out = []
+    for n in node.value:
+        folder = (p.parent / n.value).resolve()
+        if not folder.is_dir():
+            raise DescriptionError(f"library folder {n.value} not found", p, n.start_mark.line + 1)
+        out.append(folder)
+    return out
+
+
+def load_cell(path: str | Path, taxonomy: Taxonomy,
+              by_id: Callable[[str], DeviceDescription | None] | None = None) -> Cell:
+    """Read a cell (YAML) and all its device descriptions.
+
+    An entry that is no file but a plain id (``robot``) names a catalogue device, found by ``by_id``.
+    """
     name, files = cell_device_files(path)
     devices = []
     for f, line in files:
-        if not f.is_file():
-            raise DescriptionError(f"device description {f.name} not found", path, line)
-        devices.append(load_device(f, taxonomy))
+        if f.is_file():
+            devices.append(load_device(f, taxonomy))
+            continue
+        known = by_id(f.name) if by_id is not None and f.suffix != ".ttl" else None
+        if known is None:
+            raise DescriptionError(f"device description {f.name} not found; expected a device description file "
+                                   "(relative to the cell file) or the id of a device of a loaded library", path, line)
+        devices.append(known)
     ids = [d.id for d in devices]
     for d in devices:
         if ids.count(d.id) > 1:

@@ -20,6 +20,7 @@ from plugnproduce.hmi.interfaces import CellSource, Runner
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
 from plugnproduce.hmi.routes import cell, charts, runs, task
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders
+from plugnproduce.knowledge import Knowledge
 from plugnproduce.safeio import MAX_BYTES
 
 DESCRIPTION = """\
@@ -43,14 +44,18 @@ def create_app(
     token: str,
     catalogue: list[DeviceDescription] | None = None,
     allowed_hosts: list[str] | None = None,
+    knowledge: Knowledge | None = None,
 ) -> FastAPI:
     """The HMI application over a cell source and a runner.
 
     ``token`` guards every request that changes something; ``catalogue`` is what repairs may add
-    (default: the built-in devices); ``allowed_hosts`` (e.g. ``["127.0.0.1", "localhost"]``) refuses
+    (default: the devices of ``knowledge``, itself by default the built-in library);
+    ``allowed_hosts`` (e.g. ``["127.0.0.1", "localhost"]``) refuses
     requests for any other ``Host``, which stops DNS-rebinding pages from reading the API.
     """
-    hub = Hub(source, runner, catalogue if catalogue is not None else service.catalogue())
+    knowledge = knowledge or service.knowledge()
+    devices = catalogue if catalogue is not None else service.catalogue(knowledge=knowledge)
+    hub = Hub(source, runner, devices, knowledge)
 
     @asynccontextmanager
     async def lifespan(_: FastAPI) -> AsyncIterator[None]:

@@ -20,6 +20,7 @@ from plugnproduce.description.model import Cell, Task
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun
 from plugnproduce.hmi.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
+from plugnproduce.knowledge import Knowledge
 
 log = logging.getLogger(__name__)
 
@@ -33,8 +34,9 @@ class _Run:
 class ExecutorRunner:
     """Runs tasks on the devices of ``source``'s cell, one at a time, journalling into ``runs_dir``."""
 
-    def __init__(self, source: CellSource, runs_dir: Path) -> None:
+    def __init__(self, source: CellSource, runs_dir: Path, knowledge: Knowledge | None = None) -> None:
         self._dir = Path(runs_dir)
+        self._knowledge = knowledge
         self._runs: dict[str, _Run] = {}
         self._loop: asyncio.AbstractEventLoop | None = None
         source.subscribe(self._on_cell)
@@ -58,7 +60,7 @@ class ExecutorRunner:
         if active is not None:
             raise RunRefused(f"run {active} is still running; stop it first")
         try:
-            generated = (await asyncio.to_thread(service.generate, task, cell)).task
+            generated = (await asyncio.to_thread(service.generate, task, cell, False, self._knowledge)).task
         except service.ImplausibleTask as exc:
             first = exc.result.problems[0]
             raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc

@@ -19,6 +19,7 @@ from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.executor.journal import describe
 from plugnproduce.hmi.interfaces import CellSource, CellUpdate, JournalRecord, Runner
 from plugnproduce.hmi.views import cell_json
+from plugnproduce.knowledge import Knowledge
 
 QUEUE_SIZE = 512
 """Events kept for a page that is slow to read; a page further behind is dropped (its browser reconnects)."""
@@ -32,8 +33,10 @@ def reasoner_available() -> bool:
 class Hub:
     """Current cell, device states and runs; every change is published to the subscribed pages."""
 
-    def __init__(self, source: CellSource, runner: Runner, catalogue: list[DeviceDescription]) -> None:
+    def __init__(self, source: CellSource, runner: Runner, catalogue: list[DeviceDescription],
+                 knowledge: Knowledge | None = None) -> None:
         self.source = source
+        self.knowledge = knowledge or service.knowledge()
         self.runner = runner
         self.catalogue = catalogue
         self._states = {d.id: d.initial for d in source.cell.devices}
@@ -79,14 +82,14 @@ class Hub:
         cached = self._commands
         if cached is not None and cached[0] is cell:
             return cached[1]
-        value = service.capabilities(cell).to_json() if reasoner_available() else None
+        value = service.capabilities(cell, self.knowledge).to_json() if reasoner_available() else None
         self._commands = (cell, value)
         return value
 
     def cell_view(self, cell: Cell | None = None) -> dict[str, Any]:
         """The cell with its devices' states, and the process commands it offers."""
         cell = cell or self.cell
-        return {"cell": cell_json(cell, service.knowledge().taxonomy, self.states()), "commands": self.commands(cell)}
+        return {"cell": cell_json(cell, self.knowledge.taxonomy, self.states()), "commands": self.commands(cell)}
 
     def _on_cell(self, update: CellUpdate) -> None:
         with self._lock:
@@ -103,7 +106,7 @@ class Hub:
         self.publish("cell", {"change": change, **self.cell_view(update.cell)})
 
     def _state_event(self, cell: Cell, device_id: str) -> dict[str, Any]:
-        view = cell_json(cell, service.knowledge().taxonomy, self.states())
+        view = cell_json(cell, self.knowledge.taxonomy, self.states())
         device = next((d for d in view["devices"] if d["id"] == device_id), None)
         return {"device": device_id, "state": device["state"] if device else None,
                 "state_concept": device["state_concept"] if device else None}

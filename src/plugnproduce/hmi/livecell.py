@@ -17,6 +17,7 @@ from plugnproduce import service
 from plugnproduce.description.model import Cell
 from plugnproduce.discovery import LiveCell
 from plugnproduce.hmi.interfaces import CellListener, CellUpdate
+from plugnproduce.knowledge import Knowledge
 from plugnproduce.protocols.upnp import SsdpNetwork
 
 log = logging.getLogger(__name__)
@@ -25,9 +26,10 @@ log = logging.getLogger(__name__)
 class LiveCellSource:
     """The devices discovery finds on ``network``; they plug in and unplug themselves."""
 
-    def __init__(self, network: SsdpNetwork, name: str = "live", search_timeout: float = 1.0) -> None:
+    def __init__(self, network: SsdpNetwork, name: str = "live", search_timeout: float = 1.0,
+                 knowledge: Knowledge | None = None) -> None:
         self.network = network
-        self._live = LiveCell(service.knowledge().taxonomy, network=network, name=name,
+        self._live = LiveCell((knowledge or service.knowledge()).taxonomy, network=network, name=name,
                               search_timeout=search_timeout)
         self._cell = Cell(name, ())
         self._listeners: list[CellListener] = []

@@ -13,6 +13,7 @@ from plugnproduce import reasoning, service
 from plugnproduce.codegen import GeneratedTask, generate_task
 from plugnproduce.codegen.outputs import GeneratedChart, all_charts
 from plugnproduce.description.model import Cell, Task
+from plugnproduce.knowledge import Knowledge
 
 
 @dataclass(frozen=True)
@@ -24,11 +25,11 @@ class Generation:
     charts: tuple[GeneratedChart, ...]
 
 
-def generate(task: Task, cell: Cell, per_device: bool = False) -> Generation:
+def generate(task: Task, cell: Cell, per_device: bool = False, knowledge: Knowledge | None = None) -> Generation:
     """Check a task and generate its charts with the bindings the check found (none when implausible)."""
-    result = service.check(task, cell)
+    k = knowledge or service.knowledge()
+    result = service.check(task, cell, k)
     if not result.plausible:
         return Generation(result, None, ())
-    k = service.knowledge()
     generated = generate_task(task, cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
     return Generation(result, generated, tuple(all_charts(generated, cell, per_device)))

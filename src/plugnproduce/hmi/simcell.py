@@ -16,6 +16,7 @@ from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.errors import ProtocolTimeout
 from plugnproduce.hmi.interfaces import CellChangeRefused
 from plugnproduce.hmi.livecell import LiveCellSource
+from plugnproduce.knowledge import Knowledge
 from plugnproduce.protocols.upnp import private_network
 from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
@@ -31,9 +32,9 @@ class SimulatedCellSource(LiveCellSource):
     """The devices of ``cell`` simulated, and what discovery sees of them; ``faults`` as ``pnp run --faults``."""
 
     def __init__(self, cell: Cell, catalogue: list[DeviceDescription], faults: str = "",
-                 wait: float = 10.0) -> None:
+                 wait: float = 10.0, knowledge: Knowledge | None = None) -> None:
         """``wait``: seconds a plug, unplug or the start may take until discovery has seen it."""
-        super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS)
+        super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS, knowledge=knowledge)
         self._wanted = [d.id for d in cell.devices]
         self._wait = wait
         self.sim = SimulatedCell(Cell(cell.name, ()), catalogue=[*catalogue, *cell.devices], network=self.network,

@@ -21,6 +21,7 @@ from plugnproduce.description.loader import load_task, task_to_yaml
 from plugnproduce.description.model import Task
 from plugnproduce.errors import DescriptionError
 from plugnproduce.hmi.schemas import TaskIn
+from plugnproduce.knowledge import Knowledge
 from plugnproduce.safeio import MAX_BYTES
 
 _validating = threading.Lock()
@@ -57,14 +58,14 @@ def _fields(loaded: Task, rounds: int) -> dict[int, tuple[int, str]]:
     return out
 
 
-def validate_task(task: TaskIn) -> dict[str, Any]:
+def validate_task(task: TaskIn, knowledge: Knowledge | None = None) -> dict[str, Any]:
     """Validate a task as ``pnp validate`` validates a task file; each problem names its editor field."""
     with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
         path = Path(folder) / "task.yaml"
         path.write_text(_block_yaml(task), encoding="utf-8")
         fields = _fields(load_task(path), task.repeat)
         with _validating:
-            report = service.validate([path])
+            report = service.validate([path], knowledge)
         problems = []
         for p in report.sorted():
             row, field = fields.get(p.line, (None, "task")) if p.file == str(path) else (None, p.file)

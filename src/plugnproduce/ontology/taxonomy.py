@@ -23,7 +23,7 @@ from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, local_name
 from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import parse_turtle
 
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 _CAPABILITY_PREFIX = PNP_IRI + "_HasSkill_"
 ROOTS = ("Device", "Skill", "StateConcept", "Process", "Quantity")
 
@@ -140,6 +140,9 @@ def load_taxonomy(
     """The taxonomy closure of the ontology, from the cache or from HermiT."""
     paths = list(files) if files is not None else ontology_files()
     digest = _digest(paths)
+    shipped = shipped_closure(digest)
+    if shipped is not None:
+        return shipped
     cache = (cache_dir or default_cache_dir()) / f"taxonomy-{digest[:32]}.json"
     if use_cache and cache.is_file():
         try:
@@ -158,6 +161,29 @@ def load_taxonomy(
     return taxonomy
 
 
+SHIPPED_CLOSURE = "closure.json"
+"""The built-in ontology's closure, computed once and shipped beside it (see :func:`ship_closure`)."""
+
+
+def shipped_closure(digest: str) -> Taxonomy | None:
+    """The shipped closure if it was computed from content with this ``digest``, else None."""
+    path = ontology_path() / SHIPPED_CLOSURE
+    try:
+        taxonomy = Taxonomy.from_json(path.read_text())
+    except (OSError, ValueError, KeyError):
+        return None
+    return taxonomy if taxonomy.digest == digest else None
+
+
+def ship_closure(folder: Path | None = None) -> Path:
+    """Classify the built-in ontology with HermiT and write its closure beside it (a build step)."""
+    folder = folder or ontology_path()
+    files = ontology_files(folder)
+    path = folder / SHIPPED_CLOSURE
+    path.write_text(classify(read_tbox(files), _digest(files)).to_json() + "\n")
+    return path
+
+
 def _named_subclasses(g: rdflib.Graph, root: rdflib.URIRef) -> set[str]:
     return {str(c) for c in g.transitive_subjects(RDFS.subClassOf, root) if isinstance(c, rdflib.URIRef)}
 
@@ -168,8 +194,8 @@ def classify(g: rdflib.Graph, digest: str = "") -> Taxonomy:
 
     skills = sorted(_named_subclasses(g, PNP.Skill) - {str(PNP.Skill)})
     cap = rdflib.Graph()
-    for s in skills:  # _HasSkill_S ≡ Device ⊓ ∃hasSkill.S, so classification reveals implied skills
-        c, r, i = rdflib.URIRef(_CAPABILITY_PREFIX + local_name(s)), rdflib.BNode(), rdflib.BNode()
+    for n, s in enumerate(skills):  # _HasSkill_n ≡ Device ⊓ ∃hasSkill.S reveals implied skills
+        c, r, i = rdflib.URIRef(f"{_CAPABILITY_PREFIX}{n}"), rdflib.BNode(), rdflib.BNode()
         cap.add((c, RDF.type, OWL.Class))
         cap.add((r, RDF.type, OWL.Restriction))
         cap.add((r, OWL.onProperty, PNP.hasSkill))
@@ -209,7 +235,7 @@ def _read_closure(world: object, g: rdflib.Graph, skills: list[str], digest: str
         named = {a.iri for a in cls.ancestors() if isinstance(a, owlready2.ThingClass)}
         named |= {e.iri for e in cls.equivalent_to if isinstance(e, owlready2.ThingClass)}
         named.discard(str(OWL.Thing))
-        caps = {PNP_IRI + a[len(_CAPABILITY_PREFIX):] for a in named if a.startswith(_CAPABILITY_PREFIX)}
+        caps = {skills[int(a[len(_CAPABILITY_PREFIX):])] for a in named if a.startswith(_CAPABILITY_PREFIX)}
         superclasses[iri] = frozenset(a for a in named if not a.startswith(_CAPABILITY_PREFIX))
         if caps and iri != str(PNP.Device):
             implied[iri] = frozenset(caps)
@@ -222,3 +248,7 @@ def _read_closure(world: object, g: rdflib.Graph, skills: list[str], digest: str
             mandatory[s] = frozenset(states)
     labels = {str(s): str(o) for s, o in g.subject_objects(RDFS.label) if isinstance(s, rdflib.URIRef)}
     return Taxonomy(digest, superclasses, implied, mandatory, labels)
+
+
+if __name__ == "__main__":  # python -m plugnproduce.ontology.taxonomy: refresh the shipped closure
+    print(ship_closure())

@@ -73,3 +73,8 @@ def local_name(iri: str) -> str:
 def concept_iri(value: str) -> str:
     """The IRI of a state or quantity concept written as a local name or a full IRI."""
     return value if ":" in value else PNP_IRI + value
+
+
+def concept_value(iri: str) -> str:
+    """How a chart names a concept: its local name in the ``pnp`` namespace, else its full IRI."""
+    return iri[len(PNP_IRI):] if iri.startswith(PNP_IRI) else iri

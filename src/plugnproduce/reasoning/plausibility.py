@@ -9,6 +9,7 @@ from plugnproduce.description.model import Cell, ProcessDescription, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning.accepts import not_accepted
 from plugnproduce.reasoning.facts import fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program, context
 from plugnproduce.reasoning.results import CheckResult, Problem, StepCheck, StepExplanation
@@ -61,8 +62,11 @@ def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proces
     """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems."""
     model, ctx = run_check(task, cell, taxonomy, processes)
     steps, final = _steps(model, task)
-    plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible])
-    return CheckResult(task.name, cell.name, plausible, tuple(_problems(model, ctx)), steps, final)
+    parameters = {p.id: {x.name: x for x in p.parameters} for p in processes}
+    lost = list(not_accepted(task, cell, steps, parameters, taxonomy))
+    plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not lost
+    problems = sorted(_problems(model, ctx) + lost, key=lambda p: (p.step, p.kind, p.parameter or ""))
+    return CheckResult(task.name, cell.name, plausible, tuple(problems), steps, final)
 
 
 def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,

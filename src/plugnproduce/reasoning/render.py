@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task, Where
@@ -152,7 +153,9 @@ def binding_problem(ctx: Context, kind: str, i: int, r: str, devices: list[str])
 def unknown_command(ctx: Context, a: s.UnknownCommand) -> Problem:
     """A step names no known process command."""
     known = ", ".join(sorted(ctx.processes))
-    reason = Reason("unknown_command", f"step {a.i}: unknown process command '{a.p}'; known: {known}")
+    close = difflib.get_close_matches(a.p, sorted(ctx.processes), n=2)
+    hint = f"; did you mean {' or '.join(close)}?" if close else f"; known: {known}"
+    reason = Reason("unknown_command", f"step {a.i}: unknown process command '{a.p}'{hint}")
     return Problem(a.i, a.p, "unknown_command", reason, ctx.step_where(a.i))
 
 

@@ -122,7 +122,7 @@ def repair(
 
 
 def repaired_task(model: Model, task: Task) -> Task:
-    """The task the model's edits produce (expanded: ``repeat`` 1)."""
+    """The task the model's edits produce; ``repeat`` kept when every round was repaired alike."""
     plays: dict[int, dict[str, str]] = {}
     for p in model[s.Plays]:
         if p.explicit:
@@ -138,7 +138,18 @@ def repaired_task(model: Model, task: Task) -> Task:
         old = task.steps[run.i - 1]
         params = {k: v for k, v in old.params.items() if (run.i, k) not in resets}
         steps.append(Step(index, run.p, bind, params, old.line, dict(old.param_lines)))
-    return Task(task.name, tuple(steps), task.file, task.description, 1)
+    return Task(task.name, tuple(steps), task.file, task.description, folded_repeat(steps, task.repeat))
+
+
+def folded_repeat(steps: list[Step], most: int) -> int:
+    """The largest ``repeat`` (at most ``most``) such that the steps are that many equal rounds."""
+    for r in range(most, 1, -1):
+        n = len(steps) // r
+        shifted = zip(steps, steps[n:], strict=False)
+        if n * r == len(steps) and all((a.command, a.bind, a.params) == (b.command, b.bind, b.params)
+                                       for a, b in shifted):
+            return r
+    return 1
 
 
 def read_repair(model: Model, rank: int, task: Task, book: FactBook, devices: dict[str, DeviceDescription],

@@ -11,7 +11,8 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from plugnproduce.description.model import Cell, DeviceDescription
-from plugnproduce.errors import PlugNProduceError, ProtocolError
+from plugnproduce.errors import DescriptionError, PlugNProduceError, ProtocolError
+from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.sim import control
 from plugnproduce.sim.device import SimulatedDevice
@@ -56,8 +57,11 @@ class SimulatedCell:
     """The devices of a cell, simulated; ``catalogue`` holds the devices that may be plugged in later."""
 
     def __init__(self, cell: Cell, *, catalogue: Iterable[DeviceDescription] = (),
-                 network: upnp.SsdpNetwork = upnp.LOOPBACK, faults: dict[str, xirp.Faults] | None = None) -> None:
+                 network: upnp.SsdpNetwork = upnp.LOOPBACK, faults: dict[str, xirp.Faults] | None = None,
+                 taxonomy: Taxonomy | None = None) -> None:
+        """``taxonomy`` reads device description files plugged in by path (default: the built-in ontology)."""
         self.cell = cell
+        self.taxonomy = taxonomy
         self.network = network
         self.faults = faults or {}
         self.catalogue = {d.id: d for d in (*catalogue, *cell.devices)}
@@ -81,7 +85,9 @@ class SimulatedCell:
             await self.unplug(device_id)
 
     async def plug(self, device_id: str) -> list[str]:
-        """Start a catalogue device; returns the running devices."""
+        """Start a catalogue device, or the device a description file describes; returns the running devices."""
+        if device_id.endswith(".ttl"):
+            device_id = self._add_file(Path(device_id))
         if device_id in self.devices:
             raise ProtocolError(f"device {device_id!r} is plugged in already")
         if device_id not in self.catalogue:
@@ -90,6 +96,19 @@ class SimulatedCell:
         await device.start()
         self.devices[device_id] = device
         return sorted(self.devices)
+
+    def _add_file(self, path: Path) -> str:
+        from plugnproduce.description.loader import load_device  # reads RDF: only when a file is plugged
+        from plugnproduce.ontology.taxonomy import load_taxonomy
+
+        try:
+            device = load_device(path, self.taxonomy or load_taxonomy())
+        except DescriptionError as exc:
+            raise ProtocolError(exc.location_message()) from exc
+        known = self.catalogue.setdefault(device.id, device)
+        if known.where != device.where:
+            raise ProtocolError(f"{device.where}: device id {device.id!r} is already the catalogue's {known.where}")
+        return device.id
 
     async def unplug(self, device_id: str) -> list[str]:
         """Stop a running device; returns the running devices."""

@@ -27,6 +27,7 @@ from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
 
 _ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
+_CHART = re.compile(r"(pnp:stateChart\s+)<[^>]*>")
 
 
 def served_description(device: DeviceDescription, endpoint: str) -> tuple[str, str]:
@@ -35,6 +36,8 @@ def served_description(device: DeviceDescription, endpoint: str) -> tuple[str, s
     turtle, found = _ENDPOINT.subn(lambda m: f'{m.group(1)}"{endpoint}"', turtle, count=1)
     if not found:
         raise ValueError(f"{device.where.file}: no pnp:endpoint literal to fill in")
+    # The chart is served beside the Turtle whatever folder it sits in, so the reference is its name.
+    turtle = _CHART.sub(lambda m: f"{m.group(1)}<{Path(device.chart_file).name}>", turtle, count=1)
     return turtle, Path(device.chart_file).read_text(encoding="utf-8")
 
 

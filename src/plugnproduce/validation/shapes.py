@@ -35,6 +35,8 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
         return []
     problems = []
     for result in results.subjects(rdflib.RDF.type, SH.ValidationResult):
+        if (None, SH.detail, result) in results:
+            continue  # the detail of a result reported in its own words
         focus = results.value(result, SH.focusNode)
         message = str(results.value(result, SH.resultMessage) or "does not conform")
         where = kg.places.get(str(focus))

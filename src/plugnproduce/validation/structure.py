@@ -8,9 +8,11 @@ roles and parameters.
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Iterator
 
 from plugnproduce.description.model import Command, DeviceDescription, ProcessDescription, Task
+from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.validation.findings import Problem
@@ -47,7 +49,8 @@ def process_problems(process: ProcessDescription, taxonomy: Taxonomy) -> Iterato
         for s in role.region:
             if not taxonomy.is_kind(s.concept, "StateConcept"):
                 yield Problem(file, s.line or 0, f"state {s.id!r} is annotated with {local_name(s.concept)}, "
-                              "which is not a state concept of the ontology")
+                              "which is not a state concept of the ontology"
+                              + did_you_mean(s.concept, taxonomy.classes_of_kind("StateConcept")))
             for name in s.params:
                 if name not in params:
                     yield Problem(file, s.line or 0, f"transition into {s.id!r} consumes parameter {name!r}, "
@@ -67,9 +70,9 @@ def task_problems(task: Task, processes: dict[str, ProcessDescription]) -> Itera
         line = step.line or 0
         process = processes.get(step.command)
         if process is None:
-            known = ", ".join(sorted(processes))
-            yield Problem(task.file, line, f"step {step.index}: unknown process command {step.command!r}; "
-                          f"expected one of {known}")
+            close = difflib.get_close_matches(step.command, sorted(processes), n=2)
+            hint = f"did you mean {' or '.join(close)}?" if close else f"expected one of {', '.join(sorted(processes))}"
+            yield Problem(task.file, line, f"step {step.index}: unknown process command {step.command!r}; {hint}")
             continue
         roles = {r.name for r in process.roles}
         for role in step.bind:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
+import rdflib
 from rdflib.namespace import OWL, RDF
 
 from plugnproduce.description.charts import device_chart
@@ -12,6 +13,7 @@ from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.description.loader import (
     Loaded,
     cell_device_files,
+    cell_libraries,
     device_from,
     device_subject,
     file_of,
@@ -19,15 +21,17 @@ from plugnproduce.description.loader import (
     process_from,
     read_description,
 )
-from plugnproduce.description.model import ProcessDescription
+from plugnproduce.description.model import ProcessDescription, Task, Where
 from plugnproduce.errors import DescriptionError, UnreadableError
-from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
-from plugnproduce.ontology.vocabulary import PNP
-from plugnproduce.resources import descriptions_path
+from plugnproduce.knowledge import Knowledge, Library, library_folders, load_knowledge
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import PNP, local_name
+from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import read_bytes
 from plugnproduce.statechart.io.reader import read_chart
 from plugnproduce.statechart.io.schema import schema_problems
 from plugnproduce.validation.findings import Problem, Report
+from plugnproduce.validation.names import chart_name_problems, turtle_name_problems
 from plugnproduce.validation.shapes import shape_problems
 from plugnproduce.validation.structure import device_problems, process_problems, task_problems
 
@@ -45,26 +49,25 @@ def expand(paths: Iterable[str | Path]) -> list[Path]:
     return sorted(out)
 
 
-def validate_paths(
-    paths: Iterable[str | Path], taxonomy: Taxonomy | None = None, ontology: list[Path] | None = None,
-    progress: Callable[[str], None] | None = None,
-) -> Report:
+def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = None,
+                   progress: Callable[[str], None] | None = None) -> Report:
     """Validate every description under ``paths`` against the schema, shapes and structure rules.
 
-    ``ontology`` names the TBox files (default: the built-in ontology); ``taxonomy`` is their
-    closure if the caller has it already. ``progress`` is told each phase as it begins.
+    ``knowledge`` gives the ontology and the known processes (default: the built-in library);
+    TBox files among ``paths`` (``owl:Ontology`` documents, or files in an ``ontology/`` folder)
+    are classified together with it. ``progress`` is told each phase as it begins.
     """
     say = progress or (lambda _: None)
     files = expand(paths)
     say(f"reading {len(files)} description file(s)")
     report = Report(files=[str(f) for f in files])
-    tbox_files = ontology or ontology_files()
-    taxonomy = taxonomy or load_taxonomy(tbox_files)
+    knowledge = _with_extensions(knowledge or load_knowledge(), files, report)
+    taxonomy = knowledge.taxonomy
     kg = KnowledgeGraph()
-    kg.add_tbox(read_tbox(tbox_files), taxonomy)
+    kg.add_tbox(knowledge.tbox(), taxonomy)
     processes: dict[str, ProcessDescription] = {}
     tasks = []
-    known: dict[str, ProcessDescription] = {}
+    described: dict[str, Where] = {}
     for f in files:
         try:
             if not f.is_file():
@@ -72,29 +75,74 @@ def validate_paths(
             elif f.suffix == ".scxml":
                 for e in schema_problems(read_bytes(f), f):
                     report.add(Problem.from_error(e))
+                for problem in chart_name_problems(f, taxonomy):
+                    report.add(problem)
             elif f.suffix == ".ttl":
-                _turtle(read_description(f), taxonomy, kg, processes, report)
+                loaded = read_description(f)
+                _same_iri(loaded, described, report)
+                _turtle(loaded, taxonomy, kg, processes, report)
             elif _yaml_kind(f) == "task":
                 tasks.append(load_task(f))
             else:
-                _cell(f, report)
+                _cell(f, report, knowledge)
         except DescriptionError as exc:
             report.add(Problem.from_error(exc))
-    if tasks:
-        builtin = {p.id: (loaded, p) for loaded, p in _builtin_processes() if p.id not in processes}
-        known = {k: p for k, (_, p) in builtin.items()} | processes
-        for loaded, process in builtin.values():
-            kg.add_description(loaded)
-            kg.add_process(process)
-    for task in tasks:
-        for p in task_problems(task, known):
-            report.add(p)
-        kg.add_task(task, known)
+    _tasks(tasks, knowledge, processes, kg, report)
     if not report.unreadable:
         say("checking the SHACL shapes")
         for p in shape_problems(kg):
             report.add(p)
     return report
+
+
+def _with_extensions(knowledge: Knowledge, files: list[Path], report: Report) -> Knowledge:
+    """The knowledge with the TBox files among ``files`` and those of the libraries the files sit in."""
+    known = set(knowledge.ontology_files())
+    extra = {f.resolve() for f in files if f.suffix == ".ttl" and f not in known and _is_tbox(f)}
+    builtin = ontology_path().resolve()
+    for root in {p.resolve() for f in files for p in f.resolve().parents[:3] if (p / "ontology").is_dir()}:
+        if (root / "ontology").resolve() == builtin:
+            continue
+        extra |= {t for t in Library(root).files("ontology") if t not in known}
+    if not extra:
+        return knowledge
+    try:
+        return load_knowledge(knowledge.libraries, extra_tbox=sorted(extra), left_out=knowledge.left_out)
+    except DescriptionError as exc:
+        report.add(Problem.from_error(exc))
+        return knowledge
+
+
+def _is_tbox(path: Path) -> bool:
+    if path.parent.name == "ontology":
+        return path.name != "shapes.ttl"
+    head = read_bytes(path)[:8192]
+    return b"owl:Ontology" in head or b"2002/07/owl#Ontology" in head
+
+
+def _same_iri(loaded: Loaded, described: dict[str, Where], report: Report) -> None:
+    """Two files describing the same IRI (a device, process, role, parameter or class) are refused."""
+    for s in sorted({str(s) for s in loaded.graph.subjects(RDF.type) if isinstance(s, rdflib.URIRef)}):
+        first = described.setdefault(s, loaded.where(s))
+        if first.file != str(loaded.path):
+            report.add(Problem(str(loaded.path), loaded.line(s) or 0,
+                               f"{local_name(s)} ({s}) is already described at {first}; "
+                               "each IRI may be described by one file only"))
+
+
+def _tasks(tasks: list[Task], knowledge: Knowledge, processes: dict[str, ProcessDescription], kg: KnowledgeGraph,
+           report: Report) -> None:
+    if not tasks:
+        return
+    library = {p.id: p for p in knowledge.processes if p.id not in processes}
+    known = library | processes
+    for process in library.values():
+        kg.add_description(read_description(process.where.file))
+        kg.add_process(process)
+    for task in tasks:
+        for p in task_problems(task, known):
+            report.add(p)
+        kg.add_task(task, known)
 
 
 def _turtle(
@@ -104,6 +152,8 @@ def _turtle(
     if (None, RDF.type, OWL.Ontology) in g or loaded.path.name == "shapes.ttl":
         return  # the ontology itself: parsed (so syntax is checked) and reasoned over already
     kg.add_description(loaded)
+    for problem in turtle_name_problems(loaded, taxonomy):
+        report.add(problem)
     if (None, PNP.generalChart, None) in g:
         process = process_from(loaded)
         processes[process.id] = process
@@ -139,16 +189,9 @@ def _yaml_kind(path: Path) -> str:
     return "task"
 
 
-def _cell(path: Path, report: Report) -> None:
+def _cell(path: Path, report: Report, knowledge: Knowledge) -> None:
     _, files = cell_device_files(path)
+    knowledge = knowledge.with_libraries(library_folders(cell_libraries(path)))
     for f, line in files:
-        if not f.is_file():
+        if not f.is_file() and (f.suffix == ".ttl" or knowledge.device(f.name) is None):
             report.add(Problem(str(path), line, f"device description {f} not found"))
-
-
-def _builtin_processes() -> list[tuple[Loaded, ProcessDescription]]:
-    out = []
-    for f in sorted((descriptions_path() / "processes").glob("*.ttl")):
-        loaded = read_description(f)
-        out.append((loaded, process_from(loaded)))
-    return out

@@ -29,7 +29,7 @@ def get_cell(hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 @router.get("/catalogue", dependencies=read, summary="Devices that can be plugged in or added by a repair")
 def get_catalogue(hub: Hub = Depends(hub_of)) -> list[dict[str, Any]]:
     """The catalogue: every known device, and whether it is in the cell now."""
-    taxonomy = service.knowledge().taxonomy
+    taxonomy = hub.knowledge.taxonomy
     present = {d.id for d in hub.cell.devices}
     source = hub.source
     devices = source.catalogue() if isinstance(source, PluggableCellSource) else hub.catalogue
@@ -68,20 +68,20 @@ def get_commands(hub: Hub = Depends(hub_of)) -> dict[str, Any]:
             summary="Why a process command is (not) offered")
 def explain_command(command: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.explain_process``: the bindings, or the reasons with the terms and lines they rest on."""
-    return service.explain_process(hub.cell, command).to_json()
+    return service.explain_process(hub.cell, command, hub.knowledge).to_json()
 
 
 @router.get("/processes", dependencies=read, summary="Every known process with its roles and parameters")
-def get_processes() -> list[dict[str, Any]]:
+def get_processes(hub: Hub = Depends(hub_of)) -> list[dict[str, Any]]:
     """The processes: command, label, roles (skill, start and end state) and parameters for the dialogs."""
-    k = service.knowledge()
+    k = hub.knowledge
     return [process_json(p, k.taxonomy) for p in k.processes]
 
 
 @router.get("/processes/{command}", dependencies=read, summary="One process with its roles and parameters")
-def get_process(command: str) -> dict[str, Any]:
+def get_process(command: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """One process by its command name."""
-    k = service.knowledge()
+    k = hub.knowledge
     try:
         process = k.process(command)
     except KeyError:

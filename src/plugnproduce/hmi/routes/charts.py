@@ -6,7 +6,6 @@ from fastapi import APIRouter, Depends, Request
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
 
-from plugnproduce import service
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
 from plugnproduce.hmi.routes import hub_of
@@ -31,9 +30,9 @@ async def device_chart(device_id: str, request: Request, hub: Hub = Depends(hub_
 
 
 @router.get("/process/{command}.svg", response_class=Response, responses=SVG, summary="A General Process State Chart")
-async def process_chart(command: str, request: Request) -> Response:
+async def process_chart(command: str, request: Request, hub: Hub = Depends(hub_of)) -> Response:
     """The General Process State Chart of a process."""
-    k = service.knowledge()
+    k = hub.knowledge
     try:
         process = k.process(command)
     except KeyError:

@@ -35,15 +35,15 @@ def _rows(problems: list[dict[str, Any]], task: TaskIn) -> list[dict[str, Any]]:
 
 
 @router.post("/validate", summary="Validate the task like a task file: types, ranges, known commands")
-def validate(task: TaskIn) -> dict[str, Any]:
+def validate(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """Schema, SHACL shapes and structure, as ``pnp validate`` does; each problem names its editor field."""
-    return taskfiles.validate_task(task)
+    return taskfiles.validate_task(task, hub.knowledge)
 
 
 @router.post("/check", dependencies=reasoner, summary="Is the task plausible in the cell as it is now?")
 def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.check``: per step its bindings and device states, and every problem at its step."""
-    result = service.check(task.to_task(), hub.cell).to_json()
+    result = service.check(task.to_task(), hub.cell, hub.knowledge).to_json()
     result["problems"] = _rows(list(result["problems"]), task)  # type: ignore[arg-type]
     return result
 
@@ -52,8 +52,8 @@ def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.repair`` with the catalogue: each repair's edits, cost and resulting task (ready to apply)."""
     model, cell = task.to_task(), hub.cell
-    result = service.check(model, cell)
-    repairs = [] if result.plausible else service.repair(model, cell, hub.catalogue, top)
+    result = service.check(model, cell, hub.knowledge)
+    repairs = [] if result.plausible else service.repair(model, cell, hub.catalogue, top, knowledge=hub.knowledge)
     return {
         "plausible": result.plausible,
         "problems": _rows([p.to_json() for p in result.problems], task),
@@ -65,13 +65,13 @@ def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hu
 def explain(task: TaskIn, step: int = Query(..., ge=1, description="The step, from 1 in the repeated order"),
             hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.explain_step``: each device's state before the step, where it came from, what the step needs."""
-    return service.explain_step(task.to_task(), hub.cell, step).to_json()
+    return service.explain_step(task.to_task(), hub.cell, step, hub.knowledge).to_json()
 
 
 @router.post("/generate", dependencies=reasoner, summary="Generate the SCXML charts of a plausible task")
 def generate(task: TaskIn, request: Request, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """Specific process charts, the Task State Chart and the closed-world chart, each as SCXML and SVG."""
-    result = pending.generate(task.to_task(), hub.cell)
+    result = pending.generate(task.to_task(), hub.cell, knowledge=hub.knowledge)
     out: dict[str, Any] = {"plausible": result.check.plausible,
                            "problems": _rows([p.to_json() for p in result.check.problems], task),
                            "generation": None, "charts": []}

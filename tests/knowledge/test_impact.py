@@ -1,0 +1,64 @@
+"""``pnp impact``: what a TBox edit does to every cell, the catalogue and the tasks."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from plugnproduce import service
+from plugnproduce.cli import app
+from tests.knowledge.test_libraries import THREE_FINGER
+
+runner = CliRunner()
+BUILTIN = service.builtin()
+SCREWING_VACUUM = """@prefix pnp:  <http://plugnproduce.org/ontology#> .
+@prefix owl:  <http://www.w3.org/2002/07/owl#> .
+<http://example.org/screwing-vacuum> a owl:Ontology .
+pnp:VacuumGripper <http://www.w3.org/2000/01/rdf-schema#subClassOf>
+    [ a owl:Restriction ; owl:onProperty pnp:hasSkill ; owl:someValuesFrom pnp:CanScrew ] .
+"""
+
+
+def test_an_extension_that_changes_nothing_exits_0(tmp_path: Path) -> None:
+    ext = tmp_path / "nothing.ttl"
+    ext.write_text("@prefix owl: <http://www.w3.org/2002/07/owl#> .\n<http://example.org/n> a owl:Ontology .\n")
+    result = runner.invoke(app, ["impact", str(ext)])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith("no change")
+
+
+def test_a_new_gripper_class_adds_offers_and_makes_a_task_plausible(tmp_path: Path) -> None:
+    (tmp_path / "cells").mkdir()
+    (tmp_path / "cells" / "robot-3f.yaml").write_text(
+        f"cell: robot-3f\ndevices:\n  - {BUILTIN / 'devices' / 'robot.ttl'}\n"
+        f"  - {THREE_FINGER / 'devices' / 'gripper-3f.ttl'}\n")
+    result = runner.invoke(app, ["impact", str(THREE_FINGER / "ontology" / "three-finger.ttl"),
+                                 "--cells", str(tmp_path / "cells"), "--json"])
+    assert result.exit_code == 1, result.output
+    doc = json.loads(result.stdout)
+    cell = doc["cells"][0]
+    assert {"command": "pick", "bindings": ["gripper=gripper-3f robot=robot"]} in cell["added"]
+    assert {"task": str(BUILTIN / "tasks" / "pick-and-place.yaml"), "cell": str(tmp_path / "cells" / "robot-3f.yaml"),
+            "plausible_before": False, "plausible_after": True} in doc["tasks"]
+
+
+def test_a_catalogue_device_gaining_a_role_is_reported(tmp_path: Path) -> None:
+    ext = tmp_path / "screwing-vacuum.ttl"
+    ext.write_text(SCREWING_VACUUM)
+    result = runner.invoke(app, ["impact", str(ext)])
+    assert result.exit_code == 1
+    assert "catalogue device vacuum-gripper: roles +screw.screwdriver" in result.stdout
+
+
+def test_the_impact_of_a_loaded_library_s_own_ontology_file(tmp_path: Path) -> None:
+    # The library is loaded (and its cell lists it): "before" is the knowledge without the file.
+    cell = tmp_path / "robot-3f.yaml"
+    cell.write_text(f"cell: robot-3f\nlibraries: [{THREE_FINGER}]\ndevices:\n  - {BUILTIN / 'devices' / 'robot.ttl'}\n"
+                    f"  - {THREE_FINGER / 'devices' / 'gripper-3f.ttl'}\n")
+    result = runner.invoke(app, ["--library", str(THREE_FINGER), "impact",
+                                 str(THREE_FINGER / "ontology" / "three-finger.ttl"), "--cells", str(cell)])
+    assert result.exit_code == 1, result.output
+    assert "+ pick             gripper=gripper-3f robot=robot" in result.stdout
+    assert "catalogue device gripper-3f: roles +" in result.stdout
