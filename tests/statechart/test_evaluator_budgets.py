@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from plugnproduce.statechart.evaluator import EvaluationError, Evaluator
+from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator
 
 UNTRUSTED = Evaluator()
 
