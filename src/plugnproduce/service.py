@@ -18,19 +18,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from plugnproduce import reasoning
-from plugnproduce.codegen import GeneratedTask, generate_task
-from plugnproduce.codegen.outputs import Chart, all_charts
 from plugnproduce.description.loader import load_cell, load_devices, load_processes, load_task
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy
 from plugnproduce.resources import descriptions_path
-from plugnproduce.validation import Report, validate_paths
 
-if TYPE_CHECKING:  # execution pulls in the network stack: imported when a run needs it
+if TYPE_CHECKING:  # validation, code generation and execution are imported by the use cases that need them
+    from plugnproduce.codegen import GeneratedTask
+    from plugnproduce.codegen.outputs import Chart
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.journal import RunRecord
     from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
+    from plugnproduce.validation import Report
 
 
 @dataclass(frozen=True)
@@ -58,6 +58,8 @@ def knowledge(processes_dir: Path | None = None) -> Knowledge:
 
 def validate(paths: list[str | Path]) -> Report:
     """Validate description files and folders."""
+    from plugnproduce.validation import validate_paths
+
     return validate_paths(paths, knowledge().taxonomy)
 
 
@@ -187,6 +189,9 @@ def generate(task_or_path: Task | str | Path, cell_or_path: Cell | str | Path, p
     result = check(the_task, the_cell)
     if not result.plausible:
         raise ImplausibleTask(result)
+    from plugnproduce.codegen import generate_task
+    from plugnproduce.codegen.outputs import all_charts
+
     k = knowledge()
     generated = generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
     return Generated(generated, all_charts(generated, the_cell, per_device))

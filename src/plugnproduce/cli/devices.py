@@ -9,14 +9,18 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail
-from plugnproduce.description.model import Cell
 from plugnproduce.errors import ProtocolError
-from plugnproduce.sim import control
+from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:  # the network stack is imported by the commands that use it
+    from plugnproduce import service
+    from plugnproduce.description.model import Cell
     from plugnproduce.discovery import CellChange
+    from plugnproduce.sim import control
+else:
+    control = lazy_module("plugnproduce.sim.control")
+    service = lazy_module("plugnproduce.service")
 
 sim_app = typer.Typer(no_args_is_help=True, help="Run simulated devices: the paper's bin-picking cell and more.")
 app.add_typer(sim_app, name="sim")

@@ -7,7 +7,6 @@ from pathlib import Path
 import typer
 
 from plugnproduce.cli.app import app, boundary
-from plugnproduce.drawing import draw_chart
 
 
 @app.command()
@@ -17,4 +16,6 @@ def draw(
     output: Path = typer.Option(..., "-o", "--output", help="Picture to write: .svg, .png, .pdf or .dot."),
 ) -> None:
     """Draw a state chart: regions as clusters, commands on the edges."""
+    from plugnproduce.drawing import draw_chart
+
     typer.echo(f"wrote {draw_chart(chart, output)}")

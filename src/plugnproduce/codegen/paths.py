@@ -1,8 +1,8 @@
 """Path search in a Device State Chart (paper section 6.1).
 
 A General Process State Chart says which state concept a device must reach next; the
-Device State Chart says how. The chart becomes a networkx multigraph whose edges are
-its transitions; a path to any state whose concept is subsumed by the wanted one is
+Device State Chart says how. The chart becomes a multigraph whose edges are its
+transitions; a path to any state whose concept is subsumed by the wanted one is
 searched, shortest by number of device commands; among equally short paths the one
 whose requests accept more of the parameters the step hands over wins (a lift with a
 pose moves to it rather than homing), then the one first by state ids, so the result
@@ -11,14 +11,11 @@ never depends on dict or set order.
 
 from __future__ import annotations
 
+import heapq
 from dataclasses import dataclass
-
-import networkx as nx
 
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.taxonomy import Taxonomy
-
-_GOAL = "\0goal"
 
 
 class NoPath(Exception):
@@ -44,12 +41,11 @@ def commands(t: ChartTransition) -> int:
     return (1 if t.request else 0) + len(t.sends)
 
 
-def chart_graph(device: DeviceDescription) -> nx.MultiDiGraph:
-    """The Device State Chart as a graph: one edge per transition, weighted by its commands."""
-    g = nx.MultiDiGraph()
-    g.add_nodes_from(s.id for s in device.states)
-    for i, t in enumerate(device.transitions):
-        g.add_edge(t.source, t.target, key=i, transition=t, weight=commands(t))
+def chart_graph(device: DeviceDescription) -> dict[str, dict[str, list[ChartTransition]]]:
+    """The Device State Chart as a graph: for each state, its successors and the transitions to each."""
+    g: dict[str, dict[str, list[ChartTransition]]] = {s.id: {} for s in device.states}
+    for t in device.transitions:
+        g.setdefault(t.source, {}).setdefault(t.target, []).append(t)
     return g
 
 
@@ -75,23 +71,65 @@ def find_path(
     if not goals:
         raise NoPath(device.id, source, concept)
     g = chart_graph(device)
-    for s in goals:
-        g.add_edge(s, _GOAL, key=-1, weight=0)
-    try:
-        candidates = list(nx.all_shortest_paths(g, source, _GOAL, weight="weight"))
-    except nx.NetworkXNoPath as exc:
-        raise NoPath(device.id, source, concept) from exc
+    candidates = _shortest_paths(g, source, frozenset(goals))
+    if not candidates:
+        raise NoPath(device.id, source, concept)
     ranked = []
     for nodes in candidates:
-        steps = tuple(_best_edge(g, a, b, wanted) for a, b in zip(nodes[:-2], nodes[1:-1], strict=True))
+        steps = tuple(_best_edge(g, a, b, wanted) for a, b in zip(nodes[:-1], nodes[1:], strict=True))
         accepted = sum(len(wanted.intersection(t.accepts)) for t in steps)
-        ranked.append((-accepted, tuple(nodes[:-1]), tuple(t.line or 0 for t in steps), steps))
+        ranked.append((-accepted, nodes, tuple(t.line or 0 for t in steps), steps))
     _, nodes, _, steps = min(ranked)
     return Path(source, nodes[-1], steps)
 
 
-def _best_edge(g: nx.MultiDiGraph, a: str, b: str, wanted: frozenset[str]) -> ChartTransition:
-    edges = g.get_edge_data(a, b).values()
-    best = min(edges, key=lambda e: (e["weight"], -len(wanted.intersection(e["transition"].accepts)),
-                                     e["transition"].line or 0))
-    return best["transition"]  # type: ignore[no-any-return]
+def _shortest_paths(
+    g: dict[str, dict[str, list[ChartTransition]]], source: str, goals: frozenset[str]
+) -> list[tuple[str, ...]]:
+    """Every path of least weight from ``source`` to any state of ``goals`` (Dijkstra, all predecessors kept).
+
+    An edge weighs the fewest commands among its parallel transitions. A goal reached on the
+    way to another goal at no extra weight yields both paths, as a search to one virtual goal
+    node behind all goals would.
+    """
+    dist = {source: 0}
+    preds: dict[str, list[str]] = {source: []}
+    heap = [(0, source)]
+    done: set[str] = set()
+    while heap:
+        d, u = heapq.heappop(heap)
+        if u in done:
+            continue
+        done.add(u)
+        for v, transitions in g.get(u, {}).items():
+            nd = d + min(commands(t) for t in transitions)
+            if v not in dist or nd < dist[v]:
+                dist[v], preds[v] = nd, [u]
+                heapq.heappush(heap, (nd, v))
+            elif nd == dist[v] and u not in preds[v] and v != source:
+                preds[v].append(u)
+    reached = [s for s in goals if s in dist]
+    if not reached:
+        return []
+    best = min(dist[s] for s in reached)
+    paths: list[tuple[str, ...]] = []
+    for goal in sorted(s for s in reached if dist[s] == best):
+        paths.extend(_paths_back(preds, source, goal, ()))
+    return paths
+
+
+def _paths_back(preds: dict[str, list[str]], source: str, node: str, after: tuple[str, ...]) -> list[tuple[str, ...]]:
+    """The paths from ``source`` to ``node`` through ``preds``, followed by ``after`` (no state twice)."""
+    if node == source:
+        return [(source, *after)]
+    out: list[tuple[str, ...]] = []
+    for p in preds[node]:
+        if p not in after and p != node:
+            out.extend(_paths_back(preds, source, p, (node, *after)))
+    return out
+
+
+def _best_edge(
+    g: dict[str, dict[str, list[ChartTransition]]], a: str, b: str, wanted: frozenset[str]
+) -> ChartTransition:
+    return min(g[a][b], key=lambda t: (commands(t), -len(wanted.intersection(t.accepts)), t.line or 0))
