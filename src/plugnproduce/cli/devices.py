@@ -22,7 +22,8 @@ else:
     control = lazy_module("plugnproduce.sim.control")
     service = lazy_module("plugnproduce.service")
 
-sim_app = typer.Typer(no_args_is_help=True, help="Run simulated devices: the paper's bin-picking cell and more.")
+sim_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
+                      help="Run simulated devices: the paper's bin-picking cell and more.")
 app.add_typer(sim_app, name="sim")
 
 
