@@ -257,8 +257,10 @@ async def run_task(
         if simulate:
             sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices))
             await stack.enter_async_context(sim)
-        live = await stack.enter_async_context(LiveCell(knowledge().taxonomy, network=network, name=the_cell.name))
-        devices = await find_devices(live, [d.id for d in the_cell.devices], discovery_timeout)
+        wanted = [d.id for d in the_cell.devices]
+        live = await stack.enter_async_context(LiveCell(knowledge().taxonomy, network=network, name=the_cell.name,
+                                                        expected=wanted))
+        devices = await find_devices(live, wanted, discovery_timeout)
         run = TaskRun(generated, devices, journal, observer)
         if started is not None:
             started(run)
