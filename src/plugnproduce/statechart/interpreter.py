@@ -57,6 +57,7 @@ from typing import Any
 
 from plugnproduce.errors import ExecutionError
 from plugnproduce.safeio import read_bytes
+from plugnproduce.statechart import gcpause
 from plugnproduce.statechart.actions import Block
 from plugnproduce.statechart.checks import check_structure
 from plugnproduce.statechart.clock import Clock, MonotonicClock
@@ -116,7 +117,9 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         self.io_processors = io_processors
         self.base_dir = base_dir
         self.session_id = session_id
-        self.compiled = CompiledChart(chart, Evaluator(trusted), chart.name or "chart")
+        with gcpause.paused():  # a large chart would otherwise pay for collections that find nothing
+            self.compiled = CompiledChart(chart, Evaluator(trusted), chart.name or "chart")
+        self._holds_gc = False
         self.running = False
         self.started = False
         self.final_state: str | None = None
@@ -181,6 +184,9 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         if self.started:
             raise ExecutionError(f"session {self.session_id} of {self.chart.name or 'chart'} is already started")
         self.started = self.running = True
+        if len(self.compiled.states) + len(self.compiled.transitions) >= gcpause.LARGE_CHART:
+            self._holds_gc = True  # released when the session ends: see gcpause
+            gcpause.hold()
         step = self._begin(None)
         self._init_datamodel()
         for block in self.compiled.scripts:
@@ -448,6 +454,9 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
             self._exit_one(s)
         self._atomic = None
         self._sessions.pop(self.session_id, None)
+        if self._holds_gc:
+            self._holds_gc = False
+            gcpause.release()
         if self._parent is not None and final is not None:
             self._parent._from_child(self.invokeid, Event(f"done.invoke.{self.invokeid}", done))
 
