@@ -29,7 +29,8 @@ def _anchor(el: etree._Element) -> str:
     """The node an edge to ``el`` points at: itself, or its first atomic descendant."""
     while _is_compound(el):
         el = next(c for c in el if c.tag in _CONTAINERS and c.tag != SCXML + "initial")
-    return el.get("id", "")
+    anchor: str = el.get("id", "")
+    return anchor
 
 
 def _label(t: etree._Element) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import asyncio
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypedDict
 
 import typer
 
@@ -27,7 +27,12 @@ sim_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
 app.add_typer(sim_app, name="sim")
 
 
-def _device_json(cell: Cell) -> list[dict[str, object]]:
+DeviceRow = TypedDict("DeviceRow", {"id": str, "label": str, "class": list[str], "skills": list[str],
+                                     "protocol": str, "endpoint": str})
+"""A device as ``pnp discover`` shows it (``class`` is a Python keyword: hence the functional form)."""
+
+
+def _device_json(cell: Cell) -> list[DeviceRow]:
     taxonomy = service.knowledge().taxonomy
     return [
         {

@@ -27,4 +27,5 @@ def to_bytes(root: etree._Element) -> bytes:
     """The document as pretty-printed UTF-8 with an XML declaration; same tree, same bytes."""
     etree.cleanup_namespaces(root, top_nsmap=NSMAP)
     etree.indent(root, space="  ")
-    return etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
+    data: bytes = etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
+    return data

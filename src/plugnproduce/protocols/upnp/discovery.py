@@ -284,8 +284,8 @@ class AdvertisementListener:
         self._queue.put_nowait(advertisement)
         self._changed.notify()
 
-    async def next(self, timeout: float) -> Advertisement:
-        """The next report; :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time."""
+    async def next(self, timeout: float | None) -> Advertisement:
+        """The next report; :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time (None: no limit)."""
         try:
             async with asyncio.timeout(timeout):
                 return await self._queue.get()

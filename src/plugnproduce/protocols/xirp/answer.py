@@ -115,7 +115,7 @@ class Responder:
             return None
         if inspect.isawaitable(results):
             return self._finish(link, request, results, fault)
-        self._send(link, Response(request.id, dict(results or {})), fault)  # type: ignore[call-overload]
+        self._send(link, Response(request.id, dict(results or {})), fault)
         return None
 
     async def _finish(
