@@ -66,3 +66,23 @@ def test_compiling_leaves_the_collector_as_it_found_it() -> None:
         assert not gc.isenabled()
     finally:
         gc.enable()
+
+
+async def test_a_loop_cancelled_mid_session_lets_go(nothing_frozen: None, monkeypatch: pytest.MonkeyPatch) -> None:
+    import asyncio
+
+    from plugnproduce.statechart.loop import ChartLoop
+
+    monkeypatch.setattr(gcpause, "LARGE_CHART", 1)
+    interpreter = Interpreter(parse_chart(CHART, "abandoned"))
+    task = asyncio.create_task(ChartLoop(interpreter).run())
+    async with asyncio.timeout(60):
+        while not interpreter.started:
+            await asyncio.sleep(0)
+    assert gcpause.holders() == 1
+    task.cancel()
+    with pytest.raises(asyncio.CancelledError):
+        await task
+    assert interpreter.running
+    assert gcpause.holders() == 0
+    assert gc.get_freeze_count() == 0

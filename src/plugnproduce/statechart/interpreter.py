@@ -454,11 +454,18 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
             self._exit_one(s)
         self._atomic = None
         self._sessions.pop(self.session_id, None)
+        self.release()
+        if self._parent is not None and final is not None:
+            self._parent._from_child(self.invokeid, Event(f"done.invoke.{self.invokeid}", done))
+
+    def release(self) -> None:
+        """Let the garbage collector walk this session's chart again (see :mod:`~plugnproduce.statechart.gcpause`).
+
+        Done when the session ends; call it for a session abandoned while it runs. Idempotent.
+        """
         if self._holds_gc:
             self._holds_gc = False
             gcpause.release()
-        if self._parent is not None and final is not None:
-            self._parent._from_child(self.invokeid, Event(f"done.invoke.{self.invokeid}", done))
 
     def _stop(self) -> None:
         """Cancelled by the parent: leave every state, send nothing back."""
