@@ -18,8 +18,14 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-LARGE_CHART = 2_000
-"""Compiled states and transitions from which a session freezes the collector's view."""
+LARGE_CHART = 200
+"""Compiled states and transitions from which a session freezes the collector's view.
+
+Generated charts are above it (a 10-step closed world compiles to about 350); device
+models (at most a few dozen), which a simulation runs for as long as it lives, are below,
+so they never keep old garbage frozen. Below it, a full collection walks the program's
+other long-lived objects (the ontology, the reasoner's data) and costs a small chart as
+much per event as it would cost a large one."""
 
 _lock = threading.Lock()
 _holders = 0
