@@ -1,7 +1,9 @@
-"""The notebooks run from top to bottom without an error, and are stored with their outputs for reading."""
+"""The notebooks run from top to bottom and show what their text says they show; they are stored with
+their outputs for reading."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import nbformat
@@ -10,17 +12,58 @@ from nbclient import NotebookClient
 
 NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
 
+EXPECTED: dict[str, list[str]] = {
+    # Per notebook, patterns its printed output must match, in this order.
+    "ontology-engineer": [
+        r"built-in knows ThreeFingerGripper: False",
+        r"ThreeFingerGripper implies: \[.*'pnp:CanGrip', 'pnp:CanRelease'\]",  # derived from the new class
+        r"\d+ files, valid: True",
+        r"gripper-3f\.scxml:\d+: pnp:accepts: unknown quantity GripForse .*did you mean GripForce\?",
+        r"changed: True",
+        r"\+ pick \['gripper=gripper-3f robot=robot'\]",
+        r"plausible: True",
+        r"outcome: succeeded",
+    ],
+    "cell-planner": [
+        r"offered +pick +gripper=gripper robot=robot",
+        r"not +screw +role 'screwdriver' of screw needs a device that can screw",
+        r"implausible: 1 problem",
+        r"step 2 \(bin-pick\): device 'gripper' .* the step needs it open",
+        r"repair 1 \(cost \d+\): insert open-gripper before step 2",
+        r"repaired task plausible: True",
+    ],
+    "operator": [
+        r"→ gripper: Close \{'GripForce': 30\}",
+        r"end: succeeded",
+        r"refused at step 1 \(pick-and-place\), device gripper .*fault injected",
+    ],
+}
+
+
+def _printed(notebook: nbformat.NotebookNode) -> str:
+    return "".join(o.get("text", "") for c in notebook.cells if c.cell_type == "code" for o in c.outputs
+                   if o.output_type == "stream")
+
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
-def test_notebook_runs(path: Path) -> None:
+def test_notebook_runs_and_shows_its_findings(path: Path) -> None:
     notebook = nbformat.read(path, as_version=4)
     NotebookClient(notebook, timeout=300, kernel_name="python3").execute()
     errors = [o for c in notebook.cells if c.cell_type == "code" for o in c.outputs if o.output_type == "error"]
     assert errors == []
+    printed, at = _printed(notebook), 0
+    for pattern in EXPECTED[path.stem]:
+        found = re.compile(pattern).search(printed, at)
+        assert found, f"{path.name}: nothing printed after position {at} matches {pattern!r}:\n{printed}"
+        at = found.end()
 
 
 def test_each_kind_of_user_has_a_notebook() -> None:
     assert {p.stem for p in NOTEBOOKS} >= {"ontology-engineer", "cell-planner", "operator"}
+
+
+def test_every_notebook_has_expectations() -> None:
+    assert {p.stem for p in NOTEBOOKS} == set(EXPECTED)
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)

@@ -13,7 +13,7 @@ import codecs
 import re
 import stat
 from pathlib import Path
-from typing import Any
+from typing import Protocol, cast
 
 import rdflib
 import yaml
@@ -138,21 +138,94 @@ def _check_depth(root: etree._Element, source: str | Path) -> None:
         stack.extend((child, depth + 1) for child in el)
 
 
-class _NoAliasLoader(yaml.SafeLoader):
-    """A safe YAML loader that refuses anchors and aliases (no YAML bombs)."""
+MAX_YAML_DEPTH = 64
+"""Deepest YAML collection nesting accepted."""
 
-    def compose_node(self, parent: Any, index: Any) -> Any:  # noqa: D102
-        if self.check_event(yaml.AliasEvent):
-            event = self.peek_event()
-            raise yaml.MarkedYAMLError(
-                None, None, "aliases are refused in descriptions", event.start_mark
-            )
-        event = self.peek_event()
-        if getattr(event, "anchor", None):
-            raise yaml.MarkedYAMLError(
-                None, None, "anchors are refused in descriptions", event.start_mark
-            )
-        return super().compose_node(parent, index)
+_YAML_LOADER: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+"""libyaml's C parser where PyYAML was built with it (several times faster), else the pure-Python one."""
+
+
+class _EventParser(Protocol):
+    """What is used of a PyYAML loader here: its parser's events (the stubs leave them untyped)."""
+
+    def check_event(self, *choices: type[yaml.Event]) -> bool: ...
+    def get_event(self) -> yaml.Event: ...
+    def dispose(self) -> None: ...
+
+
+class _TagResolver(Protocol):
+    """What is used of PyYAML's resolver here: the implicit tag of a node."""
+
+    def resolve(self, kind: type[yaml.Node], value: str | None, implicit: bool | tuple[bool, bool] | None) -> str: ...
+
+
+def _mark(mark: object) -> yaml.Mark:
+    """A parser's mark as the nodes take it: libyaml's marks have the same line and column attributes."""
+    return cast(yaml.Mark, mark)
+
+
+def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
+    """Compose one YAML document into nodes with marks, as ``yaml.compose`` does, but safely.
+
+    The events come from the fastest parser available; the nodes are built here, without
+    recursion (libyaml's own composer recurses in C and crashes the process on deep
+    nesting), refusing anchors and aliases (no YAML bombs) and nesting beyond
+    :data:`MAX_YAML_DEPTH`.
+    """
+    parser: _EventParser = _YAML_LOADER(text)
+    resolver: _TagResolver = yaml.resolver.Resolver()
+    stack: list[yaml.CollectionNode] = []
+    keys: list[yaml.Node | None] = []
+    document: yaml.Node | None = None
+    documents = 0
+    try:
+        while parser.check_event():
+            event = parser.get_event()
+            if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None):
+                what = "aliases" if isinstance(event, yaml.AliasEvent) else "anchors"
+                raise yaml.MarkedYAMLError(None, None, f"{what} are refused in descriptions",
+                                           _mark(event.start_mark))
+            if isinstance(event, yaml.DocumentStartEvent):
+                documents += 1
+                if documents > 1:
+                    raise yaml.composer.ComposerError("expected a single document in the stream", None,
+                                               "but found another document", _mark(event.start_mark))
+                continue
+            node: yaml.Node
+            if isinstance(event, yaml.ScalarEvent):
+                tag = event.tag if event.tag not in (None, "!") else resolver.resolve(
+                    yaml.ScalarNode, event.value, event.implicit)
+                node = yaml.ScalarNode(tag, event.value, _mark(event.start_mark), _mark(event.end_mark),
+                                       style=event.style or None)  # libyaml says '' for plain
+            elif isinstance(event, yaml.CollectionStartEvent):
+                kind = yaml.SequenceNode if isinstance(event, yaml.SequenceStartEvent) else yaml.MappingNode
+                tag = event.tag if event.tag not in (None, "!") else resolver.resolve(kind, None, event.implicit)
+                collection = kind(tag, [], _mark(event.start_mark), None, flow_style=event.flow_style)
+                if len(stack) >= MAX_YAML_DEPTH:
+                    raise HostileInputError(f"YAML nested more than {MAX_YAML_DEPTH} levels deep; at most "
+                                            f"{MAX_YAML_DEPTH} are accepted", source, _mark(event.start_mark).line + 1)
+                stack.append(collection)
+                keys.append(None)
+                continue
+            elif isinstance(event, yaml.CollectionEndEvent):
+                node = stack.pop()
+                node.end_mark = _mark(event.end_mark)
+                keys.pop()
+            else:  # stream and document ends
+                continue
+            if not stack:
+                document = node
+            elif isinstance(stack[-1], yaml.MappingNode):
+                if keys[-1] is None:
+                    keys[-1] = node
+                else:
+                    stack[-1].value.append((keys[-1], node))
+                    keys[-1] = None
+            else:
+                stack[-1].value.append(node)
+    finally:
+        parser.dispose()
+    return document
 
 
 def parse_yaml_node(path: str | Path) -> yaml.Node:
@@ -163,10 +236,7 @@ def parse_yaml_node(path: str | Path) -> yaml.Node:
     except UnicodeDecodeError as exc:
         raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
     try:
-        node = yaml.compose(text, Loader=_NoAliasLoader)
-    except RecursionError as exc:
-        raise HostileInputError(f"YAML nested too deeply; at most {MAX_YAML_DEPTH} levels are accepted",
-                                path) from exc
+        node = _compose_yaml(text, path)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None

@@ -18,21 +18,21 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from plugnproduce import reasoning
-from plugnproduce.codegen import GeneratedTask, generate_task
-from plugnproduce.codegen.outputs import GeneratedChart, all_charts
 from plugnproduce.description.loader import cell_libraries, load_cell, load_devices, load_task
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
 from plugnproduce.resources import descriptions_path
-from plugnproduce.validation import Report, validate_paths
 
-if TYPE_CHECKING:  # execution pulls in the network stack: imported when a run needs it
+if TYPE_CHECKING:  # validation, code generation and execution are imported by the use cases that need them
+    from plugnproduce.codegen import GeneratedTask
+    from plugnproduce.codegen.outputs import GeneratedChart
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
     from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
     from plugnproduce.reasoning.impact import Impact
+    from plugnproduce.validation import Report
 
 
 @lru_cache(maxsize=8)
@@ -63,6 +63,8 @@ def _k(k: Knowledge | None) -> Knowledge:
 def validate(paths: list[str | Path], knowledge: Knowledge | None = None,
              progress: Callable[[str], None] | None = None) -> Report:
     """Validate description files and folders; ``progress`` is told each phase as it begins."""
+    from plugnproduce.validation import validate_paths
+
     return validate_paths(paths, _k(knowledge), progress=progress)
 
 
@@ -227,6 +229,9 @@ def generate(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = Fa
     result = check(the_task, the_cell, k)
     if not result.plausible:
         raise ImplausibleTask(result)
+    from plugnproduce.codegen import generate_task
+    from plugnproduce.codegen.outputs import all_charts
+
     generated = generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
     return Generated(generated, all_charts(generated, the_cell, per_device))
 
@@ -302,8 +307,10 @@ async def run_task(
             sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices))
             await stack.enter_async_context(sim)
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
-        live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name))
-        devices = await find_devices(live, [d.id for d in the_cell.devices], discovery_timeout)
+        wanted = [d.id for d in the_cell.devices]
+        live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
+                                                        expected=wanted))
+        devices = await find_devices(live, wanted, discovery_timeout)
         say("running")
         run = TaskRun(generated, devices, journal, observer)
         if started is not None:

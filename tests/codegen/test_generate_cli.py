@@ -47,14 +47,18 @@ def test_gripper_region_sends_open_and_waits_for_the_event(tmp_path: Path) -> No
 
 
 def test_output_is_byte_identical_across_runs(tmp_path: Path) -> None:
-    generate(tmp_path / "a")
-    generate(tmp_path / "b")
-    for f in (tmp_path / "a").iterdir():
-        assert f.read_bytes() == (tmp_path / "b" / f.name).read_bytes(), f.name
+    assert generate(tmp_path / "a").exit_code == 0
+    assert generate(tmp_path / "b").exit_code == 0
+    names = sorted(f.name for f in (tmp_path / "a").iterdir())
+    assert names == sorted(f.name for f in (tmp_path / "b").iterdir())
+    assert "bin-picking.task.scxml" in names and "bin-picking.closed-world.scxml" in names
+    for name in names:
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
 
 
 def test_generated_charts_round_trip_through_the_reader_and_writer(tmp_path: Path) -> None:
-    generate(tmp_path)
+    assert generate(tmp_path).exit_code == 0
+    assert len(list(tmp_path.iterdir())) >= 3
     for f in tmp_path.iterdir():
         once = write_chart(parse_chart(f.read_bytes(), f))
         assert write_chart(parse_chart(once, f)) == once, f.name

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import socket
 from collections.abc import Mapping
 from typing import Any
@@ -121,3 +122,14 @@ async def test_a_spoofed_byebye_does_not_unplug_a_device_that_still_answers(netw
         with pytest.raises(TimeoutError):
             await live.next_change(2 * CONFIRM_TIMEOUT + 0.5)
         assert [d.id for d in live.cell.devices] == ["sensor3d"]
+async def test_entering_returns_once_the_expected_devices_have_answered(network, taxonomy) -> None:
+    # A search window far longer than the bound: entering must not wait for the window to end.
+    async with sensor_server(network), asyncio.timeout(WAIT):
+        async with LiveCell(taxonomy, network=network, search_timeout=3600, expected=["sensor3d"]) as live:
+            assert [d.id for d in live.cell.devices] == ["sensor3d"]
+
+
+async def test_an_expected_device_that_never_answers_costs_the_window_only(network, taxonomy) -> None:
+    async with sensor_server(network), asyncio.timeout(WAIT):
+        async with LiveCell(taxonomy, network=network, search_timeout=1, expected=["gripper", "sensor3d"]) as live:
+            assert [d.id for d in live.cell.devices] == ["sensor3d"]

@@ -255,9 +255,12 @@ def test_the_reasoner_check_matches_the_service() -> None:
     from plugnproduce.hmi.schemas import TaskIn
 
     from_file = service.task(service.builtin("tasks", "bin-picking.yaml"))
+    # The JSON the editor sends for that file, written out here (not copied from the file's model).
+    bind = {"sensor": "sensor3d", "localizer": "binpicking-pc", "robot": "robot", "gripper": "gripper"}
     from_json = TaskIn.model_validate({**TASK, "steps": [
-        {**BIN_PICK, "bind": from_file.steps[0].bind, "params": from_file.steps[0].params},
-        {**PLACE, "params": from_file.steps[1].params}]}).to_task()
+        {**BIN_PICK, "bind": bind, "params": {"grip_force": 45, "exposure": 25, "part_type": "bracket"}},
+        {**PLACE, "params": {"place_pose": [0.60, -0.20, 0.10, 0, 180, 0], "speed": 80}}]}).to_task()
+    assert len(from_json.steps) == 6  # one round per repeat
     assert [(s.index, s.command, s.bind, s.params) for s in from_json.steps] == \
         [(s.index, s.command, s.bind, s.params) for s in from_file.steps]
 

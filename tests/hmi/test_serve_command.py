@@ -14,30 +14,42 @@ from typer.testing import CliRunner
 from plugnproduce.cli import app
 from plugnproduce.protocols.upnp import private_network
 from tests.hmi.conftest import TOKEN
+from tests.lines import Lines
 
 SERVE = [sys.executable, "-m", "plugnproduce", "serve", "--port", "0"]
 
 
-def _start(*args: str, env: dict[str, str] | None = None) -> tuple[subprocess.Popen[str], list[str]]:
+def _start(*args: str, env: dict[str, str] | None = None) -> tuple[subprocess.Popen[str], Lines, list[str]]:
     proc = subprocess.Popen([*SERVE, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, **(env or {})})
-    assert proc.stdout is not None
-    lines = [proc.stdout.readline().strip()]  # blocks until the server listens and says where
-    return proc, lines
+    out = Lines(proc.stdout)
+    try:
+        lines = [out.next().strip()]  # comes once the server listens and says where
+    except AssertionError:
+        proc.kill()
+        raise
+    return proc, out, lines
 
 
-def _stop(proc: subprocess.Popen[str]) -> str:
+def _stop(proc: subprocess.Popen[str], out: Lines) -> str:
     proc.send_signal(signal.SIGINT)  # Ctrl-C
-    out, err = proc.communicate(timeout=20)
-    assert proc.returncode == 0, err
-    return out
+    try:
+        code = proc.wait(timeout=60)
+    finally:
+        proc.kill()  # no effect once it has exited
+    rest = "".join(out.rest())
+    assert proc.stdout is not None and proc.stderr is not None
+    err = proc.stderr.read()
+    proc.stdout.close()
+    proc.stderr.close()
+    assert code == 0, err
+    return rest
 
 
 def test_serve_prints_the_url_and_a_new_token() -> None:
-    proc, lines = _start("--sim")
+    proc, out, lines = _start("--sim")
     try:
-        assert proc.stdout is not None
-        lines += [proc.stdout.readline().strip(), proc.stdout.readline().strip()]
+        lines += [out.next().strip(), out.next().strip()]
         url = lines[0].rsplit(" ", 1)[1]
         token = lines[2].removeprefix("token: ")
         assert url.startswith("http://127.0.0.1:") and lines[1] == f"open {url}#token={token}"
@@ -47,33 +59,33 @@ def test_serve_prints_the_url_and_a_new_token() -> None:
                             headers={"Authorization": f"Bearer {token}"}).status_code == 200
         assert httpx.get(url, headers={"Host": "attacker.example"}).status_code == 400
     finally:
-        out = _stop(proc)
-    assert out.strip().endswith("stopped")
+        rest = _stop(proc, out)
+    assert rest.strip().endswith("stopped")
 
 
 def test_serve_takes_the_token_from_a_file_and_the_cell_given(tmp_path: Path) -> None:
     token_file = tmp_path / "token"
     token_file.write_text(TOKEN + "\n")
     cell = Path(__file__).resolve().parents[2] / "descriptions" / "cells" / "assembly.yaml"
-    proc, lines = _start("--sim", "--token-file", str(token_file), "--cell", str(cell))
+    proc, out, lines = _start("--sim", "--token-file", str(token_file), "--cell", str(cell))
     try:
         url = lines[0].rsplit(" ", 1)[1]
         assert httpx.get(url + "api/cell").json()["name"] == "assembly"
         res = httpx.post(url + "api/cell/devices", json={"device": "gripper"}, headers={"Authorization": f"Bearer {TOKEN}"})
         assert res.status_code == 200
     finally:
-        out = _stop(proc)
-    assert TOKEN not in out
+        rest = _stop(proc, out)
+    assert TOKEN not in "".join(lines) + rest
 
 
 def test_without_sim_the_cell_is_what_discovery_finds() -> None:
-    proc, lines = _start(env={"PNP_SSDP_PORT": str(private_network().port)})
+    proc, out, lines = _start(env={"PNP_SSDP_PORT": str(private_network().port)})
     try:
         url = lines[0].rsplit(" ", 1)[1]
         cell = httpx.get(url + "api/cell").json()
         assert (cell["name"], cell["devices"], cell["pluggable"]) == ("live", [], False)
     finally:
-        _stop(proc)
+        _stop(proc, out)
 
 
 def test_faults_need_sim() -> None:

@@ -14,6 +14,8 @@ from playwright.sync_api import Page, expect
 from plugnproduce import service
 from tests.hmi.conftest import AUTH, Served, needs_reasoner, screenshot
 
+expect.set_options(timeout=30_000)  # a bound, not a speed: CI runs the suite on a fully loaded machine
+
 CHART_SHOWN = "() => { const i = document.querySelector('#chart-img'); return i.complete && i.naturalWidth > 0; }"
 """The chart picture has loaded (a function, not an expression: the page's policy forbids eval)."""
 

@@ -9,7 +9,7 @@ from tests.knowledge.test_machine_tending import CELL, MT
 
 
 def test_serve_honours_the_library() -> None:
-    proc, lines = _start("--sim", "--cell", str(CELL), env={"PNP_LIBRARY": str(MT)})
+    proc, out, lines = _start("--sim", "--cell", str(CELL), env={"PNP_LIBRARY": str(MT)})
     try:
         url = lines[0].rsplit(" ", 1)[1]
         assert httpx.get(url + "api/cell").json()["name"] == "machine-tending"
@@ -18,4 +18,4 @@ def test_serve_honours_the_library() -> None:
         catalogue = {d["id"] for d in httpx.get(url + "api/catalogue").json()}
         assert {"mt-cnc", "gripper"} <= catalogue
     finally:
-        _stop(proc)
+        _stop(proc, out)

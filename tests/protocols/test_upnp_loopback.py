@@ -113,6 +113,13 @@ async def test_discover_reads_type_and_name_of_each_device(network: SsdpNetwork,
     assert found.refused == ()
 
 
+async def test_discover_ends_once_the_expected_devices_have_answered(network: SsdpNetwork,
+                                                                    device: UpnpDeviceServer) -> None:
+    async with asyncio.timeout(WAIT):  # far shorter than the search window
+        found = await discover(3600, network=network, expected=[device.udn])
+    assert [d.udn for d in found.devices] == [device.udn]
+
+
 async def test_action_is_invoked_with_its_argument(client: UpnpDeviceClient, recorder: Recorder) -> None:
     result = await client.call("MoveTo", Pose="0.4 0.1 0.2 0 180 0")
     assert result == {"Result": "done MoveTo"}

@@ -129,6 +129,9 @@ CHAIN_CASES = {
         WORLD + cell("g") + task("close", "close"), {'wrong_state("c","t",2,"gripper","g","c","Open")'}),
     "after a wrong start the chain goes on from where the role leaves it": (
         WORLD + cell("g") + task("close", "close", "open"), {'wrong_state("c","t",2,"gripper","g","c","Open")'}),
+    "after a wrong start the next step is checked from where the role would have left the device": (
+        WORLD + cell("g") + task("close", "close", "close"),
+        {'wrong_state("c","t",2,"gripper","g","c","Open")', 'wrong_state("c","t",3,"gripper","g","c","Open")'}),
     "the first use is checked against the initial state": (
         WORLD + cell("g") + task("open"), {'wrong_state("c","t",1,"gripper","g","o","Closed")'}),
     "an unbound role with two fitting devices is ambiguous": (

@@ -76,7 +76,11 @@ def test_milli_rounds_and_clamps() -> None:
 
 def test_facts_are_text_clingo_reads(cell: Cell) -> None:
     k = service.knowledge()
-    text = program(a for d in cell.devices for a in device_facts(d, k.taxonomy, k.processes))
+    atoms = [a for d in cell.devices for a in device_facts(d, k.taxonomy, k.processes)]
     ctl = clingo.Control(["--warn=none"])
-    ctl.add("base", [], text)
+    ctl.add("base", [], program(atoms))
     ctl.ground([("base", [])])
+    kinds = {(type(a).asp, len(type(a)._fields)): type(a) for a in atoms}
+    read = [kinds[(s.symbol.name, len(s.symbol.arguments))].from_symbol(s.symbol) for s in ctl.symbolic_atoms]
+    assert len(atoms) > 100
+    assert sorted(map(str, read)) == sorted(map(str, set(atoms)))  # each fact read back as itself, none lost

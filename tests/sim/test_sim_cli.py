@@ -15,6 +15,7 @@ import pytest
 
 from plugnproduce import service
 from plugnproduce.protocols.upnp import private_network
+from tests.lines import Lines
 
 CELL = str(service.builtin("cells", "bin-picking.yaml"))
 
@@ -46,36 +47,35 @@ def simulated_cell(env: dict[str, str], tmp_path: Path) -> Iterator[Path]:
     assert "stopped" in log.read_text()
 
 
-def test_discover_lists_the_four_devices_within_5_s(simulated_cell: Path, env: dict[str, str]) -> None:
-    started = time.monotonic()
+def test_discover_lists_the_four_devices(simulated_cell: Path, env: dict[str, str]) -> None:
     result = subprocess.run(command("discover", "--json"), env=env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     found = json.loads(result.stdout)
     assert sorted(d["id"] for d in found["devices"]) == ["binpicking-pc", "gripper", "robot", "sensor3d"]
     assert "pick" in found["offered"]
-    print(f"discover: {time.monotonic() - started:.2f} s including start-up")
 
 
-def test_unplugging_the_gripper_removes_pick_within_1_s_and_plugging_brings_it_back(
+def test_unplugging_the_gripper_removes_pick_and_plugging_brings_it_back(
         simulated_cell: Path, env: dict[str, str]) -> None:
     watch = subprocess.Popen(command("discover", "--json", "--watch"), env=env, text=True, stdout=subprocess.PIPE)
+    lines = Lines(watch.stdout)
     try:
-        assert watch.stdout is not None
-        first = json.loads(watch.stdout.readline())
+        first = json.loads(lines.next())
         assert "pick" in first["offered"]
         control = ["--control", ":".join(map(str, json.loads(simulated_cell.read_text()).values()))]
-        unplugged_at = time.monotonic()
         subprocess.run(command("sim", "unplug", "gripper", *control), env=env, check=True, timeout=60,
                        capture_output=True)
-        change = json.loads(watch.stdout.readline())
+        change = json.loads(lines.next())
         assert (change["change"], change["device"]) == ("unplug", "gripper")
         assert "pick" not in change["offered"] and "bin-pick" not in change["offered"]
         subprocess.run(command("sim", "plug", "gripper", *control), env=env, check=True, timeout=60,
                        capture_output=True)
-        change = json.loads(watch.stdout.readline())
+        change = json.loads(lines.next())
         assert (change["change"], change["device"]) == ("plug", "gripper")
         assert "pick" in change["offered"]
-        print(f"unplug seen {time.monotonic() - unplugged_at:.2f} s after starting pnp sim unplug (a process start)")
     finally:
         watch.terminate()
-        watch.communicate(timeout=10)
+        watch.wait(timeout=10)
+        lines.rest()
+        assert watch.stdout is not None
+        watch.stdout.close()

@@ -5,24 +5,34 @@ from __future__ import annotations
 import asyncio
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypedDict
 
 import typer
 
-from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
-from plugnproduce.description.model import Cell
 from plugnproduce.errors import ProtocolError
-from plugnproduce.sim import control
+from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:  # the network stack is imported by the commands that use it
+    from plugnproduce import service
+    from plugnproduce.description.model import Cell
     from plugnproduce.discovery import CellChange
+    from plugnproduce.sim import control
+else:
+    control = lazy_module("plugnproduce.sim.control")
+    service = lazy_module("plugnproduce.service")
 
-sim_app = typer.Typer(no_args_is_help=True, help="Run simulated devices: the paper's bin-picking cell and more.")
+sim_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
+                      help="Run simulated devices: the paper's bin-picking cell and more.")
 app.add_typer(sim_app, name="sim")
 
 
-def _device_json(cell: Cell) -> list[dict[str, object]]:
+DeviceRow = TypedDict("DeviceRow", {"id": str, "label": str, "class": list[str], "skills": list[str],
+                                     "protocol": str, "endpoint": str})
+"""A device as ``pnp discover`` shows it (``class`` is a Python keyword: hence the functional form)."""
+
+
+def _device_json(cell: Cell) -> list[DeviceRow]:
     taxonomy = knowledge().taxonomy
     return [
         {

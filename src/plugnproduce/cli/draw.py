@@ -7,7 +7,6 @@ from pathlib import Path
 import typer
 
 from plugnproduce.cli.app import app, boundary
-from plugnproduce.drawing import draw_chart
 
 
 @app.command()
@@ -18,4 +17,6 @@ def draw(
                                 help="Picture to write: .svg, .png, .pdf or .dot."),
 ) -> None:
     """Draw a state chart: regions as clusters, commands on the edges."""
+    from plugnproduce.drawing import draw_chart
+
     typer.echo(f"wrote {draw_chart(chart, output)}")

@@ -54,4 +54,4 @@ class QuietPipe:
 def tolerate_closed_stdout() -> None:
     """Make ``sys.stdout`` a :class:`QuietPipe` (once), so a closed pipe ends output, not the command."""
     if not isinstance(sys.stdout, QuietPipe):
-        sys.stdout = QuietPipe(sys.stdout)  # type: ignore[assignment]
+        sys.stdout = QuietPipe(sys.stdout)

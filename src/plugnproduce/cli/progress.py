@@ -9,10 +9,11 @@ from __future__ import annotations
 import sys
 import time
 from types import TracebackType
+from typing import TYPE_CHECKING
 
-from rich.console import Console
-from rich.live import Live
-from rich.spinner import Spinner
+if TYPE_CHECKING:  # rich is imported when progress is really shown: start-up stays light
+    from rich.console import Console
+    from rich.live import Live
 
 
 def on_a_terminal(json_out: bool = False) -> bool:
@@ -28,7 +29,7 @@ class Phases:
 
     def __init__(self, enabled: bool, console: Console | None = None):
         self.enabled = enabled
-        self.console = console or Console(stderr=True)
+        self._console = console
         self._live: Live | None = None
         self._phase: str | None = None
         self._since = 0.0
@@ -37,6 +38,9 @@ class Phases:
         """Begin ``phase``: the one before it is shown as done."""
         if not self.enabled:
             return
+        from rich.live import Live
+        from rich.spinner import Spinner
+
         self._finish()
         self._phase, self._since = phase, time.monotonic()
         spinner = Spinner("dots", f"{phase} …")
@@ -50,7 +54,18 @@ class Phases:
     def update(self, text: str) -> None:
         """Change what the current phase says (e.g. the step being run), without ending it."""
         if self.enabled and self._live is not None and self._phase is not None:
+            from rich.spinner import Spinner
+
             self._live.update(Spinner("dots", f"{self._phase}: {text}"))
+
+    @property
+    def console(self) -> Console:
+        """Where progress goes: the given console, else stderr."""
+        if self._console is None:
+            from rich.console import Console
+
+            self._console = Console(stderr=True)
+        return self._console
 
     def _finish(self) -> None:
         if self._phase is not None:

@@ -11,15 +11,21 @@ import io
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
-from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from plugnproduce import reasoning, service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
 from plugnproduce.cli.progress import on_a_terminal
-from plugnproduce.description.loader import task_to_yaml
+from plugnproduce.lazy import lazy_module
+
+if TYPE_CHECKING:
+    from plugnproduce import reasoning, service
+    from plugnproduce.description import loader
+else:
+    loader = lazy_module("plugnproduce.description.loader")
+    reasoning = lazy_module("plugnproduce.reasoning")
+    service = lazy_module("plugnproduce.service")
 
 CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
 
@@ -116,7 +122,7 @@ def repair(
             for e in r.edits:
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
             typer.echo("  resulting task:")
-            typer.echo("".join(f"    {line}\n" for line in task_to_yaml(r.task).splitlines()), nl=False)
+            typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.task).splitlines()), nl=False)
     if not result.plausible and not repairs:
         raise typer.Exit(1)
 
@@ -193,6 +199,9 @@ def batch(
             fail(f"--sizes: {exc}")
     else:
         configurations = reasoning.read_configurations(configs)  # type: ignore[arg-type]
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
     err = Console(stderr=True)
     columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     with Progress(*columns, console=err, transient=True, disable=not on_a_terminal()) as bar:

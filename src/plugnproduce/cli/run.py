@@ -9,14 +9,17 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.cli.generate import refuse
 from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.executor.journal import describe
+from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
+    from plugnproduce import service
     from plugnproduce.executor.run import TaskRun
+else:
+    service = lazy_module("plugnproduce.service")
 
 
 @app.command()

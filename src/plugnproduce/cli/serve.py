@@ -8,11 +8,14 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce import service
 from plugnproduce.cli.app import app, boundary, fail, knowledge
+from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
+    from plugnproduce import service
     from plugnproduce.hmi import CellSource, Runner
+else:
+    service = lazy_module("plugnproduce.service")
 
 LOOPBACK_NAMES = ("127.0.0.1", "localhost")
 

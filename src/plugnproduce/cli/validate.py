@@ -3,12 +3,18 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.cli.progress import Phases, on_a_terminal
+from plugnproduce.lazy import lazy_module
+
+if TYPE_CHECKING:
+    from plugnproduce import service
+else:
+    service = lazy_module("plugnproduce.service")
 
 
 @app.command()

@@ -250,7 +250,7 @@ def _mapping(node: yaml.Node, path: Path, what: str) -> dict[str, yaml.Node]:
 
 
 def _plain(node: yaml.Node) -> object:
-    return yaml.SafeLoader("").construct_document(node)  # type: ignore[no-untyped-call]
+    return yaml.SafeLoader("").construct_document(node)
 
 
 def _unknown_keys(m: dict[str, yaml.Node], allowed: set[str], path: Path, what: str) -> None:

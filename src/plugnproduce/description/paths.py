@@ -12,11 +12,13 @@ never depends on dict or set order.
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-import networkx as nx
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.taxonomy import Taxonomy
+
+if TYPE_CHECKING:  # networkx is imported on first use: a command that searches no path never pays for it
+    import networkx as nx
 
 _GOAL = "\0goal"
 
@@ -46,6 +48,8 @@ def commands(t: ChartTransition) -> int:
 
 def chart_graph(device: DeviceDescription) -> nx.MultiDiGraph:
     """The Device State Chart as a graph: one edge per transition, weighted by its commands."""
+    import networkx as nx
+
     g = nx.MultiDiGraph()
     g.add_nodes_from(s.id for s in device.states)
     for i, t in enumerate(device.transitions):
@@ -74,6 +78,8 @@ def find_path(
         return Path(source, source, ())
     if not goals:
         raise NoPath(device.id, source, concept)
+    import networkx as nx
+
     g = chart_graph(device)
     for s in goals:
         g.add_edge(s, _GOAL, key=-1, weight=0)

@@ -5,7 +5,8 @@ a UPnP root device and serves its own description (Turtle + Device State Chart) 
 the address it was discovered at (see ``docs/upnp.md``). The live cell searches once
 at start, then follows ``alive`` and ``byebye`` announcements; each change yields a
 :class:`CellChange` with the new cell, so the offered process commands can be
-re-inferred at once.
+re-inferred at once. Entering the cell waits for the search window, or only until the
+``expected`` devices have answered; answers later in the window still plug in.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import logging
 import re
 import shutil
 import tempfile
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Collection
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
@@ -24,22 +25,22 @@ from urllib.parse import urlparse
 
 from plugnproduce.description.loader import file_of, load_device, read_description
 from plugnproduce.description.model import Cell, DeviceDescription
-from plugnproduce.errors import DescriptionError, ProtocolError
+from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP
 from plugnproduce.protocols.upnp import (
     LOOPBACK,
     Advertisement,
     AdvertisementListener,
+    DeviceSearch,
     FoundDevice,
+    SearchHit,
     SsdpNetwork,
     UntrustedUrlError,
     UpnpDeviceClient,
     describe,
-    discover,
 )
 from plugnproduce.protocols.xirp import parse_endpoint
-
 
 _LOGGER = logging.getLogger(__name__)
 
@@ -73,13 +74,19 @@ class LiveCell:
         network: SsdpNetwork = LOOPBACK,
         name: str = "live",
         search_timeout: float = 1.0,
+        expected: Collection[str] = (),
     ) -> None:
         self.taxonomy = taxonomy
         self.network = network
         self.name = name
         self.search_timeout = search_timeout
+        self.expected = frozenset(expected)
+        """Device ids whose answers end the wait at start (none: the whole search window is waited)."""
         self._devices: dict[str, DeviceDescription] = {}
         self._found: dict[str, FoundDevice] = {}
+        self._claimed: set[str] = set()  # UDNs being described, so a search answer and an alive plug once
+        self._plugged = asyncio.Event()
+        self._search: asyncio.Task[None] | None = None
         self._changes: asyncio.Queue[CellChange] = asyncio.Queue()
         self._listener = AdvertisementListener(network)
         self._task: asyncio.Task[None] | None = None
@@ -92,19 +99,34 @@ class LiveCell:
 
     async def __aenter__(self) -> LiveCell:
         await self._listener.start()
-        found = await discover(self.search_timeout, network=self.network)
-        for device in sorted(found.devices, key=lambda d: d.udn):
-            await self._plug(device)
-        for refusal in found.refused:
-            self._publish(CellChange("refused", refusal.udn, self.cell, refusal.reason))
+        search = DeviceSearch(self.network, mx=max(1, min(5, int(self.search_timeout))))
+        try:
+            await search.start()
+        except BaseException:
+            await self._listener.stop()
+            raise
+        self._search = asyncio.create_task(self._follow_search(search))
+        while not self._search.done() and not self._expected_present():
+            self._plugged.clear()
+            plugged = asyncio.create_task(self._plugged.wait())
+            await asyncio.wait((self._search, plugged), return_when=asyncio.FIRST_COMPLETED)
+            plugged.cancel()
+        if self._search.done() and (error := self._search.exception()) is not None:
+            await self._listener.stop()
+            raise error
         self._task = asyncio.create_task(self._follow())
         return self
 
+    def _expected_present(self) -> bool:
+        """Whether every expected device is in the cell (never, when none is expected: the window decides)."""
+        return bool(self.expected) and self.expected <= {d.id for d in self._devices.values()}
+
     async def __aexit__(self, *exc_info: object) -> None:
-        if self._task is not None:
-            self._task.cancel()
-            with contextlib.suppress(asyncio.CancelledError):
-                await self._task
+        for task in (self._task, self._search):
+            if task is not None:
+                task.cancel()
+                with contextlib.suppress(asyncio.CancelledError):
+                    await task
         await self._listener.stop()
         shutil.rmtree(self._workdir, ignore_errors=True)
 
@@ -122,11 +144,25 @@ class LiveCell:
             change = replace(change, reason=" ".join(change.reason.split())[:500])
         self._changes.put_nowait(change)
 
+    async def _follow_search(self, search: DeviceSearch) -> None:
+        """Plug each device that answers the search, in the order they answer, until the window ends."""
+        deadline = asyncio.get_running_loop().time() + self.search_timeout
+        try:
+            while (left := deadline - asyncio.get_running_loop().time()) > 0:
+                try:
+                    hit = await search.next_hit(left)
+                except ProtocolTimeout:
+                    break
+                if hit.udn not in self._claimed:
+                    await self._plug_advertised(hit)
+        finally:
+            search.stop()
+
     async def _follow(self) -> None:
         while True:
             ad = await self._listener.next(None)
             try:
-                if ad.alive and ad.udn not in self._devices:
+                if ad.alive and ad.udn not in self._devices and ad.udn not in self._claimed:
                     await self._plug_advertised(ad)
                 elif not ad.alive and ad.udn in self._devices:
                     await self._unplug_confirmed(ad.udn)
@@ -146,15 +182,19 @@ class LiveCell:
             return
         _LOGGER.warning("byebye for %s ignored: the device still answers at %s", udn, found.location)
 
-    async def _plug_advertised(self, ad: Advertisement) -> None:
+    async def _plug_advertised(self, ad: Advertisement | SearchHit) -> None:
+        self._claimed.add(ad.udn)
         try:
             found = await describe(ad)
         except ProtocolError as exc:
             self._publish(CellChange("refused", ad.udn, self.cell, str(exc)))
             return
+        finally:
+            self._claimed.discard(ad.udn)
         await self._plug(found)
 
     async def _plug(self, found: FoundDevice) -> None:
+        self._claimed.add(found.udn)
         try:
             device = await self._fetch(found)
         except (ProtocolError, DescriptionError) as exc:
@@ -164,9 +204,12 @@ class LiveCell:
             reason = f"its description cannot be read ({type(exc).__name__}: {exc})"
             self._publish(CellChange("refused", found.udn, self.cell, reason))
             return
+        finally:
+            self._claimed.discard(found.udn)
         self._devices[found.udn] = device
         self._found[found.udn] = found
         self._publish(CellChange("plug", device.id, self.cell))
+        self._plugged.set()
 
     async def _fetch(self, found: FoundDevice) -> DeviceDescription:
         """Fetch the device's own description files and read them as any description."""

@@ -105,7 +105,8 @@ def read_journal(path: str | Path) -> RunRecord:
     try:
         lines = data.decode("utf-8").splitlines()
     except UnicodeDecodeError as exc:
-        raise DescriptionError(f"not a journal: not UTF-8 text ({exc.reason})", p, data.count(b"\n", 0, exc.start) + 1) from exc
+        at = data.count(b"\n", 0, exc.start) + 1
+        raise DescriptionError(f"not a journal: not UTF-8 text ({exc.reason})", p, at) from exc
     run = RunRecord(p)
     for number, line in enumerate(lines, start=1):
         try:

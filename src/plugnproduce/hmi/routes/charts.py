@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from fastapi import APIRouter, Depends, Request
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
@@ -12,7 +14,7 @@ from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.security import allow_read
 
 router = APIRouter(prefix="/api/charts", tags=["charts"], dependencies=[Depends(allow_read)])
-SVG = {200: {"content": {"image/svg+xml": {}}}}
+SVG: dict[int | str, dict[str, Any]] = {200: {"content": {"image/svg+xml": {}}}}
 
 
 def _svg(data: bytes) -> Response:

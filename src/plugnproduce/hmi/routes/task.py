@@ -44,7 +44,10 @@ def validate(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.check``: per step its bindings and device states, and every problem at its step."""
     result = service.check(task.to_task(), hub.cell, hub.knowledge).to_json()
-    result["problems"] = _rows(list(result["problems"]), task)  # type: ignore[arg-type]
+    problems = result["problems"]
+    if not isinstance(problems, list):
+        raise TypeError(f"a check result's problems are a list; found {type(problems).__name__}")
+    result["problems"] = _rows(problems, task)
     return result
 
 

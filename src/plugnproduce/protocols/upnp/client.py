@@ -237,7 +237,7 @@ class UpnpDeviceClient:
         self._last_seq[sid] = number
         return request
 
-    def _on_event(self, _service: UpnpService, variables: Sequence[UpnpStateVariable]) -> None:
+    def _on_event(self, _service: UpnpService, variables: Sequence[UpnpStateVariable[Any]]) -> None:
         changes = [VariableChange(v.name, v.value) for v in variables if self._values.get(v.name, _UNSET) != v.value]
         self._values.update((v.name, v.value) for v in variables)
         if not self._baseline:  # the initial event (none before it can be stale)
@@ -334,7 +334,7 @@ class UpnpDeviceClient:
 _UNSET = object()
 
 
-def _checked_value(variable: UpnpStateVariable, name: str, value: Any, what: str) -> Any:
+def _checked_value(variable: UpnpStateVariable[Any], name: str, value: Any, what: str) -> Any:
     """``value`` in the argument's Python type, or a :class:`ProtocolError` saying what is allowed."""
     python_type = variable.data_type_mapping["type"]
     try:

@@ -102,11 +102,12 @@ def _action_method(action: ActionSpec, dispatch: ActionHandler) -> Callable[...,
 
     invoke.__annotations__ = {a.name: STATE_VARIABLE_TYPE_MAPPING[a.data_type]["type"] for a in action.inputs}
     invoke.__name__ = f"action_{action.name}"
-    return callable_action(
+    method: Callable[..., Any] = callable_action(
         name=action.name,
         in_args={a.name: _arg_var_name(action, a) for a in action.inputs},
         out_args={a.name: _arg_var_name(action, a) for a in action.outputs},
     )(invoke)
+    return method
 
 
 def _service_class(spec: ServiceSpec, dispatch: ActionHandler) -> type[UpnpServerService]:
@@ -333,7 +334,7 @@ class UpnpDeviceServer:
             raise UpnpActionError(error_code=UpnpActionErrorCode.ACTION_FAILED.value, error_desc="bad result")
         return result
 
-    def _variable(self, name: str) -> UpnpStateVariable:
+    def _variable(self, name: str) -> UpnpStateVariable[Any]:
         try:
             self.spec.variable(name)
         except KeyError:

@@ -10,7 +10,9 @@ from: the only host the device is trusted for (see
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
 from async_upnp_client.advertisement import SsdpAdvertisementListener
@@ -167,6 +169,10 @@ class DeviceSearch:
         """The answer of the device ``udn``, as soon as it arrives."""
         return await self._changed.wait_for(lambda: self.hits.get(udn), timeout, f"SSDP search for {udn}")
 
+    async def wait_until(self, done: Callable[[], bool], timeout: float) -> None:
+        """Return once ``done()`` holds (looked at after each answer); ProtocolTimeout after ``timeout`` seconds."""
+        await self._changed.wait_for(lambda: True if done() else None, timeout, f"SSDP search for {self.search_target}")
+
 
 async def describe(found: SearchHit | Advertisement, *, timeout: float = 5.0) -> FoundDevice:
     """Read the description of a device seen by SSDP, from the address it was seen at only.
@@ -200,17 +206,25 @@ async def discover(
     network: SsdpNetwork = LOOPBACK,
     search_target: str = SERVICE_TYPE,
     describe_timeout: float = 5.0,
+    expected: Collection[str] = (),
 ) -> Discovery:
     """Search for devices for ``timeout`` seconds, then read each one's description.
 
-    SSDP gives no end to the answers, so the whole ``timeout`` is waited; devices
-    answer within ``MX`` seconds, here ``timeout`` rounded down and clamped to 1..5,
-    so ``timeout`` should be at least 1 s. By default only Plug'n'Produce devices
-    (those with :data:`~plugnproduce.protocols.upnp.spec.SERVICE_TYPE`) answer.
+    SSDP gives no end to the answers, so the whole ``timeout`` is waited, unless the
+    UDNs of the ``expected`` devices are given: then the search ends as soon as they
+    have all answered. Devices answer within ``MX`` seconds, here ``timeout`` rounded
+    down and clamped to 1..5, so ``timeout`` should be at least 1 s. By default only
+    Plug'n'Produce devices (those with
+    :data:`~plugnproduce.protocols.upnp.spec.SERVICE_TYPE`) answer.
     """
     mx = max(1, min(5, int(timeout)))
+    wanted = frozenset(expected)
     async with DeviceSearch(network, search_target, mx) as search:
-        await asyncio.sleep(timeout)  # the search window: answers arrive through the callback meanwhile
+        if wanted:
+            with contextlib.suppress(ProtocolTimeout):  # then those that answered are all there is
+                await search.wait_until(lambda: wanted <= search.hits.keys(), timeout)
+        else:
+            await asyncio.sleep(timeout)  # the search window: answers arrive through the callback meanwhile
     hits = sorted(search.hits.values(), key=lambda h: h.udn)
     results = await asyncio.gather(*(_describe_or_refuse(hit, describe_timeout) for hit in hits))
     return Discovery(
@@ -284,8 +298,8 @@ class AdvertisementListener:
         self._queue.put_nowait(advertisement)
         self._changed.notify()
 
-    async def next(self, timeout: float) -> Advertisement:
-        """The next report; :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time."""
+    async def next(self, timeout: float | None) -> Advertisement:
+        """The next report; :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time (None: no limit)."""
         try:
             async with asyncio.timeout(timeout):
                 return await self._queue.get()

@@ -11,6 +11,7 @@ See ``docs/xirp.md``.
 
 from __future__ import annotations
 
+from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.answer import RequestFailed, RequestHandler
 from plugnproduce.protocols.xirp.client import RemoteFailure, XirpClient
 from plugnproduce.protocols.xirp.codec import MAX_FRAME, encode, encode_frame, frame
@@ -28,7 +29,6 @@ from plugnproduce.protocols.xirp.messages import (
     UNEXPECTED,
     UNKNOWN_REQUEST,
     Bye,
-    DeviceFiles,
     Document,
     ErrorMessage,
     Event,

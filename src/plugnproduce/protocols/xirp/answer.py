@@ -18,6 +18,7 @@ import logging
 from collections.abc import Awaitable, Callable, Coroutine, Mapping
 from typing import Any
 
+from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.codec import encode_frame, frame
 from plugnproduce.protocols.xirp.decoding import decode
 from plugnproduce.protocols.xirp.faults import REQUEST_FAULTS, Fault, FaultKind, Faults
@@ -28,7 +29,6 @@ from plugnproduce.protocols.xirp.messages import (
     UNEXPECTED,
     UNKNOWN_REQUEST,
     Bye,
-    DeviceFiles,
     ErrorMessage,
     Failure,
     MessageError,
@@ -116,7 +116,7 @@ class Responder:
             return None
         if inspect.isawaitable(results):
             return self._finish(link, request, results, fault)
-        self._send(link, Response(request.id, dict(results or {})), fault)  # type: ignore[call-overload]
+        self._send(link, Response(request.id, dict(results or {})), fault)
         return None
 
     async def _finish(

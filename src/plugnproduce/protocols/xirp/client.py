@@ -19,6 +19,7 @@ from collections.abc import AsyncIterator
 from typing import NamedTuple
 
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
+from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.codec import MAX_FRAME, encode_frame
 from plugnproduce.protocols.xirp.decoding import decode
 from plugnproduce.protocols.xirp.inbox import EventCallback, EventInbox, LinkStats
@@ -28,7 +29,6 @@ from plugnproduce.protocols.xirp.messages import (
     UNEXPECTED,
     VERSION,
     Bye,
-    DeviceFiles,
     ErrorMessage,
     Event,
     Hello,

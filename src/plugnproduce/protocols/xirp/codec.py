@@ -111,7 +111,7 @@ def _checked(pattern: re.Pattern[str], value: object, label: str, rule: str) -> 
 
 def _name(value: object, label: str) -> str:
     if value.__class__ is str and value in _NAMES:
-        return value  # type: ignore[return-value]
+        return value
     name = _checked(NAME_PATTERN, value, label, _NAME_RULE)
     if len(_NAMES) < _NAMES_LIMIT:
         _NAMES.add(name)
@@ -119,7 +119,7 @@ def _name(value: object, label: str) -> str:
 
 
 def _decimal(value: object) -> str:
-    if value.__class__ is float and math.isfinite(value):  # type: ignore[arg-type]
+    if value.__class__ is float and math.isfinite(value):
         text = repr(value)
         return text if "e" not in text else format(Decimal(text), "f")
     if isinstance(value, float) and math.isfinite(value):

@@ -181,7 +181,7 @@ _VALUE_READERS: dict[str, Callable[[str], Value]] = {
 def _read_values(el: etree._Element) -> dict[str, Value]:
     values: dict[str, Value] = {}
     for child in el:
-        reader = _VALUE_READERS.get(child.tag)  # type: ignore[call-overload]
+        reader = _VALUE_READERS.get(child.tag)
         if reader is not None:
             text = "".join(child.itertext()) if len(child) else child.text  # comments may split the text
             values[child.get("name")] = reader(text or "")

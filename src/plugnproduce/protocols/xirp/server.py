@@ -16,6 +16,7 @@ from collections import deque
 from datetime import UTC, datetime
 
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
+from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.answer import Finish, RequestHandler, Responder
 from plugnproduce.protocols.xirp.codec import MAX_FRAME, encode_frame, frame
 from plugnproduce.protocols.xirp.faults import EVENT_FAULTS, Fault, FaultKind, Faults
@@ -23,7 +24,6 @@ from plugnproduce.protocols.xirp.messages import (
     DESCRIBE,
     TOO_LARGE,
     Bye,
-    DeviceFiles,
     ErrorMessage,
     Event,
     Hello,

@@ -9,18 +9,23 @@ from __future__ import annotations
 import re
 from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import xmlschema
 from lxml import etree
 
 from plugnproduce.errors import DescriptionError
 from plugnproduce.resources import package_file
 from plugnproduce.safeio import parse_xml_bytes
 
+if TYPE_CHECKING:  # imported when a schema is first needed: it is slow to import
+    import xmlschema
+
 
 @lru_cache(maxsize=1)
 def scxml_schema() -> xmlschema.XMLSchema:
     """The W3C SCXML schema, loaded once (from package data; nothing is fetched)."""
+    import xmlschema
+
     return xmlschema.XMLSchema(str(package_file("statechart", "io", "w3c", "scxml.xsd")))
 
 

@@ -56,7 +56,8 @@ def write_chart(chart: Chart) -> bytes:
     writer = _Writer()
     root = writer.scxml(chart, etree.Element(_NS + "scxml", nsmap=_nsmap(chart)))
     etree.indent(root, space="  ")
-    data: bytes = b'<?xml version="1.0" encoding="UTF-8"?>\n' + etree.tostring(root, encoding="UTF-8") + b"\n"
+    body: bytes = etree.tostring(root, encoding="UTF-8")
+    data = b'<?xml version="1.0" encoding="UTF-8"?>\n' + body + b"\n"
     for token, markup in writer.markup.items():
         data = data.replace(token.encode(), _standalone_markup(markup).encode(), 1)
     return data

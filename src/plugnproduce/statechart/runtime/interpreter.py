@@ -60,6 +60,7 @@ from plugnproduce.safeio import read_bytes
 from plugnproduce.statechart.io.checks import check_structure
 from plugnproduce.statechart.io.reader import parse_chart
 from plugnproduce.statechart.model import Chart
+from plugnproduce.statechart.runtime import gcpause
 from plugnproduce.statechart.runtime.actions import Block
 from plugnproduce.statechart.runtime.clock import Clock, MonotonicClock
 from plugnproduce.statechart.runtime.compiled import ROOT, CompiledChart, CState, CTransition
@@ -119,7 +120,9 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         self.io_processors = io_processors
         self.base_dir = base_dir
         self.session_id = session_id
-        self.compiled = CompiledChart(chart, Evaluator(trusted), chart.name or "chart")
+        with gcpause.paused():  # a large chart would otherwise pay for collections that find nothing
+            self.compiled = CompiledChart(chart, Evaluator(trusted), chart.name or "chart")
+        self._holds_gc = False
         self.running = False
         self.started = False
         self.final_state: str | None = None
@@ -184,6 +187,9 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
         if self.started:
             raise ExecutionError(f"session {self.session_id} of {self.chart.name or 'chart'} is already started")
         self.started = self.running = True
+        if len(self.compiled.states) + len(self.compiled.transitions) >= gcpause.LARGE_CHART:
+            self._holds_gc = True  # released when the session ends: see gcpause
+            gcpause.hold()
         step = self._begin(None)
         self._init_datamodel()
         for block in self.compiled.scripts:
@@ -462,8 +468,18 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
             self._exit_one(s)
         self._atomic = None
         self._sessions.pop(self.session_id, None)
+        self.release()
         if self._parent is not None and final is not None:
             self._parent._from_child(self.invokeid, Event(f"done.invoke.{self.invokeid}", done))
+
+    def release(self) -> None:
+        """Let the garbage collector walk this session's chart again (see :mod:`.gcpause`).
+
+        Done when the session ends; call it for a session abandoned while it runs. Idempotent.
+        """
+        if self._holds_gc:
+            self._holds_gc = False
+            gcpause.release()
 
     def _stop(self) -> None:
         """Cancelled by the parent: leave every state, send nothing back."""

@@ -35,18 +35,21 @@ class ChartLoop:
     async def run(self) -> None:
         """Start the chart and process events and due sends until it reaches a top-level final state."""
         chart = self.interpreter
-        if not chart.started:
-            self._report(chart.start())
-        while chart.running:
-            self._wake.clear()
-            for step in chart.execute():
-                self._report(step)
-            if not chart.running:
-                break
-            due = chart.next_due()
-            timeout = None if due is None else max(0.0, due - chart.clock.time())
-            with contextlib.suppress(TimeoutError):
-                await asyncio.wait_for(self._wake.wait(), timeout)
+        try:
+            if not chart.started:
+                self._report(chart.start())
+            while chart.running:
+                self._wake.clear()
+                for step in chart.execute():
+                    self._report(step)
+                if not chart.running:
+                    break
+                due = chart.next_due()
+                timeout = None if due is None else max(0.0, due - chart.clock.time())
+                with contextlib.suppress(TimeoutError):
+                    await asyncio.wait_for(self._wake.wait(), timeout)
+        finally:
+            chart.release()  # a session cancelled while it runs lets go of what it holds, as one that ended
 
     def _report(self, step: MacroStep) -> None:
         if self._on_step is not None:

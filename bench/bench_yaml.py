@@ -1,0 +1,60 @@
+"""Benchmark of task YAML loading (prints figures; not a test).
+
+    python bench/bench_yaml.py [--steps 1000] [--rounds 5]
+
+A long task (the bin-picking task's steps repeated) loaded with ``load_task``: events
+from libyaml's C parser against the pure-Python parser, and the pure-Python
+``yaml.compose`` the loader used before, all in the same run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import yaml
+
+from plugnproduce import safeio
+from plugnproduce.description.loader import load_task
+
+TASK = Path(__file__).resolve().parents[1] / "descriptions" / "tasks" / "bin-picking.yaml"
+
+
+def _best(rounds: int, work: Callable[[], object]) -> float:
+    times = []
+    for _ in range(rounds):
+        start = time.perf_counter()
+        work()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main(steps: int, rounds: int) -> None:
+    head, body = TASK.read_text(encoding="utf-8").split("steps:\n")
+    per_copy = body.count("- command:")
+    text = "task: long\nsteps:\n" + body * max(1, steps // per_copy)
+    n = text.count("- command:")
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "long.yaml"
+        path.write_text(text, encoding="utf-8")
+        fast = _best(rounds, lambda: load_task(path))
+        safeio._YAML_LOADER = yaml.SafeLoader  # the pure-Python parser under the same composer
+        slow = _best(rounds, lambda: load_task(path))
+        safeio._YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+        compose = _best(rounds, lambda: yaml.compose(text, Loader=yaml.SafeLoader))
+    print(f"{n}-step task, best of {rounds}:")
+    print(f"  load_task, libyaml events      {1000 * fast / n:6.3f} ms per step")
+    print(f"  load_task, pure-Python events  {1000 * slow / n:6.3f} ms per step = {slow / fast:.1f}× libyaml")
+    print(f"  yaml.compose alone, pure Python {1000 * compose / n:6.3f} ms per step = {compose / fast:.1f}× "
+          "the whole libyaml load_task")
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=1000)
+    parser.add_argument("--rounds", type=int, default=5)
+    options = parser.parse_args()
+    main(options.steps, options.rounds)
