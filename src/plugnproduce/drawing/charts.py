@@ -10,7 +10,9 @@ segments as clusters side by side, each naming the steps that run it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
+from itertools import pairwise
 
 import graphviz
 
@@ -19,9 +21,17 @@ from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.model import Chart, Final, Parallel, Raise, Send, State, StateNode, Transition, walk
 
 COLUMN = 10
-"""Steps per column of a task's picture; further steps start a new column to the right."""
+"""The fewest steps per column of a task's picture; further steps start a new column to the right."""
+_ASPECT = 2.7
+"""How many step boxes, stacked, are as tall as one is wide (spacing included)."""
 START = "pnp_start"
 _Edge = tuple[str, str, str, "str | None"]
+
+
+def column_length(steps: int) -> int:
+    """Steps per column for a task of ``steps`` steps: at least :data:`COLUMN`, and as many as keep
+    the picture about as wide as it is tall."""
+    return max(COLUMN, math.ceil(math.sqrt(_ASPECT * steps)))
 
 
 def step_node(number: int) -> str:
@@ -104,6 +114,7 @@ class _Drawing:
         self.edges: list[_Edge] = []
         self.hidden: set[str] = set()
         self.expanded: Step | None = None
+        self._segment_of = self._segment_states(plan) if plan and not plan.is_task else {}
         if plan and plan.is_task:
             self.hidden = {plan.picker.id or ""}.union(*(_subtree(b) for b in plan.bodies.values()))
             if expand is not None and 1 <= expand <= len(plan.steps):
@@ -120,7 +131,7 @@ class _Drawing:
                 self._segments(graph, plan)
         for child in container.children:
             if isinstance(child, State | Parallel | Final) and child.id not in self.hidden:
-                if not (plan and not plan.is_task and container is plan.container and child.id in self._segment_of):
+                if not (container is getattr(plan, "container", None) and child.id in self._segment_of):
                     self._state(graph, child)
 
     def _state(self, graph: graphviz.Digraph, child: State | Parallel | Final) -> None:
@@ -153,12 +164,13 @@ class _Drawing:
                 graph.node(step_node(step.number), _step_label(step), shape="box", style="rounded,filled",
                            fillcolor="#f4f4f4")
                 names.append(step_node(step.number))
+        column = column_length(len(plan.steps))
         ends = [self._entry(n) for n in names]
         exits = [self._exit(n) for n in names]
         for i in range(1, len(names)):
             attrs: dict[str, str] = {}
-            if i % COLUMN == 1 and i > 1:
-                attrs["constraint"] = "false"
+            if i % column == 1 and i > 1:
+                attrs.update(constraint="false", style="dashed", color="#808080")
             if self._is_expanded(names[i - 1]):
                 attrs["ltail"] = f"cluster_{names[i - 1]}"
             if self._is_expanded(names[i]):
@@ -166,11 +178,11 @@ class _Drawing:
             graph.edge(exits[i - 1], ends[i], **attrs)
         if plan.end and plan.end in self.ids:
             self.edges.append(("", plan.end, "", exits[-1]))
-        tops = [ends[i] for i in range(1, len(names), COLUMN)]
+        tops = [ends[i] for i in range(1, len(names), column)]
         if len(tops) > 1:
             with graph.subgraph() as row:
                 row.attr(rank="same")
-                for a, b in zip(tops, tops[1:]):
+                for a, b in pairwise(tops):
                     row.edge(a, b, style="invis")
 
     def _is_expanded(self, name: str) -> bool:
@@ -188,23 +200,20 @@ class _Drawing:
 
     # ------------------------------------------------------------ a device program's segments
 
-    @property
-    def _segment_of(self) -> dict[str, str]:
+    def _segment_states(self, plan: Plan) -> dict[str, str]:
         """Each state of a device program's segments → the segment's first state."""
-        if not hasattr(self, "_segments_cache"):
-            out: dict[str, str] = {}
-            plan = self.plan
-            for body in plan.bodies if plan else ():
-                todo = [body]
-                while todo:
-                    sid = todo.pop()
-                    node = self.ids.get(sid)
-                    if node is None or sid in out or sid == (plan.picker.id if plan else None) or sid == plan.end:
-                        continue
-                    out[sid] = body
-                    todo.extend(t for tr in getattr(node, "transitions", ()) for t in tr.targets)
-            self._segments_cache = out
-        return self._segments_cache
+        out: dict[str, str] = {}
+        stop = {plan.picker.id, plan.end}
+        for body in plan.bodies:
+            todo = [body]
+            while todo:
+                sid = todo.pop()
+                node = self.ids.get(sid)
+                if node is None or sid in out or sid in stop:
+                    continue
+                out[sid] = body
+                todo.extend(t for tr in getattr(node, "transitions", ()) for t in tr.targets)
+        return out
 
     def _segments(self, graph: graphviz.Digraph, plan: Plan) -> None:
         for k, body in enumerate(plan.bodies, start=1):
@@ -251,8 +260,6 @@ def build_graph(chart: Chart, title: str, expand: int | None = None) -> graphviz
     plan = find_plan(chart)
     graph = graphviz.Digraph(name=title)
     graph.attr(rankdir="TB" if plan else "LR", compound="true", fontname="Helvetica", label=title)
-    if plan and plan.is_task:
-        graph.attr(newrank="true")
     graph.attr("node", fontname="Helvetica", fontsize="10")
     graph.attr("edge", fontname="Helvetica", fontsize="8")
     drawing = _Drawing(graph, chart, plan, expand)
