@@ -10,7 +10,7 @@ import graphviz
 import pytest
 
 from plugnproduce import service
-from plugnproduce.drawing import Layout, chart_to_dot, column_length, layout, render, step_node
+from plugnproduce.drawing import Layout, chart_to_dot, column_length, layout, run_dot, step_node
 from plugnproduce.resources import descriptions_path
 from plugnproduce.statechart import parse_chart
 
@@ -86,6 +86,6 @@ def test_graphviz_warnings_are_logged_not_printed(capfd: pytest.CaptureFixture[s
     graph.attr(compound="true")
     graph.edge("a", "b", lhead="cluster_nowhere")
     with caplog.at_level(logging.INFO, logger="plugnproduce.drawing"):
-        assert render(graph, "svg").startswith(b"<?xml")
+        assert run_dot(graph, "svg").startswith(b"<?xml")
     assert capfd.readouterr().err == ""
     assert len(caplog.records) == 1 and "Graphviz" in caplog.records[0].getMessage()

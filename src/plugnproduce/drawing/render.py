@@ -34,7 +34,7 @@ def chart_to_dot(chart: Chart | str | Path, name: str | None = None, *, expand: 
     return build_graph(chart, chart.name or name or "chart", expand)
 
 
-def render(graph: graphviz.Digraph, fmt: str, where: str | Path = "picture") -> bytes:
+def run_dot(graph: graphviz.Digraph, fmt: str, where: str | Path = "picture") -> bytes:
     """Run Graphviz ``dot`` on ``graph`` into format ``fmt``; its warnings are logged in one line."""
     try:
         done = subprocess.run(["dot", f"-T{fmt}"], input=graph.source.encode("utf-8"), capture_output=True,
@@ -60,7 +60,7 @@ def draw_chart(path: str | Path, output: str | Path, *, expand: int | None = Non
     if fmt == "dot":
         out.write_text(graph.source)
         return out
-    out.write_bytes(render(graph, fmt, out))
+    out.write_bytes(run_dot(graph, fmt, out))
     return out
 
 
@@ -78,7 +78,7 @@ def layout(graph: graphviz.Digraph) -> Layout:
     """Lay ``graph`` out with ``dot`` and read back its size and its nodes' centres."""
     width = height = 0.0
     nodes: dict[str, tuple[float, float]] = {}
-    for line in render(graph, "plain").decode("utf-8").splitlines():
+    for line in run_dot(graph, "plain").decode("utf-8").splitlines():
         fields = _split(line)
         if fields and fields[0] == "graph":
             width, height = float(fields[2]) * POINTS, float(fields[3]) * POINTS
