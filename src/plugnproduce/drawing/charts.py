@@ -87,15 +87,18 @@ def _step_label(step: Step) -> str:
     return "\\n".join(lines)
 
 
-def _runs(numbers: Iterable[int]) -> str:
-    """``1, 3–6``: step numbers as ranges."""
+def _runs(numbers: Iterable[int], most: int = 6) -> str:
+    """``1, 3–6``: step numbers as ranges; past ``most`` ranges, the first few and how many in all."""
     spans: list[list[int]] = []
+    count = 0
     for n in numbers:
+        count += 1
         if spans and spans[-1][1] == n - 1:
             spans[-1][1] = n
         else:
             spans.append([n, n])
-    return ", ".join(str(a) if a == b else f"{a}–{b}" for a, b in spans)
+    text = ", ".join(str(a) if a == b else f"{a}–{b}" for a, b in spans[:most])
+    return text if len(spans) <= most else f"{text}, … ({count} in all)"
 
 
 def _subtree(node: StateNode) -> set[str]:
@@ -216,13 +219,19 @@ class _Drawing:
         return out
 
     def _segments(self, graph: graphviz.Digraph, plan: Plan) -> None:
-        for k, body in enumerate(plan.bodies, start=1):
+        bodies = list(plan.bodies)
+        row = column_length(len(bodies)) if len(bodies) > COLUMN else len(bodies)
+        members: dict[str, list[str]] = {body: [] for body in bodies}
+        for sid, first in self._segment_of.items():
+            members[first].append(sid)
+        for k, body in enumerate(bodies, start=1):
             runs = _runs(s.number for s in plan.steps if s.body == body)
             with graph.subgraph(name=f"cluster_segment_{body}") as sub:
-                sub.attr(label=f"segment {k} · runs {runs}", style="rounded")
-                for sid, first in self._segment_of.items():
-                    if first == body:
-                        self._state(sub, self.ids[sid])  # type: ignore[arg-type]
+                sub.attr(label=f"segment {k} · device's runs {runs}", style="rounded")
+                for sid in members[body]:
+                    self._state(sub, self.ids[sid])  # type: ignore[arg-type]
+            if k > row:  # folded: below the segment a row earlier
+                graph.edge(members[bodies[k - 1 - row]][-1], body, style="invis")
 
     # ------------------------------------------------------------ edges
 
