@@ -13,6 +13,7 @@ from plugnproduce import service
 from plugnproduce.drawing import Layout, chart_to_dot, column_length, layout, run_dot, step_node
 from plugnproduce.resources import descriptions_path
 from plugnproduce.statechart import parse_chart
+from plugnproduce.statechart.model import Chart, Data, Final, State, StateNode, Transition
 
 D = descriptions_path()
 BOUND = {6: (600.0, 1000.0), 100: (2000.0, 2000.0)}
@@ -89,3 +90,30 @@ def test_graphviz_warnings_are_logged_not_printed(capfd: pytest.CaptureFixture[s
         assert run_dot(graph, "svg").startswith(b"<?xml")
     assert capfd.readouterr().err == ""
     assert len(caplog.records) == 1 and "Graphviz" in caplog.records[0].getMessage()
+
+
+def _program(segments: int) -> Chart:
+    """A device program of ``segments`` distinct three-state segments, each run once."""
+    plan = ", ".join(str(k) for k in range(1, segments + 1))
+    picker = State(id="next_step", transitions=[
+        *(Transition(cond=f"pnp_plan[pnp_step] == {k}", targets=[f"q{k}_0"]) for k in range(1, segments + 1)),
+        Transition(cond="pnp_plan[pnp_step] == 0", targets=["end"])])
+    states: list[StateNode] = [State(id="p0", transitions=[Transition(targets=["next_step"])]), picker]
+    for k in range(1, segments + 1):
+        states += [State(id=f"q{k}_0", transitions=[Transition(event="xirp.request.Open", targets=[f"q{k}_1"])]),
+                   State(id=f"q{k}_1", transitions=[Transition(event="done", targets=[f"q{k}_2"])]),
+                   State(id=f"q{k}_2", transitions=[Transition(targets=["next_step"])])]
+    return Chart(name="gripper-program", initial=["p0"], children=[*states, Final(id="end")],
+                 data=[Data(id="pnp_plan", expr=f"[{plan}, 0]"), Data(id="pnp_step", expr="0")])
+
+
+def test_a_device_program_s_many_segments_fold_into_rows_in_order() -> None:
+    drawn = layout(chart_to_dot(_program(40)))
+    row = 7  # segments to a row: about as many as rows
+    firsts = [drawn.nodes[f"q{k}_0"] for k in range(1, 41)]
+    for start in range(0, 40, row):
+        xs = [x for x, _ in firsts[start:start + row]]
+        assert xs == sorted(xs), f"segments {start + 1}… not left to right"
+    tops = [firsts[start][1] for start in range(0, 40, row)]
+    assert tops == sorted(tops) and len(set(tops)) == len(tops), "rows not top to bottom"
+    assert drawn.width <= 2000 and drawn.height <= 2000, f"{drawn.width:.0f} × {drawn.height:.0f} pt"

@@ -118,6 +118,7 @@ class _Drawing:
         self.hidden: set[str] = set()
         self.expanded: Step | None = None
         self._segment_of = self._segment_states(plan) if plan and not plan.is_task else {}
+        self._folded = False
         if plan and plan.is_task:
             self.hidden = {plan.picker.id or ""}.union(*(_subtree(b) for b in plan.bodies.values()))
             if expand is not None and 1 <= expand <= len(plan.steps):
@@ -220,7 +221,7 @@ class _Drawing:
 
     def _segments(self, graph: graphviz.Digraph, plan: Plan) -> None:
         bodies = list(plan.bodies)
-        row = column_length(len(bodies)) if len(bodies) > COLUMN else len(bodies)
+        row = math.ceil(math.sqrt(len(bodies))) if len(bodies) > COLUMN else len(bodies)  # about square
         members: dict[str, list[str]] = {body: [] for body in bodies}
         for sid, first in self._segment_of.items():
             members[first].append(sid)
@@ -232,11 +233,17 @@ class _Drawing:
                     self._state(sub, self.ids[sid])  # type: ignore[arg-type]
             if k > row:  # folded: below the segment a row earlier
                 graph.edge(members[bodies[k - 1 - row]][-1], body, style="invis")
+        self._folded = len(bodies) > row
+        if self._folded:
+            for body in bodies[:row]:
+                graph.edge(plan.picker.id or "", body, style="invis")
 
     # ------------------------------------------------------------ edges
 
     def draw_edges(self) -> None:
         """The transitions noted while drawing the states, each from and to a drawn node."""
+        if self._folded and self.plan:
+            self.graph.node(self.plan.picker.id or "", "next_step\\nruns the segment the plan names,\\nthen comes back")
         for source, target, label, tail in self.edges:
             if target not in self.ids or target in self.hidden or source in self.hidden:
                 continue
@@ -247,11 +254,27 @@ class _Drawing:
                     attrs["ltail"] = tail
             else:
                 src = tail or START
-            if self.plan and not self.plan.is_task and target == self.plan.picker.id and source in self._segment_of:
-                attrs["constraint"] = "false"
+            if self._segment_of:
+                extra = self._segment_edge(source, target)
+                if extra is None:
+                    continue
+                attrs.update(extra)
             if _is_compound(self.ids[target]) and not (source and self._inside(source, target)):
                 attrs["lhead"] = f"cluster_{target}"
             self.graph.edge(src, self._anchor(target), **attrs)
+
+    def _segment_edge(self, source: str, target: str) -> dict[str, str] | None:
+        """How a device program's edge between ``next_step`` and a segment is drawn (None: not at all).
+
+        The edges back to ``next_step`` do not rank; the segment's label names its runs, so the plan's
+        condition is left off; once the segments fold into rows, the picture names the plan instead
+        of drawing an edge to and from each segment."""
+        picker = self.plan.picker.id if self.plan else None
+        if target == picker and source in self._segment_of:
+            return None if self._folded else {"constraint": "false"}
+        if source == picker and target in self._segment_of:
+            return None if self._folded else {"label": ""}
+        return {}
 
     def _inside(self, node: str, container: str) -> bool:
         return container in self.ids and node in _subtree(self.ids[container])
