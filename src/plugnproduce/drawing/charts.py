@@ -159,15 +159,13 @@ class _Drawing:
         graph.node(START, "", shape="point", width="0.12")
         names = [START]
         for step in plan.steps:
+            names.append(step_node(step.number))
             if step is self.expanded:
-                with graph.subgraph(name=f"cluster_{step_node(step.number)}") as sub:
+                with graph.subgraph(name=f"cluster_{names[-1]}") as sub:
                     sub.attr(label=_step_label(step).replace("\\n", " · ", 1), style="bold,rounded")
                     self.add(sub, self.ids[step.body])  # type: ignore[arg-type]
-                names.append(step_node(step.number))
             else:
-                graph.node(step_node(step.number), _step_label(step), shape="box", style="rounded,filled",
-                           fillcolor="#f4f4f4")
-                names.append(step_node(step.number))
+                graph.node(names[-1], _step_label(step), shape="box", style="rounded,filled", fillcolor="#f4f4f4")
         column = column_length(len(plan.steps))
         ends = [self._entry(n) for n in names]
         exits = [self._exit(n) for n in names]
@@ -225,8 +223,11 @@ class _Drawing:
         members: dict[str, list[str]] = {body: [] for body in bodies}
         for sid, first in self._segment_of.items():
             members[first].append(sid)
+        runs_of: dict[str, list[int]] = {body: [] for body in bodies}
+        for step in plan.steps:
+            runs_of[step.body].append(step.number)
         for k, body in enumerate(bodies, start=1):
-            runs = _runs(s.number for s in plan.steps if s.body == body)
+            runs = _runs(runs_of[body])
             with graph.subgraph(name=f"cluster_segment_{body}") as sub:
                 sub.attr(label=f"segment {k} · device's runs {runs}", style="rounded")
                 for sid in members[body]:
