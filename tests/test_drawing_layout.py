@@ -76,6 +76,7 @@ def test_an_expanded_step_shows_its_regions_and_the_others_stay_boxes(tmp_path: 
     assert f"cluster_{step_node(3)}" in source and "s3_robot_idle" in source
     assert all(f"\t{step_node(n)} [" in source for n in (1, 2, 4, 5, 6))
     assert f"\t{step_node(3)} [" not in source and "s1_robot_idle" not in source
+    assert source.count("subgraph cluster_s3_robot ") == 1 and source.count("s3_robot_idle -> s3_robot_approach") == 1
     drawn = layout(chart_to_dot(chart, expand=3))
     ys = [drawn.nodes[step_node(2)][1], drawn.nodes["s3_robot_idle"][1], drawn.nodes[step_node(4)][1]]
     assert ys == sorted(ys)

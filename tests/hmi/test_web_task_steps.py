@@ -70,3 +70,25 @@ def test_the_step_buttons_walk_the_steps(page: Page) -> None:
     expect(page.locator("#chart-img")).to_have_attribute("src", re.compile(r".*\.svg\?step=5$"))
     page.locator("#chart-step").select_option("")
     expect(page.locator("#chart-img")).to_have_attribute("src", re.compile(r".*bin-picking\.task\.scxml\.svg$"))
+
+
+@needs_reasoner
+def test_a_hundred_step_task_is_drawn_step_by_step(page: Page) -> None:
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "bin-picking.yaml")))
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    page.locator("#task-repeat").fill("50")
+    page.locator("#task-repeat").dispatch_event("change")
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    page.get_by_role("button", name="Generate code").click()
+    expect(page.locator("#chart-step option")).to_have_count(101)
+    page.locator("#chart-step").select_option("57")
+    expect(page.locator("#chart-img")).to_have_attribute("src", re.compile(r".*\.svg\?step=57$"))
+    page.wait_for_function(CHART_SHOWN)
+    drawn = page.evaluate(DRAWN)
+    assert drawn["clusters"].count("cluster_pnp_step_57") == 1
+    assert len([n for n in drawn["nodes"] if n.startswith("pnp_step_")]) == 99
+    page.wait_for_function("() => document.querySelector('#chart-frame').dataset.focused === '57'")
+    screenshot(page, "charts-task-100-steps")
+    focused = float(page.locator("#chart-frame").evaluate("f => f.dataset.scale"))
+    page.get_by_role("button", name="Fit").click()
+    assert focused > 2 * float(page.locator("#chart-frame").evaluate("f => f.dataset.scale"))  # the step, larger

@@ -133,9 +133,10 @@ class _Drawing:
                 self._task_steps(graph, plan)
             else:
                 self._segments(graph, plan)
+        drawn_apart = set(self._segment_of) | (set(plan.bodies) if plan and plan.is_task else set())
         for child in container.children:
             if isinstance(child, State | Parallel | Final) and child.id not in self.hidden:
-                if not (container is getattr(plan, "container", None) and child.id in self._segment_of):
+                if not (plan and container is plan.container and child.id in drawn_apart):
                     self._state(graph, child)
 
     def _state(self, graph: graphviz.Digraph, child: State | Parallel | Final) -> None:

@@ -5,8 +5,11 @@
 import { get, post } from "./api.js";
 import { $, fill, h } from "./dom.js";
 import { state, taskBody } from "./state.js";
+import { focusOn } from "./zoom.js";
 
-const steps = { url: null, list: [], caption: "", shown: 0 }; // the task chart drawn step by step; `shown` counts pictures
+// The task chart drawn step by step: its picture's address, steps, caption; `shown` counts pictures shown,
+// `expanded` is the address of the picture with the step expanded now.
+const steps = { url: null, list: [], caption: "", shown: 0, expanded: null };
 
 function setPicture(url, caption) {
   const img = $("#chart-img");
@@ -25,6 +28,7 @@ export function showChart(url, caption) {
   const task = state.generated.find((c) => c.kind === "task" && c.svg === url);
   $("#chart-steps").hidden = true;
   steps.url = null;
+  steps.expanded = null;
   steps.shown += 1;
   if (task) loadSteps(task, caption, steps.shown);
 }
@@ -59,8 +63,44 @@ export function expandStep(n) {
   $("#step-next").disabled = number >= steps.list.length;
   const frame = $("#chart-frame");
   frame.dataset.step = String(number);
-  setPicture(number ? `${steps.url}?step=${number}` : steps.url, steps.caption);
-  if (number) $("#chart-img").alt = `${steps.caption}, step ${stepText(steps.list[number - 1])} expanded`;
+  const url = number ? `${steps.url}?step=${number}` : steps.url;
+  steps.expanded = url;
+  const img = $("#chart-img");
+  if (number) img.addEventListener("load", () => focusStep(url, number), { once: true });
+  setPicture(url, steps.caption);
+  if (number) img.alt = `${steps.caption}, step ${stepText(steps.list[number - 1])} expanded`;
+}
+
+/** Where Graphviz drew the cluster `title` in the SVG at `url`, in the picture's pixels (null if nowhere). */
+async function clusterBox(url, title, naturalWidth) {
+  const doc = new DOMParser().parseFromString(await (await fetch(url)).text(), "image/svg+xml");
+  const cluster = [...doc.querySelectorAll("g.cluster")].find((g) => g.querySelector("title")?.textContent === title);
+  const graph = doc.querySelector("g.graph");
+  const shape = cluster?.querySelector("path, polygon");
+  if (!shape || !graph) return null;
+  const view = (doc.documentElement.getAttribute("viewBox") || "").split(/[\s,]+/).map(Number);
+  const shift = /translate\(([-\d.]+)[\s,]+([-\d.]+)\)/.exec(graph.getAttribute("transform") || "");
+  const [tx, ty] = shift ? [Number(shift[1]), Number(shift[2])] : [0, 0];
+  const points = [...(shape.getAttribute("d") || shape.getAttribute("points") || "").matchAll(/(-?[\d.]+),(-?[\d.]+)/g)];
+  if (!points.length || !view[2]) return null;
+  const xs = points.map((m) => Number(m[1]) + tx);
+  const ys = points.map((m) => Number(m[2]) + ty);
+  const r = naturalWidth / view[2];
+  const [x, y] = [Math.min(...xs), Math.min(...ys)];
+  return { x: x * r, y: y * r, w: (Math.max(...xs) - x) * r, h: (Math.max(...ys) - y) * r };
+}
+
+/** Bring step `number`, expanded in the picture at `url`, into view (once the picture has been fitted). */
+async function focusStep(url, number) {
+  let box = null;
+  try {
+    box = await clusterBox(url, `cluster_pnp_step_${number}`, $("#chart-img").naturalWidth);
+  } catch {
+    return; // the picture stays fitted
+  }
+  if (!box || steps.expanded !== url) return;
+  focusOn(box);
+  $("#chart-frame").dataset.focused = String(number);
 }
 
 /** Fill the chart picker: the cell's and catalogue's devices, every process, the generated charts. */
