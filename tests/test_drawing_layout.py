@@ -10,7 +10,7 @@ import graphviz
 import pytest
 
 from plugnproduce import service
-from plugnproduce.drawing import Layout, chart_to_dot, column_length, layout, run_dot, step_node
+from plugnproduce.drawing import SHOWN, Layout, chart_to_dot, column_length, layout, run_dot, shown_steps, step_node
 from plugnproduce.resources import descriptions_path
 from plugnproduce.statechart import parse_chart
 from plugnproduce.statechart.model import Chart, Data, Final, State, StateNode, Transition
@@ -118,3 +118,14 @@ def test_a_device_program_s_many_segments_fold_into_rows_in_order() -> None:
     tops = [firsts[start][1] for start in range(0, 40, row)]
     assert tops == sorted(tops) and len(set(tops)) == len(tops), "rows not top to bottom"
     assert drawn.width <= 2000 and drawn.height <= 2000, f"{drawn.width:.0f} × {drawn.height:.0f} pt"
+
+
+def test_a_long_task_draws_the_steps_around_the_expanded_one(tmp_path: Path) -> None:
+    chart = parse_chart(_charts(1000, tmp_path)["task"], "task.scxml")
+    first, last = shown_steps(1000, 700)
+    assert (first, last) == (600, 799) and last - first + 1 == SHOWN
+    drawn = layout(chart_to_dot(chart, expand=700))
+    steps = [n for n in drawn.nodes if n.startswith("pnp_step_")]
+    assert step_node(599) not in steps and step_node(800) not in steps and step_node(600) in steps
+    assert {"pnp_steps_before", "pnp_steps_after"} <= set(drawn.nodes)
+    assert drawn.width <= 5000 and drawn.height <= 5000, f"{drawn.width:.0f} × {drawn.height:.0f} pt"

@@ -24,6 +24,9 @@ COLUMN = 10
 """The fewest steps per column of a task's picture; further steps start a new column to the right."""
 _ASPECT = 2.7
 """How many step boxes, stacked, are as tall as one is wide (spacing included)."""
+SHOWN = 200
+"""The most step boxes a picture draws: a longer task shows those around the expanded step (or its
+first ones) and one box for the steps before and one for those after."""
 START = "pnp_start"
 _Edge = tuple[str, str, str, "str | None"]
 
@@ -32,6 +35,14 @@ def column_length(steps: int) -> int:
     """Steps per column for a task of ``steps`` steps: at least :data:`COLUMN`, and as many as keep
     the picture about as wide as it is tall."""
     return max(COLUMN, math.ceil(math.sqrt(_ASPECT * steps)))
+
+
+def shown_steps(steps: int, expanded: int | None = None) -> tuple[int, int]:
+    """The first and last step a picture draws as boxes: all, or :data:`SHOWN` around ``expanded``."""
+    if steps <= SHOWN:
+        return 1, steps
+    first = max(1, min((expanded or 1) - SHOWN // 2, steps - SHOWN + 1))
+    return first, first + SHOWN - 1
 
 
 def step_node(number: int) -> str:
@@ -159,7 +170,11 @@ class _Drawing:
     def _task_steps(self, graph: graphviz.Digraph, plan: Plan) -> None:
         graph.node(START, "", shape="point", width="0.12")
         names = [START]
-        for step in plan.steps:
+        first, last = shown_steps(len(plan.steps), self.expanded.number if self.expanded else None)
+        if first > 1:
+            names.append("pnp_steps_before")
+            graph.node(names[-1], f"steps 1–{first - 1}\\n(not drawn)", shape="box", style="dashed,rounded")
+        for step in plan.steps[first - 1:last]:
             names.append(step_node(step.number))
             if step is self.expanded:
                 with graph.subgraph(name=f"cluster_{names[-1]}") as sub:
@@ -167,7 +182,11 @@ class _Drawing:
                     self.add(sub, self.ids[step.body])  # type: ignore[arg-type]
             else:
                 graph.node(names[-1], _step_label(step), shape="box", style="rounded,filled", fillcolor="#f4f4f4")
-        column = column_length(len(plan.steps))
+        if last < len(plan.steps):
+            names.append("pnp_steps_after")
+            graph.node(names[-1], f"steps {last + 1}–{len(plan.steps)}\\n(not drawn)", shape="box",
+                       style="dashed,rounded")
+        column = column_length(len(names) - 1)
         ends = [self._entry(n) for n in names]
         exits = [self._exit(n) for n in names]
         for i in range(1, len(names)):
