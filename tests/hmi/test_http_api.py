@@ -245,6 +245,18 @@ async def test_generate_gives_scxml_and_pictures(client: httpx.AsyncClient) -> N
 
 
 @needs_reasoner
+async def test_a_task_chart_lists_its_steps_and_draws_one_expanded(client: httpx.AsyncClient) -> None:
+    result = (await client.post("/api/task/generate", json=TASK)).json()
+    task_chart = next(c for c in result["charts"] if c["kind"] == "task")
+    steps = (await client.get(task_chart["scxml"] + "/steps")).json()
+    assert [(s["number"], s["command"]) for s in steps] == [(n, ("bin-pick", "place")[(n - 1) % 2]) for n in range(1, 7)]
+    assert steps[1]["binding"] == {"gripper": "gripper", "robot": "robot"} and steps[1]["chart"] == "step02-place.scxml"
+    svg = (await client.get(task_chart["svg"] + "?step=2")).text
+    assert "cluster_pnp_step_2" in svg and "cluster_pnp_step_1" not in svg
+    assert (await client.get(task_chart["svg"] + "?step=0")).status_code == 422
+
+
+@needs_reasoner
 async def test_generating_an_implausible_task_is_a_result(client: httpx.AsyncClient) -> None:
     result = (await client.post("/api/task/generate", json=INVALID)).json()
     assert result["plausible"] is False and result["charts"] == [] and result["problems"][0]["step"] == 2

@@ -15,8 +15,11 @@ def draw(
     chart: Path = typer.Argument(..., metavar="CHART", help="An SCXML chart: device, process, task or closed-world."),
     output: Path = typer.Option(..., "-o", "--output", metavar="FILE",
                                 help="Picture to write: .svg, .png, .pdf or .dot."),
+    step: int | None = typer.Option(None, "--step", metavar="N", min=1,
+                                    help="Of a task or closed-world chart, the step to draw with its regions."),
 ) -> None:
-    """Draw a state chart: regions as clusters, commands on the edges."""
+    """Draw a state chart: regions as clusters, commands on the edges; a task's steps in order,
+    each one box with its process and binding."""
     from plugnproduce.drawing import draw_chart
 
-    typer.echo(f"wrote {draw_chart(chart, output)}")
+    typer.echo(f"wrote {draw_chart(chart, output, expand=step)}")

@@ -11,7 +11,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 from plugnproduce.codegen.outputs import GeneratedChart
-from plugnproduce.drawing import draw_chart
+from plugnproduce.drawing import Step, draw_chart, find_plan
+from plugnproduce.statechart import parse_chart
 
 
 class _Bounded(OrderedDict[str, object]):
@@ -39,15 +40,15 @@ class Pictures:
         key = f"file:{p}:{p.stat().st_mtime_ns}"
         return self._cached(key, lambda: self._draw(p))
 
-    def of_chart(self, chart: GeneratedChart) -> bytes:
-        """The picture of a generated chart."""
-        key = "chart:" + hashlib.sha256(chart.data).hexdigest()
+    def of_chart(self, chart: GeneratedChart, step: int | None = None) -> bytes:
+        """The picture of a generated chart; of a task chart, with ``step`` (from 1) expanded."""
+        key = f"chart:{step}:" + hashlib.sha256(chart.data).hexdigest()
 
         def draw() -> bytes:
             with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
                 src = Path(folder) / "chart.scxml"
                 src.write_bytes(chart.data)
-                return self._draw(src)
+                return self._draw(src, step)
 
         return self._cached(key, draw)
 
@@ -62,9 +63,15 @@ class Pictures:
         return data
 
     @staticmethod
-    def _draw(src: Path) -> bytes:
+    def _draw(src: Path, step: int | None = None) -> bytes:
         with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
-            return draw_chart(src, Path(folder) / "chart.svg").read_bytes()
+            return draw_chart(src, Path(folder) / "chart.svg", expand=step).read_bytes()
+
+
+def steps_of(chart: GeneratedChart) -> tuple[Step, ...]:
+    """The steps a generated task chart runs, in order (none for a chart without a plan of processes)."""
+    plan = find_plan(parse_chart(chart.data, chart.name))
+    return plan.steps if plan and plan.is_task else ()
 
 
 class GeneratedCharts:

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from fastapi import APIRouter, Depends, Request
+from fastapi import APIRouter, Depends, Query, Request
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
 
 from plugnproduce.hmi.hub import Hub
-from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
+from plugnproduce.hmi.pictures import GeneratedCharts, Pictures, steps_of
 from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.security import allow_read
 
@@ -45,11 +45,22 @@ async def process_chart(command: str, request: Request, hub: Hub = Depends(hub_o
 
 @router.get("/generated/{generation}/{name}.svg", response_class=Response, responses=SVG,
             summary="A generated chart, drawn")
-async def generated_picture(generation: str, name: str, request: Request) -> Response:
-    """The picture of a chart ``POST /api/task/generate`` produced."""
+async def generated_picture(generation: str, name: str, request: Request,
+                            step: int | None = Query(None, ge=1, description="A task chart's step to draw expanded"),
+                            ) -> Response:
+    """The picture of a chart ``POST /api/task/generate`` produced; of a task chart, its steps in order,
+    each one box with its process and binding, and ``step`` (if given) expanded into its regions."""
     store: GeneratedCharts = request.app.state.generated
     pictures: Pictures = request.app.state.pictures
-    return _svg(await run_in_threadpool(pictures.of_chart, store.chart(generation, name)))
+    return _svg(await run_in_threadpool(pictures.of_chart, store.chart(generation, name), step))
+
+
+@router.get("/generated/{generation}/{name}/steps", summary="The steps of a generated task chart")
+async def generated_steps(generation: str, name: str, request: Request) -> list[dict[str, object]]:
+    """Each step a generated task chart runs, in order: its number, process, binding and step chart."""
+    store: GeneratedCharts = request.app.state.generated
+    steps = await run_in_threadpool(steps_of, store.chart(generation, name))
+    return [{"number": s.number, "command": s.command, "binding": dict(s.binding), "chart": s.chart} for s in steps]
 
 
 @router.get("/generated/{generation}/{name}", response_class=Response,

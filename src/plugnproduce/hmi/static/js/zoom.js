@@ -1,5 +1,6 @@
 // Pan and zoom of the chart picture: the mouse wheel zooms around the pointer, dragging pans,
-// the buttons and keys (+, -, 0, arrows) do the same from the keyboard. A new picture starts fitted.
+// the buttons and keys (+, -, 0, arrows) do the same from the keyboard. A new picture starts fitted
+// (a task chart's expanded step is then brought into view by charts.js).
 
 import { $ } from "./dom.js";
 
@@ -27,6 +28,16 @@ export function fit() {
   view.scale = Math.min(fw / w, fh / hgt, 1);
   view.x = (fw - w * view.scale) / 2;
   view.y = (fh - hgt * view.scale) / 2;
+  apply();
+}
+
+/** Show the part `box` ({x, y, w, h} in the picture's pixels) centred, as large as fits, never enlarged. */
+export function focusOn(box) {
+  const fw = frame.clientWidth;
+  const fh = frame.clientHeight;
+  view.scale = Math.max(MIN_SCALE, Math.min((0.95 * fw) / box.w, (0.95 * fh) / box.h, 1));
+  view.x = fw / 2 - (box.x + box.w / 2) * view.scale;
+  view.y = fh / 2 - (box.y + box.h / 2) * view.scale;
   apply();
 }
 
