@@ -10,8 +10,10 @@ the file and line.
 from __future__ import annotations
 
 import codecs
+import logging
 import re
 import stat
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -22,11 +24,42 @@ from rdflib.plugins.parsers.notation3 import BadSyntax
 
 from plugnproduce.errors import HostileInputError, UnreadableError
 
+logging.getLogger("rdflib.term").setLevel(logging.ERROR)
+# rdflib logs a warning for every odd IRI or literal it builds, unasked, on stderr; what matters of
+# them is reported as a finding with its file and line, so its own chatter is silenced.
+
 MAX_BYTES = 4 * 1024 * 1024
 """Largest description file accepted (descriptions are a few kB; 4 MiB is generous)."""
 
 MAX_XML_DEPTH = 64
 """Deepest XML element nesting accepted."""
+
+MAX_EXCERPT = 60
+"""Most characters of the input an error message quotes in one piece."""
+
+_QUOTED = re.compile(r"'[^']*'|\"[^\"]*\"")
+
+
+def excerpt(text: str, limit: int = MAX_EXCERPT) -> str:
+    """``text`` on one line and at most about ``limit`` characters: its start and end around an ellipsis."""
+    text = " ".join(str(text).split())
+    if len(text) <= limit:
+        return text
+    half = max(limit // 2 - 1, 1)
+    return f"{text[:half]}…{text[-half:]}"
+
+
+def tidy(message: str, limit: int = 300) -> str:
+    """A library's error message made fit for a ``file:line: message`` line.
+
+    One line; every quoted value cut to a short excerpt; at most ``limit`` characters. Parsers
+    quote what they could not read, and what they read is the input, which a message must not
+    repeat at length.
+    """
+    text = " ".join(str(message).split())
+    text = _QUOTED.sub(lambda m: m.group()[0] + excerpt(m.group()[1:-1]) + m.group()[-1], text)
+    return excerpt(text, limit)
+
 
 _DOCTYPE = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
 _COMMENT = re.compile(r"<!--.*?-->", re.DOTALL)
@@ -96,7 +129,7 @@ def parse_xml_bytes(data: bytes, source: str | Path) -> etree._ElementTree:
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if exc.lineno else None
         msg = exc.msg.split(f", line {line}")[0] if exc.msg else "malformed XML"
-        raise UnreadableError(f"malformed XML: {msg}", source, line) from exc
+        raise UnreadableError(f"malformed XML: {tidy(msg)}", source, line) from exc
     tree = root.getroottree()
     if tree.docinfo.internalDTD is not None or tree.docinfo.doctype:  # an encoding the search did not know
         raise HostileInputError("DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "
@@ -156,9 +189,13 @@ def parse_yaml_node(path: str | Path) -> yaml.Node:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
         what = exc.problem or exc.context or "malformed YAML"
-        raise UnreadableError(f"malformed YAML: {what}", path, line) from exc
+        raise UnreadableError(f"malformed YAML: {tidy(what)}", path, line) from exc
+    except yaml.reader.ReaderError as exc:  # a character YAML does not allow (NUL, other controls)
+        line = text.count("\n", 0, max(exc.position, 0)) + 1
+        raise UnreadableError(f"malformed YAML: {tidy(exc.reason)} (character #x{exc.character:04x}); "
+                              "expected printable text", path, line) from exc
     except yaml.YAMLError as exc:
-        raise UnreadableError(f"malformed YAML: {exc}", path) from exc
+        raise UnreadableError(f"malformed YAML: {tidy(str(exc))}", path) from exc
     if node is None:
         raise UnreadableError("empty YAML document", path, 1)
     _check_yaml_values(node, path)
@@ -224,9 +261,11 @@ def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
     text = read_turtle_text(p)
     g = rdflib.Graph()
     try:
-        g.parse(data=text, format="turtle", publicID=p.resolve().as_uri())
-    except BadSyntax as exc:
-        raise UnreadableError(f"malformed Turtle: {exc.message}", p, exc.lines + 1) from exc
+        with warnings.catch_warnings():  # rdflib warns (and logs) about odd literals and IRIs: no chatter
+            warnings.simplefilter("ignore")
+            g.parse(data=text, format="turtle", publicID=p.resolve().as_uri())
+    except BadSyntax as exc:  # its str() is several lines quoting the file: keep the reason only
+        raise UnreadableError(f"malformed Turtle: {tidy(exc._why)}", p, exc.lines + 1) from exc
     except Exception as exc:  # rdflib raises assorted types for bad literals and IRIs
-        raise UnreadableError(f"malformed Turtle: {exc}", p) from exc
+        raise UnreadableError(f"malformed Turtle: {tidy(str(exc))}", p) from exc
     return g, text

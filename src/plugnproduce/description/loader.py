@@ -29,7 +29,7 @@ from plugnproduce.description.rdf import term_line
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import parse_turtle, parse_yaml_node
+from plugnproduce.safeio import excerpt, parse_turtle, parse_yaml_node
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 
@@ -218,7 +218,7 @@ def _mapping(node: yaml.Node, path: Path, what: str) -> dict[str, yaml.Node]:
         if not isinstance(k, yaml.ScalarNode):
             raise DescriptionError(f"{what}: keys must be plain names", path, k.start_mark.line + 1)
         if k.value in out:
-            raise DescriptionError(f"{what}: key {k.value!r} appears twice", path, k.start_mark.line + 1)
+            raise DescriptionError(f"{what}: key {excerpt(k.value)!r} appears twice", path, k.start_mark.line + 1)
         out[k.value] = v
     return out
 
@@ -231,7 +231,8 @@ def _unknown_keys(m: dict[str, yaml.Node], allowed: set[str], path: Path, what: 
     for k, v in m.items():
         if k not in allowed:
             raise DescriptionError(
-                f"{what}: unknown key {k!r}; expected one of {', '.join(sorted(allowed))}", path, v.start_mark.line + 1
+                f"{what}: unknown key {excerpt(k)!r}; expected one of {', '.join(sorted(allowed))}", path,
+                v.start_mark.line + 1,
             )
 
 
@@ -253,7 +254,7 @@ def load_task(path: str | Path) -> Task:
         raise DescriptionError("a task needs 'task' (its name) and 'steps'", p, 1)
     repeat = _plain(top["repeat"]) if "repeat" in top else 1
     if not isinstance(repeat, int) or isinstance(repeat, bool) or not 1 <= repeat <= 1000:
-        raise DescriptionError(f"repeat must be a whole number from 1 to 1000; found {repeat!r}", p,
+        raise DescriptionError(f"repeat must be a whole number from 1 to 1000; found {excerpt(repr(repeat))}", p,
                                top["repeat"].start_mark.line + 1)
     steps_node = top["steps"]
     if not isinstance(steps_node, yaml.SequenceNode) or not steps_node.value:
@@ -315,8 +316,22 @@ def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
     for node in top["devices"].value:
         if not isinstance(node, yaml.ScalarNode):
             raise DescriptionError("each device is a path to a device description", p, node.start_mark.line + 1)
-        files.append(((p.parent / node.value).resolve(), node.start_mark.line + 1))
+        files.append((_device_path(p, node), node.start_mark.line + 1))
     return str(_plain(top["cell"])), files
+
+
+MAX_PATH = 1024
+"""Longest device path a cell may list (file systems refuse names much longer than 255 bytes anyway)."""
+
+
+def _device_path(cell: Path, node: yaml.ScalarNode) -> Path:
+    """A device path a cell lists, resolved beside the cell; one no file system could hold is refused."""
+    value = str(node.value)
+    parts = value.replace("\\", "/").split("/")
+    if "\0" in value or len(value) > MAX_PATH or any(len(part.encode("utf-8", "replace")) > 255 for part in parts):
+        raise DescriptionError(f"device path {excerpt(value)!r} ({len(value)} characters) cannot name a file; "
+                               "expected a path to a device description", cell, node.start_mark.line + 1)
+    return (cell.parent / value).resolve()
 
 
 def load_cell(path: str | Path, taxonomy: Taxonomy) -> Cell:
@@ -325,12 +340,12 @@ def load_cell(path: str | Path, taxonomy: Taxonomy) -> Cell:
     devices = []
     for f, line in files:
         if not f.is_file():
-            raise DescriptionError(f"device description {f.name} not found", path, line)
+            raise DescriptionError(f"device description {excerpt(f.name)} not found", path, line)
         devices.append(load_device(f, taxonomy))
     ids = [d.id for d in devices]
     for d in devices:
         if ids.count(d.id) > 1:
-            raise DescriptionError(f"device id {d.id!r} appears twice in the cell", path)
+            raise DescriptionError(f"device id {excerpt(d.id)!r} appears twice in the cell", path)
     return Cell(name, tuple(devices), str(path))
 
 

@@ -32,6 +32,7 @@ from plugnproduce.protocols.upnp import (
     Advertisement,
     AdvertisementListener,
     FoundDevice,
+    RemoteFiles,
     SsdpNetwork,
     UntrustedUrlError,
     UpnpDeviceClient,
@@ -39,7 +40,6 @@ from plugnproduce.protocols.upnp import (
     discover,
 )
 from plugnproduce.protocols.xirp import parse_endpoint
-
 
 _LOGGER = logging.getLogger(__name__)
 
@@ -172,21 +172,29 @@ class LiveCell:
         """Fetch the device's own description files and read them as any description."""
         async with await UpnpDeviceClient.from_found(found) as client:
             files = await client.fetch_files()
-        folder = self._workdir / _safe_name(found.udn)
-        folder.mkdir(exist_ok=True)
-        ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
-        ttl.write_text(files.description, encoding="utf-8")
-        chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
-        chart.write_text(files.chart, encoding="utf-8")
-        for named in read_description(ttl).graph.objects(None, PNP.stateChart):
-            if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
-                raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected the "
-                                       f"chart it serves ({chart.name})")
-        device = load_device(ttl, self.taxonomy)
-        if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
-            return replace(device, endpoint=found.location)
-        host = urlparse(found.location).hostname
-        if parse_endpoint(device.endpoint)[0] != host:
-            raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {device.endpoint} "
-                                    "on another host; refused")
-        return device
+        return read_served(files, found, self._workdir / _safe_name(found.udn), self.taxonomy)
+
+
+def read_served(files: RemoteFiles, found: FoundDevice, folder: Path, taxonomy: Taxonomy) -> DeviceDescription:
+    """Read the description and chart a device served (fetched already) in ``folder``, as any description.
+
+    The chart must be the one the device serves and an XIRP endpoint must be on the host the
+    device was found at; anything else is refused (:class:`DescriptionError`, :class:`ProtocolError`).
+    """
+    folder.mkdir(exist_ok=True)
+    ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
+    ttl.write_text(files.description, encoding="utf-8")
+    chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
+    chart.write_text(files.chart, encoding="utf-8")
+    for named in read_description(ttl).graph.objects(None, PNP.stateChart):
+        if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
+            raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected the "
+                                   f"chart it serves ({chart.name})")
+    device = load_device(ttl, taxonomy)
+    if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
+        return replace(device, endpoint=found.location)
+    host = urlparse(found.location).hostname
+    if parse_endpoint(device.endpoint)[0] != host:
+        raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {device.endpoint} "
+                                "on another host; refused")
+    return device

@@ -15,7 +15,7 @@ from lxml import etree
 
 from plugnproduce.errors import DescriptionError
 from plugnproduce.resources import package_file
-from plugnproduce.safeio import parse_xml_bytes
+from plugnproduce.safeio import parse_xml_bytes, tidy
 
 
 @lru_cache(maxsize=1)
@@ -31,7 +31,7 @@ def schema_problems(data: bytes, source: str | Path) -> list[DescriptionError]:
     for error in scxml_schema().iter_errors(tree):
         reason = (error.reason or str(error.message)).rstrip(".")
         line = _line(tree, error, reason)
-        problems.append(DescriptionError(f"not valid W3C SCXML: {reason}", source, line))
+        problems.append(DescriptionError(f"not valid W3C SCXML: {tidy(reason)}", source, line))
     return problems
 
 

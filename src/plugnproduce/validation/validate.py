@@ -24,7 +24,7 @@ from plugnproduce.errors import DescriptionError, UnreadableError
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
 from plugnproduce.ontology.vocabulary import PNP
 from plugnproduce.resources import descriptions_path
-from plugnproduce.safeio import read_bytes
+from plugnproduce.safeio import excerpt, read_bytes
 from plugnproduce.statechart.schema import schema_problems
 from plugnproduce.validation.findings import Problem, Report
 from plugnproduce.validation.shapes import shape_problems
@@ -138,7 +138,7 @@ def _cell(path: Path, report: Report) -> None:
     _, files = cell_device_files(path)
     for f, line in files:
         if not f.is_file():
-            report.add(Problem(str(path), line, f"device description {f} not found"))
+            report.add(Problem(str(path), line, f"device description {excerpt(str(f), 120)} not found"))
 
 
 def _builtin_processes() -> list[tuple[Loaded, ProcessDescription]]:

@@ -18,6 +18,7 @@ from decimal import Decimal
 from typing import NamedTuple, TypeAlias
 
 from plugnproduce.errors import ProtocolError
+from plugnproduce.safeio import excerpt
 
 NAMESPACE = "urn:plugnproduce-org:xirp:1"
 """XML namespace of every XIRP message (version 1)."""
@@ -192,9 +193,10 @@ class DeviceFiles:
     def __post_init__(self) -> None:
         for name in (self.description_name, self.chart_name):
             if not FILE_NAME_PATTERN.fullmatch(name):
-                raise MessageError(f"file name {name!r} cannot be served; expected a plain file name", INVALID_VALUE)
+                raise MessageError(f"file name {excerpt(name)!r} cannot be served; expected a plain file name",
+                                   INVALID_VALUE)
         if self.description_name == self.chart_name:
-            raise MessageError(f"description and chart share the file name {self.chart_name!r}", INVALID_VALUE)
+            raise MessageError(f"description and chart share the file name {excerpt(self.chart_name)!r}", INVALID_VALUE)
 
     def documents(self) -> tuple[Document, Document]:
         """The two documents of a ``describe`` response."""
@@ -218,7 +220,7 @@ def parse_endpoint(endpoint: str) -> tuple[str, int]:
     """``xirp://HOST:PORT`` (a device's ``pnp:endpoint``) → ``(host, port)``."""
     match = re.fullmatch(r"xirp://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9.\-]+):(\d{1,5})/?", endpoint.strip())
     if match is None or int(match.group(2)) > 65535:
-        raise ProtocolError(f"endpoint {endpoint!r} is not an XIRP endpoint; expected xirp://HOST:PORT")
+        raise ProtocolError(f"endpoint {excerpt(endpoint)!r} is not an XIRP endpoint; expected xirp://HOST:PORT")
     return match.group(1).strip("[]"), int(match.group(2))
 
 
