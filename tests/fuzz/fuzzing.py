@@ -461,7 +461,7 @@ def mutate_request(seed: tuple[str, str, dict[str, object]], rng: random.Random)
     else:
         from urllib.parse import quote
 
-        part = mutate(url.rsplit("/", 1)[1].encode(), rng).decode("latin-1")
+        part = mutate(url.rsplit("/", 1)[1].encode(), rng).decode("latin-1")[:2000]  # a client sends no longer URL
         url = url.rsplit("/", 1)[0] + "/" + quote(part, safe="")
     return method, url, kwargs
 

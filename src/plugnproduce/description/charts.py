@@ -16,7 +16,7 @@ from lxml import etree
 from plugnproduce.description.model import ChartState, ChartTransition, Command, RegionState
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.vocabulary import PNP_IRI, concept_iri
-from plugnproduce.safeio import parse_xml
+from plugnproduce.safeio import excerpt, parse_xml
 
 SCXML = "{http://www.w3.org/2005/07/scxml}"
 CONCEPT = "{" + PNP_IRI + "}concept"
@@ -30,8 +30,8 @@ _STATES = (SCXML + "state", SCXML + "final")
 def _root(path: str | Path) -> etree._Element:
     root = parse_xml(path).getroot()
     if root.tag != SCXML + "scxml":
-        raise DescriptionError(f"expected an <scxml> document in the SCXML namespace; found <{root.tag}>", path,
-                               root.sourceline)
+        raise DescriptionError(f"expected an <scxml> document in the SCXML namespace; found <{excerpt(root.tag)}>",
+                               path, root.sourceline)
     return root
 
 
