@@ -51,8 +51,8 @@ def _peak_mb() -> float:
 
 
 def _cases(rng: random.Random, ws: fuzzing.Workspace, hmi: fuzzing.InProcessHmi | None,
-           deep_every: int) -> dict[str, Callable[[int], tuple[str, bytes]]]:
-    """Per target, a function that makes case ``i``, runs it and returns (outcome, the input for the record)."""
+           deep_every: int) -> dict[str, Callable[[int], tuple[bytes, Callable[[], str]]]]:
+    """Per target, a function that makes case ``i``: the input (to record) and the call that runs it."""
     kinds = {k: fuzzing.seeds(k) for k in ("turtle", "chart", "task", "cell")}
     xirp = fuzzing.xirp_seeds()
     devices = [(r.split("/")[1].removesuffix(".ttl"), d) for r, d in kinds["turtle"] if r.startswith("devices/")]
@@ -61,35 +61,35 @@ def _cases(rng: random.Random, ws: fuzzing.Workspace, hmi: fuzzing.InProcessHmi 
     runners = {"turtle": fuzzing.run_turtle, "chart": fuzzing.run_chart, "task": fuzzing.run_task,
                "cell": fuzzing.run_cell}
 
-    def description(kind: str) -> Callable[[int], tuple[str, bytes]]:
-        def case(i: int) -> tuple[str, bytes]:
+    def description(kind: str) -> Callable[[int], tuple[bytes, Callable[[], str]]]:
+        def case(i: int) -> tuple[bytes, Callable[[], str]]:
             relative, data = rng.choice(kinds[kind])
             data = fuzzing.mutate(data, rng)
-            return runners[kind](ws, relative, data, i % deep_every == 0), relative.encode() + b"\n" + data
+            return relative.encode() + b"\n" + data, lambda: runners[kind](ws, relative, data, i % deep_every == 0)
         return case
 
-    def xirp_case(i: int) -> tuple[str, bytes]:
+    def xirp_case(i: int) -> tuple[bytes, Callable[[], str]]:
         data = fuzzing.mutate(rng.choice(xirp), rng)
-        return fuzzing.run_xirp(data), data
+        return data, lambda: fuzzing.run_xirp(data)
 
-    def served_case(i: int) -> tuple[str, bytes]:
+    def served_case(i: int) -> tuple[bytes, Callable[[], str]]:
         name, ttl = rng.choice(devices)
         chart = charts[name]
         if rng.random() < 0.5:
             ttl = fuzzing.mutate(ttl, rng)
         else:
             chart = fuzzing.mutate(chart, rng)
-        out = fuzzing.run_served(ws, name, ttl, chart, "http://127.0.0.1:8000/dev/description.xml")
-        return out, name.encode() + b"\n" + ttl + b"\n----\n" + chart
+        return (name.encode() + b"\n" + ttl + b"\n----\n" + chart,
+                lambda: fuzzing.run_served(ws, name, ttl, chart, "http://127.0.0.1:8000/dev/description.xml"))
 
-    def reference_case(i: int) -> tuple[str, bytes]:
+    def reference_case(i: int) -> tuple[bytes, Callable[[], str]]:
         ref = fuzzing.mutate(rng.choice(fuzzing.REFERENCES).encode(), rng).decode("utf-8", "replace")
-        return fuzzing.run_reference("http://127.0.0.1:8000/dev/description.xml", ref), ref.encode()
+        return ref.encode(), lambda: fuzzing.run_reference("http://127.0.0.1:8000/dev/description.xml", ref)
 
-    def hmi_case(i: int) -> tuple[str, bytes]:
+    def hmi_case(i: int) -> tuple[bytes, Callable[[], str]]:
         assert hmi is not None
         request = fuzzing.mutate_request(rng.choice(requests), rng)
-        return fuzzing.run_hmi(hmi, request), repr(request).encode()
+        return repr(request).encode(), lambda: fuzzing.run_hmi(hmi, request)
 
     out = {k: description(k) for k in runners} | {"xirp": xirp_case, "served": served_case,
                                                   "reference": reference_case}
@@ -135,11 +135,11 @@ def main() -> int:
         for i, target in enumerate(order):
             peak = _peak_mb()
             t0 = time.perf_counter()
-            data = b""
+            data, run = makers[target](i)
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 try:
-                    outcome, data = makers[target](i)
+                    outcome = run()
                     if caught:
                         raise fuzzing.Crash(f"warning: {caught[0].category.__name__}: {str(caught[0].message)[:200]}")
                     if chatter.records:
@@ -154,7 +154,7 @@ def main() -> int:
                     signatures[signature] += 1
                     if args.save is not None:
                         args.save.mkdir(parents=True, exist_ok=True)
-                        (args.save / f"{target}-{i}.bin").write_bytes(data or b"(input not recorded)")
+                        (args.save / f"{target}-{i}.bin").write_bytes(data)
                 finally:
                     chatter.records.clear()
             elapsed = time.perf_counter() - t0
@@ -164,6 +164,9 @@ def main() -> int:
             if elapsed > args.max_seconds or _peak_mb() - peak > args.max_mb:
                 counts[target]["overrun"] += 1
                 signatures[f"{target}: overrun ({elapsed:.1f} s, +{_peak_mb() - peak:.0f} MB)"] += 1
+                if args.save is not None:
+                    args.save.mkdir(parents=True, exist_ok=True)
+                    (args.save / f"{target}-{i}-overrun.bin").write_bytes(data)
             if (i + 1) % 1000 == 0:
                 rate = (i + 1) / (time.perf_counter() - started)
                 print(f"... {i + 1} cases, {rate:.0f}/s", file=sys.stderr, flush=True)

@@ -6,6 +6,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import unquote, urlparse
@@ -26,7 +27,7 @@ from plugnproduce.description.model import (
     Where,
 )
 from plugnproduce.description.rdf import term_line
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, UnreadableError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.safeio import excerpt, parse_turtle, parse_yaml_node
@@ -123,8 +124,8 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
         states=states,
         transitions=transitions,
         where=loaded.where(str(s)),
-        command_timeout=float(timeout.toPython()) if isinstance(timeout, rdflib.Literal) else 10.0,
-        cost=float(cost.toPython()) if isinstance(cost, rdflib.Literal) else 0.0,
+        command_timeout=_or(_finite(loaded, s, timeout, "command timeout"), 10.0),
+        cost=_or(_finite(loaded, s, cost, "cost"), 0.0),
         skills=tuple(sorted(taxonomy.device_skills(classes, declared))),
     )
 
@@ -180,8 +181,22 @@ def process_from(loaded: Loaded) -> ProcessDescription:
     )
 
 
-def _number(node: rdflib.term.Node | None) -> float | None:
-    return float(node.toPython()) if isinstance(node, rdflib.Literal) else None
+def _finite(loaded: Loaded, subject: rdflib.term.Node, node: rdflib.term.Node | None, what: str) -> float | None:
+    """A literal read as a finite number (None if absent); an ill-typed, huge or NaN one is refused at its line."""
+    if not isinstance(node, rdflib.Literal):
+        return None
+    try:
+        value = float(node.toPython())
+    except (TypeError, ValueError, OverflowError):
+        value = math.nan
+    if not math.isfinite(value):
+        raise UnreadableError(f"{local_name(str(subject))}: {what} {excerpt(str(node))!r} is not a finite number; "
+                              "expected a decimal such as 2.5", loaded.path, loaded.line(str(subject)))
+    return value
+
+
+def _or(value: float | None, default: float) -> float:
+    return default if value is None else value
 
 
 def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
@@ -195,8 +210,8 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
         quantity=str(_one(loaded, p, PNP.quantity, "quantity")),
         datatype=str(_one(loaded, p, PNP.datatype, "datatype")),
         unit=str(_opt(loaded, p, PNP.unit) or ""),
-        minimum=_number(_opt(loaded, p, PNP.minValue)),
-        maximum=_number(_opt(loaded, p, PNP.maxValue)),
+        minimum=_finite(loaded, p, _opt(loaded, p, PNP.minValue), "minimum"),
+        maximum=_finite(loaded, p, _opt(loaded, p, PNP.maxValue), "maximum"),
         default=default.toPython() if isinstance(default, rdflib.Literal) else None,
         where=loaded.where(str(p)),
     )

@@ -40,6 +40,7 @@ from plugnproduce.protocols.upnp import (
     discover,
 )
 from plugnproduce.protocols.xirp import parse_endpoint
+from plugnproduce.safeio import excerpt
 
 _LOGGER = logging.getLogger(__name__)
 
@@ -188,7 +189,7 @@ def read_served(files: RemoteFiles, found: FoundDevice, folder: Path, taxonomy: 
     chart.write_text(files.chart, encoding="utf-8")
     for named in read_description(ttl).graph.objects(None, PNP.stateChart):
         if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
-            raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected the "
+            raise DescriptionError(f"device {found.udn} names its chart <{excerpt(str(named))}>; expected the "
                                    f"chart it serves ({chart.name})")
     device = load_device(ttl, taxonomy)
     if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says

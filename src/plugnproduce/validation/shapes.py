@@ -12,7 +12,7 @@ from rdflib.namespace import SH
 from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.resources import ontology_path
-from plugnproduce.safeio import parse_turtle
+from plugnproduce.safeio import parse_turtle, tidy
 from plugnproduce.validation.findings import Problem
 
 
@@ -36,7 +36,7 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
     problems = []
     for result in results.subjects(rdflib.RDF.type, SH.ValidationResult):
         focus = results.value(result, SH.focusNode)
-        message = str(results.value(result, SH.resultMessage) or "does not conform")
+        message = tidy(str(results.value(result, SH.resultMessage) or "does not conform"))  # values quoted short
         where = kg.places.get(str(focus))
         if not message.startswith("step ") and local_name(str(focus)) not in message:
             message = f"{local_name(str(focus))}: {message}"
