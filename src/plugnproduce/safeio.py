@@ -70,22 +70,29 @@ _WIDE = (  # (leading bytes, codec) of the encodings whose text the byte-wise se
 )
 
 
+def shown(path: str | Path) -> str:
+    """A path as an error message names it: whole, or its ends if it is so long it must come from the input."""
+    text = str(path)
+    return text if len(text) <= 200 else excerpt(text, 120)
+
+
 def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
     """Read a file whole, refusing one larger than ``limit`` before reading it."""
     p = Path(path)
+    where = shown(p)
     try:
         info = p.stat()
         if not stat.S_ISREG(info.st_mode):  # a FIFO or a device would block the reader; a folder is no file
-            raise UnreadableError("not a regular file (a folder, pipe or device); expected a description file", p)
+            raise UnreadableError("not a regular file (a folder, pipe or device); expected a description file", where)
         size = info.st_size
         if size > limit:
-            raise HostileInputError(f"file is {size} bytes; at most {limit} are accepted", p)
+            raise HostileInputError(f"file is {size} bytes; at most {limit} are accepted", where)
         with p.open("rb") as f:
             data = f.read(limit + 1)
     except OSError as exc:
-        raise UnreadableError(f"cannot read file: {exc.strerror or exc}", p) from exc
+        raise UnreadableError(f"cannot read file: {exc.strerror or exc}", where) from exc
     if len(data) > limit:
-        raise HostileInputError(f"file is larger than the {limit} bytes accepted", p)
+        raise HostileInputError(f"file is larger than the {limit} bytes accepted", where)
     return data
 
 
@@ -171,6 +178,16 @@ class _NoAliasLoader(yaml.SafeLoader):
                 None, None, "anchors are refused in descriptions", event.start_mark
             )
         return super().compose_node(parent, index)
+
+
+class PlainDumper(yaml.SafeDumper):
+    """A YAML writer that never writes anchors and aliases, which :func:`parse_yaml_node` refuses.
+
+    A value shared by two places (one pose in two steps) is written out at each.
+    """
+
+    def ignore_aliases(self, data: Any) -> bool:  # noqa: D102
+        return True
 
 
 def parse_yaml_node(path: str | Path) -> yaml.Node:

@@ -170,3 +170,21 @@ def test_the_checker_itself_catches_a_long_quote() -> None:
         check_message(f"bad: {GRIPPER[:300]}", GRIPPER)
     with pytest.raises(Crash):
         check_message("two\nlines", "")
+
+
+def test_issue_15_a_chart_path_from_the_input_is_named_short(workspace: Workspace, taxonomy: Taxonomy) -> None:
+    text = GRIPPER.replace("<gripper.scxml>", "<" + "[" * 3000 + ".scxml>")
+    path = workspace.write("devices/gripper.ttl", text.encode())
+    with pytest.raises(UnreadableError) as info:
+        load_device(path, taxonomy)
+    _one_line(info.value, text)
+
+
+def test_issue_15_a_task_sharing_one_value_between_steps_is_written_without_aliases() -> None:
+    from plugnproduce.hmi.schemas import TaskIn
+    from plugnproduce.hmi.taskfiles import validate_task
+
+    pose = [0.6, -0.2, 0.1, 0, 180, 0]
+    steps = [{"command": "place", "params": {"place_pose": pose, "speed": 80}}] * 2  # one list in both steps
+    result = validate_task(TaskIn.model_validate({"name": "t", "steps": steps}))
+    assert all("anchors" not in p["message"] for p in result["problems"])

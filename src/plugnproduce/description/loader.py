@@ -30,7 +30,7 @@ from plugnproduce.description.rdf import term_line
 from plugnproduce.errors import DescriptionError, UnreadableError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import excerpt, parse_turtle, parse_yaml_node
+from plugnproduce.safeio import PlainDumper, excerpt, parse_turtle, parse_yaml_node
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 
@@ -317,7 +317,7 @@ def task_to_yaml(task: Task) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = steps
-    return yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
+    return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=None)
 
 
 def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
