@@ -22,7 +22,7 @@ import yaml
 from lxml import etree
 from rdflib.plugins.parsers.notation3 import BadSyntax
 
-from plugnproduce.errors import HostileInputError, UnreadableError
+from plugnproduce.errors import HostileInputError, UnreadableError, excerpt, tidy
 
 logging.getLogger("rdflib.term").setLevel(logging.ERROR)
 # rdflib logs a warning for every odd IRI or literal it builds, unasked, on stderr; what matters of
@@ -33,33 +33,6 @@ MAX_BYTES = 4 * 1024 * 1024
 
 MAX_XML_DEPTH = 64
 """Deepest XML element nesting accepted."""
-
-MAX_EXCERPT = 60
-"""Most characters of the input an error message quotes in one piece."""
-
-_QUOTED = re.compile(r"'[^']*'|\"[^\"]*\"")
-
-
-def excerpt(text: str, limit: int = MAX_EXCERPT) -> str:
-    """``text`` on one line and at most about ``limit`` characters: its start and end around an ellipsis."""
-    text = " ".join(str(text).split())
-    if len(text) <= limit:
-        return text
-    half = max(limit // 2 - 1, 1)
-    return f"{text[:half]}…{text[-half:]}"
-
-
-def tidy(message: str, limit: int = 300) -> str:
-    """A library's error message made fit for a ``file:line: message`` line.
-
-    One line; every quoted value cut to a short excerpt; at most ``limit`` characters. Parsers
-    quote what they could not read, and what they read is the input, which a message must not
-    repeat at length.
-    """
-    text = " ".join(str(message).split())
-    text = _QUOTED.sub(lambda m: m.group()[0] + excerpt(m.group()[1:-1]) + m.group()[-1], text)
-    return excerpt(text, limit)
-
 
 _DOCTYPE = re.compile(r"<!DOCTYPE|<!ENTITY", re.IGNORECASE)
 _COMMENT = re.compile(r"<!--.*?-->", re.DOTALL)
@@ -91,6 +64,8 @@ def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
             data = f.read(limit + 1)
     except OSError as exc:
         raise UnreadableError(f"cannot read file: {exc.strerror or exc}", where) from exc
+    except ValueError as exc:  # a NUL in the path (a chart named <a%00b.scxml>)
+        raise UnreadableError("cannot read file: its name holds a NUL character", where) from exc
     if len(data) > limit:
         raise HostileInputError(f"file is larger than the {limit} bytes accepted", where)
     return data

@@ -47,10 +47,27 @@ def check_message(message: str, data: bytes | str) -> None:
         raise Crash(f"message of {len(message)} characters: {message[:300]!r}")
     text = data.decode("utf-8", "replace") if isinstance(data, bytes) else data
     half = MAX_QUOTE // 2
-    for start in range(0, max(len(text) - MAX_QUOTE, 0) + 1, half):
+    for start in range(0, max(len(text) - half, 0) + 1, half):
         window = text[start:start + half]  # any quote of MAX_QUOTE characters contains one aligned window
-        if len(window) == half and len(set(window)) >= 8 and window in message:  # "((((" quotes nothing
-            raise Crash(f"message quotes the input at length: {message[:300]!r}")
+        if len(window) < half or len(set(window)) < 8:  # "((((" quotes nothing
+            continue
+        at = message.find(window)
+        while at >= 0:
+            if _quoted_length(message, at, text, start, half) >= MAX_QUOTE:
+                raise Crash(f"message quotes the input at length: {message[:300]!r}")
+            at = message.find(window, at + 1)
+
+
+def _quoted_length(message: str, at: int, text: str, start: int, n: int) -> int:
+    """How long the run of ``text`` quoted at ``message[at:]`` is, ``n`` characters known to match."""
+    left = 0
+    while at - left > 0 and start - left > 0 and message[at - left - 1] == text[start - left - 1]:
+        left += 1
+    right = 0
+    while (at + n + right < len(message) and start + n + right < len(text)
+           and message[at + n + right] == text[start + n + right]):
+        right += 1
+    return left + n + right
 
 
 # ---------------------------------------------------------------------------------------------------------------

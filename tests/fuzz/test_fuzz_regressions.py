@@ -188,3 +188,18 @@ def test_issue_15_a_task_sharing_one_value_between_steps_is_written_without_alia
     steps = [{"command": "place", "params": {"place_pose": pose, "speed": 80}}] * 2  # one list in both steps
     result = validate_task(TaskIn.model_validate({"name": "t", "steps": steps}))
     assert all("anchors" not in p["message"] for p in result["problems"])
+
+
+def test_issue_15_a_nul_in_a_chart_name_is_refused_at_its_file(workspace: Workspace, taxonomy: Taxonomy) -> None:
+    text = GRIPPER.replace("<gripper.scxml>", "<grip%00per.scxml>")
+    path = workspace.write("devices/gripper.ttl", text.encode())
+    with pytest.raises(UnreadableError) as info:
+        load_device(path, taxonomy)
+    assert "NUL" in _one_line(info.value, text)
+
+
+def test_issue_15_every_description_error_is_one_line_with_short_quotes() -> None:
+    error = DescriptionError(f"transition target '{LONG}' does not exist;\nexpected a state", "f.scxml", 5)
+    assert error.location_message() == f"f.scxml:5: transition target '{excerpt(LONG)}' does not exist; expected a state"
+    assert DescriptionError("the gripper's state is the ontology's Released").message == \
+        "the gripper's state is the ontology's Released"
