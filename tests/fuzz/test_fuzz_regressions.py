@@ -203,3 +203,18 @@ def test_issue_15_every_description_error_is_one_line_with_short_quotes() -> Non
     assert error.location_message() == f"f.scxml:5: transition target '{excerpt(LONG)}' does not exist; expected a state"
     assert DescriptionError("the gripper's state is the ontology's Released").message == \
         "the gripper's state is the ontology's Released"
+
+
+def test_issue_15_a_long_unknown_command_or_parameter_in_a_task_is_quoted_short(workspace: Workspace) -> None:
+    text = f"task: t\nsteps:\n  - command: 'pick-{'[ <urn:p> ' * 400}'\n  - command: pick\n    params:\n" \
+           f"      'grip_force:{'- ' * 2000}': 1\n"
+    path = workspace.write("tasks/bin-picking.yaml", text.encode())
+    problems = service.validate([path]).sorted()
+    assert problems
+    for problem in problems:
+        check_message(str(problem), text)
+
+
+def test_issue_15_a_long_field_name_in_a_request_is_quoted_short(hmi: InProcessHmi) -> None:
+    task = {"name": "t", "steps": [{"command": "pick", "params": {"(" * 3000: None}}]}
+    assert run_hmi(hmi, ("POST", "/api/task/validate", {"json": task})) == "refused"

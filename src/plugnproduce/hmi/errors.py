@@ -16,7 +16,7 @@ from fastapi.responses import JSONResponse
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 from plugnproduce.hmi.interfaces import CellChangeRefused, RunRefused
-from plugnproduce.safeio import tidy
+from plugnproduce.safeio import excerpt, tidy
 
 
 def field_name(loc: Sequence[int | str]) -> str:
@@ -47,7 +47,7 @@ def _one(status_code: int, detail: str, **extra: Any) -> JSONResponse:
 
 async def _invalid_request(_: Request, exc: Exception) -> JSONResponse:
     raw = cast(RequestValidationError, exc).errors()  # registered for this class only
-    errors = [{"field": "body" if e.get("type") == "json_invalid" else field_name(e.get("loc", ())),
+    errors = [{"field": "body" if e.get("type") == "json_invalid" else excerpt(field_name(e.get("loc", ()))),
                "reason": _reason(e)} for e in raw]
     unique = list({(e["field"], e["reason"]): e for e in errors}.values())
     code = status.HTTP_400_BAD_REQUEST if any(e.get("type") == "json_invalid" for e in raw) \
