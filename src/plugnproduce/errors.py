@@ -7,7 +7,37 @@ the machinery itself.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
+
+MAX_EXCERPT = 60
+"""Most characters of the input an error message quotes in one piece."""
+
+MAX_MESSAGE = 600
+"""Longest message a description error carries (its file and line come on top)."""
+
+_QUOTED = re.compile(r"(?<![A-Za-z])'[^']*'|\"[^\"]*\"")  # an apostrophe inside a word (device's) opens none
+
+
+def excerpt(text: str, limit: int = MAX_EXCERPT) -> str:
+    """``text`` on one line and at most about ``limit`` characters: its start and end around an ellipsis."""
+    text = " ".join(str(text).split())
+    if len(text) <= limit:
+        return text
+    half = max(limit // 2 - 1, 1)
+    return f"{text[:half]}…{text[-half:]}"
+
+
+def tidy(message: str, limit: int = 300) -> str:
+    """A library's error message made fit for a ``file:line: message`` line.
+
+    One line; every quoted value cut to a short excerpt; at most ``limit`` characters. Parsers
+    quote what they could not read, and what they read is the input, which a message must not
+    repeat at length.
+    """
+    text = " ".join(str(message).split())
+    text = _QUOTED.sub(lambda m: m.group()[0] + excerpt(m.group()[1:-1]) + m.group()[-1], text)
+    return excerpt(text, limit)
 
 
 class PlugNProduceError(Exception):
@@ -18,7 +48,7 @@ class DescriptionError(PlugNProduceError):
     """A description (or task, cell, chart) that cannot be read: says what, and where."""
 
     def __init__(self, message: str, file: str | Path | None = None, line: int | None = None):
-        self.message = message
+        self.message = tidy(message, MAX_MESSAGE)  # one line, and what it quotes of the input kept short
         self.file = str(file) if file is not None else None
         self.line = line
         super().__init__(self.location_message())

@@ -10,17 +10,23 @@ the file and line.
 from __future__ import annotations
 
 import codecs
+import logging
 import re
 import stat
+import warnings
 from pathlib import Path
-from typing import Protocol, cast
+from typing import Any, Protocol, cast
 
 import rdflib
 import yaml
 from lxml import etree
 from rdflib.plugins.parsers.notation3 import BadSyntax
 
-from plugnproduce.errors import HostileInputError, UnreadableError
+from plugnproduce.errors import HostileInputError, UnreadableError, excerpt, tidy
+
+logging.getLogger("rdflib.term").setLevel(logging.ERROR)
+# rdflib logs a warning for every odd IRI or literal it builds, unasked, on stderr; what matters of
+# them is reported as a finding with its file and line, so its own chatter is silenced.
 
 MAX_BYTES = 4 * 1024 * 1024
 """Largest description file accepted (descriptions are a few kB; 4 MiB is generous)."""
@@ -37,22 +43,31 @@ _WIDE = (  # (leading bytes, codec) of the encodings whose text the byte-wise se
 )
 
 
+def shown(path: str | Path) -> str:
+    """A path as an error message names it: whole, or its ends if it is so long it must come from the input."""
+    text = str(path)
+    return text if len(text) <= 200 else excerpt(text, 120)
+
+
 def read_bytes(path: str | Path, limit: int = MAX_BYTES) -> bytes:
     """Read a file whole, refusing one larger than ``limit`` before reading it."""
     p = Path(path)
+    where = shown(p)
     try:
         info = p.stat()
         if not stat.S_ISREG(info.st_mode):  # a FIFO or a device would block the reader; a folder is no file
-            raise UnreadableError("not a regular file (a folder, pipe or device); expected a description file", p)
+            raise UnreadableError("not a regular file (a folder, pipe or device); expected a description file", where)
         size = info.st_size
         if size > limit:
-            raise HostileInputError(f"file is {size} bytes; at most {limit} are accepted", p)
+            raise HostileInputError(f"file is {size} bytes; at most {limit} are accepted", where)
         with p.open("rb") as f:
             data = f.read(limit + 1)
     except OSError as exc:
-        raise UnreadableError(f"cannot read file: {exc.strerror or exc}", p) from exc
+        raise UnreadableError(f"cannot read file: {exc.strerror or exc}", where) from exc
+    except ValueError as exc:  # a NUL in the path (a chart named <a%00b.scxml>)
+        raise UnreadableError("cannot read file: its name holds a NUL character", where) from exc
     if len(data) > limit:
-        raise HostileInputError(f"file is larger than the {limit} bytes accepted", p)
+        raise HostileInputError(f"file is larger than the {limit} bytes accepted", where)
     return data
 
 
@@ -96,7 +111,7 @@ def parse_xml_bytes(data: bytes, source: str | Path) -> etree._ElementTree:
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if exc.lineno else None
         msg = exc.msg.split(f", line {line}")[0] if exc.msg else "malformed XML"
-        raise UnreadableError(f"malformed XML: {msg}", source, line) from exc
+        raise UnreadableError(f"malformed XML: {tidy(msg)}", source, line) from exc
     tree = root.getroottree()
     if tree.docinfo.internalDTD is not None or tree.docinfo.doctype:  # an encoding the search did not know
         raise HostileInputError("DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "
@@ -228,6 +243,16 @@ def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
     return document
 
 
+class PlainDumper(yaml.SafeDumper):
+    """A YAML writer that never writes anchors and aliases, which :func:`parse_yaml_node` refuses.
+
+    A value shared by two places (one pose in two steps) is written out at each.
+    """
+
+    def ignore_aliases(self, data: Any) -> bool:  # noqa: D102
+        return True
+
+
 def parse_yaml_node(path: str | Path) -> yaml.Node:
     """Read a YAML file into a node tree that keeps line numbers (``node.start_mark.line``)."""
     data = read_bytes(path)
@@ -241,9 +266,13 @@ def parse_yaml_node(path: str | Path) -> yaml.Node:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
         what = exc.problem or exc.context or "malformed YAML"
-        raise UnreadableError(f"malformed YAML: {what}", path, line) from exc
+        raise UnreadableError(f"malformed YAML: {tidy(what)}", path, line) from exc
+    except yaml.reader.ReaderError as exc:  # a character YAML does not allow (NUL, other controls)
+        line = text.count("\n", 0, max(exc.position, 0)) + 1
+        raise UnreadableError(f"malformed YAML: {tidy(exc.reason)} (character #x{exc.character:04x}); "
+                              "expected printable text", path, line) from exc
     except yaml.YAMLError as exc:
-        raise UnreadableError(f"malformed YAML: {exc}", path) from exc
+        raise UnreadableError(f"malformed YAML: {tidy(str(exc))}", path) from exc
     if node is None:
         raise UnreadableError("empty YAML document", path, 1)
     _check_yaml_values(node, path)
@@ -323,12 +352,13 @@ def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
     text = read_turtle_text(p)
     g = rdflib.Graph()
     try:
-        g.parse(data=text, format="turtle", publicID=p.resolve().as_uri())
-    except BadSyntax as exc:
-        why = str(getattr(exc, "_why", "") or "syntax error").strip()
-        raise UnreadableError(f"malformed Turtle: {why}", p, exc.lines + 1) from exc
+        with warnings.catch_warnings():  # rdflib warns (and logs) about odd literals and IRIs: no chatter
+            warnings.simplefilter("ignore")
+            g.parse(data=text, format="turtle", publicID=p.resolve().as_uri())
+    except BadSyntax as exc:  # its str() is several lines quoting the file: keep the reason only
+        raise UnreadableError(f"malformed Turtle: {tidy(exc._why)}", p, exc.lines + 1) from exc
     except Exception as exc:  # rdflib raises assorted types for bad literals and IRIs
-        raise UnreadableError(f"malformed Turtle: {exc}", p) from exc
+        raise UnreadableError(f"malformed Turtle: {tidy(str(exc))}", p) from exc
     if len(g) > MAX_TRIPLES:
         raise HostileInputError(f"{len(g)} triples; at most {MAX_TRIPLES} are accepted in one file", p)
     return g, text

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import httpx
+import pytest
 from typer.testing import CliRunner
 
 from plugnproduce.cli import app
@@ -98,3 +101,51 @@ def test_a_missing_token_file_is_one_line_and_exit_2(tmp_path: Path) -> None:
     result = CliRunner().invoke(app, ["serve", "--token-file", str(tmp_path / "none")])
     assert result.exit_code == 2
     assert result.output.strip() == f"{tmp_path / 'none'}: cannot read the token file: No such file or directory"
+
+
+def _busy_task(rounds: int) -> dict[str, object]:
+    steps = [{"command": "bin-pick", "params": {"grip_force": 45, "exposure": 25, "part_type": "bracket"}},
+             {"command": "place", "params": {"place_pose": [0.6, -0.2, 0.1, 0, 180, 0], "speed": 80}}]
+    return {"name": "busy", "steps": steps * 100, "repeat": rounds}
+
+
+def _stops_cleanly(proc: subprocess.Popen[str], sig: signal.Signals) -> None:
+    proc.send_signal(sig)
+    try:
+        out, err = proc.communicate(timeout=60)  # a bound against hanging, not a measure of speed
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        raise AssertionError(f"pnp serve did not exit on {sig.name}") from None
+    assert proc.returncode == 0, err
+    assert out.strip().endswith("stopped")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_issue_15_serve_stops_on_a_signal_while_a_run_is_active(sig: signal.Signals) -> None:
+    proc, lines = _start("--sim")
+    assert proc.stdout is not None
+    lines += [proc.stdout.readline().strip(), proc.stdout.readline().strip()]
+    url, token = lines[0].rsplit(" ", 1)[1], lines[2].removeprefix("token: ")
+    res = httpx.post(url + "api/runs", json={"task": _busy_task(10)}, headers={"Authorization": f"Bearer {token}"},
+                     timeout=120)
+    assert res.status_code == 202 and res.json()["status"] == "running"
+    _stops_cleanly(proc, sig)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_issue_15_serve_stops_on_a_signal_while_a_request_is_being_worked_on(sig: signal.Signals) -> None:
+    proc, lines = _start("--sim")
+    url = lines[0].rsplit(" ", 1)[1]
+    sent = threading.Event()
+
+    def check() -> None:
+        with httpx.Client(timeout=120) as client, contextlib.suppress(httpx.HTTPError):
+            sent.set()
+            client.post(url + "api/task/repair", json=_busy_task(10))
+
+    worker = threading.Thread(target=check, daemon=True)
+    worker.start()
+    sent.wait(10)
+    _stops_cleanly(proc, sig)
+    worker.join(60)

@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+import asyncio
+import os
+import signal
 import socket
+import sys
+import threading
 from pathlib import Path
+from types import FrameType
 from typing import TYPE_CHECKING
 
 import typer
@@ -12,6 +18,8 @@ from plugnproduce.cli.app import app, boundary, fail, knowledge
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
+    import uvicorn
+
     from plugnproduce import service
     from plugnproduce.hmi import CellSource, Runner
 else:
@@ -98,8 +106,47 @@ def serve(
         typer.echo(f"open {url}#token={token}")
         typer.echo(f"token: {token}")
     config = uvicorn.Config(application, log_level="warning", timeout_graceful_shutdown=2, lifespan="on", ws="none")
+    previous = signal.signal(signal.SIGTERM, _interrupt)  # uvicorn re-raises the signal it stopped on: as Ctrl-C
     try:
-        uvicorn.Server(config).run(sockets=[sock])  # Ctrl-C: a graceful shutdown, then KeyboardInterrupt
+        _serve(uvicorn.Server(config), sock)  # SIGINT/SIGTERM: a graceful shutdown, then KeyboardInterrupt
     except KeyboardInterrupt:
         pass
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     typer.echo("stopped")
+    _leave_busy_workers()
+
+
+def _interrupt(signum: int, frame: FrameType | None) -> None:
+    raise KeyboardInterrupt
+
+
+def _serve(server: uvicorn.Server, sock: socket.socket) -> None:
+    """Serve until stopped; unlike ``asyncio.run``, never wait for worker threads still busy at the end.
+
+    A request's reasoning or a run's code generation runs in a worker thread and cannot be
+    interrupted; ``asyncio.run`` would wait for it to finish before returning.
+    """
+    loop = (server.config.get_loop_factory() or asyncio.new_event_loop)()
+    try:
+        loop.run_until_complete(server.serve(sockets=[sock]))
+    finally:
+        tasks = asyncio.all_tasks(loop)
+        for task in tasks:
+            task.cancel()
+        if tasks:
+            loop.run_until_complete(asyncio.gather(*tasks, return_exceptions=True))
+        loop.run_until_complete(loop.shutdown_asyncgens())
+        loop.close()  # the default executor is shut down without waiting
+
+
+def _leave_busy_workers() -> None:
+    """Exit now if a worker thread is still busy: it would hold the process until its work is done.
+
+    The server has shut down (every run stopped, its journal closed), so nothing is lost.
+    """
+    busy = [t for t in threading.enumerate() if t is not threading.main_thread() and t.is_alive() and not t.daemon]
+    if busy:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(0)

@@ -6,6 +6,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from decimal import Decimal
@@ -28,11 +29,11 @@ from plugnproduce.description.model import (
     Where,
 )
 from plugnproduce.description.rdf import term_line
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
 from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import parse_turtle, parse_yaml_node
+from plugnproduce.safeio import PlainDumper, parse_turtle, parse_yaml_node
 from plugnproduce.statechart.io.reader import read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
@@ -138,8 +139,8 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
         states=states,
         transitions=transitions,
         where=loaded.where(str(s)),
-        command_timeout=float(timeout.toPython()) if isinstance(timeout, rdflib.Literal) else 10.0,
-        cost=float(cost.toPython()) if isinstance(cost, rdflib.Literal) else 0.0,
+        command_timeout=_or(_finite(loaded, s, timeout, "command timeout"), 10.0),
+        cost=_or(_finite(loaded, s, cost, "cost"), 0.0),
         skills=tuple(sorted(taxonomy.device_skills(classes, declared))),
         chart=chart,
     )
@@ -198,8 +199,22 @@ def process_from(loaded: Loaded) -> ProcessDescription:
     )
 
 
-def _number(node: rdflib.term.Node | None) -> float | None:
-    return float(node.toPython()) if isinstance(node, rdflib.Literal) else None
+def _finite(loaded: Loaded, subject: rdflib.term.Node, node: rdflib.term.Node | None, what: str) -> float | None:
+    """A literal read as a finite number (None if absent); an ill-typed, huge or NaN one is refused at its line."""
+    if not isinstance(node, rdflib.Literal):
+        return None
+    try:
+        value = float(node.toPython())
+    except (TypeError, ValueError, OverflowError):
+        value = math.nan
+    if not math.isfinite(value):
+        raise UnreadableError(f"{local_name(str(subject))}: {what} {excerpt(str(node))!r} is not a finite number; "
+                              "expected a decimal such as 2.5", loaded.path, loaded.line(str(subject)))
+    return value
+
+
+def _or(value: float | None, default: float) -> float:
+    return default if value is None else value
 
 
 def _default(node: rdflib.term.Node | None) -> object:
@@ -221,8 +236,8 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
         quantity=str(_one(loaded, p, PNP.quantity, "quantity")),
         datatype=str(_one(loaded, p, PNP.datatype, "datatype")),
         unit=str(_opt(loaded, p, PNP.unit) or ""),
-        minimum=_number(_opt(loaded, p, PNP.minValue)),
-        maximum=_number(_opt(loaded, p, PNP.maxValue)),
+        minimum=_finite(loaded, p, _opt(loaded, p, PNP.minValue), "minimum"),
+        maximum=_finite(loaded, p, _opt(loaded, p, PNP.maxValue), "maximum"),
         default=_default(default),
         where=loaded.where(str(p)),
     )
@@ -244,7 +259,7 @@ def _mapping(node: yaml.Node, path: Path, what: str) -> dict[str, yaml.Node]:
         if not isinstance(k, yaml.ScalarNode):
             raise DescriptionError(f"{what}: keys must be plain names", path, k.start_mark.line + 1)
         if k.value in out:
-            raise DescriptionError(f"{what}: key {k.value!r} appears twice", path, k.start_mark.line + 1)
+            raise DescriptionError(f"{what}: key {excerpt(k.value)!r} appears twice", path, k.start_mark.line + 1)
         out[k.value] = v
     return out
 
@@ -257,7 +272,8 @@ def _unknown_keys(m: dict[str, yaml.Node], allowed: set[str], path: Path, what: 
     for k, v in m.items():
         if k not in allowed:
             raise DescriptionError(
-                f"{what}: unknown key {k!r}; expected one of {', '.join(sorted(allowed))}", path, v.start_mark.line + 1
+                f"{what}: unknown key {excerpt(k)!r}; expected one of {', '.join(sorted(allowed))}", path,
+                v.start_mark.line + 1,
             )
 
 
@@ -279,7 +295,7 @@ def load_task(path: str | Path) -> Task:
         raise DescriptionError("a task needs 'task' (its name) and 'steps'", p, 1)
     repeat = _plain(top["repeat"]) if "repeat" in top else 1
     if not isinstance(repeat, int) or isinstance(repeat, bool) or not 1 <= repeat <= 1000:
-        raise DescriptionError(f"repeat must be a whole number from 1 to 1000; found {repeat!r}", p,
+        raise DescriptionError(f"repeat must be a whole number from 1 to 1000; found {excerpt(repr(repeat))}", p,
                                top["repeat"].start_mark.line + 1)
     steps_node = top["steps"]
     if not isinstance(steps_node, yaml.SequenceNode) or not steps_node.value:
@@ -327,14 +343,7 @@ def task_to_yaml(task: Task) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = steps
-    return yaml.dump(doc, Dumper=_NoAliases, sort_keys=False, default_flow_style=None)
-
-
-class _NoAliases(yaml.SafeDumper):
-    """Writes a value shared by several steps out each time: task files refuse anchors and aliases."""
-
-    def ignore_aliases(self, data: object) -> bool:
-        return True
+    return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=None)
 
 
 def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
@@ -348,7 +357,7 @@ def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
     for node in top["devices"].value:
         if not isinstance(node, yaml.ScalarNode):
             raise DescriptionError("each device is a path to a device description", p, node.start_mark.line + 1)
-        files.append(((p.parent / node.value).resolve(), node.start_mark.line + 1))
+        files.append((_device_path(p, node), node.start_mark.line + 1))
     return str(_plain(top["cell"])), files
 
 
@@ -366,9 +375,23 @@ def cell_libraries(path: str | Path) -> list[Path]:
     for n in node.value:
         folder = (p.parent / n.value).resolve()
         if not folder.is_dir():
-            raise DescriptionError(f"library folder {n.value} not found", p, n.start_mark.line + 1)
+            raise DescriptionError(f"library folder {excerpt(n.value)} not found", p, n.start_mark.line + 1)
         out.append(folder)
     return out
+
+
+MAX_PATH = 1024
+"""Longest device path a cell may list (file systems refuse names much longer than 255 bytes anyway)."""
+
+
+def _device_path(cell: Path, node: yaml.ScalarNode) -> Path:
+    """A device path a cell lists, resolved beside the cell; one no file system could hold is refused."""
+    value = str(node.value)
+    parts = value.replace("\\", "/").split("/")
+    if "\0" in value or len(value) > MAX_PATH or any(len(part.encode("utf-8", "replace")) > 255 for part in parts):
+        raise DescriptionError(f"device path {excerpt(value)!r} ({len(value)} characters) cannot name a file; "
+                               "expected a path to a device description", cell, node.start_mark.line + 1)
+    return (cell.parent / value).resolve()
 
 
 def load_cell(path: str | Path, taxonomy: Taxonomy,
@@ -385,13 +408,14 @@ def load_cell(path: str | Path, taxonomy: Taxonomy,
             continue
         known = by_id(f.name) if by_id is not None and f.suffix != ".ttl" else None
         if known is None:
-            raise DescriptionError(f"device description {f.name} not found; expected a device description file "
-                                   "(relative to the cell file) or the id of a device of a loaded library", path, line)
+            raise DescriptionError(f"device description {excerpt(f.name)} not found; expected a device description "
+                                   "file (relative to the cell file) or the id of a device of a loaded library",
+                                   path, line)
         devices.append(known)
     ids = [d.id for d in devices]
     for d in devices:
         if ids.count(d.id) > 1:
-            raise DescriptionError(f"device id {d.id!r} appears twice in the cell", path)
+            raise DescriptionError(f"device id {excerpt(d.id)!r} appears twice in the cell", path)
     return Cell(name, tuple(devices), str(path))
 
 

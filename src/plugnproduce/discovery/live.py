@@ -25,7 +25,7 @@ from urllib.parse import urlparse
 
 from plugnproduce.description.loader import file_of, load_device, read_description
 from plugnproduce.description.model import Cell, DeviceDescription
-from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout
+from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout, excerpt
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP
 from plugnproduce.protocols.upnp import (
@@ -34,6 +34,7 @@ from plugnproduce.protocols.upnp import (
     AdvertisementListener,
     DeviceSearch,
     FoundDevice,
+    RemoteFiles,
     SearchHit,
     SsdpNetwork,
     UntrustedUrlError,
@@ -215,26 +216,35 @@ class LiveCell:
         """Fetch the device's own description files and read them as any description."""
         async with await UpnpDeviceClient.from_found(found) as client:
             files = await client.fetch_files()
-        folder = self._workdir / _safe_name(found.udn)
-        folder.mkdir(exist_ok=True)
-        ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
-        ttl.write_text(files.description, encoding="utf-8")
-        chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
-        chart.write_text(files.chart, encoding="utf-8")
-        try:
-            for named in read_description(ttl).graph.objects(None, PNP.stateChart):
-                if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
-                    raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected "
-                                           f"the chart it serves ({chart.name})", ttl)
-            device = load_device(ttl, self.taxonomy)
-        except DescriptionError as exc:  # say where the device serves the file, not where it was kept
-            served = {str(ttl): files.description_url, str(chart): files.chart_url}
-            raise DescriptionError(exc.message.replace(str(folder), ""), served.get(exc.file or "", found.location),
-                                   exc.line) from exc
-        if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
-            return replace(device, endpoint=found.location)
-        host = urlparse(found.location).hostname
-        if parse_endpoint(device.endpoint)[0] != host:
-            raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {device.endpoint} "
-                                    "on another host; refused")
-        return device
+        return read_served(files, found, self._workdir / _safe_name(found.udn), self.taxonomy)
+
+
+def read_served(files: RemoteFiles, found: FoundDevice, folder: Path, taxonomy: Taxonomy) -> DeviceDescription:
+    """Read the description and chart a device served (fetched already) in ``folder``, as any description.
+
+    The chart must be the one the device serves and an XIRP endpoint must be on the host the
+    device was found at; anything else is refused (:class:`DescriptionError`, :class:`ProtocolError`),
+    with the URL the device served the file at, never the folder it was kept in.
+    """
+    folder.mkdir(exist_ok=True)
+    ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
+    ttl.write_text(files.description, encoding="utf-8")
+    chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
+    chart.write_text(files.chart, encoding="utf-8")
+    try:
+        for named in read_description(ttl).graph.objects(None, PNP.stateChart):
+            if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
+                raise DescriptionError(f"device {found.udn} names its chart <{excerpt(str(named))}>; expected "
+                                       f"the chart it serves ({chart.name})", ttl)
+        device = load_device(ttl, taxonomy)
+    except DescriptionError as exc:
+        served = {str(ttl): files.description_url, str(chart): files.chart_url}
+        raise DescriptionError(exc.message.replace(str(folder), ""), served.get(exc.file or "", found.location),
+                               exc.line) from exc
+    if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
+        return replace(device, endpoint=found.location)
+    host = urlparse(found.location).hostname
+    if parse_endpoint(device.endpoint)[0] != host:
+        raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {device.endpoint} "
+                                "on another host; refused")
+    return device

@@ -14,7 +14,7 @@ from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
-from plugnproduce.errors import DescriptionError, PlugNProduceError
+from plugnproduce.errors import DescriptionError, PlugNProduceError, excerpt, tidy
 from plugnproduce.hmi.interfaces import CellChangeRefused, RunRefused
 
 
@@ -37,7 +37,7 @@ def _reason(error: dict[str, Any]) -> str:
         loc = error.get("loc", ())
         at = f" at character {loc[-1]}" if loc and isinstance(loc[-1], int) else ""
         return f"not valid JSON{at}: {error.get('ctx', {}).get('error', msg)}"
-    return msg[:1].lower() + msg[1:]
+    return tidy(msg[:1].lower() + msg[1:])
 
 
 def _one(status_code: int, detail: str, **extra: Any) -> JSONResponse:
@@ -46,7 +46,7 @@ def _one(status_code: int, detail: str, **extra: Any) -> JSONResponse:
 
 async def _invalid_request(_: Request, exc: Exception) -> JSONResponse:
     raw = cast(RequestValidationError, exc).errors()  # registered for this class only
-    errors = [{"field": "body" if e.get("type") == "json_invalid" else field_name(e.get("loc", ())),
+    errors = [{"field": "body" if e.get("type") == "json_invalid" else excerpt(field_name(e.get("loc", ()))),
                "reason": _reason(e)} for e in raw]
     unique = list({(e["field"], e["reason"]): e for e in errors}.values())
     code = status.HTTP_400_BAD_REQUEST if any(e.get("type") == "json_invalid" for e in raw) \
@@ -61,15 +61,15 @@ async def _description(_: Request, exc: Exception) -> JSONResponse:
 
 async def _unknown(_: Request, exc: Exception) -> JSONResponse:
     name = exc.args[0] if exc.args else "name"
-    return _one(status.HTTP_404_NOT_FOUND, f"error: unknown {name}")
+    return _one(status.HTTP_404_NOT_FOUND, f"error: unknown {tidy(str(name))}")  # the name came in the request
 
 
 async def _conflict(_: Request, exc: Exception) -> JSONResponse:
-    return _one(status.HTTP_409_CONFLICT, f"error: {exc}")
+    return _one(status.HTTP_409_CONFLICT, f"error: {tidy(str(exc))}")
 
 
 async def _other(_: Request, exc: Exception) -> JSONResponse:
-    return _one(status.HTTP_400_BAD_REQUEST, f"error: {exc}")
+    return _one(status.HTTP_400_BAD_REQUEST, f"error: {tidy(str(exc))}")
 
 
 def install(app: FastAPI) -> None:

@@ -22,7 +22,7 @@ from plugnproduce.description.model import Task
 from plugnproduce.errors import DescriptionError
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.knowledge import Knowledge
-from plugnproduce.safeio import MAX_BYTES
+from plugnproduce.safeio import MAX_BYTES, PlainDumper
 
 _validating = threading.Lock()
 """One validation at a time: the shapes engine is not meant to share its graphs between threads."""
@@ -43,7 +43,7 @@ def _block_yaml(task: TaskIn) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = steps
-    return yaml.safe_dump(doc, sort_keys=False, default_flow_style=False, allow_unicode=True)
+    return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=False, allow_unicode=True)
 
 
 def _fields(loaded: Task, rounds: int) -> dict[int, tuple[int, str]]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from plugnproduce.errors import DescriptionError, UnreadableError
+from plugnproduce.errors import MAX_MESSAGE, DescriptionError, UnreadableError, tidy
 
 
 @dataclass(frozen=True, order=True)
@@ -16,6 +16,9 @@ class Problem:
     message: str
     unreadable: bool = False
     """The file could not be read at all (malformed or hostile), rather than being invalid."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "message", tidy(self.message, MAX_MESSAGE))  # one line, short quotes of the input
 
     def __str__(self) -> str:
         return f"{self.file}:{self.line}: {self.message}" if self.line else f"{self.file}: {self.message}"

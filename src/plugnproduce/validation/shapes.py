@@ -10,6 +10,7 @@ from pyshacl import validate as shacl_validate
 from rdflib.namespace import SH
 
 from plugnproduce.description.knowledge import KnowledgeGraph
+from plugnproduce.errors import tidy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import parse_turtle
@@ -38,7 +39,7 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
         if (None, SH.detail, result) in results:
             continue  # the detail of a result reported in its own words
         focus = results.value(result, SH.focusNode)
-        message = str(results.value(result, SH.resultMessage) or "does not conform")
+        message = tidy(str(results.value(result, SH.resultMessage) or "does not conform"))  # values quoted short
         where = kg.places.get(str(focus))
         if not message.startswith("step ") and local_name(str(focus)) not in message:
             message = f"{local_name(str(focus))}: {message}"

@@ -22,7 +22,7 @@ from plugnproduce.description.loader import (
     read_description,
 )
 from plugnproduce.description.model import ProcessDescription, Task, Where
-from plugnproduce.errors import DescriptionError, UnreadableError
+from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
 from plugnproduce.knowledge import Knowledge, Library, library_folders, load_knowledge
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
@@ -194,4 +194,4 @@ def _cell(path: Path, report: Report, knowledge: Knowledge) -> None:
     knowledge = knowledge.with_libraries(library_folders(cell_libraries(path)))
     for f, line in files:
         if not f.is_file() and (f.suffix == ".ttl" or knowledge.device(f.name) is None):
-            report.add(Problem(str(path), line, f"device description {f} not found"))
+            report.add(Problem(str(path), line, f"device description {excerpt(str(f), 120)} not found"))

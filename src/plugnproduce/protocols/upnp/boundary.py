@@ -35,7 +35,7 @@ from async_upnp_client.exceptions import (
 )
 from async_upnp_client.ssdp import SSDP_IP_V4, SSDP_PORT
 
-from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
+from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError, excerpt
 
 T = TypeVar("T")
 
@@ -109,10 +109,11 @@ def check_trusted(url: str, trusted_host: str, what: str) -> str:
         host = None
         parts = None
     if parts is None or parts.scheme != "http" or host is None:
-        raise UntrustedUrlError(f"{what}: {url!r} is refused; expected an http URL on host {trusted_host}")
+        raise UntrustedUrlError(f"{what}: {excerpt(url)!r} is refused; expected an http URL on host {trusted_host}")
     if _host_key(host) != _host_key(trusted_host):
         raise UntrustedUrlError(
-            f"{what}: {url!r} points at host {host}, but the device was discovered at {trusted_host}; "
+            f"{what}: {excerpt(url)!r} points at host {excerpt(host)}, but the device was discovered at "
+            f"{trusted_host}; "
             "a device is trusted only for the address it was discovered at, so the URL is refused"
         )
     return url
@@ -123,7 +124,7 @@ def resolve_trusted(base_url: str, reference: str, trusted_host: str, what: str)
     try:
         url = urljoin(base_url, reference.strip())
     except ValueError as exc:
-        raise UntrustedUrlError(f"{what}: {reference!r} is not a URL") from exc
+        raise UntrustedUrlError(f"{what}: {excerpt(reference)!r} is not a URL") from exc
     return check_trusted(url, trusted_host, what)
 
 

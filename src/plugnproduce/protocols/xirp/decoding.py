@@ -16,7 +16,7 @@ from functools import lru_cache
 
 from lxml import etree
 
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, excerpt, tidy
 from plugnproduce.protocols.xirp.messages import (
     ID_PATTERN,
     MALFORMED,
@@ -123,7 +123,7 @@ def _decode_document(data: bytes, source: str) -> Message:
         schema().assertValid(root)
     except etree.DocumentInvalid as exc:
         reason = str(exc.args[0] if exc.args else exc).replace(_NS, "").replace(_NS[1:-1], "xirp")
-        reason = _LINE_SUFFIX.sub("", reason)  # a message is one document: its line says nothing
+        reason = tidy(_LINE_SUFFIX.sub("", reason))  # a message is one document: its line says nothing
         ref = root.get("id") if root.tag == _NS + "request" else None
         ref = ref if ref is not None and ID_PATTERN.fullmatch(ref) else None
         raise MessageError(f"{source}: not a valid XIRP message: {reason}", MALFORMED, ref) from exc
@@ -217,7 +217,7 @@ def _decode_event(el: etree._Element) -> Event:
     try:
         time = datetime.fromisoformat(text)
     except ValueError as exc:  # xs:dateTime admits a few forms Python does not (24:00:00, year 0)
-        raise MessageError(f"event time {text!r} cannot be read ({exc})", MALFORMED) from exc
+        raise MessageError(f"event time {excerpt(text)!r} cannot be read ({tidy(str(exc))})", MALFORMED) from exc
     if time.tzinfo is None:
         time = time.replace(tzinfo=UTC)
     seq = _integer(el.get("seq"))

@@ -17,7 +17,7 @@ from datetime import datetime
 from decimal import Decimal
 from typing import NamedTuple, TypeAlias
 
-from plugnproduce.errors import DescriptionError, ProtocolError
+from plugnproduce.errors import DescriptionError, ProtocolError, excerpt
 from plugnproduce.protocols.files import DeviceFiles
 
 NAMESPACE = "urn:plugnproduce-org:xirp:1"
@@ -202,7 +202,7 @@ def parse_endpoint(endpoint: str) -> tuple[str, int]:
     """``xirp://HOST:PORT`` (a device's ``pnp:endpoint``) → ``(host, port)``."""
     match = re.fullmatch(r"xirp://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9.\-]+):(\d{1,5})/?", endpoint.strip())
     if match is None or int(match.group(2)) > 65535:
-        raise ProtocolError(f"endpoint {endpoint!r} is not an XIRP endpoint; expected xirp://HOST:PORT")
+        raise ProtocolError(f"endpoint {excerpt(endpoint)!r} is not an XIRP endpoint; expected xirp://HOST:PORT")
     return match.group(1).strip("[]"), int(match.group(2))
 
 

@@ -7,7 +7,7 @@ and what was expected.
 
 from __future__ import annotations
 
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, excerpt
 from plugnproduce.statechart.model import Chart, History, Parallel, State, StateNode, Transition
 
 
@@ -49,10 +49,10 @@ def _check_initial(container: Chart | State, initial: list[str], ids: dict[str, 
     for target in initial:
         node = ids.get(target)
         if node is None:
-            raise DescriptionError(f"{what} names the state {target!r}, which does not exist; "
+            raise DescriptionError(f"{what} names the state {excerpt(target)!r}, which does not exist; "
                                    "expected the id of a state in the chart", source, line)
         if not _is_descendant(node, container):
-            raise DescriptionError(f"{what} names the state {target!r}, which is not inside "
+            raise DescriptionError(f"{what} names the state {excerpt(target)!r}, which is not inside "
                                    f"{_label(container)}; expected a descendant", source, line)
 
 

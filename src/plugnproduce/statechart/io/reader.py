@@ -17,7 +17,7 @@ from xml.sax.saxutils import escape
 
 from lxml import etree
 
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, excerpt
 from plugnproduce.safeio import parse_xml_bytes, read_bytes
 from plugnproduce.statechart.io.checks import check_structure
 from plugnproduce.statechart.model import (
@@ -65,8 +65,8 @@ def parse_chart(data: bytes, source: str | Path) -> Chart:
     root = parse_xml_bytes(data, source).getroot()
     reader = _Reader(str(source))
     if root.tag != _NS + "scxml":
-        raise DescriptionError(f"found <{_name(root)}> at the top; expected <scxml> in the namespace {SCXML_NS}",
-                               source, root.sourceline)
+        raise DescriptionError(f"found <{excerpt(_name(root))}> at the top; expected <scxml> in the namespace "
+                               f"{SCXML_NS}", source, root.sourceline)
     chart = reader.scxml(root)
     check_structure(chart, str(source))
     return chart

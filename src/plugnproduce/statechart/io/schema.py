@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from lxml import etree
 
-from plugnproduce.errors import DescriptionError
+from plugnproduce.errors import DescriptionError, tidy
 from plugnproduce.resources import package_file
 from plugnproduce.safeio import parse_xml_bytes
 
@@ -36,7 +36,7 @@ def schema_problems(data: bytes, source: str | Path) -> list[DescriptionError]:
     for error in scxml_schema().iter_errors(tree):
         reason = (error.reason or str(error.message)).rstrip(".")
         line = _line(tree, error, reason)
-        problems.append(DescriptionError(f"not valid W3C SCXML: {reason}", source, line))
+        problems.append(DescriptionError(f"not valid W3C SCXML: {tidy(reason)}", source, line))
     return problems
 
 
