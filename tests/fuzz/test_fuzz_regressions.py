@@ -11,7 +11,6 @@ from pathlib import Path
 
 import pytest
 from fuzzing import Crash, InProcessHmi, Workspace, check_message, run_hmi, run_reference, run_served, seeds
-from plugnproduce.statechart.io.reader import parse_chart
 
 from plugnproduce import service
 from plugnproduce.description.loader import load_cell, load_device, load_task
@@ -19,6 +18,7 @@ from plugnproduce.errors import DescriptionError, UnreadableError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.protocols.xirp import MessageError, decode
 from plugnproduce.safeio import excerpt, parse_turtle, parse_yaml_node, tidy
+from plugnproduce.statechart.io.reader import parse_chart
 
 LONG = "(" * 5000
 GRIPPER = dict(seeds("turtle"))["devices/gripper.ttl"].decode()
