@@ -109,33 +109,36 @@ def _busy_task(rounds: int) -> dict[str, object]:
     return {"name": "busy", "steps": steps * 100, "repeat": rounds}
 
 
-def _stops_cleanly(proc: subprocess.Popen[str], sig: signal.Signals) -> None:
+def _stops_cleanly(proc: subprocess.Popen[str], out: Lines, sig: signal.Signals) -> None:
     proc.send_signal(sig)
     try:
-        out, err = proc.communicate(timeout=60)  # a bound against hanging, not a measure of speed
+        code = proc.wait(timeout=60)  # a bound against hanging, not a measure of speed
     except subprocess.TimeoutExpired:
         proc.kill()
-        proc.communicate()
         raise AssertionError(f"pnp serve did not exit on {sig.name}") from None
-    assert proc.returncode == 0, err
-    assert out.strip().endswith("stopped")
+    rest = "".join(out.rest())
+    assert proc.stdout is not None and proc.stderr is not None
+    err = proc.stderr.read()
+    proc.stdout.close()
+    proc.stderr.close()
+    assert code == 0, err
+    assert rest.strip().endswith("stopped")
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_issue_15_serve_stops_on_a_signal_while_a_run_is_active(sig: signal.Signals) -> None:
-    proc, lines = _start("--sim")
-    assert proc.stdout is not None
-    lines += [proc.stdout.readline().strip(), proc.stdout.readline().strip()]
+    proc, out, lines = _start("--sim")
+    lines += [out.next().strip(), out.next().strip()]
     url, token = lines[0].rsplit(" ", 1)[1], lines[2].removeprefix("token: ")
     res = httpx.post(url + "api/runs", json={"task": _busy_task(10)}, headers={"Authorization": f"Bearer {token}"},
                      timeout=120)
     assert res.status_code == 202 and res.json()["status"] == "running"
-    _stops_cleanly(proc, sig)
+    _stops_cleanly(proc, out, sig)
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_issue_15_serve_stops_on_a_signal_while_a_request_is_being_worked_on(sig: signal.Signals) -> None:
-    proc, lines = _start("--sim")
+    proc, out, lines = _start("--sim")
     url = lines[0].rsplit(" ", 1)[1]
     sent = threading.Event()
 
@@ -147,5 +150,5 @@ def test_issue_15_serve_stops_on_a_signal_while_a_request_is_being_worked_on(sig
     worker = threading.Thread(target=check, daemon=True)
     worker.start()
     sent.wait(10)
-    _stops_cleanly(proc, sig)
+    _stops_cleanly(proc, out, sig)
     worker.join(60)
