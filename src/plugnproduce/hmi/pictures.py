@@ -7,7 +7,7 @@ import hashlib
 import tempfile
 import threading
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from plugnproduce.codegen.outputs import GeneratedChart
@@ -74,7 +74,7 @@ class GeneratedCharts:
         self._store = _Bounded(limit)
         self._lock = threading.Lock()
 
-    def add(self, charts: tuple[GeneratedChart, ...]) -> str:
+    def add(self, charts: Sequence[GeneratedChart]) -> str:
         """Keep a generation's charts; its id is a digest of their content."""
         digest = hashlib.sha256(b"".join(c.name.encode() + b"\0" + c.data for c in charts)).hexdigest()[:16]
         with self._lock:
