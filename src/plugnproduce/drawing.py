@@ -104,13 +104,19 @@ def draw_chart(path: str | Path, output: str | Path) -> Path:
     fmt = out.suffix.lstrip(".").lower()
     if fmt not in FORMATS:
         raise DescriptionError(f"cannot draw to {out.name}; expected a file ending in .svg, .png, .pdf or .dot", out)
-    graph = chart_to_dot(path)
-    if fmt == "dot":
-        out.write_text(graph.source)
-        return out
-    try:
-        data = graph.pipe(format=fmt)
-    except graphviz.ExecutableNotFound as exc:
-        raise DescriptionError("Graphviz 'dot' is not installed (scripts/setup.sh installs it)", out) from exc
-    out.write_bytes(data)
+    out.write_bytes(render_chart(path, fmt, out))
     return out
+
+
+def render_chart(chart: Chart | str | Path, fmt: str = "svg", where: str | Path = "picture",
+                 name: str | None = None) -> bytes:
+    """A chart (a model, or an SCXML file) drawn in ``fmt`` (svg, png, pdf or dot), in memory;
+    ``where`` names the picture in messages."""
+    graph = chart_to_dot(chart, name)
+    if fmt == "dot":
+        return str(graph.source).encode("utf-8")
+    try:
+        data: bytes = graph.pipe(format=fmt)
+    except graphviz.ExecutableNotFound as exc:
+        raise DescriptionError("Graphviz 'dot' is not installed (scripts/setup.sh installs it)", where) from exc
+    return data

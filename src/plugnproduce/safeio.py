@@ -230,23 +230,30 @@ def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
 
 def parse_yaml_node(path: str | Path) -> yaml.Node:
     """Read a YAML file into a node tree that keeps line numbers (``node.start_mark.line``)."""
-    data = read_bytes(path)
+    return parse_yaml_bytes(read_bytes(path), path)
+
+
+def parse_yaml_bytes(data: bytes, source: str | Path) -> yaml.Node:
+    """Parse YAML text (UTF-8, at most :data:`MAX_BYTES`) into a node tree that keeps line numbers;
+    ``source`` names the text in error messages (a file name, an upload's name)."""
+    if len(data) > MAX_BYTES:
+        raise HostileInputError(f"file is {len(data)} bytes; at most {MAX_BYTES} are accepted", source)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
+        raise UnreadableError(f"not UTF-8 text ({exc.reason})", source) from exc
     try:
-        node = _compose_yaml(text, path)
+        node = _compose_yaml(text, source)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
         what = exc.problem or exc.context or "malformed YAML"
-        raise UnreadableError(f"malformed YAML: {what}", path, line) from exc
+        raise UnreadableError(f"malformed YAML: {what}", source, line) from exc
     except yaml.YAMLError as exc:
-        raise UnreadableError(f"malformed YAML: {exc}", path) from exc
+        raise UnreadableError(f"malformed YAML: {exc}", source) from exc
     if node is None:
-        raise UnreadableError("empty YAML document", path, 1)
-    _check_yaml_values(node, path)
+        raise UnreadableError("empty YAML document", source, 1)
+    _check_yaml_values(node, source)
     return node
 
 

@@ -18,7 +18,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TypedDict
 
 from plugnproduce import reasoning
-from plugnproduce.description.loader import cell_libraries, load_cell, load_devices, load_task
+from plugnproduce.description.loader import (
+    cell_libraries,
+    load_cell,
+    load_devices,
+    load_task,
+    parse_task,
+    task_to_yaml,
+)
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
@@ -69,6 +76,13 @@ def validate(paths: list[str | Path], knowledge: Knowledge | None = None,
     return validate_paths(paths, _k(knowledge), progress=progress)
 
 
+def validate_tasks(tasks: list[Task], knowledge: Knowledge | None = None) -> Report:
+    """Validate tasks already read (e.g. from an editor's YAML) as :func:`validate` validates task files."""
+    from plugnproduce.validation import validate_tasks as validate_read
+
+    return validate_read(tasks, _k(knowledge))
+
+
 def cell(path: str | Path, knowledge: Knowledge | None = None) -> Cell:
     """Read a cell file (with the libraries it lists, added to ``knowledge``)."""
     k = knowledge_for_cell(path, knowledge)
@@ -84,6 +98,16 @@ def catalogue(folder: str | Path | None = None, knowledge: Knowledge | None = No
 def task(path: str | Path) -> Task:
     """Read a task file."""
     return load_task(path)
+
+
+def task_from_text(data: bytes | str, name: str) -> Task:
+    """Read a task description from YAML text (an upload, an editor's buffer); ``name`` names it in messages."""
+    return parse_task(data.encode("utf-8") if isinstance(data, str) else data, name)
+
+
+def task_text(the_task: Task, block: bool = False) -> str:
+    """A task as a YAML task file (``block``: every value on a line of its own)."""
+    return task_to_yaml(the_task, block)
 
 
 def builtin(*parts: str) -> Path:

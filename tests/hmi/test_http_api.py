@@ -292,3 +292,20 @@ async def test_discover_json_shows_each_device_with_the_keys_and_values_of_the_h
     for device in discovered:
         assert set(device) == {"id", "label", "classes", "skills", "protocol", "endpoint"}
         assert device == {key: over_http[device["id"]][key] for key in device}, device["id"]
+
+
+async def test_the_editor_task_is_validated_imported_and_drawn_without_temporary_files(
+        client: httpx.AsyncClient, monkeypatch: pytest.MonkeyPatch) -> None:
+    import tempfile
+
+    def refuse(*_: object, **__: object) -> str:
+        raise AssertionError("a temporary file was made")
+
+    monkeypatch.setattr(tempfile, "mkdtemp", refuse)
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    assert (await client.post("/api/task/validate", json=TASK)).json()["valid"] is True
+    text = (await client.post("/api/task/export", json=TASK)).text
+    assert (await client.post("/api/task/import", content=text.encode(), headers=YAML)).json()["repeat"] == 3
+    chart = next(c for c in (await client.post("/api/task/generate", json=TASK)).json()["charts"] if c["kind"] == "task")
+    svg = await client.get(chart["svg"])
+    assert svg.status_code == 200 and svg.content.lstrip().startswith((b"<?xml", b"<svg"))

@@ -32,7 +32,7 @@ from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import parse_turtle, parse_yaml_node
+from plugnproduce.safeio import parse_turtle, parse_yaml_bytes, parse_yaml_node, read_bytes
 from plugnproduce.statechart.io.reader import read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
@@ -272,8 +272,13 @@ def _str_map(node: yaml.Node | None, path: Path, what: str) -> dict[str, object]
 
 def load_task(path: str | Path) -> Task:
     """Read a task description (YAML)."""
-    p = Path(path)
-    top = _mapping(parse_yaml_node(p), p, "task")
+    return parse_task(read_bytes(path), path)
+
+
+def parse_task(data: bytes, source: str | Path) -> Task:
+    """Read a task description from YAML text; ``source`` names it in messages and in ``Task.file``."""
+    p = Path(source)
+    top = _mapping(parse_yaml_bytes(data, p), p, "task")
     _unknown_keys(top, {"task", "description", "repeat", "steps"}, p, "task")
     if "task" not in top or "steps" not in top:
         raise DescriptionError("a task needs 'task' (its name) and 'steps'", p, 1)
@@ -288,8 +293,8 @@ def load_task(path: str | Path) -> Task:
         raise DescriptionError(f"{len(steps_node.value)} steps repeated {repeat} times make "
                                f"{len(steps_node.value) * repeat}; at most {Task.MAX_STEPS} are accepted",
                                p, steps_node.start_mark.line + 1)
-    one_round: list[tuple[str, dict[str, str], dict[str, object], int, dict[str, int]]] = []
-    for node in steps_node.value:
+    one_round: list[Step] = []
+    for i, node in enumerate(steps_node.value):
         line = node.start_mark.line + 1
         m = _mapping(node, p, "step")
         _unknown_keys(m, {"command", "bind", "params"}, p, "step")
@@ -300,21 +305,18 @@ def load_task(path: str | Path) -> Task:
         lines = {}
         if isinstance(params, yaml.MappingNode):
             lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value}
-        one_round.append((str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
-    steps = [
-        Step(i * len(one_round) + j + 1, cmd, bind, params, line, lines)
-        for i in range(repeat)
-        for j, (cmd, bind, params, line, lines) in enumerate(one_round)
-    ]
+        one_round.append(Step(i + 1, str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
     description = _plain(top["description"]) if "description" in top else ""
-    return Task(str(_plain(top["task"])), tuple(steps), str(p), str(description or ""), repeat)
+    return Task.repeated(str(_plain(top["task"])), one_round, str(p), str(description or ""), repeat)
 
 
-def task_to_yaml(task: Task) -> str:
-    """Write a task back as YAML (one round of its steps when it repeats)."""
-    n = len(task.steps) // task.repeat
+def task_to_yaml(task: Task, block: bool = False) -> str:
+    """Write a task as a task file (one round of its steps when it repeats): the one task writer.
+
+    ``block`` puts every value on a line of its own, so that a finding's line names its field.
+    """
     steps = []
-    for s in task.steps[:n]:
+    for s in task.one_round():
         entry: dict[str, object] = {"command": s.command}
         if s.bind:
             entry["bind"] = dict(s.bind)
@@ -327,7 +329,8 @@ def task_to_yaml(task: Task) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = steps
-    return yaml.dump(doc, Dumper=_NoAliases, sort_keys=False, default_flow_style=None)
+    return yaml.dump(doc, Dumper=_NoAliases, sort_keys=False, default_flow_style=False if block else None,
+                     allow_unicode=True)
 
 
 class _NoAliases(yaml.SafeDumper):

@@ -1,17 +1,17 @@
-"""Pictures of charts for the page (SVG drawn by :func:`plugnproduce.drawing.draw_chart`), and the
+"""Pictures of charts for the page (SVG drawn by :func:`plugnproduce.drawing.render_chart`, in memory), and the
 charts generated for recent tasks, kept in memory so the page can fetch them by id."""
 
 from __future__ import annotations
 
 import hashlib
-import tempfile
 import threading
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from plugnproduce.codegen.outputs import GeneratedChart
-from plugnproduce.drawing import draw_chart
+from plugnproduce.drawing import render_chart
+from plugnproduce.statechart import parse_chart
 
 
 class _Bounded(OrderedDict[str, object]):
@@ -37,19 +37,14 @@ class Pictures:
         """The picture of a chart file (redrawn when the file changes)."""
         p = Path(path)
         key = f"file:{p}:{p.stat().st_mtime_ns}"
-        return self._cached(key, lambda: self._draw(p))
+        return self._cached(key, lambda: render_chart(p, "svg", p))
 
     def of_chart(self, chart: GeneratedChart) -> bytes:
         """The picture of a generated chart."""
         key = "chart:" + hashlib.sha256(chart.data).hexdigest()
 
-        def draw() -> bytes:
-            with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
-                src = Path(folder) / "chart.scxml"
-                src.write_bytes(chart.data)
-                return self._draw(src)
-
-        return self._cached(key, draw)
+        return self._cached(key, lambda: render_chart(parse_chart(chart.data, chart.name), "svg", chart.name,
+                                                      name="chart"))
 
     def _cached(self, key: str, draw: Callable[[], bytes]) -> bytes:
         with self._lock:
@@ -60,11 +55,6 @@ class Pictures:
         with self._lock:
             self._cache.keep(key, data)
         return data
-
-    @staticmethod
-    def _draw(src: Path) -> bytes:
-        with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
-            return draw_chart(src, Path(folder) / "chart.svg").read_bytes()
 
 
 class GeneratedCharts:
