@@ -312,22 +312,33 @@ _PREFIX = re.compile(r"^[ \t]*(@prefix|prefix)\b", re.IGNORECASE | re.MULTILINE)
 
 def read_turtle_text(path: str | Path) -> str:
     """Read a Turtle file as text, bounded in size and prefixes (rdflib's Turtle parser expands no entities)."""
-    data = read_bytes(path)
+    return _turtle_text(read_bytes(path), path)
+
+
+def _turtle_text(data: bytes, source: str | Path) -> str:
+    if len(data) > MAX_BYTES:
+        raise HostileInputError(f"file is {len(data)} bytes; at most {MAX_BYTES} are accepted", source)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
+        raise UnreadableError(f"not UTF-8 text ({exc.reason})", source) from exc
     for count, m in enumerate(_PREFIX.finditer(text), start=1):
         if count > MAX_PREFIXES:
-            raise HostileInputError(f"more than {MAX_PREFIXES} prefix declarations", path,
+            raise HostileInputError(f"more than {MAX_PREFIXES} prefix declarations", source,
                                     text.count("\n", 0, m.start()) + 1)
     return text
 
 
 def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
     """Parse a Turtle file; returns the graph and the text (for line look-ups)."""
+    return parse_turtle_bytes(read_bytes(path), path)
+
+
+def parse_turtle_bytes(data: bytes, path: str | Path) -> tuple[rdflib.Graph, str]:
+    """Parse Turtle text as if it were the file at ``path`` (its relative IRIs resolve against it, and
+    messages name it); returns the graph and the text (for line look-ups). Nothing is read from ``path``."""
     p = Path(path)
-    text = read_turtle_text(p)
+    text = _turtle_text(data, p)
     g = rdflib.Graph()
     try:
         g.parse(data=text, format="turtle", publicID=p.resolve().as_uri())

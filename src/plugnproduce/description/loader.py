@@ -6,7 +6,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
@@ -32,8 +32,8 @@ from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import parse_turtle, parse_yaml_bytes, parse_yaml_node, read_bytes
-from plugnproduce.statechart.io.reader import read_chart
+from plugnproduce.safeio import parse_turtle, parse_turtle_bytes, parse_yaml_bytes, parse_yaml_node, read_bytes
+from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 
@@ -59,6 +59,14 @@ def read_description(path: str | Path) -> Loaded:
     """Parse a Turtle description file."""
     p = Path(path)
     g, text = parse_turtle(p)
+    return Loaded(p, g, text)
+
+
+def parse_description(data: bytes, path: str | Path) -> Loaded:
+    """Parse a Turtle description from bytes as if it were the file at ``path`` (relative IRIs resolve
+    against it, messages name it); nothing is read from disk."""
+    p = Path(path)
+    g, text = parse_turtle_bytes(data, p)
     return Loaded(p, g, text)
 
 
@@ -109,8 +117,12 @@ def _unknown_device_class(loaded: Loaded, taxonomy: Taxonomy) -> None:
                 raise DescriptionError(unknown_class(str(s), str(c), taxonomy), loaded.path, loaded.line(str(s)))
 
 
-def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
-    """Build the device of a parsed description, with its chart and reasoned skills."""
+def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes] | None = None) -> DeviceDescription:
+    """Build the device of a parsed description, with its chart and reasoned skills.
+
+    The chart is read from the file its ``pnp:stateChart`` names or, given ``charts`` (SCXML by path,
+    e.g. the files a device serves), taken from there only: a chart not among them is an error.
+    """
     s = device_subject(loaded, taxonomy)
     classes = tuple(sorted(str(c) for c in loaded.graph.objects(s, RDF.type) if taxonomy.is_kind(str(c), "Device")))
     declared = tuple(sorted(str(k) for k in loaded.graph.objects(s, PNP.hasSkill)))
@@ -120,7 +132,14 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
             f"unknown protocol {local_name(protocol)}; expected pnp:XIRP or pnp:UPnP", loaded.path, loaded.line(str(s))
         )
     chart_file = file_of(_one(loaded, s, PNP.stateChart, "state chart"))
-    chart = read_chart(chart_file)
+    if charts is None:
+        chart = read_chart(chart_file)
+    elif chart_file in charts:
+        chart = parse_chart(charts[chart_file], chart_file)
+    else:
+        raise DescriptionError(f"{local_name(str(s))} names chart {chart_file.name}; expected one of "
+                               f"{', '.join(sorted(c.name for c in charts)) or 'none'}",
+                               loaded.path, loaded.line(str(s)))
     initial, states, transitions = device_chart(chart, chart_file)
     timeout = _opt(loaded, s, PNP.commandTimeout)
     cost = _opt(loaded, s, PNP.cost)

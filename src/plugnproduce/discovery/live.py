@@ -15,15 +15,13 @@ import asyncio
 import contextlib
 import logging
 import re
-import shutil
-import tempfile
 from collections.abc import AsyncIterator, Collection
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 from urllib.parse import urlparse
 
-from plugnproduce.description.loader import file_of, load_device, read_description
+from plugnproduce.description.loader import device_from, file_of, parse_description
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -43,6 +41,10 @@ from plugnproduce.protocols.upnp import (
 from plugnproduce.protocols.xirp import parse_endpoint
 
 _LOGGER = logging.getLogger(__name__)
+
+SERVED = Path("/served")
+"""Where a discovered device's files are said to be: a name for messages and relative IRIs, never a folder
+on disk (a device's chart is only the chart it serves)."""
 
 CONFIRM_TIMEOUT = 1.0
 """Seconds a device's address is given to answer before its byebye is believed."""
@@ -90,7 +92,6 @@ class LiveCell:
         self._changes: asyncio.Queue[CellChange] = asyncio.Queue()
         self._listener = AdvertisementListener(network)
         self._task: asyncio.Task[None] | None = None
-        self._workdir = Path(tempfile.mkdtemp(prefix="pnp-live-"))
 
     @property
     def cell(self) -> Cell:
@@ -128,7 +129,6 @@ class LiveCell:
                 with contextlib.suppress(asyncio.CancelledError):
                     await task
         await self._listener.stop()
-        shutil.rmtree(self._workdir, ignore_errors=True)
 
     async def changes(self) -> AsyncIterator[CellChange]:
         """Every change from now on (and the ones not yet taken), as they happen."""
@@ -215,18 +215,16 @@ class LiveCell:
         """Fetch the device's own description files and read them as any description."""
         async with await UpnpDeviceClient.from_found(found) as client:
             files = await client.fetch_files()
-        folder = self._workdir / _safe_name(found.udn)
-        folder.mkdir(exist_ok=True)
+        folder = SERVED / _safe_name(found.udn)  # names the files for messages and relative IRIs; nothing is written
         ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
-        ttl.write_text(files.description, encoding="utf-8")
         chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
-        chart.write_text(files.chart, encoding="utf-8")
         try:
-            for named in read_description(ttl).graph.objects(None, PNP.stateChart):
+            loaded = parse_description(files.description.encode("utf-8"), ttl)
+            for named in loaded.graph.objects(None, PNP.stateChart):
                 if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
                     raise DescriptionError(f"device {found.udn} names its chart <{str(named)[:200]}>; expected "
                                            f"the chart it serves ({chart.name})", ttl)
-            device = load_device(ttl, self.taxonomy)
+            device = device_from(loaded, self.taxonomy, charts={chart: files.chart.encode("utf-8")})
         except DescriptionError as exc:  # say where the device serves the file, not where it was kept
             served = {str(ttl): files.description_url, str(chart): files.chart_url}
             raise DescriptionError(exc.message.replace(str(folder), ""), served.get(exc.file or "", found.location),

@@ -10,8 +10,9 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from plugnproduce.codegen.outputs import GeneratedChart
+from plugnproduce.description.model import DeviceDescription
 from plugnproduce.drawing import render_chart
-from plugnproduce.statechart import parse_chart
+from plugnproduce.statechart import parse_chart, write_chart
 
 
 class _Bounded(OrderedDict[str, object]):
@@ -38,6 +39,12 @@ class Pictures:
         p = Path(path)
         key = f"file:{p}:{p.stat().st_mtime_ns}"
         return self._cached(key, lambda: render_chart(p, "svg", p))
+
+    def of_device(self, device: DeviceDescription) -> bytes:
+        """The picture of the Device State Chart a device carries (a discovered device's has no file on disk)."""
+        key = "device:" + hashlib.sha256(write_chart(device.chart)).hexdigest()
+        return self._cached(key, lambda: render_chart(device.chart, "svg", device.chart_file,
+                                                      name=Path(device.chart_file).stem))
 
     def of_chart(self, chart: GeneratedChart) -> bytes:
         """The picture of a generated chart."""
