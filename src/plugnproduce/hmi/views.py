@@ -80,12 +80,11 @@ def process_json(p: ProcessDescription, taxonomy: Taxonomy) -> dict[str, Any]:
 
 def task_json(task: Task) -> dict[str, Any]:
     """A task as the editor holds it: one round of its steps, and how often they repeat."""
-    n = len(task.steps) // max(task.repeat, 1)
     return {
         "name": task.name,
         "description": task.description,
         "repeat": task.repeat,
-        "steps": [{"command": s.command, "bind": dict(s.bind), "params": dict(s.params)} for s in task.steps[:n]],
+        "steps": [{"command": s.command, "bind": dict(s.bind), "params": dict(s.params)} for s in task.one_round()],
     }
 
 
