@@ -255,27 +255,34 @@ class PlainDumper(yaml.SafeDumper):
 
 def parse_yaml_node(path: str | Path) -> yaml.Node:
     """Read a YAML file into a node tree that keeps line numbers (``node.start_mark.line``)."""
-    data = read_bytes(path)
+    return parse_yaml_bytes(read_bytes(path), path)
+
+
+def parse_yaml_bytes(data: bytes, source: str | Path) -> yaml.Node:
+    """Parse YAML text (UTF-8, at most :data:`MAX_BYTES`) into a node tree that keeps line numbers;
+    ``source`` names the text in error messages (a file name, an upload's name)."""
+    if len(data) > MAX_BYTES:
+        raise HostileInputError(f"file is {len(data)} bytes; at most {MAX_BYTES} are accepted", source)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
+        raise UnreadableError(f"not UTF-8 text ({exc.reason})", source) from exc
     try:
-        node = _compose_yaml(text, path)
+        node = _compose_yaml(text, source)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
         what = exc.problem or exc.context or "malformed YAML"
-        raise UnreadableError(f"malformed YAML: {tidy(what)}", path, line) from exc
+        raise UnreadableError(f"malformed YAML: {tidy(what)}", source, line) from exc
     except yaml.reader.ReaderError as exc:  # a character YAML does not allow (NUL, other controls)
         line = text.count("\n", 0, max(exc.position, 0)) + 1
         raise UnreadableError(f"malformed YAML: {tidy(exc.reason)} (character #x{exc.character:04x}); "
-                              "expected printable text", path, line) from exc
+                              "expected printable text", source, line) from exc
     except yaml.YAMLError as exc:
-        raise UnreadableError(f"malformed YAML: {tidy(str(exc))}", path) from exc
+        raise UnreadableError(f"malformed YAML: {tidy(str(exc))}", source) from exc
     if node is None:
-        raise UnreadableError("empty YAML document", path, 1)
-    _check_yaml_values(node, path)
+        raise UnreadableError("empty YAML document", source, 1)
+    _check_yaml_values(node, source)
     return node
 
 
@@ -334,22 +341,33 @@ _PREFIX = re.compile(r"^[ \t]*(@prefix|prefix)\b", re.IGNORECASE | re.MULTILINE)
 
 def read_turtle_text(path: str | Path) -> str:
     """Read a Turtle file as text, bounded in size and prefixes (rdflib's Turtle parser expands no entities)."""
-    data = read_bytes(path)
+    return _turtle_text(read_bytes(path), path)
+
+
+def _turtle_text(data: bytes, source: str | Path) -> str:
+    if len(data) > MAX_BYTES:
+        raise HostileInputError(f"file is {len(data)} bytes; at most {MAX_BYTES} are accepted", source)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise UnreadableError(f"not UTF-8 text ({exc.reason})", path) from exc
+        raise UnreadableError(f"not UTF-8 text ({exc.reason})", source) from exc
     for count, m in enumerate(_PREFIX.finditer(text), start=1):
         if count > MAX_PREFIXES:
-            raise HostileInputError(f"more than {MAX_PREFIXES} prefix declarations", path,
+            raise HostileInputError(f"more than {MAX_PREFIXES} prefix declarations", source,
                                     text.count("\n", 0, m.start()) + 1)
     return text
 
 
 def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
     """Parse a Turtle file; returns the graph and the text (for line look-ups)."""
+    return parse_turtle_bytes(read_bytes(path), path)
+
+
+def parse_turtle_bytes(data: bytes, path: str | Path) -> tuple[rdflib.Graph, str]:
+    """Parse Turtle text as if it were the file at ``path`` (its relative IRIs resolve against it, and
+    messages name it); returns the graph and the text (for line look-ups). Nothing is read from ``path``."""
     p = Path(path)
-    text = read_turtle_text(p)
+    text = _turtle_text(data, p)
     g = rdflib.Graph()
     try:
         with warnings.catch_warnings():  # rdflib warns (and logs) about odd literals and IRIs: no chatter

@@ -15,10 +15,17 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypedDict
 
 from plugnproduce import reasoning
-from plugnproduce.description.loader import cell_libraries, load_cell, load_devices, load_task
+from plugnproduce.description.loader import (
+    cell_libraries,
+    load_cell,
+    load_devices,
+    load_task,
+    parse_task,
+    task_to_yaml,
+)
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
@@ -31,6 +38,7 @@ if TYPE_CHECKING:  # validation, code generation and execution are imported by t
     from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
     from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
+    from plugnproduce.ontology.taxonomy import Taxonomy
     from plugnproduce.reasoning.impact import Impact
     from plugnproduce.validation import Report
 
@@ -68,6 +76,13 @@ def validate(paths: list[str | Path], knowledge: Knowledge | None = None,
     return validate_paths(paths, _k(knowledge), progress=progress)
 
 
+def validate_tasks(tasks: list[Task], knowledge: Knowledge | None = None) -> Report:
+    """Validate tasks already read (e.g. from an editor's YAML) as :func:`validate` validates task files."""
+    from plugnproduce.validation import validate_tasks as validate_read
+
+    return validate_read(tasks, _k(knowledge))
+
+
 def cell(path: str | Path, knowledge: Knowledge | None = None) -> Cell:
     """Read a cell file (with the libraries it lists, added to ``knowledge``)."""
     k = knowledge_for_cell(path, knowledge)
@@ -85,10 +100,41 @@ def task(path: str | Path) -> Task:
     return load_task(path)
 
 
+def task_from_text(data: bytes | str, name: str) -> Task:
+    """Read a task description from YAML text (an upload, an editor's buffer); ``name`` names it in messages."""
+    return parse_task(data.encode("utf-8") if isinstance(data, str) else data, name)
+
+
+def task_text(the_task: Task, block: bool = False) -> str:
+    """A task as a YAML task file (``block``: every value on a line of its own)."""
+    return task_to_yaml(the_task, block)
+
+
 def builtin(*parts: str) -> Path:
     """A path inside the built-in descriptions, e.g. ``builtin("cells", "bin-picking.yaml")``."""
     return descriptions_path().joinpath(*parts)
 
+
+
+class DeviceView(TypedDict):
+    """A device as every face shows it (``pnp discover --json``, the HTTP API, the page)."""
+
+    id: str
+    label: str
+    classes: list[str]
+    """The labels of its classes in the taxonomy."""
+    skills: list[str]
+    """The labels of its skills."""
+    protocol: str
+    endpoint: str
+
+
+def device_view(device: DeviceDescription, taxonomy: Taxonomy) -> DeviceView:
+    """The one JSON view of a device both faces give: id, label, classes, skills, protocol, endpoint."""
+    return {"id": device.id, "label": device.label,
+            "classes": [taxonomy.label(c) for c in device.classes],
+            "skills": [taxonomy.label(s) for s in device.skills],
+            "protocol": device.protocol, "endpoint": device.endpoint}
 
 
 CellArg = Cell | str | Path
@@ -221,19 +267,49 @@ class Generated:
     charts: list[GeneratedChart]
 
 
+@dataclass(frozen=True)
+class Generation:
+    """The plausibility check of a task and, when it is plausible, its generated program (else None)."""
+
+    check: reasoning.CheckResult
+    generated: Generated | None
+
+    @property
+    def charts(self) -> list[GeneratedChart]:
+        """The charts written for the task (none for an implausible task)."""
+        return self.generated.charts if self.generated is not None else []
+
+
+def _generate_task(the_task: Task, the_cell: Cell, result: reasoning.CheckResult, k: Knowledge) -> GeneratedTask:
+    from plugnproduce.codegen import generate_task
+
+    return generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
+
+
+def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,
+               knowledge: Knowledge | None = None) -> Generation:
+    """Check a task and, when it is plausible, generate its charts (as :func:`generate`).
+
+    An implausible task is a result here (``generated`` is None), not an error.
+    """
+    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    result = check(the_task, the_cell, k)
+    if not result.plausible:
+        return Generation(result, None)
+    from plugnproduce.codegen.outputs import all_charts
+
+    generated = _generate_task(the_task, the_cell, result, k)
+    return Generation(result, Generated(generated, all_charts(generated, the_cell, per_device)))
+
+
 def generate(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,
              knowledge: Knowledge | None = None) -> Generated:
     """Check a task, then generate its specific process charts, task chart, closed-world chart and,
     with ``per_device``, each device's program. Raises :class:`ImplausibleTask` for an implausible task."""
-    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
-    result = check(the_task, the_cell, k)
-    if not result.plausible:
-        raise ImplausibleTask(result)
-    from plugnproduce.codegen import generate_task
-    from plugnproduce.codegen.outputs import all_charts
-
-    generated = generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
-    return Generated(generated, all_charts(generated, the_cell, per_device))
+    result = generation(task_or_path, cell_or_path, per_device, knowledge)
+    if result.generated is None:
+        raise ImplausibleTask(result.check)
+    return result.generated
 
 
 # ------------------------------------------------------------------ execution
@@ -288,17 +364,13 @@ async def run_task(
     before anything runs.
     """
     from plugnproduce.discovery import LiveCell
-    from plugnproduce.executor.run import TaskRun
     from plugnproduce.protocols.upnp import network_from_env, private_network
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     say = progress or (lambda _: None)
     say("checking the task in the cell")
     the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
-    if not (result := check(the_task, the_cell, k)).plausible:
-        raise ImplausibleTask(result)
-    say(f"generating the charts of {len(the_task.steps)} step(s)")
-    generated = generate(the_task, the_cell, knowledge=k).task
+    generated = plan_run(the_task, the_cell, k, progress=say)
     journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
     network = private_network() if simulate else network_from_env()
     async with contextlib.AsyncExitStack() as stack:
@@ -312,7 +384,7 @@ async def run_task(
                                                         expected=wanted))
         devices = await find_devices(live, wanted, discovery_timeout)
         say("running")
-        run = TaskRun(generated, devices, journal, observer)
+        run = start_run(generated, devices, journal, observer)
         if started is not None:
             started(run)
         follow = asyncio.create_task(_follow_unplugs(live, run))
@@ -320,6 +392,31 @@ async def run_task(
             return await run.run()
         finally:
             follow.cancel()
+
+
+def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None,
+             progress: Callable[[str], None] | None = None) -> GeneratedTask:
+    """Check a task and generate only what a run needs: the task chart (no closed-world chart, no device
+    programs, no chart written). Raises :class:`ImplausibleTask` for an implausible task."""
+    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    if not (result := check(the_task, the_cell, k)).plausible:
+        raise ImplausibleTask(result)
+    if progress is not None:
+        progress(f"generating the charts of {len(the_task.steps)} step(s)")
+    return _generate_task(the_task, the_cell, result, k)
+
+
+def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
+              observer: RecordObserver | None = None) -> TaskRun:
+    """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
+    real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
+
+    Both faces start runs this way: ``pnp run`` after discovering the cell's devices
+    (:func:`run_task`), the HMI with the devices its cell source follows.
+    """
+    from plugnproduce.executor.run import TaskRun
+
+    return TaskRun(generated, devices, journal, observer)
 
 
 async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:

@@ -11,6 +11,7 @@ from plugnproduce.description.loader import (
     load_device,
     load_process,
     load_task,
+    parse_task,
     task_to_yaml,
 )
 from plugnproduce.description.model import Command
@@ -108,3 +109,36 @@ def test_cell_with_missing_device_file(tmp_path: Path, taxonomy: Taxonomy) -> No
     with pytest.raises(DescriptionError, match="nowhere.ttl not found") as err:
         load_cell(f, taxonomy)
     assert err.value.line == 3
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in (D / "tasks").glob("*.yaml")))
+def test_a_task_read_from_bytes_is_the_task_read_from_its_file(name: str) -> None:
+    path = D / "tasks" / name
+    from_file, from_bytes = load_task(path), parse_task(path.read_bytes(), "upload.yaml")
+    assert from_bytes.file == "upload.yaml"
+    assert from_bytes.steps == from_file.steps and from_bytes.repeat == from_file.repeat
+    assert [s.param_lines for s in from_bytes.steps] == [s.param_lines for s in from_file.steps]
+
+
+@pytest.mark.parametrize("block", [False, True])
+def test_the_task_writer_writes_one_round_and_reads_back_the_same_steps(block: bool) -> None:
+    task = load_task(D / "tasks" / "bin-picking.yaml")
+    text = task_to_yaml(task, block=block)
+    assert text.count("command:") == len(task.one_round()) == 2
+    back = parse_task(text.encode(), "written.yaml")
+    assert [(s.index, s.command, s.bind, s.params) for s in back.steps] == \
+        [(s.index, s.command, s.bind, s.params) for s in task.steps]
+    assert back.repeat == task.repeat == 3
+
+
+def test_a_block_written_task_puts_each_parameter_on_its_own_line() -> None:
+    task = load_task(D / "tasks" / "bin-picking.yaml")
+    back = parse_task(task_to_yaml(task, block=True).encode(), "written.yaml")
+    lines = [line for s in back.one_round() for line in s.param_lines.values()]
+    assert len(lines) == len(set(lines)) == sum(len(s.params) for s in task.one_round())
+
+
+def test_bad_task_text_names_its_source_and_line() -> None:
+    with pytest.raises(DescriptionError) as err:
+        parse_task(b"task: t\nsteps:\n  - command: pick\n    colour: red\n", "mine.yaml")
+    assert (err.value.file, err.value.line) == ("mine.yaml", 4)

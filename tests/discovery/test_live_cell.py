@@ -104,7 +104,7 @@ async def test_a_bad_device_is_refused_and_the_others_are_still_followed(network
             refused = await live.next_change(WAIT)
             assert refused.kind == "refused" and "\n" not in refused.reason
             assert "root:" not in refused.reason  # nothing of a local file is read, let alone quoted
-            assert "pnp-live-" not in refused.reason  # nor where the controller keeps the device's files
+            assert "pnp-live-" not in refused.reason and "/served/" not in refused.reason  # nor a folder of the controller
         honest = sensor_server(network)
         await honest.start()
         assert ("plug", "sensor3d") in await changes_until(live, "plug", "sensor3d")
@@ -133,3 +133,19 @@ async def test_an_expected_device_that_never_answers_costs_the_window_only(netwo
     async with sensor_server(network), asyncio.timeout(WAIT):
         async with LiveCell(taxonomy, network=network, search_timeout=1, expected=["gripper", "sensor3d"]) as live:
             assert [d.id for d in live.cell.devices] == ["sensor3d"]
+
+
+async def test_a_device_is_read_from_the_files_it_serves_without_writing_them(network, taxonomy,
+                                                                             monkeypatch) -> None:
+    import tempfile
+
+    def refuse(*_: object, **__: object) -> str:
+        raise AssertionError("discovery wrote a device's files to disk")
+
+    monkeypatch.setattr(tempfile, "mkdtemp", refuse)
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    async with sensor_server(network), LiveCell(taxonomy, network=network) as live:
+        assert await changes_until(live, "plug", "sensor3d") == [("plug", "sensor3d")]
+        device = live.cell.device("sensor3d")
+        assert {s.id for s in device.states} == {"ready", "capturing", "captured"}
+        assert device.chart.states() and device.initial == "ready"

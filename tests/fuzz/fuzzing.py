@@ -336,10 +336,8 @@ def run_served(ws: Workspace, device: str, description: bytes, chart: bytes, loc
     files = RemoteFiles(f"{base}/{device}.ttl", description.decode("utf-8", "replace"), f"{base}/{device}.scxml",
                         chart.decode("utf-8", "replace"))
     found = FoundDevice("uuid:fuzz", location, "urn:schemas-plugnproduce-org:device:Device:1", "fuzz", "127.0.0.1")
-    folder = ws.root / "served"
-    shutil.rmtree(folder, ignore_errors=True)
     try:
-        read_served(files, found, folder, service.knowledge().taxonomy)
+        read_served(files, found, service.knowledge().taxonomy)
     except (DescriptionError, ProtocolError) as exc:
         return _refused(exc, description + b"\n" + chart)
     return "accepted"

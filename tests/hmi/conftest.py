@@ -25,12 +25,6 @@ CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 
-needs_reasoner = pytest.mark.skipif(
-    not callable(getattr(service, "capabilities", None)),
-    reason="the reasoner's use cases (service.capabilities, check, repair, explain) are not in service.py yet",
-)
-
-
 @dataclass
 class Hmi:
     """An HMI application and what it was built over."""

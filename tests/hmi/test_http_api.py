@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import asyncio
+import json
+import os
+import subprocess
+import sys
 from collections.abc import AsyncIterator
 
 import httpx
@@ -9,7 +14,7 @@ import pytest
 import yaml
 
 from plugnproduce import service
-from tests.hmi.conftest import AUTH, Hmi, needs_reasoner
+from tests.hmi.conftest import AUTH, Hmi
 
 BIN_PICK = {"command": "bin-pick", "params": {"grip_force": 45, "exposure": 25}}
 PLACE = {"command": "place", "params": {"place_pose": [0.6, -0.2, 0.1, 0, 180, 0], "speed": 80}}
@@ -179,20 +184,17 @@ async def test_unknown_names_get_the_cli_message(client: httpx.AsyncClient) -> N
 # ------------------------------------------------------------------ with the reasoner
 
 
-@needs_reasoner
 async def test_the_bin_picking_cell_offers_pick_place_pick_and_place_and_bin_pick(client: httpx.AsyncClient) -> None:
     offered = {o["command"] for o in (await client.get("/api/commands")).json()["offered"]}
     assert {"pick", "place", "pick-and-place", "bin-pick"} <= offered
 
 
-@needs_reasoner
 async def test_a_command_not_offered_is_explained(client: httpx.AsyncClient) -> None:
     ex = (await client.get("/api/commands/screw/explanation")).json()
     assert ex["offered"] is False
     assert any("pnp:CanScrew" in r["text"] for r in ex["reasons"])
 
 
-@needs_reasoner
 async def test_unplugging_the_gripper_withdraws_pick(client: httpx.AsyncClient) -> None:
     res = await client.delete("/api/cell/devices/gripper", headers=AUTH)
     assert res.status_code == 200
@@ -206,7 +208,6 @@ async def test_plugging_a_device_twice_is_a_conflict(client: httpx.AsyncClient) 
     assert res.status_code == 409 and res.json()["detail"] == "error: device 'gripper' is in cell 'bin-picking' already"
 
 
-@needs_reasoner
 async def test_check_puts_the_problem_at_its_step(client: httpx.AsyncClient) -> None:
     result = (await client.post("/api/task/check", json=INVALID)).json()
     assert result["plausible"] is False
@@ -214,7 +215,6 @@ async def test_check_puts_the_problem_at_its_step(client: httpx.AsyncClient) -> 
     assert (problem["step"], problem["row"], problem["kind"], problem["device"]) == (2, 1, "wrong_state", "gripper")
 
 
-@needs_reasoner
 async def test_repairs_are_ranked_tasks_ready_to_apply(client: httpx.AsyncClient) -> None:
     result = (await client.post("/api/task/repair?top=2", json=INVALID)).json()
     first = result["repairs"][0]
@@ -224,7 +224,6 @@ async def test_repairs_are_ranked_tasks_ready_to_apply(client: httpx.AsyncClient
     assert fixed["plausible"] is True
 
 
-@needs_reasoner
 async def test_explain_a_step(client: httpx.AsyncClient) -> None:
     ex = (await client.post("/api/task/explain?step=2", json=INVALID)).json()
     assert ex["plausible"] is False and any("left there by step 1" in s["text"] for s in ex["states"])
@@ -232,7 +231,6 @@ async def test_explain_a_step(client: httpx.AsyncClient) -> None:
     assert res.status_code == 404 and res.json()["detail"] == "error: unknown step 9; the task has steps 1 to 3"
 
 
-@needs_reasoner
 async def test_generate_gives_scxml_and_pictures(client: httpx.AsyncClient) -> None:
     result = (await client.post("/api/task/generate", json=TASK)).json()
     names = [c["name"] for c in result["charts"]]
@@ -244,7 +242,6 @@ async def test_generate_gives_scxml_and_pictures(client: httpx.AsyncClient) -> N
     assert svg.headers["content-type"] == "image/svg+xml"
 
 
-@needs_reasoner
 async def test_a_task_chart_lists_its_steps_and_draws_one_expanded(client: httpx.AsyncClient) -> None:
     result = (await client.post("/api/task/generate", json=TASK)).json()
     task_chart = next(c for c in result["charts"] if c["kind"] == "task")
@@ -256,7 +253,6 @@ async def test_a_task_chart_lists_its_steps_and_draws_one_expanded(client: httpx
     assert (await client.get(task_chart["svg"] + "?step=0")).status_code == 422
 
 
-@needs_reasoner
 async def test_generating_an_implausible_task_is_a_result(client: httpx.AsyncClient) -> None:
     result = (await client.post("/api/task/generate", json=INVALID)).json()
     assert result["plausible"] is False and result["charts"] == [] and result["problems"][0]["step"] == 2
@@ -292,3 +288,35 @@ async def test_a_task_too_long_once_repeated_is_refused(client: httpx.AsyncClien
     res = await client.post("/api/task/check", json=body)
     assert res.status_code == 422
     assert "1000 steps repeated 1000 times make 1000000; at most 10000 are accepted" in res.json()["detail"]
+
+
+async def test_discover_json_shows_each_device_with_the_keys_and_values_of_the_http_api(
+        client: httpx.AsyncClient, hmi: Hmi) -> None:
+    """One device view: ``pnp discover --json`` on the HMI's simulated cell and ``GET /api/cell`` agree."""
+    over_http = {d["id"]: d for d in (await client.get("/api/cell")).json()["devices"]}
+    env = {**os.environ, "PNP_SSDP_PORT": str(hmi.source.network.port)}
+    done = await asyncio.to_thread(subprocess.run, [sys.executable, "-m", "plugnproduce", "discover", "--json"],
+                                   env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    discovered = json.loads(done.stdout)["devices"]
+    assert sorted(d["id"] for d in discovered) == sorted(over_http)
+    for device in discovered:
+        assert set(device) == {"id", "label", "classes", "skills", "protocol", "endpoint"}
+        assert device == {key: over_http[device["id"]][key] for key in device}, device["id"]
+
+
+async def test_the_editor_task_is_validated_imported_and_drawn_without_temporary_files(
+        client: httpx.AsyncClient, monkeypatch: pytest.MonkeyPatch) -> None:
+    import tempfile
+
+    def refuse(*_: object, **__: object) -> str:
+        raise AssertionError("a temporary file was made")
+
+    monkeypatch.setattr(tempfile, "mkdtemp", refuse)
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    assert (await client.post("/api/task/validate", json=TASK)).json()["valid"] is True
+    text = (await client.post("/api/task/export", json=TASK)).text
+    assert (await client.post("/api/task/import", content=text.encode(), headers=YAML)).json()["repeat"] == 3
+    chart = next(c for c in (await client.post("/api/task/generate", json=TASK)).json()["charts"] if c["kind"] == "task")
+    svg = await client.get(chart["svg"])
+    assert svg.status_code == 200 and svg.content.lstrip().startswith((b"<?xml", b"<svg"))

@@ -11,7 +11,7 @@ import httpx
 import pytest
 
 from plugnproduce.hmi.hub import Hub
-from tests.hmi.conftest import AUTH, Hmi, Served, needs_reasoner
+from tests.hmi.conftest import AUTH, Hmi, Served
 
 TASK = {"name": "pick-and-place", "steps": [{"command": "pick-and-place"}, {"command": "move-to"}]}
 
@@ -22,7 +22,6 @@ async def _until_end(client: httpx.AsyncClient, hmi: Hmi, run_id: str) -> dict[s
     return dict((await client.get(f"/api/runs/{run_id}")).json())
 
 
-@needs_reasoner
 async def test_a_run_walks_every_step_and_journals_it(client: httpx.AsyncClient, hmi: Hmi) -> None:
     res = await client.post("/api/runs", json={"task": TASK}, headers=AUTH)
     assert res.status_code == 202 and res.json()["status"] == "running"
@@ -38,7 +37,6 @@ async def test_a_run_walks_every_step_and_journals_it(client: httpx.AsyncClient,
     assert listed["active"] is None and listed["runs"][0]["status"] == "succeeded"
 
 
-@needs_reasoner
 async def test_a_device_lost_during_a_run_is_a_fault(client: httpx.AsyncClient, hmi: Hmi) -> None:
     hub = hmi.app.state.hub
     gripper_busy = asyncio.Event()
@@ -60,21 +58,18 @@ async def test_a_device_lost_during_a_run_is_a_fault(client: httpx.AsyncClient, 
                              if r["seq"] > fault["seq"]]
 
 
-@needs_reasoner
 async def test_a_run_can_be_stopped(client: httpx.AsyncClient) -> None:
     run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
     run = (await client.post(f"/api/runs/{run_id}/stop", headers=AUTH)).json()
     assert run["status"] == "stopped" and run["end"]["reason"].endswith(": stopped by the operator")
 
 
-@needs_reasoner
 async def test_a_second_run_waits_for_the_first(client: httpx.AsyncClient) -> None:
     first = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
     res = await client.post("/api/runs", json={"task": TASK}, headers=AUTH)
     assert res.status_code == 409 and res.json()["detail"] == f"error: run {first} is still running; stop it first"
 
 
-@needs_reasoner
 async def test_an_implausible_task_does_not_start(client: httpx.AsyncClient) -> None:
     task = {"name": "t", "steps": [{"command": "pick"}, {"command": "pick"}]}
     res = await client.post("/api/runs", json={"task": task}, headers=AUTH)
@@ -103,7 +98,6 @@ async def _next(events: AsyncIterator[tuple[str, dict[str, object]]], name: str)
     raise AssertionError(f"the stream ended before a {name!r} event")
 
 
-@needs_reasoner
 async def test_unplug_reaches_the_event_stream(served: Served) -> None:
     # How soon is measured by bench/bench_discovery.py; here only that it comes (within a generous bound).
     async with httpx.AsyncClient(base_url=served.url, timeout=60) as client:
@@ -120,7 +114,6 @@ async def test_unplug_reaches_the_event_stream(served: Served) -> None:
             await events.aclose()
 
 
-@needs_reasoner
 async def test_run_progress_reaches_the_event_stream(served: Served) -> None:
     async with httpx.AsyncClient(base_url=served.url, timeout=60) as client:
         async with client.stream("GET", "/events") as response:

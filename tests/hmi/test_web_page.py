@@ -12,7 +12,7 @@ import yaml
 from playwright.sync_api import Page, expect
 
 from plugnproduce import service
-from tests.hmi.conftest import AUTH, Served, needs_reasoner, screenshot
+from tests.hmi.conftest import AUTH, Served, screenshot
 
 expect.set_options(timeout=30_000)  # a bound, not a speed: CI runs the suite on a fully loaded machine
 
@@ -44,7 +44,6 @@ def steps(page: Page) -> list[str]:
     return page.locator("#steps li.step").evaluate_all("els => els.map(e => e.dataset.command)")
 
 
-@needs_reasoner
 def test_build_the_bin_picking_task_through_the_dialogs(page: Page) -> None:
     page.locator("#task-name").fill("bin-picking")
     page.locator("#task-name").press("Tab")
@@ -84,7 +83,6 @@ def test_an_out_of_range_value_is_refused_with_the_shape_message(page: Page) -> 
     assert steps(page) == []
 
 
-@needs_reasoner
 def test_an_invalid_task_shows_its_problem_at_its_step_and_a_repair_fixes_it(page: Page) -> None:
     page.locator("#import").set_input_files(str(service.builtin("tasks", "bin-picking-invalid.yaml")))
     second = page.locator("#steps li.step[data-row='1']")
@@ -100,7 +98,6 @@ def test_an_invalid_task_shows_its_problem_at_its_step_and_a_repair_fixes_it(pag
     assert steps(page) == ["bin-pick", "open-gripper", "bin-pick", "place"]
 
 
-@needs_reasoner
 def test_unplugging_the_gripper_takes_pick_away(page: Page, served: Served) -> None:
     pick = page.locator("#offered li[data-command='pick']")
     expect(pick).to_be_visible()
@@ -114,7 +111,6 @@ def test_unplugging_the_gripper_takes_pick_away(page: Page, served: Served) -> N
     expect(page.locator("#why-pick")).to_contain_text("pnp:CanGrip")
 
 
-@needs_reasoner
 def test_a_device_plugged_in_elsewhere_shows_up_live(page: Page, served: Served) -> None:
     import httpx
 
@@ -142,7 +138,6 @@ SLOW_GRIPPER = "gripper:delay-event:gripper_closed:1"
 """The simulated gripper reports closed a second late (within its 2 s timeout): time to watch the run."""
 
 
-@needs_reasoner
 @pytest.mark.parametrize("served", [SLOW_GRIPPER], indirect=True)
 def test_a_run_on_the_simulated_cell_shows_its_step_and_device_states_to_the_end(page: Page) -> None:
     page.locator("#import").set_input_files(str(service.builtin("tasks", "pick-and-place.yaml")))
@@ -167,7 +162,6 @@ def test_a_run_on_the_simulated_cell_shows_its_step_and_device_states_to_the_end
     expect(page.locator("#steps li.step.running")).to_have_count(0)
 
 
-@needs_reasoner
 @pytest.mark.parametrize("served", [SLOW_GRIPPER], indirect=True)
 def test_a_device_unplugged_during_a_run_shows_the_fault_report(page: Page, served: Served) -> None:
     import httpx
@@ -196,7 +190,6 @@ def test_charts_of_devices_and_processes_are_shown(page: Page) -> None:
     screenshot(page, "charts-process")
 
 
-@needs_reasoner
 def test_generated_task_chart_is_shown(page: Page) -> None:
     page.locator("#import").set_input_files(str(service.builtin("tasks", "pick-and-place.yaml")))
     expect(page.locator("#verdict .ok")).to_be_visible()

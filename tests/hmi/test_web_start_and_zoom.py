@@ -10,13 +10,12 @@ import pytest
 from playwright.sync_api import Locator, Page, expect
 
 from plugnproduce import service
-from tests.hmi.conftest import needs_reasoner, screenshot
+from tests.hmi.conftest import screenshot
 
 CHART_SHOWN = "() => { const i = document.querySelector('#chart-img'); return i.complete && i.naturalWidth > 0; }"
 FITTED = "() => document.querySelector('#chart-frame').dataset.scale !== undefined"
 
 
-@needs_reasoner
 def test_an_implausible_task_cannot_be_started_and_the_last_run_s_step_is_cleared(page: Page) -> None:
     start = page.get_by_role("button", name="Start run")
     expect(start).to_be_disabled()  # no steps yet

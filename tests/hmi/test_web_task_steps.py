@@ -11,7 +11,7 @@ import re
 from playwright.sync_api import Page, expect
 
 from plugnproduce import service
-from tests.hmi.conftest import needs_reasoner, screenshot
+from tests.hmi.conftest import screenshot
 
 CHART_SHOWN = "() => { const i = document.querySelector('#chart-img'); return i.complete && i.naturalWidth > 0; }"
 DRAWN = """async () => {
@@ -33,7 +33,6 @@ def _generate_bin_picking(page: Page) -> None:
     page.wait_for_function(CHART_SHOWN)
 
 
-@needs_reasoner
 def test_a_task_chart_starts_with_its_first_step_expanded(page: Page) -> None:
     _generate_bin_picking(page)
     expect(page.locator("#chart-step")).to_have_value("1")
@@ -42,7 +41,6 @@ def test_a_task_chart_starts_with_its_first_step_expanded(page: Page) -> None:
     expect(page.get_by_role("button", name="Expand the previous step")).to_be_disabled()
 
 
-@needs_reasoner
 def test_expanding_a_step_collapses_the_others_to_process_and_binding(page: Page) -> None:
     _generate_bin_picking(page)
     page.locator("#chart-step").select_option("3")
@@ -58,7 +56,6 @@ def test_expanding_a_step_collapses_the_others_to_process_and_binding(page: Page
     screenshot(page, "charts-task-step-by-step")
 
 
-@needs_reasoner
 def test_the_step_buttons_walk_the_steps(page: Page) -> None:
     _generate_bin_picking(page)
     page.get_by_role("button", name="Expand the next step").click()
@@ -72,7 +69,6 @@ def test_the_step_buttons_walk_the_steps(page: Page) -> None:
     expect(page.locator("#chart-img")).to_have_attribute("src", re.compile(r".*bin-picking\.task\.scxml\.svg$"))
 
 
-@needs_reasoner
 def test_a_hundred_step_task_is_drawn_step_by_step(page: Page) -> None:
     page.locator("#import").set_input_files(str(service.builtin("tasks", "bin-picking.yaml")))
     expect(page.locator("#verdict .ok")).to_be_visible()

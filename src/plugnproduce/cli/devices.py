@@ -5,7 +5,7 @@ from __future__ import annotations
 import asyncio
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING, TypedDict
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -27,24 +27,9 @@ sim_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
 app.add_typer(sim_app, name="sim")
 
 
-DeviceRow = TypedDict("DeviceRow", {"id": str, "label": str, "class": list[str], "skills": list[str],
-                                     "protocol": str, "endpoint": str})
-"""A device as ``pnp discover`` shows it (``class`` is a Python keyword: hence the functional form)."""
-
-
-def _device_json(cell: Cell) -> list[DeviceRow]:
+def _device_json(cell: Cell) -> list[service.DeviceView]:
     taxonomy = knowledge().taxonomy
-    return [
-        {
-            "id": d.id,
-            "label": d.label,
-            "class": [taxonomy.label(c) for c in d.classes],
-            "skills": [taxonomy.label(s) for s in d.skills],
-            "protocol": d.protocol,
-            "endpoint": d.endpoint,
-        }
-        for d in cell.devices
-    ]
+    return [service.device_view(d, taxonomy) for d in cell.devices]
 
 
 def _offered(cell: Cell) -> list[str]:
@@ -82,7 +67,7 @@ async def _discover(json_out: bool, watch: bool, timeout: float) -> None:
             emit_json({"devices": _device_json(cell), "offered": _offered(cell)})
         else:
             for d in _device_json(cell):
-                typer.echo(f"{d['id']:16} {', '.join(d['class']):22} {d['protocol']:5} {', '.join(d['skills'])}")
+                typer.echo(f"{d['id']:16} {', '.join(d['classes']):22} {d['protocol']:5} {', '.join(d['skills'])}")
             typer.echo(f"offered: {', '.join(_offered(cell)) or 'nothing'}")
         shown = {d.id for d in cell.devices}
         while watch:

@@ -7,7 +7,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
@@ -33,8 +33,15 @@ from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
 from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import PlainDumper, parse_turtle, parse_yaml_node
-from plugnproduce.statechart.io.reader import read_chart
+from plugnproduce.safeio import (
+    PlainDumper,
+    parse_turtle,
+    parse_turtle_bytes,
+    parse_yaml_bytes,
+    parse_yaml_node,
+    read_bytes,
+)
+from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 
@@ -60,6 +67,14 @@ def read_description(path: str | Path) -> Loaded:
     """Parse a Turtle description file."""
     p = Path(path)
     g, text = parse_turtle(p)
+    return Loaded(p, g, text)
+
+
+def parse_description(data: bytes, path: str | Path) -> Loaded:
+    """Parse a Turtle description from bytes as if it were the file at ``path`` (relative IRIs resolve
+    against it, messages name it); nothing is read from disk."""
+    p = Path(path)
+    g, text = parse_turtle_bytes(data, p)
     return Loaded(p, g, text)
 
 
@@ -110,8 +125,12 @@ def _unknown_device_class(loaded: Loaded, taxonomy: Taxonomy) -> None:
                 raise DescriptionError(unknown_class(str(s), str(c), taxonomy), loaded.path, loaded.line(str(s)))
 
 
-def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
-    """Build the device of a parsed description, with its chart and reasoned skills."""
+def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes] | None = None) -> DeviceDescription:
+    """Build the device of a parsed description, with its chart and reasoned skills.
+
+    The chart is read from the file its ``pnp:stateChart`` names or, given ``charts`` (SCXML by path,
+    e.g. the files a device serves), taken from there only: a chart not among them is an error.
+    """
     s = device_subject(loaded, taxonomy)
     classes = tuple(sorted(str(c) for c in loaded.graph.objects(s, RDF.type) if taxonomy.is_kind(str(c), "Device")))
     declared = tuple(sorted(str(k) for k in loaded.graph.objects(s, PNP.hasSkill)))
@@ -121,7 +140,14 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy) -> DeviceDescription:
             f"unknown protocol {local_name(protocol)}; expected pnp:XIRP or pnp:UPnP", loaded.path, loaded.line(str(s))
         )
     chart_file = file_of(_one(loaded, s, PNP.stateChart, "state chart"))
-    chart = read_chart(chart_file)
+    if charts is None:
+        chart = read_chart(chart_file)
+    elif chart_file in charts:
+        chart = parse_chart(charts[chart_file], chart_file)
+    else:
+        raise DescriptionError(f"{local_name(str(s))} names chart {chart_file.name}; expected one of "
+                               f"{', '.join(sorted(c.name for c in charts)) or 'none'}",
+                               loaded.path, loaded.line(str(s)))
     initial, states, transitions = device_chart(chart, chart_file)
     timeout = _opt(loaded, s, PNP.commandTimeout)
     cost = _opt(loaded, s, PNP.cost)
@@ -288,8 +314,13 @@ def _str_map(node: yaml.Node | None, path: Path, what: str) -> dict[str, object]
 
 def load_task(path: str | Path) -> Task:
     """Read a task description (YAML)."""
-    p = Path(path)
-    top = _mapping(parse_yaml_node(p), p, "task")
+    return parse_task(read_bytes(path), path)
+
+
+def parse_task(data: bytes, source: str | Path) -> Task:
+    """Read a task description from YAML text; ``source`` names it in messages and in ``Task.file``."""
+    p = Path(source)
+    top = _mapping(parse_yaml_bytes(data, p), p, "task")
     _unknown_keys(top, {"task", "description", "repeat", "steps"}, p, "task")
     if "task" not in top or "steps" not in top:
         raise DescriptionError("a task needs 'task' (its name) and 'steps'", p, 1)
@@ -304,8 +335,8 @@ def load_task(path: str | Path) -> Task:
         raise DescriptionError(f"{len(steps_node.value)} steps repeated {repeat} times make "
                                f"{len(steps_node.value) * repeat}; at most {Task.MAX_STEPS} are accepted",
                                p, steps_node.start_mark.line + 1)
-    one_round: list[tuple[str, dict[str, str], dict[str, object], int, dict[str, int]]] = []
-    for node in steps_node.value:
+    one_round: list[Step] = []
+    for i, node in enumerate(steps_node.value):
         line = node.start_mark.line + 1
         m = _mapping(node, p, "step")
         _unknown_keys(m, {"command", "bind", "params"}, p, "step")
@@ -316,21 +347,18 @@ def load_task(path: str | Path) -> Task:
         lines = {}
         if isinstance(params, yaml.MappingNode):
             lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value}
-        one_round.append((str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
-    steps = [
-        Step(i * len(one_round) + j + 1, cmd, bind, params, line, lines)
-        for i in range(repeat)
-        for j, (cmd, bind, params, line, lines) in enumerate(one_round)
-    ]
+        one_round.append(Step(i + 1, str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
     description = _plain(top["description"]) if "description" in top else ""
-    return Task(str(_plain(top["task"])), tuple(steps), str(p), str(description or ""), repeat)
+    return Task.repeated(str(_plain(top["task"])), one_round, str(p), str(description or ""), repeat)
 
 
-def task_to_yaml(task: Task) -> str:
-    """Write a task back as YAML (one round of its steps when it repeats)."""
-    n = len(task.steps) // task.repeat
+def task_to_yaml(task: Task, block: bool = False) -> str:
+    """Write a task as a task file (one round of its steps when it repeats): the one task writer.
+
+    ``block`` puts every value on a line of its own, so that a finding's line names its field.
+    """
     steps = []
-    for s in task.steps[:n]:
+    for s in task.one_round():
         entry: dict[str, object] = {"command": s.command}
         if s.bind:
             entry["bind"] = dict(s.bind)
@@ -343,7 +371,8 @@ def task_to_yaml(task: Task) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = steps
-    return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=None)
+    return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=False if block else None,
+                     allow_unicode=True)
 
 
 def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:

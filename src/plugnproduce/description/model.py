@@ -7,6 +7,8 @@ finding can say where it rests.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -217,6 +219,22 @@ class Task:
     file: str
     description: str = ""
     repeat: int = 1
+
+    @classmethod
+    def repeated(cls, name: str, one_round: Sequence[Step], file: str, description: str = "",
+                 repeat: int = 1) -> Task:
+        """The task whose steps are ``one_round`` done ``repeat`` times, numbered from 1 in that order.
+
+        The one place a task's repeats are expanded (task files and the HTTP API's tasks alike).
+        """
+        n = len(one_round)
+        steps = tuple(dataclasses.replace(s, index=r * n + i + 1) for r in range(repeat)
+                      for i, s in enumerate(one_round))
+        return cls(name, steps, file, description, repeat)
+
+    def one_round(self) -> tuple[Step, ...]:
+        """The steps as written once, before the repeats."""
+        return self.steps[: len(self.steps) // max(self.repeat, 1)]
 
     def where(self, step: Step, parameter: str | None = None) -> Where:
         """The place of a step (or of one of its parameter values) in the task file."""

@@ -15,15 +15,13 @@ import asyncio
 import contextlib
 import logging
 import re
-import shutil
-import tempfile
 from collections.abc import AsyncIterator, Collection
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 from urllib.parse import urlparse
 
-from plugnproduce.description.loader import file_of, load_device, read_description
+from plugnproduce.description.loader import device_from, file_of, parse_description
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout, excerpt
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -44,6 +42,10 @@ from plugnproduce.protocols.upnp import (
 from plugnproduce.protocols.xirp import parse_endpoint
 
 _LOGGER = logging.getLogger(__name__)
+
+SERVED = Path("/served")
+"""Where a discovered device's files are said to be: a name for messages and relative IRIs, never a folder
+on disk (a device's chart is only the chart it serves)."""
 
 CONFIRM_TIMEOUT = 1.0
 """Seconds a device's address is given to answer before its byebye is believed."""
@@ -91,7 +93,6 @@ class LiveCell:
         self._changes: asyncio.Queue[CellChange] = asyncio.Queue()
         self._listener = AdvertisementListener(network)
         self._task: asyncio.Task[None] | None = None
-        self._workdir = Path(tempfile.mkdtemp(prefix="pnp-live-"))
 
     @property
     def cell(self) -> Cell:
@@ -129,7 +130,6 @@ class LiveCell:
                 with contextlib.suppress(asyncio.CancelledError):
                     await task
         await self._listener.stop()
-        shutil.rmtree(self._workdir, ignore_errors=True)
 
     async def changes(self) -> AsyncIterator[CellChange]:
         """Every change from now on (and the ones not yet taken), as they happen."""
@@ -216,28 +216,27 @@ class LiveCell:
         """Fetch the device's own description files and read them as any description."""
         async with await UpnpDeviceClient.from_found(found) as client:
             files = await client.fetch_files()
-        return read_served(files, found, self._workdir / _safe_name(found.udn), self.taxonomy)
+        return read_served(files, found, self.taxonomy)
 
 
-def read_served(files: RemoteFiles, found: FoundDevice, folder: Path, taxonomy: Taxonomy) -> DeviceDescription:
-    """Read the description and chart a device served (fetched already) in ``folder``, as any description.
+def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> DeviceDescription:
+    """Read the description and chart a device served (fetched already) as any description, from memory.
 
     The chart must be the one the device serves and an XIRP endpoint must be on the host the
     device was found at; anything else is refused (:class:`DescriptionError`, :class:`ProtocolError`),
-    with the URL the device served the file at, never the folder it was kept in.
+    naming the URL the device served the file at.
     """
-    folder.mkdir(exist_ok=True)
+    folder = SERVED / _safe_name(found.udn)  # names the files for messages and relative IRIs; nothing is written
     ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
-    ttl.write_text(files.description, encoding="utf-8")
     chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
-    chart.write_text(files.chart, encoding="utf-8")
     try:
-        for named in read_description(ttl).graph.objects(None, PNP.stateChart):
+        loaded = parse_description(files.description.encode("utf-8"), ttl)
+        for named in loaded.graph.objects(None, PNP.stateChart):
             if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
                 raise DescriptionError(f"device {found.udn} names its chart <{excerpt(str(named))}>; expected "
                                        f"the chart it serves ({chart.name})", ttl)
-        device = load_device(ttl, taxonomy)
-    except DescriptionError as exc:
+        device = device_from(loaded, taxonomy, charts={chart: files.chart.encode("utf-8")})
+    except DescriptionError as exc:  # say where the device serves the file, not the name it was read under
         served = {str(ttl): files.description_url, str(chart): files.chart_url}
         raise DescriptionError(exc.message.replace(str(folder), ""), served.get(exc.file or "", found.location),
                                exc.line) from exc
@@ -245,6 +244,6 @@ def read_served(files: RemoteFiles, found: FoundDevice, folder: Path, taxonomy: 
         return replace(device, endpoint=found.location)
     host = urlparse(found.location).hostname
     if parse_endpoint(device.endpoint)[0] != host:
-        raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {device.endpoint} "
+        raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {excerpt(device.endpoint)} "
                                 "on another host; refused")
     return device

@@ -63,12 +63,18 @@ def draw_chart(path: str | Path, output: str | Path, *, expand: int | None = Non
     fmt = out.suffix.lstrip(".").lower()
     if fmt not in FORMATS:
         raise DescriptionError(f"cannot draw to {out.name}; expected a file ending in .svg, .png, .pdf or .dot", out)
-    graph = chart_to_dot(path, expand=expand)
-    if fmt == "dot":
-        out.write_text(graph.source)
-        return out
-    out.write_bytes(run_dot(graph, fmt, out))
+    out.write_bytes(render_chart(path, fmt, out, expand=expand))
     return out
+
+
+def render_chart(chart: Chart | str | Path, fmt: str = "svg", where: str | Path = "picture",
+                 name: str | None = None, *, expand: int | None = None) -> bytes:
+    """A chart (a model, or an SCXML file) drawn in ``fmt`` (svg, png, pdf or dot), in memory; ``where``
+    names the picture in messages; of a task chart, step ``expand`` (from 1) is drawn with its regions."""
+    graph = chart_to_dot(chart, name, expand=expand)
+    if fmt == "dot":
+        return str(graph.source).encode("utf-8")
+    return run_dot(graph, fmt, where)
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,9 @@
 """The executor as the HMI's :class:`~plugnproduce.hmi.interfaces.Runner`.
 
-A run checks and generates the task for the cell as it is now, then runs the task chart
-against the cell's devices at the endpoints discovery found
-(:class:`~plugnproduce.executor.run.TaskRun`), journalling into the runs folder. A device
+A run takes the service's one path (:func:`plugnproduce.service.plan_run` checks the task for
+the cell as it is now and generates only its task chart; :func:`plugnproduce.service.start_run`
+runs it against the cell's devices at the endpoints discovery found), journalling into the
+runs folder. A device
 the cell source sees leave during the run is a lost device: the run stops with a fault.
 One run at a time.
 """
@@ -18,7 +19,7 @@ from pathlib import Path
 from plugnproduce import service
 from plugnproduce.description.model import Cell, Task
 from plugnproduce.executor.journal import read_journal
-from plugnproduce.executor.run import TaskRun
+from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
 from plugnproduce.hmi.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
 from plugnproduce.knowledge import Knowledge
 
@@ -60,7 +61,7 @@ class ExecutorRunner:
         if active is not None:
             raise RunRefused(f"run {active} is still running; stop it first")
         try:
-            generated = (await asyncio.to_thread(service.generate, task, cell, False, self._knowledge)).task
+            generated = await asyncio.to_thread(service.plan_run, task, cell, self._knowledge)
         except service.ImplausibleTask as exc:
             first = exc.result.problems[0]
             raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc
@@ -71,7 +72,7 @@ class ExecutorRunner:
             started.set()
             observer(run_id, record)
 
-        run = TaskRun(generated, cell, self._dir / f"{run_id}.jsonl", observe)
+        run = service.start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe)
         self._loop = asyncio.get_running_loop()
         running = asyncio.create_task(run.run(), name=f"run {run_id}")
         running.add_done_callback(self._finished)

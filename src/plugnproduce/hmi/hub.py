@@ -25,11 +25,6 @@ QUEUE_SIZE = 512
 """Events kept for a page that is slow to read; a page further behind is dropped (its browser reconnects)."""
 
 
-def reasoner_available() -> bool:
-    """Whether the reasoner's use cases are in :mod:`plugnproduce.service` (capabilities, check, ...)."""
-    return callable(getattr(service, "capabilities", None))
-
-
 class Hub:
     """Current cell, device states and runs; every change is published to the subscribed pages."""
 
@@ -44,7 +39,7 @@ class Hub:
         self._loop: asyncio.AbstractEventLoop | None = None
         self._unsubscribe: Callable[[], None] | None = None
         self._lock = threading.Lock()
-        self._commands: tuple[Cell, dict[str, Any] | None] | None = None
+        self._commands: tuple[Cell, dict[str, Any]] | None = None
 
     # ------------------------------------------------------------------ lifecycle
 
@@ -76,13 +71,13 @@ class Hub:
         with self._lock:
             return dict(self._states)
 
-    def commands(self, cell: Cell | None = None) -> dict[str, Any] | None:
-        """Offered process commands (with bindings) and the others with reasons; None without the reasoner."""
+    def commands(self, cell: Cell | None = None) -> dict[str, Any]:
+        """Offered process commands (with bindings) and the others with reasons."""
         cell = cell or self.cell
         cached = self._commands
         if cached is not None and cached[0] is cell:
             return cached[1]
-        value = service.capabilities(cell, self.knowledge).to_json() if reasoner_available() else None
+        value = service.capabilities(cell, self.knowledge).to_json()
         self._commands = (cell, value)
         return value
 

@@ -1,18 +1,18 @@
-"""Pictures of charts for the page (SVG drawn by :func:`plugnproduce.drawing.draw_chart`), and the
+"""Pictures of charts for the page (SVG drawn by :func:`plugnproduce.drawing.render_chart`, in memory), and the
 charts generated for recent tasks, kept in memory so the page can fetch them by id."""
 
 from __future__ import annotations
 
 import hashlib
-import tempfile
 import threading
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from plugnproduce.codegen.outputs import GeneratedChart
-from plugnproduce.drawing import Step, draw_chart, find_plan
-from plugnproduce.statechart import parse_chart
+from plugnproduce.description.model import DeviceDescription
+from plugnproduce.drawing import Step, find_plan, render_chart
+from plugnproduce.statechart import parse_chart, write_chart
 
 
 class _Bounded(OrderedDict[str, object]):
@@ -38,19 +38,20 @@ class Pictures:
         """The picture of a chart file (redrawn when the file changes)."""
         p = Path(path)
         key = f"file:{p}:{p.stat().st_mtime_ns}"
-        return self._cached(key, lambda: self._draw(p))
+        return self._cached(key, lambda: render_chart(p, "svg", p))
+
+    def of_device(self, device: DeviceDescription) -> bytes:
+        """The picture of the Device State Chart a device carries (a discovered device's has no file on disk)."""
+        key = "device:" + hashlib.sha256(write_chart(device.chart)).hexdigest()
+        return self._cached(key, lambda: render_chart(device.chart, "svg", device.chart_file,
+                                                      name=Path(device.chart_file).stem))
 
     def of_chart(self, chart: GeneratedChart, step: int | None = None) -> bytes:
         """The picture of a generated chart; of a task chart, with ``step`` (from 1) expanded."""
         key = f"chart:{step}:" + hashlib.sha256(chart.data).hexdigest()
 
-        def draw() -> bytes:
-            with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
-                src = Path(folder) / "chart.scxml"
-                src.write_bytes(chart.data)
-                return self._draw(src, step)
-
-        return self._cached(key, draw)
+        return self._cached(key, lambda: render_chart(parse_chart(chart.data, chart.name), "svg", chart.name,
+                                                      name="chart", expand=step))
 
     def _cached(self, key: str, draw: Callable[[], bytes]) -> bytes:
         with self._lock:
@@ -62,17 +63,12 @@ class Pictures:
             self._cache.keep(key, data)
         return data
 
-    @staticmethod
-    def _draw(src: Path, step: int | None = None) -> bytes:
-        with tempfile.TemporaryDirectory(prefix="pnp-hmi-") as folder:
-            return draw_chart(src, Path(folder) / "chart.svg", expand=step).read_bytes()
 
 
 def steps_of(chart: GeneratedChart) -> tuple[Step, ...]:
     """The steps a generated task chart runs, in order (none for a chart without a plan of processes)."""
     plan = find_plan(parse_chart(chart.data, chart.name))
     return plan.steps if plan and plan.is_task else ()
-
 
 class GeneratedCharts:
     """The charts generated for the last few tasks, by generation id."""
@@ -81,7 +77,7 @@ class GeneratedCharts:
         self._store = _Bounded(limit)
         self._lock = threading.Lock()
 
-    def add(self, charts: tuple[GeneratedChart, ...]) -> str:
+    def add(self, charts: Sequence[GeneratedChart]) -> str:
         """Keep a generation's charts; its id is a digest of their content."""
         digest = hashlib.sha256(b"".join(c.name.encode() + b"\0" + c.data for c in charts)).hexdigest()[:16]
         with self._lock:

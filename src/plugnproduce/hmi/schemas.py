@@ -83,13 +83,8 @@ class TaskIn(BaseModel):
 
     def to_task(self) -> Task:
         """The model's task: steps numbered from 1 in the expanded (repeated) order."""
-        n = len(self.steps)
-        steps = tuple(
-            Step(r * n + i + 1, s.command, dict(s.bind), dict(s.params))
-            for r in range(self.repeat)
-            for i, s in enumerate(self.steps)
-        )
-        return Task(self.name, steps, TASK_SOURCE, self.description, self.repeat)
+        one_round = [Step(i + 1, s.command, dict(s.bind), dict(s.params)) for i, s in enumerate(self.steps)]
+        return Task.repeated(self.name, one_round, TASK_SOURCE, self.description, self.repeat)
 
 
 class PlugIn(BaseModel):

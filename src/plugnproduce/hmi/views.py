@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription, Parameter, ProcessDescription, Task
 from plugnproduce.executor.journal import describe
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -14,7 +15,8 @@ DATATYPES = {"decimal": "decimal", "integer": "integer", "boolean": "boolean", "
 
 
 def device_json(device: DeviceDescription, taxonomy: Taxonomy, state: str | None = None) -> dict[str, Any]:
-    """A device: id, label, classes, skills, protocol, endpoint and (when known) its current chart state."""
+    """A device as ``pnp discover --json`` shows it (:func:`plugnproduce.service.device_view`), with its cost,
+    states, chart picture and (when known) its current chart state."""
     concept = None
     if state is not None:
         try:
@@ -22,12 +24,7 @@ def device_json(device: DeviceDescription, taxonomy: Taxonomy, state: str | None
         except KeyError:
             concept = None
     return {
-        "id": device.id,
-        "label": device.label,
-        "classes": [taxonomy.label(c) for c in device.classes],
-        "skills": [taxonomy.label(s) for s in device.skills],
-        "protocol": device.protocol,
-        "endpoint": device.endpoint,
+        **service.device_view(device, taxonomy),
         "cost": device.cost,
         "state": state,
         "state_concept": taxonomy.label(concept) if concept else None,
@@ -83,12 +80,11 @@ def process_json(p: ProcessDescription, taxonomy: Taxonomy) -> dict[str, Any]:
 
 def task_json(task: Task) -> dict[str, Any]:
     """A task as the editor holds it: one round of its steps, and how often they repeat."""
-    n = len(task.steps) // max(task.repeat, 1)
     return {
         "name": task.name,
         "description": task.description,
         "repeat": task.repeat,
-        "steps": [{"command": s.command, "bind": dict(s.bind), "params": dict(s.params)} for s in task.steps[:n]],
+        "steps": [{"command": s.command, "bind": dict(s.bind), "params": dict(s.params)} for s in task.one_round()],
     }
 
 

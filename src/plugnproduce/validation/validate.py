@@ -95,6 +95,20 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
     return report
 
 
+def validate_tasks(tasks: Iterable[Task], knowledge: Knowledge | None = None) -> Report:
+    """Validate tasks already read (from text, say) as :func:`validate_paths` validates task files:
+    structure and SHACL shapes, each problem at its task's ``file`` and line."""
+    tasks = list(tasks)
+    knowledge = knowledge or load_knowledge()
+    report = Report(files=[t.file for t in tasks])
+    kg = KnowledgeGraph()
+    kg.add_tbox(knowledge.tbox(), knowledge.taxonomy)
+    _tasks(tasks, knowledge, {}, kg, report)
+    for p in shape_problems(kg):
+        report.add(p)
+    return report
+
+
 def _with_extensions(knowledge: Knowledge, files: list[Path], report: Report) -> Knowledge:
     """The knowledge with the TBox files among ``files`` and those of the libraries the files sit in."""
     known = set(knowledge.ontology_files())

@@ -9,7 +9,7 @@ from fastapi import APIRouter, Depends, HTTPException, status
 from plugnproduce import service
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.interfaces import PluggableCellSource
-from plugnproduce.hmi.routes import hub_of, require_reasoner
+from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.schemas import PlugIn
 from plugnproduce.hmi.security import allow_read, require_token
 from plugnproduce.hmi.views import device_json, process_json
@@ -57,14 +57,14 @@ async def unplug(device_id: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     return hub.cell_view()
 
 
-@router.get("/commands", dependencies=[*read, Depends(require_reasoner)],
+@router.get("/commands", dependencies=read,
             summary="Offered process commands with bindings; the others with reasons")
 def get_commands(hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.capabilities`` of the cell as it is now."""
-    return hub.commands() or {}
+    return hub.commands()
 
 
-@router.get("/commands/{command}/explanation", dependencies=[*read, Depends(require_reasoner)],
+@router.get("/commands/{command}/explanation", dependencies=read,
             summary="Why a process command is (not) offered")
 def explain_command(command: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.explain_process``: the bindings, or the reasons with the terms and lines they rest on."""

@@ -28,7 +28,7 @@ async def device_chart(device_id: str, request: Request, hub: Hub = Depends(hub_
     if device_id not in known:
         raise KeyError(f"device {device_id!r} (known: {', '.join(sorted(known))})")
     pictures: Pictures = request.app.state.pictures
-    return _svg(await run_in_threadpool(pictures.of_file, known[device_id].chart_file))
+    return _svg(await run_in_threadpool(pictures.of_device, known[device_id]))
 
 
 @router.get("/process/{command}.svg", response_class=Response, responses=SVG, summary="A General Process State Chart")

@@ -12,16 +12,15 @@ from fastapi import APIRouter, Depends, HTTPException, Query, Request, status
 from fastapi.responses import PlainTextResponse
 
 from plugnproduce import service
-from plugnproduce.hmi import pending, taskfiles
+from plugnproduce.hmi import taskfiles
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.pictures import GeneratedCharts
-from plugnproduce.hmi.routes import hub_of, require_reasoner
+from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.security import allow_read
 from plugnproduce.hmi.views import task_json
 
 router = APIRouter(prefix="/api/task", tags=["task"], dependencies=[Depends(allow_read)])
-reasoner = [Depends(require_reasoner)]
 
 
 def _rows(problems: list[dict[str, Any]], task: TaskIn) -> list[dict[str, Any]]:
@@ -40,7 +39,7 @@ def validate(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     return taskfiles.validate_task(task, hub.knowledge)
 
 
-@router.post("/check", dependencies=reasoner, summary="Is the task plausible in the cell as it is now?")
+@router.post("/check", summary="Is the task plausible in the cell as it is now?")
 def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.check``: per step its bindings and device states, and every problem at its step."""
     result = service.check(task.to_task(), hub.cell, hub.knowledge).to_json()
@@ -51,7 +50,7 @@ def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     return result
 
 
-@router.post("/repair", dependencies=reasoner, summary="Ranked minimal repairs of an implausible task")
+@router.post("/repair", summary="Ranked minimal repairs of an implausible task")
 def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.repair`` with the catalogue: each repair's edits, cost and resulting task (ready to apply)."""
     model, cell = task.to_task(), hub.cell
@@ -64,17 +63,20 @@ def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hu
     }
 
 
-@router.post("/explain", dependencies=reasoner, summary="Why a step is (not) plausible")
+@router.post("/explain", summary="Why a step is (not) plausible")
 def explain(task: TaskIn, step: int = Query(..., ge=1, description="The step, from 1 in the repeated order"),
             hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.explain_step``: each device's state before the step, where it came from, what the step needs."""
     return service.explain_step(task.to_task(), hub.cell, step, hub.knowledge).to_json()
 
 
-@router.post("/generate", dependencies=reasoner, summary="Generate the SCXML charts of a plausible task")
+@router.post("/generate", summary="Generate the SCXML charts of a plausible task")
 def generate(task: TaskIn, request: Request, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
-    """Specific process charts, the Task State Chart and the closed-world chart, each as SCXML and SVG."""
-    result = pending.generate(task.to_task(), hub.cell, knowledge=hub.knowledge)
+    """Specific process charts, the Task State Chart and the closed-world chart, each as SCXML and SVG.
+
+    ``service.generation``: an implausible task is a result (its problems, no charts), not an error.
+    """
+    result = service.generation(task.to_task(), hub.cell, knowledge=hub.knowledge)
     out: dict[str, Any] = {"plausible": result.check.plausible,
                            "problems": _rows([p.to_json() for p in result.check.problems], task),
                            "generation": None, "charts": []}

@@ -111,7 +111,6 @@ export function shortWhere(where) {
 /** Show the offered process commands and, behind "Why not?", the others. */
 export function renderCommands() {
   const commands = state.commands;
-  $("#no-reasoner").hidden = commands !== null;
   const offered = commands ? commands.offered : [];
   fill($("#offered"), offered.map((o) => h("li", { dataset: { command: o.command } },
     h("div", { class: "cmd" }, h("span", { class: "cmd-label" }, o.label), h("code", {}, o.command)),

@@ -4,7 +4,7 @@ const TASK_KEY = "pnp-task";
 
 export const state = {
   cell: null, // {name, devices: [...]}
-  commands: null, // {offered: [{command, label, bindings}], not_offered: [{command, label, reasons}]} or null
+  commands: null, // {offered: [{command, label, bindings}], not_offered: [{command, label, reasons}]}; null until loaded
   pluggable: false,
   catalogue: [],
   processes: new Map(), // command -> process (roles, parameters)
