@@ -218,3 +218,10 @@ def test_issue_15_a_long_unknown_command_or_parameter_in_a_task_is_quoted_short(
 def test_issue_15_a_long_field_name_in_a_request_is_quoted_short(hmi: InProcessHmi) -> None:
     task = {"name": "t", "steps": [{"command": "pick", "params": {"(" * 3000: None}}]}
     assert run_hmi(hmi, ("POST", "/api/task/validate", {"json": task})) == "refused"
+
+
+def test_issue_15_a_long_endpoint_on_another_host_is_quoted_short(workspace: Workspace) -> None:
+    endpoint = "xirp://" + "9" * 3000 + ":1"
+    description = GRIPPER.replace("xirp://127.0.0.1:0", endpoint).encode()
+    assert run_served(workspace, "gripper", description, GRIPPER_CHART.encode(),
+                      "http://127.0.0.1:8000/dev/description.xml") == "refused"

@@ -244,6 +244,7 @@ def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> D
         return replace(device, endpoint=found.location)
     host = urlparse(found.location).hostname
     if parse_endpoint(device.endpoint)[0] != host:
-        raise UntrustedUrlError(f"device {device.id} found at {host} names XIRP endpoint {excerpt(device.endpoint)} "
+        raise UntrustedUrlError(f"device {excerpt(device.id)} found at {host} names XIRP endpoint "
+                                f"{excerpt(device.endpoint)} "
                                 "on another host; refused")
     return device
