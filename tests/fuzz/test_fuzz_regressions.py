@@ -225,3 +225,9 @@ def test_issue_15_a_long_endpoint_on_another_host_is_quoted_short(workspace: Wor
     description = GRIPPER.replace("xirp://127.0.0.1:0", endpoint).encode()
     assert run_served(workspace, "gripper", description, GRIPPER_CHART.encode(),
                       "http://127.0.0.1:8000/dev/description.xml") == "refused"
+
+
+def test_issue_15_a_served_chart_named_with_a_null_character_is_refused(workspace: Workspace) -> None:
+    description = GRIPPER.replace("<gripper.scxml>", "<gripper\\u0000.scxml>").encode()
+    assert run_served(workspace, "gripper", description, GRIPPER_CHART.encode(),
+                      "http://127.0.0.1:8000/dev/description.xml") == "refused"

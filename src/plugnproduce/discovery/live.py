@@ -232,7 +232,7 @@ def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> D
     try:
         loaded = parse_description(files.description.encode("utf-8"), ttl)
         for named in loaded.graph.objects(None, PNP.stateChart):
-            if file_of(named).resolve() != chart.resolve():  # a chart elsewhere (a local file, another host)
+            if "\0" in str(named) or file_of(named).resolve() != chart.resolve():  # elsewhere, or no path at all
                 raise DescriptionError(f"device {found.udn} names its chart <{excerpt(str(named))}>; expected "
                                        f"the chart it serves ({chart.name})", ttl)
         device = device_from(loaded, taxonomy, charts={chart: files.chart.encode("utf-8")})
