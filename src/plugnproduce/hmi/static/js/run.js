@@ -127,10 +127,16 @@ export function takeDeviceState({ device, state: s, state_concept: concept }) {
   renderDeviceState(device, s, concept);
 }
 
+/** Take the server's answer about a run, unless the event stream has already told more of it. */
+function adopt(answer) {
+  const seen = state.run;
+  if (!(seen && seen.run === answer.run && seen.seq > (answer.seq || 0))) state.run = answer;
+}
+
 async function start() {
   const status = $("#run-status");
   try {
-    state.run = await post("/api/runs", { task: taskBody() }, { auth: true });
+    adopt(await post("/api/runs", { task: taskBody() }, { auth: true }));
     announce(statusText(state.run));
     renderRun();
   } catch (err) {
@@ -143,7 +149,7 @@ async function start() {
 async function stop() {
   if (!state.run) return;
   try {
-    state.run = await post(`/api/runs/${encodeURIComponent(state.run.run)}/stop`, undefined, { auth: true });
+    adopt(await post(`/api/runs/${encodeURIComponent(state.run.run)}/stop`, undefined, { auth: true }));
     renderRun();
   } catch (err) {
     $("#run-status").textContent = err.message;
