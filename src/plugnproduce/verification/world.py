@@ -1,0 +1,246 @@
+"""The closed world as a transition system: the Task State Chart and every device's chart, each a
+session of the project's one SCXML runtime, joined by message channels.
+
+A :class:`World` is one global configuration: each session's snapshot, the requests on their way
+from the controller to each device and the events on their way back (each channel in order, as
+over one connection). A :class:`Move` is one thing that may happen next; which one does is left
+open, as the devices' delays are unknown:
+
+- ``request``: a device receives the next request the controller sent it;
+- ``event``: the controller receives the next event a device sent;
+- ``timer``: one of a device's delayed sends arrives (its own motion ending, say);
+- ``own``: a session takes an event it sent itself without delay (these come first).
+
+The controller's own timers (a device's command timeout) never fire: the devices are taken to
+behave as their charts say, so a controller that would wait for ever is a deadlock, not a timeout.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Hashable, Iterator
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from plugnproduce.codegen.task import DONE, STEP, GeneratedTask
+from plugnproduce.description.model import Cell, ChartTransition, DeviceDescription
+from plugnproduce.errors import ExecutionError
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.events import Event, EventData, MacroStep
+from plugnproduce.statechart.runtime.interpreter import Interpreter
+from plugnproduce.statechart.runtime.snapshot import Pending, Snapshot, assigned_variables, fire, restore, take
+from plugnproduce.verification.arguments import argument_problems
+
+CONTROLLER = "controller"
+
+
+@dataclass(frozen=True)
+class Message:
+    """A request or an event on its way: its name and arguments."""
+
+    name: str
+    data: Any
+
+    @property
+    def key(self) -> Hashable:
+        """What tells it from another message."""
+        return (self.name, repr(self.data))
+
+
+@dataclass(frozen=True)
+class World:
+    """One global configuration of the closed world."""
+
+    controller: Snapshot
+    devices: tuple[Snapshot, ...]
+    requests: tuple[tuple[Message, ...], ...]
+    """Per device (in cell order), the requests the controller sent it that it has not received yet."""
+    events: tuple[tuple[Message, ...], ...]
+    """Per device, the events it sent that the controller has not received yet."""
+    key: Hashable = field(compare=False)
+
+
+@dataclass(frozen=True)
+class Move:
+    """One thing that may happen next (see the module's description)."""
+
+    kind: Literal["request", "event", "timer", "own"]
+    session: str
+    """The session that acts: ``controller`` or a device id."""
+    device: str = ""
+    """The device the message comes from or goes to."""
+    name: str = ""
+    """The event that arrives."""
+    timer: int = -1
+    """Which delayed send arrives (``timer`` moves)."""
+
+
+@dataclass(frozen=True)
+class Violation:
+    """What went wrong in a move: its kind and one sentence."""
+
+    kind: Literal["refused", "argument", "unexpected", "failed", "error", "deadlock"]
+    message: str
+
+
+class _Outbox:
+    """An I/O processor that keeps what a session sends over the device protocols."""
+
+    def __init__(self) -> None:
+        self.sent: list[tuple[str | None, Event]] = []
+
+    def send(self, event: Event, target: str | None, type: str) -> None:  # noqa: A002 - the SCXML name
+        """Keep the event for the channel it goes to."""
+        self.sent.append((target, event))
+
+
+class ClosedWorld:
+    """The sessions of a generated task on the devices of a cell, driven one move at a time."""
+
+    def __init__(self, generated: GeneratedTask, cell: Cell):
+        self.generated = generated
+        self.devices: tuple[DeviceDescription, ...] = tuple(cell.devices)
+        self._index = {d.id: i for i, d in enumerate(self.devices)}
+        self._outbox = _Outbox()
+        self.controller = Interpreter(generated.chart, clock=ManualClock(),
+                                      io_processors={"xirp": self._outbox, "upnp": self._outbox})
+        self.sessions = [Interpreter(d.chart, clock=ManualClock(), io_processors={d.protocol: self._outbox})
+                         for d in self.devices]
+        self._vars = assigned_variables(self.controller)
+        self._device_vars = [assigned_variables(s) for s in self.sessions]
+        self._transitions = [{(t.source, t.event): t for t in d.transitions} for d in self.devices]
+
+    def start(self) -> tuple[World, Violation | None]:
+        """The initial world: every session started."""
+        self.controller.start()
+        requests = self._requests([[] for _ in self.devices])
+        for session in self.sessions:
+            session.start()
+        events: list[list[Message]] = [[] for _ in self.devices]
+        for i, _ in enumerate(self.sessions):
+            self._device_events(i, events)
+        world = self._world(take(self.controller, self._vars),
+                            tuple(take(s, v) for s, v in zip(self.sessions, self._device_vars, strict=True)),
+                            requests, events)
+        return world, self._ended(world.controller)
+
+    def moves(self, world: World) -> Iterator[Move]:
+        """Every move possible in ``world``, in a fixed order."""
+        if world.controller.final_state is not None:
+            return
+        if world.controller.external:
+            yield Move("own", CONTROLLER, name=world.controller.external[0].name)
+        for i, device in enumerate(self.devices):
+            snap = world.devices[i]
+            if snap.external:
+                yield Move("own", device.id, device.id, snap.external[0].name)
+                continue
+            if world.requests[i]:
+                yield Move("request", device.id, device.id, world.requests[i][0].name)
+            for n, pending in enumerate(snap.delayed):
+                yield Move("timer", device.id, device.id, pending.event.name, n)
+        for i, device in enumerate(self.devices):
+            if world.events[i]:
+                yield Move("event", CONTROLLER, device.id, f"{device.id}.{world.events[i][0].name}")
+
+    def apply(self, world: World, move: Move) -> tuple[World, Violation | None]:
+        """The world after ``move``, and what went wrong in it (None: nothing)."""
+        requests = [list(q) for q in world.requests]
+        events = [list(q) for q in world.events]
+        if move.session == CONTROLLER:
+            return self._controller_move(world, move, requests, events)
+        i = self._index[move.session]
+        session, variables = self.sessions[i], self._device_vars[i]
+        restore(session, world.devices[i], variables)
+        violation = None
+        try:
+            if move.kind == "timer":
+                fire(session, world.devices[i].delayed[move.timer])
+            elif move.kind == "own":
+                session.execute_once()
+            else:
+                message = requests[i].pop(0)
+                session.external.append(Event(message.name, message.data))
+                violation = self._received(i, world.devices[i], message, session.execute_once())
+        except ExecutionError as exc:
+            violation = Violation("error", f"device {move.session}: {exc}")
+        self._device_events(i, events)
+        devices = list(world.devices)
+        devices[i] = take(session, variables)
+        return self._world(world.controller, tuple(devices), requests, events), violation
+
+    def _controller_move(self, world: World, move: Move, requests: list[list[Message]],
+                         events: list[list[Message]]) -> tuple[World, Violation | None]:
+        restore(self.controller, world.controller, self._vars)
+        violation = None
+        try:
+            if move.kind == "event":
+                message = events[self._index[move.device]].pop(0)
+                self.controller.external.append(Event(move.name, message.data))
+            step = self.controller.execute_once()
+            if move.kind == "event" and step is not None and not step.transitions:
+                violation = Violation("unexpected", f"the controller does not wait for {move.name} "
+                                                    "where it is: the run would stop with a fault")
+        except ExecutionError as exc:
+            violation = Violation("error", f"the task chart: {exc}")
+        requests = self._requests(requests)
+        snap = take(self.controller, self._vars)
+        return self._world(snap, world.devices, requests, events), violation or self._ended(snap)
+
+    def _received(self, i: int, before: Snapshot, message: Message, step: MacroStep | None) -> Violation | None:
+        """A request refused where the device is, or one missing an argument the transition takes."""
+        device = self.devices[i]
+        if step is None or not step.transitions:
+            where = ", ".join(before.states) or "no state"
+            return Violation("refused", f"device {device.id} in state {where} refuses {message.name}: "
+                                        "its chart has no transition for it there")
+        taken = step.transitions[0]
+        transition: ChartTransition | None = self._transitions[i].get((taken.source, message.name))
+        problems = argument_problems(device, transition, message.data) if transition is not None else []
+        if problems:
+            return Violation("argument", f"device {device.id}: {message.name} " + "; ".join(problems))
+        return None
+
+    def _requests(self, requests: list[list[Message]]) -> tuple[tuple[Message, ...], ...]:
+        """The channels with the requests the controller just sent appended."""
+        for target, event in self._outbox.sent:
+            i = self._index.get(target or "")
+            if i is not None:
+                requests[i].append(Message(event.name, EventData(event.data or {})))
+        self._outbox.sent.clear()
+        return tuple(tuple(q) for q in requests)
+
+    def _device_events(self, i: int, events: list[list[Message]]) -> None:
+        for _, event in self._outbox.sent:
+            events[i].append(Message(event.name, EventData(event.data or {})))
+        self._outbox.sent.clear()
+
+    def _ended(self, controller: Snapshot) -> Violation | None:
+        if controller.final_state is None or controller.final_state == DONE:
+            return None
+        return Violation("failed", f"the task ends in {controller.final_state}, not {DONE}")
+
+    def _world(self, controller: Snapshot, devices: tuple[Snapshot, ...], requests: Any, events: Any) -> World:
+        requests = tuple(tuple(q) for q in requests)
+        events = tuple(tuple(q) for q in events)
+        key = (controller.key, tuple(d.key for d in devices),
+               tuple(tuple(m.key for m in q) for q in requests), tuple(tuple(m.key for m in q) for q in events))
+        return World(controller, devices, requests, events, key)
+
+    def devices_index(self, device: str) -> int:
+        """The position of a device's session and channels."""
+        return self._index[device]
+
+    def steps_ended(self, world: World) -> int:
+        """How many steps of the task the controller has ended in ``world``."""
+        if STEP not in self._vars:
+            return 0
+        value = world.controller.data[self._vars.index(STEP)]
+        return value if isinstance(value, int) else 0
+
+    def deadlock(self, world: World) -> Violation:
+        """Why nothing can happen in ``world``: where the controller waits and where the devices are."""
+        devices = ", ".join(f"{d.id} in {'/'.join(s.states) or '-'}"
+                            for d, s in zip(self.devices, world.devices, strict=True))
+        waiting = [s for s in world.controller.states if s.startswith("s")]
+        return Violation("deadlock", f"deadlock: the controller waits in {', '.join(waiting[-4:]) or 'its start'} "
+                                     f"and no device will answer ({devices})")
