@@ -15,6 +15,7 @@ LAYERS = {
     "hmi": 6,
     "service": 5,
     "executor": 4, "sim": 4, "discovery": 4,
+    "verification": 3.5,  # explores the generated program (codegen) in the runtime (statechart)
     "codegen": 3, "reasoning": 3, "validation": 3, "drawing": 3,
     "knowledge": 2.5,  # the loaded libraries: their taxonomy, descriptions and catalogue
     "description": 2,

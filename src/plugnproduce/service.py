@@ -41,6 +41,7 @@ if TYPE_CHECKING:  # validation, code generation and execution are imported by t
     from plugnproduce.ontology.taxonomy import Taxonomy
     from plugnproduce.reasoning.impact import Impact
     from plugnproduce.validation import Report
+    from plugnproduce.verification import Budget, Verification
 
 
 @lru_cache(maxsize=8)
@@ -265,6 +266,8 @@ class Generated:
 
     task: GeneratedTask
     charts: list[GeneratedChart]
+    verification: Verification | None = None
+    """Every interleaving explored (when asked for); the charts are only for a proved program."""
 
 
 @dataclass(frozen=True)
@@ -303,13 +306,49 @@ def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = 
 
 
 def generate(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,
-             knowledge: Knowledge | None = None) -> Generated:
+             knowledge: Knowledge | None = None, verify: Budget | None = None) -> Generated:
     """Check a task, then generate its specific process charts, task chart, closed-world chart and,
-    with ``per_device``, each device's program. Raises :class:`ImplausibleTask` for an implausible task."""
-    result = generation(task_or_path, cell_or_path, per_device, knowledge)
-    if result.generated is None:
-        raise ImplausibleTask(result.check)
-    return result.generated
+    with ``per_device``, each device's program. Raises :class:`ImplausibleTask` for an implausible task.
+
+    With a ``verify`` budget every interleaving of the program is explored first (:func:`verify`):
+    a program not proved raises :class:`Unverified`, and no charts are made.
+    """
+    if verify is None:
+        result = generation(task_or_path, cell_or_path, per_device, knowledge)
+        if result.generated is None:
+            raise ImplausibleTask(result.check)
+        return result.generated
+    from plugnproduce.codegen.outputs import all_charts
+
+    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    generated = plan_run(the_task, the_cell, k)
+    proof = _verify(generated, the_cell, verify)
+    if not proof.proved:
+        raise Unverified(proof)
+    return Generated(generated, all_charts(generated, the_cell, per_device), proof)
+
+
+class Unverified(PlugNProduceError):
+    """A generated program that verification refuted, or could not prove within its budget."""
+
+    def __init__(self, verification: Verification):
+        self.verification = verification
+        super().__init__("; ".join(verification.lines()[:2]))
+
+
+def verify(task_or_path: TaskArg, cell_or_path: CellArg, budget: Budget | None = None,
+           knowledge: Knowledge | None = None) -> Verification:
+    """Check and generate a task, then explore every interleaving of its program with the cell's device
+    charts within ``budget``: proved, refuted (with the shortest counterexample) or inconclusive.
+    Raises :class:`ImplausibleTask` for an implausible task."""
+    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    return _verify(plan_run(the_task, the_cell, k), the_cell, budget)
+
+
+def _verify(generated: GeneratedTask, the_cell: Cell, budget: Budget | None) -> Verification:
+    from plugnproduce.verification import verify as explore
+
+    return explore(generated, the_cell, budget)
 
 
 # ------------------------------------------------------------------ execution

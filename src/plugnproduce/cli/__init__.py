@@ -1,7 +1,8 @@
 """The ``pnp`` command line: a thin layer over :mod:`plugnproduce.service`.
 
-Exit codes: 0 done/ok; 1 a finding (invalid, infeasible, implausible, failed run);
-2 bad input or usage, reported as one ``file:line: message`` line, never a traceback.
+Exit codes: 0 done/ok; 1 a finding (invalid, infeasible, implausible, refuted, failed run);
+2 bad input or usage, reported as one ``file:line: message`` line, never a traceback;
+3 no answer within a budget (``pnp verify`` inconclusive).
 Each command module registers its commands on :data:`app`.
 """
 
@@ -13,7 +14,7 @@ from plugnproduce.cli.app import app, main
 from plugnproduce.cli import draw, validate  # noqa: E402,F401  isort: skip
 from plugnproduce.cli import generate, reasoning  # noqa: E402,F401  isort: skip
 from plugnproduce.cli import devices, run, serve  # noqa: E402,F401  isort: skip
-from plugnproduce.cli import runs  # noqa: E402,F401  isort: skip
+from plugnproduce.cli import runs, verify  # noqa: E402,F401  isort: skip
 from plugnproduce.cli import knowledge  # noqa: E402,F401  isort: skip
 
 __all__ = ["app", "main"]

@@ -37,24 +37,43 @@ def generate(
     out: Path = typer.Option(..., "--output", "-o", metavar="DIR",
                              help="Folder to write the charts to (created if missing)."),
     per_device: bool = typer.Option(False, "--per-device", help="Also write each device's program."),
+    no_verify: bool = typer.Option(False, "--no-verify", help="Write the charts without verifying them first."),
+    max_states: int = typer.Option(1_000_000, "--max-states", metavar="N", min=1,
+                                   help="Verification: most configurations to explore."),
+    timeout: float = typer.Option(60.0, "--timeout", metavar="SECONDS", help="Verification: most seconds to spend."),
     json_out: bool = JSON_OPTION,
 ) -> None:
-    """Check a task, then write its specific process charts, task chart and closed-world chart.
+    """Check a task, verify its program over every interleaving (as pnp verify), then write its specific
+    process charts, task chart and closed-world chart.
 
-    Exit 0 written, 1 the task is implausible (nothing is written), 2 bad input.
+    Exit 0 written, 1 the task is implausible or its program refuted (nothing is written), 2 bad input,
+    3 verification inconclusive within its budget (nothing is written; see --max-states, --timeout, --no-verify).
     """
+    from plugnproduce.cli.verify import budget, exit_code
+
+    limits = None if no_verify else budget(max_states, timeout)
     try:
-        generated = service.generate(task, cell, per_device, knowledge(cell))
+        generated = service.generate(task, cell, per_device, knowledge(cell), verify=limits)
     except service.ImplausibleTask as exc:
         refuse(exc, "nothing written", json_out)
+    except service.Unverified as exc:
+        if json_out:
+            emit_json(exc.verification.to_json())
+        else:
+            typer.echo("\n".join(exc.verification.lines() + ["nothing written"]), err=True)
+        raise typer.Exit(exit_code(exc.verification)) from None
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for chart in generated.charts:
         path = out / chart.name
         path.write_bytes(chart.data)
         written.append({"file": str(path), "kind": chart.kind})
+    proof = generated.verification
     if json_out:
-        emit_json({"task": generated.task.task.name, "written": written})
+        emit_json({"task": generated.task.task.name, "written": written,
+                   "verification": proof.to_json() if proof is not None else None})
         return
+    if proof is not None:
+        typer.echo(proof.lines()[0])
     for w in written:
         typer.echo(f"wrote {w['file']} ({w['kind']})")

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Final, Literal
 
-PROVED, REFUTED, INCONCLUSIVE = "proved", "refuted", "inconclusive"
 Verdict = Literal["proved", "refuted", "inconclusive"]
+PROVED: Final = "proved"
+REFUTED: Final = "refuted"
+INCONCLUSIVE: Final = "inconclusive"
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,9 @@ from plugnproduce.verification.world import CONTROLLER, ClosedWorld, Move, Viola
 def explain(world: ClosedWorld, moves: list[Move], violation: Violation) -> list[TraceStep]:
     """The steps of a counterexample: ``moves`` from the start of ``world``, then ``violation``."""
     current, _ = world.start()
-    out: list[TraceStep] = []
+    first = [f"{m.name} to {d.id}" for d, q in zip(world.devices, current.requests, strict=True) for m in q]
+    out = [TraceStep("controller starts the task" + (f"; sends {', '.join(first)}" if first else ""),
+                     _task_where(world, current))]
     for move in moves:
         session = world.controller if move.session == CONTROLLER else world.sessions[world.devices_index(move.session)]
         taken: list[Transition] = []

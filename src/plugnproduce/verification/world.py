@@ -27,7 +27,7 @@ from plugnproduce.errors import ExecutionError
 from plugnproduce.statechart.runtime.clock import ManualClock
 from plugnproduce.statechart.runtime.events import Event, EventData, MacroStep
 from plugnproduce.statechart.runtime.interpreter import Interpreter
-from plugnproduce.statechart.runtime.snapshot import Pending, Snapshot, assigned_variables, fire, restore, take
+from plugnproduce.statechart.runtime.snapshot import Snapshot, assigned_variables, fire, restore, take
 from plugnproduce.verification.arguments import argument_problems
 
 CONTROLLER = "controller"
@@ -182,9 +182,8 @@ class ClosedWorld:
                                                     "where it is: the run would stop with a fault")
         except ExecutionError as exc:
             violation = Violation("error", f"the task chart: {exc}")
-        requests = self._requests(requests)
         snap = take(self.controller, self._vars)
-        return self._world(snap, world.devices, requests, events), violation or self._ended(snap)
+        return self._world(snap, world.devices, self._requests(requests), events), violation or self._ended(snap)
 
     def _received(self, i: int, before: Snapshot, message: Message, step: MacroStep | None) -> Violation | None:
         """A request refused where the device is, or one missing an argument the transition takes."""

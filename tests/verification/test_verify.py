@@ -1,0 +1,143 @@
+"""``pnp verify`` as a user meets it: proofs of the shipped tasks, a seeded deadlock found with its
+description lines, a budget that runs out, and ``pnp generate`` refusing a refuted program."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from plugnproduce import service
+from plugnproduce.cli import app
+from plugnproduce.resources import descriptions_path
+
+runner = CliRunner()
+D = descriptions_path()
+TASK, CELL = D / "tasks" / "bin-picking.yaml", D / "cells" / "bin-picking.yaml"
+LIBRARIES = Path(__file__).parent.parent / "data" / "libraries"
+
+NAP = """  <state id="open" pnp:concept="Open">
+    <onentry><send id="nap" event="idle.timeout" delay="30s"/></onentry>
+    <onexit><cancel sendid="nap"/></onexit>
+    <transition event="idle.timeout" target="standby"/>"""
+STANDBY = """  <state id="standby" pnp:concept="Open">
+    <transition event="xirp.request.Wake" target="open"/>
+  </state>
+</scxml>"""
+"""A gripper that goes to standby after 30 s open and then refuses Close until woken: a deadlock only
+the interleavings where its timer passes before the robot reaches the part can hit."""
+
+
+def seeded_cell(tmp_path: Path, chart: str) -> Path:
+    """A copy of the bin-picking cell whose gripper chart is ``chart``; the cell file's path."""
+    (tmp_path / "devices").mkdir(parents=True)
+    (tmp_path / "cells").mkdir()
+    for name in ("robot", "gripper", "sensor3d", "binpicking-pc"):
+        for ext in ("ttl", "scxml"):
+            shutil.copy(D / "devices" / f"{name}.{ext}", tmp_path / "devices")
+    (tmp_path / "devices" / "gripper.scxml").write_text(chart, encoding="utf-8")
+    cell = tmp_path / "cells" / "bin-picking.yaml"
+    cell.write_text(CELL.read_text(encoding="utf-8"), encoding="utf-8")
+    return cell
+
+
+def napping_gripper() -> str:
+    chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8")
+    return chart.replace('  <state id="open" pnp:concept="Open">', NAP).replace("</scxml>", STANDBY)
+
+
+def test_the_bin_picking_task_is_proved_and_the_state_count_reported() -> None:
+    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--json"])
+    assert result.exit_code == 0, result.output
+    answer = json.loads(result.stdout)
+    assert answer["verdict"] == "proved" and answer["trace"] == []
+    assert answer["states"] > 0 and answer["transitions"] >= answer["states"] - 1
+
+
+def test_a_deadlock_only_some_interleavings_hit_is_refuted_with_description_lines(tmp_path: Path) -> None:
+    cell = seeded_cell(tmp_path, napping_gripper())
+    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(cell)])
+    assert result.exit_code == 1, result.output
+    lines = result.stdout.splitlines()
+    assert "refuted" in lines[0]
+    assert "device gripper in state standby refuses xirp.request.Close" in lines[1]
+    chart = tmp_path / "devices" / "gripper.scxml"
+    standby_line = chart.read_text(encoding="utf-8").splitlines().index(STANDBY.splitlines()[0]) + 1
+    nap_line = next(i for i, t in enumerate(chart.read_text(encoding="utf-8").splitlines(), 1)
+                    if 'event="idle.timeout" target="standby"' in t)
+    steps = [line for line in lines if line.startswith("  ")]
+    assert any(f"{chart}:{nap_line}: gripper delay of idle.timeout passes" in s for s in steps)
+    assert steps[-1].endswith("which has no transition for it") and f"{chart}:{standby_line}:" in steps[-1]
+    assert any(f"{TASK}:6: controller" in s for s in steps)  # the bin-pick step of the task file
+
+
+async def test_the_seeded_deadlock_is_not_hit_by_a_simulated_run(tmp_path: Path) -> None:
+    cell = seeded_cell(tmp_path, napping_gripper())
+    report = await service.run_task(TASK, cell, simulate=True, journal=tmp_path / "run.jsonl")
+    assert report.outcome == "succeeded", report.fault
+
+
+def test_the_counterexample_is_the_shortest(tmp_path: Path) -> None:
+    cell = seeded_cell(tmp_path, napping_gripper())
+    result = service.verify(TASK, cell)
+    # After the start, the one run reaches the gripper's Close at its 10th move (sensor, localizer and robot
+    # each take a request, their delay and their answer back); the nap is one move more: none is shorter.
+    assert result.trace[-1].text == ("gripper receives xirp.request.Close in state standby, "
+                                     "which has no transition for it")
+    assert len(result.trace) == 1 + 11
+
+
+def test_a_request_missing_an_argument_the_device_takes_is_refuted(tmp_path: Path) -> None:
+    chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8").replace(
+        'pnp:accepts="GripForce"', 'pnp:accepts="GripForce OpeningAngle"')
+    result = service.verify(TASK, seeded_cell(tmp_path, chart))
+    assert result.verdict == "refuted"
+    assert "xirp.request.Close lacks the argument OpeningAngle" in result.problem
+
+
+def test_a_budget_too_small_is_inconclusive_not_a_hang() -> None:
+    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--max-states", "10"])
+    assert result.exit_code == 3, result.output
+    assert "inconclusive" in result.stdout and "budget of 10 states ran out" in result.stdout
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf"])
+def test_a_timeout_that_is_not_a_positive_number_is_bad_input(value: str) -> None:
+    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--timeout", value])
+    assert result.exit_code == 2 and "--timeout" in result.output
+
+
+def test_generate_writes_nothing_for_a_refuted_program_unless_told_not_to_verify(tmp_path: Path) -> None:
+    cell = seeded_cell(tmp_path / "cell", napping_gripper())
+    refused = runner.invoke(app, ["generate", str(TASK), "--cell", str(cell), "-o", str(tmp_path / "out")])
+    assert refused.exit_code == 1 and "refuses xirp.request.Close" in refused.stderr
+    assert not (tmp_path / "out").exists()
+    written = runner.invoke(app, ["generate", str(TASK), "--cell", str(cell), "-o", str(tmp_path / "out"),
+                                  "--no-verify"])
+    assert written.exit_code == 0 and (tmp_path / "out" / "bin-picking.task.scxml").is_file()
+
+
+def test_generate_says_the_program_is_proved(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["generate", str(TASK), "--cell", str(CELL), "-o", str(tmp_path), "--json"])
+    assert result.exit_code == 0, result.output
+    answer = json.loads(result.stdout)
+    assert answer["verification"]["verdict"] == "proved" and answer["verification"]["states"] > 0
+
+
+def pairs() -> list[tuple[Path, Path]]:
+    """Every shipped task on every shipped cell, and the test libraries' tasks on their cells."""
+    shipped = [(t, c) for t in sorted((D / "tasks").glob("*.yaml")) for c in sorted((D / "cells").glob("*.yaml"))]
+    libraries = [(t, c) for lib in sorted(LIBRARIES.iterdir()) for t in sorted(lib.glob("tasks/*.yaml"))
+                 for c in sorted(lib.glob("cells/*.yaml"))]
+    return shipped + libraries
+
+
+@pytest.mark.parametrize(("task", "cell"), pairs(), ids=lambda p: p.stem)
+def test_every_task_plausible_on_a_cell_is_proved_there(task: Path, cell: Path) -> None:
+    if not service.check(task, cell).plausible:
+        pytest.skip(f"{task.stem} is not plausible on {cell.stem}")
+    result = service.verify(task, cell)
+    assert result.verdict == "proved", "\n".join(result.lines())
