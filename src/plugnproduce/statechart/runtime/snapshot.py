@@ -31,16 +31,20 @@ _PLAIN = (int, float, str, bool, type(None), tuple, frozenset)
 
 @dataclass(frozen=True)
 class Pending:
-    """A delayed send waiting in a session: its event, target and I/O processor type."""
+    """A delayed send waiting in a session: its send id, event, target and I/O processor type."""
 
+    sendid: str
     event: Event
     target: str | None
     type: str
+    named: bool
+    """Whether the chart named it (``<send id>``, so a ``<cancel>`` may refer to it)."""
 
     @property
     def key(self) -> Hashable:
-        """What tells this send from another one (its id left out)."""
-        return (self.event.name, _value_key(self.event.data), self.target, self.type)
+        """What tells this send from another one (an id the session made up left out)."""
+        return (self.sendid if self.named else None, self.event.name, _value_key(self.event.data), self.target,
+                self.type)
 
 
 @dataclass(frozen=True)
@@ -72,8 +76,9 @@ def assigned_variables(interpreter: Interpreter) -> tuple[str, ...]:
 def take(interpreter: Interpreter, variables: tuple[str, ...]) -> Snapshot:
     """The session's state now; ``variables``: the datamodel variables it may change."""
     data = tuple(_frozen(interpreter.dm.get(v)) for v in variables)
-    delayed = tuple(Pending(d.event, d.target, d.type) for d in sorted(interpreter._delayed, key=lambda d: d.seq)
-                    if not d.cancelled)
+    made_up = f"send.{interpreter.session_id}."
+    delayed = tuple(Pending(d.sendid, d.event, d.target, d.type, not d.sendid.startswith(made_up))
+                    for d in sorted(interpreter._delayed, key=lambda d: d.seq) if not d.cancelled)
     history = tuple(sorted(((h, tuple(sorted(v, key=lambda s: s.idx))) for h, v in interpreter._history.items()),
                            key=lambda hv: hv[0].idx))
     external = tuple(interpreter.external)
@@ -93,7 +98,7 @@ def restore(interpreter: Interpreter, snapshot: Snapshot, variables: tuple[str, 
         interpreter.dm[name] = value if isinstance(value, _PLAIN) else copy.deepcopy(value)
     interpreter._delayed, interpreter._pending = [], {}
     for i, p in enumerate(snapshot.delayed):
-        entry = _Delayed(_NEVER + i, i, interpreter.new_sendid(), p.event, p.target, p.type)
+        entry = _Delayed(_NEVER + i, i, p.sendid, p.event, p.target, p.type)
         heapq.heappush(interpreter._delayed, entry)
         interpreter._pending.setdefault(entry.sendid, []).append(entry)
     interpreter.external.clear()

@@ -1,0 +1,130 @@
+"""Benchmark of verification over every interleaving (prints figures; not a test).
+
+    python bench/bench_verify.py [--steps 6 100] [--repeat 3] [--naive-limit 200000]
+
+For the bin-picking task (6 steps) and bin-picking tasks of more steps (its two steps
+repeated) on the built-in bin-picking cell, with the program already generated:
+
+- **simulate** (baseline): one run of the closed-world chart (the task chart and the device
+  models in one document) in the project's runtime, delayed sends taken in time order: one
+  interleaving, the check the project made before verification. It must end in ``done``.
+- **verify**: every interleaving explored (:func:`plugnproduce.verification.verify`); its
+  verdict must be ``proved`` when the simulation reached ``done``. Its states and transitions
+  are printed, and its time as a ratio to the simulation.
+- **naive**: the same moves explored breadth-first with no visited set (every interleaving
+  walked as a separate path, as a search that does not recognise a configuration it has seen);
+  stopped after ``--naive-limit`` paths. Its verdict must agree when it finishes.
+
+Each time is the best of ``--repeat`` measurements.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from collections import deque
+from collections.abc import Callable
+from pathlib import Path
+
+from plugnproduce import service
+from plugnproduce.codegen import GeneratedTask
+from plugnproduce.codegen.closed_world import closed_world_chart
+from plugnproduce.description.model import Cell
+from plugnproduce.resources import descriptions_path
+from plugnproduce.statechart import parse_chart
+from plugnproduce.statechart.runtime.clock import ManualClock
+from plugnproduce.statechart.runtime.interpreter import Interpreter
+from plugnproduce.verification import Budget, verify
+from plugnproduce.verification.world import ClosedWorld, World
+
+CELL = descriptions_path() / "cells" / "bin-picking.yaml"
+
+
+def task_file(folder: Path, steps: int) -> Path:
+    """The bin-picking task with its two steps repeated to ``steps`` steps."""
+    text = (descriptions_path() / "tasks" / "bin-picking.yaml").read_text(encoding="utf-8")
+    path = folder / f"bin-picking-{steps}.yaml"
+    path.write_text(text.replace("repeat: 3", f"repeat: {steps // 2}"), encoding="utf-8")
+    return path
+
+
+def best(repeat: int, work: Callable[[], object]) -> tuple[float, object]:
+    """The shortest of ``repeat`` timings of ``work`` and its last result."""
+    times, result = [], None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = work()
+        times.append(time.perf_counter() - start)
+    return min(times), result
+
+
+def simulate(data: bytes) -> str | None:
+    """One run of the closed-world chart; the final state it ends in."""
+    clock = ManualClock()
+    interpreter = Interpreter(parse_chart(data, "closed-world"), clock=clock)
+    interpreter.start()
+    while interpreter.running:
+        interpreter.execute()
+        due = interpreter.next_due()
+        if due is None:
+            break
+        clock.advance_to(due)
+    return interpreter.final_state
+
+
+def naive(generated: GeneratedTask, cell: Cell, limit: int) -> tuple[str, int]:
+    """Every path walked separately (no visited set): the verdict ("proved", "refuted", "stopped") and paths."""
+    world = ClosedWorld(generated, cell)
+    start, violation = world.start()
+    frontier: deque[World] = deque([start])
+    walked = 1
+    while frontier:
+        current = frontier.popleft()
+        moves = list(world.moves(current))
+        if not moves and current.controller.final_state is None:
+            return "refuted", walked
+        for move in moves:
+            after, violation = world.apply(current, move)
+            if violation is not None:
+                return "refuted", walked
+            walked += 1
+            if walked > limit:
+                return "stopped", walked
+            frontier.append(after)
+    return "proved", walked
+
+
+def measure(steps: int, repeat: int, limit: int, folder: Path) -> None:
+    """Print the figures for the bin-picking task of ``steps`` steps."""
+    path = task_file(folder, steps)
+    cell = service.cell(CELL)
+    generated = service.plan_run(path, cell)
+    data = closed_world_chart(generated, cell)
+    t_sim, final = best(repeat, lambda: simulate(data))
+    t_verify, result = best(repeat, lambda: verify(generated, cell, Budget(10_000_000, 3600)))
+    verdict = getattr(result, "verdict", None)
+    if (final == "done") != (verdict == "proved"):
+        raise RuntimeError(f"simulation ended in {final!r} but verification answered {verdict!r}")
+    t_naive, (naive_verdict, walked) = best(1, lambda: naive(generated, cell, limit))  # type: ignore[misc]
+    if naive_verdict != "stopped" and naive_verdict != verdict:
+        raise RuntimeError(f"naive search answered {naive_verdict!r}, verification {verdict!r}")
+    print(f"{steps:>5} steps  simulate {t_sim * 1000:8.1f} ms (ends {final}) | verify {t_verify * 1000:8.1f} ms "
+          f"{verdict}, {result.states} states, {result.transitions} transitions "  # type: ignore[union-attr]
+          f"= {t_verify / t_sim:5.1f}x simulate | naive {t_naive * 1000:8.1f} ms {naive_verdict}, {walked} paths")
+
+
+def main() -> None:
+    """Run the benchmark and print the figures."""
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--steps", type=int, nargs="+", default=[6, 100])
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--naive-limit", type=int, default=200_000)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        for steps in args.steps:
+            measure(steps, args.repeat, args.naive_limit, Path(tmp))
+
+
+if __name__ == "__main__":
+    main()
