@@ -90,6 +90,17 @@ def test_the_counterexample_is_the_shortest(tmp_path: Path) -> None:
     assert len(result.trace) == 1 + 11
 
 
+def test_a_device_that_never_answers_is_a_deadlock_at_the_step_that_waits(tmp_path: Path) -> None:
+    chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8").replace(
+        '<onentry><send event="motion.done" delay="120ms"/></onentry>\n    <transition event="motion.done" '
+        'target="closed">', '<transition event="motion.done" target="closed">', 1)
+    result = service.verify(TASK, seeded_cell(tmp_path, chart))
+    assert result.verdict == "refuted"
+    assert result.problem.startswith("deadlock: the controller waits for gripper.xirp.event.gripper_closed")
+    assert "gripper in closing" in result.problem
+    assert str(result.trace[-1]).startswith(f"{TASK}:6: deadlock")
+
+
 def test_a_request_missing_an_argument_the_device_takes_is_refuted(tmp_path: Path) -> None:
     chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8").replace(
         'pnp:accepts="GripForce"', 'pnp:accepts="GripForce OpeningAngle"')

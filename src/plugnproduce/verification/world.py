@@ -237,9 +237,10 @@ class ClosedWorld:
         return value if isinstance(value, int) else 0
 
     def deadlock(self, world: World) -> Violation:
-        """Why nothing can happen in ``world``: where the controller waits and where the devices are."""
+        """Why nothing can happen in ``world``: what the controller waits for and where the devices are."""
         devices = ", ".join(f"{d.id} in {'/'.join(s.states) or '-'}"
                             for d, s in zip(self.devices, world.devices, strict=True))
-        waiting = [s for s in world.controller.states if s.startswith("s")]
-        return Violation("deadlock", f"deadlock: the controller waits in {', '.join(waiting[-4:]) or 'its start'} "
-                                     f"and no device will answer ({devices})")
+        waits = sorted({e for s in world.controller.config if s.is_atomic for t in s.evented
+                        for e in (t.events or "").split() if not e.startswith(("timeout", "error"))})
+        return Violation("deadlock", f"deadlock: the controller waits for {' or '.join(waits) or 'nothing'} "
+                                     f"and no device will send it ({devices})")
