@@ -1,9 +1,16 @@
 """Benchmark of verification over every interleaving (prints figures; not a test).
 
-    python bench/bench_verify.py [--steps 6 100] [--repeat 3] [--naive-limit 200000]
+    python bench/bench_verify.py [--steps 6 100] [--repeat 3] [--naive-limit 100000]
 
-For the bin-picking task (6 steps) and bin-picking tasks of more steps (its two steps
-repeated) on the built-in bin-picking cell, with the program already generated:
+Two families of tasks, each of ``--steps`` steps, with the program already generated:
+
+- ``bin-picking``: the bin-picking task (its two steps repeated) on the built-in bin-picking
+  cell; every process there is a sequence, so there is one interleaving per step;
+- ``adaptive``: the pick-and-place task (pick-and-place, move-to; repeated) on the test
+  library's adaptive-gripper cell, whose gripper reports finger contact before it settles:
+  the controller and the gripper overlap, one diamond per pick, 2^picks interleavings.
+
+For each:
 
 - **simulate** (baseline): one run of the closed-world chart (the task chart and the device
   models in one document) in the project's runtime, delayed sends taken in time order: one
@@ -38,14 +45,21 @@ from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.verification import Budget, verify
 from plugnproduce.verification.world import ClosedWorld, World
 
-CELL = descriptions_path() / "cells" / "bin-picking.yaml"
+TASKS = descriptions_path() / "tasks"
+FAMILIES = {
+    "bin-picking": (TASKS / "bin-picking.yaml", descriptions_path() / "cells" / "bin-picking.yaml"),
+    "adaptive": (TASKS / "pick-and-place.yaml", Path(__file__).parent.parent / "tests" / "data" / "libraries"
+                 / "adaptive-gripper" / "cells" / "bin-picking-adaptive.yaml"),
+}
 
 
-def task_file(folder: Path, steps: int) -> Path:
-    """The bin-picking task with its two steps repeated to ``steps`` steps."""
-    text = (descriptions_path() / "tasks" / "bin-picking.yaml").read_text(encoding="utf-8")
-    path = folder / f"bin-picking-{steps}.yaml"
-    path.write_text(text.replace("repeat: 3", f"repeat: {steps // 2}"), encoding="utf-8")
+def task_file(folder: Path, family: str, steps: int) -> Path:
+    """The family's task (two steps) repeated to ``steps`` steps."""
+    text = FAMILIES[family][0].read_text(encoding="utf-8")
+    path = folder / f"{family}-{steps}.yaml"
+    repeat = f"repeat: {steps // 2}\n"
+    text = text.replace("repeat: 3\n", repeat) if "repeat:" in text else text.replace("steps:\n", repeat + "steps:\n")
+    path.write_text(text, encoding="utf-8")
     return path
 
 
@@ -95,11 +109,11 @@ def naive(generated: GeneratedTask, cell: Cell, limit: int) -> tuple[str, int]:
     return "proved", walked
 
 
-def measure(steps: int, repeat: int, limit: int, folder: Path) -> None:
-    """Print the figures for the bin-picking task of ``steps`` steps."""
-    path = task_file(folder, steps)
-    cell = service.cell(CELL)
-    generated = service.plan_run(path, cell)
+def measure(family: str, steps: int, repeat: int, limit: int, folder: Path) -> None:
+    """Print the figures for the family's task of ``steps`` steps."""
+    path = task_file(folder, family, steps)
+    cell = service.cell(FAMILIES[family][1])
+    generated = service.plan_run(path, cell, service.knowledge_for_cell(FAMILIES[family][1]))
     data = closed_world_chart(generated, cell)
     t_sim, final = best(repeat, lambda: simulate(data))
     t_verify, result = best(repeat, lambda: verify(generated, cell, Budget(10_000_000, 3600)))
@@ -109,7 +123,7 @@ def measure(steps: int, repeat: int, limit: int, folder: Path) -> None:
     t_naive, (naive_verdict, walked) = best(1, lambda: naive(generated, cell, limit))  # type: ignore[misc]
     if naive_verdict != "stopped" and naive_verdict != verdict:
         raise RuntimeError(f"naive search answered {naive_verdict!r}, verification {verdict!r}")
-    print(f"{steps:>5} steps  simulate {t_sim * 1000:8.1f} ms (ends {final}) | verify {t_verify * 1000:8.1f} ms "
+    print(f"{family:<11} {steps:>4} steps  simulate {t_sim * 1000:8.1f} ms (ends {final}) | verify {t_verify * 1000:8.1f} ms "
           f"{verdict}, {result.states} states, {result.transitions} transitions "  # type: ignore[union-attr]
           f"= {t_verify / t_sim:5.1f}x simulate | naive {t_naive * 1000:8.1f} ms {naive_verdict}, {walked} paths")
 
@@ -119,11 +133,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--steps", type=int, nargs="+", default=[6, 100])
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--naive-limit", type=int, default=200_000)
+    parser.add_argument("--naive-limit", type=int, default=100_000)
+    parser.add_argument("--tasks", nargs="+", choices=sorted(FAMILIES), default=sorted(FAMILIES, reverse=True))
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        for steps in args.steps:
-            measure(steps, args.repeat, args.naive_limit, Path(tmp))
+        for family in args.tasks:
+            for steps in args.steps:
+                measure(family, steps, args.repeat, args.naive_limit, Path(tmp))
 
 
 if __name__ == "__main__":
