@@ -38,7 +38,7 @@ def generate(
                              help="Folder to write the charts to (created if missing)."),
     per_device: bool = typer.Option(False, "--per-device", help="Also write each device's program."),
     no_verify: bool = typer.Option(False, "--no-verify", help="Write the charts without verifying them first."),
-    max_states: int = typer.Option(1_000_000, "--max-states", metavar="N", min=1,
+    max_states: int = typer.Option(250_000, "--max-states", metavar="N", min=1,
                                    help="Verification: most configurations to explore."),
     timeout: float = typer.Option(60.0, "--timeout", metavar="SECONDS", help="Verification: most seconds to spend."),
     json_out: bool = JSON_OPTION,

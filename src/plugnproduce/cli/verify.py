@@ -20,7 +20,7 @@ else:
 
 INCONCLUSIVE_EXIT = 3
 """Exit code when the budget ran out before every interleaving was explored."""
-MAX_STATES_OPTION = typer.Option(1_000_000, "--max-states", metavar="N", min=1,
+MAX_STATES_OPTION = typer.Option(250_000, "--max-states", metavar="N", min=1,
                                  help="Most configurations to explore before answering 'inconclusive'.")
 TIMEOUT_OPTION = typer.Option(60.0, "--timeout", metavar="SECONDS",
                               help="Most seconds to explore before answering 'inconclusive'.")

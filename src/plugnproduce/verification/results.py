@@ -15,7 +15,7 @@ INCONCLUSIVE: Final = "inconclusive"
 class Budget:
     """How far a search may go: configurations explored and seconds spent."""
 
-    max_states: int = 1_000_000
+    max_states: int = 250_000
     seconds: float = 60.0
 
 
