@@ -123,7 +123,8 @@ def measure(family: str, steps: int, repeat: int, limit: int, folder: Path) -> N
     t_naive, (naive_verdict, walked) = best(1, lambda: naive(generated, cell, limit))  # type: ignore[misc]
     if naive_verdict != "stopped" and naive_verdict != verdict:
         raise RuntimeError(f"naive search answered {naive_verdict!r}, verification {verdict!r}")
-    print(f"{family:<11} {steps:>4} steps  simulate {t_sim * 1000:8.1f} ms (ends {final}) | verify {t_verify * 1000:8.1f} ms "
+    print(f"{family:<11} {steps:>4} steps  simulate {t_sim * 1000:8.1f} ms (ends {final}) | "
+          f"verify {t_verify * 1000:8.1f} ms "
           f"{verdict}, {result.states} states, {result.transitions} transitions "  # type: ignore[union-attr]
           f"= {t_verify / t_sim:5.1f}x simulate | naive {t_naive * 1000:8.1f} ms {naive_verdict}, {walked} paths")
 
