@@ -115,6 +115,23 @@ def test_a_budget_too_small_is_inconclusive_not_a_hang() -> None:
     assert "inconclusive" in result.stdout and "budget of 10 states ran out" in result.stdout
 
 
+def test_a_time_budget_too_small_is_inconclusive() -> None:
+    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--timeout", "1e-9", "--json"])
+    assert result.exit_code == 3, result.output
+    answer = json.loads(result.stdout)
+    assert answer["verdict"] == "inconclusive" and "time budget" in answer["problem"]
+
+
+def test_an_event_the_controller_does_not_wait_for_is_refuted(tmp_path: Path) -> None:
+    closed = '<state id="closed" pnp:concept="Closed">'
+    chatty = closed + ('<onentry><send event="tick" delay="1s"/></onentry>'
+                       '<transition event="tick"><send event="xirp.event.still_closed" type="xirp"/></transition>')
+    chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8").replace(closed, chatty)
+    result = service.verify(TASK, seeded_cell(tmp_path, chart))
+    assert result.verdict == "refuted"
+    assert result.problem.startswith("the controller does not wait for gripper.xirp.event.still_closed")
+
+
 @pytest.mark.parametrize("value", ["0", "-1", "nan", "inf"])
 def test_a_timeout_that_is_not_a_positive_number_is_bad_input(value: str) -> None:
     result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--timeout", value])

@@ -17,7 +17,7 @@ behave as their charts say, so a controller that would wait for ever is a deadlo
 
 from __future__ import annotations
 
-from collections.abc import Hashable, Iterator
+from collections.abc import Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -218,12 +218,13 @@ class ClosedWorld:
             return None
         return Violation("failed", f"the task ends in {controller.final_state}, not {DONE}")
 
-    def _world(self, controller: Snapshot, devices: tuple[Snapshot, ...], requests: Any, events: Any) -> World:
-        requests = tuple(tuple(q) for q in requests)
-        events = tuple(tuple(q) for q in events)
-        key = (controller.key, tuple(d.key for d in devices),
-               tuple(tuple(m.key for m in q) for q in requests), tuple(tuple(m.key for m in q) for q in events))
-        return World(controller, devices, requests, events, key)
+    def _world(self, controller: Snapshot, devices: tuple[Snapshot, ...], requests: Sequence[Sequence[Message]],
+               events: Sequence[Sequence[Message]]) -> World:
+        to_devices = tuple(tuple(q) for q in requests)
+        to_controller = tuple(tuple(q) for q in events)
+        key = (controller.key, tuple(d.key for d in devices), tuple(tuple(m.key for m in q) for q in to_devices),
+               tuple(tuple(m.key for m in q) for q in to_controller))
+        return World(controller, devices, to_devices, to_controller, key)
 
     def devices_index(self, device: str) -> int:
         """The position of a device's session and channels."""
