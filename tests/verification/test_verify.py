@@ -20,14 +20,14 @@ TASK, CELL = D / "tasks" / "bin-picking.yaml", D / "cells" / "bin-picking.yaml"
 LIBRARIES = Path(__file__).parent.parent / "data" / "libraries"
 
 NAP = """  <state id="open" pnp:concept="Open">
-    <onentry><send id="nap" event="idle.timeout" delay="30s"/></onentry>
+    <onentry><send id="nap" event="idle.timeout" delay="120s"/></onentry>
     <onexit><cancel sendid="nap"/></onexit>
     <transition event="idle.timeout" target="standby"/>"""
 STANDBY = """  <state id="standby" pnp:concept="Open">
     <transition event="xirp.request.Wake" target="open"/>
   </state>
 </scxml>"""
-"""A gripper that goes to standby after 30 s open and then refuses Close until woken: a deadlock only
+"""A gripper that goes to standby after 120 s open and then refuses Close until woken: a deadlock only
 the interleavings where its timer passes before the robot reaches the part can hit."""
 
 
