@@ -43,7 +43,7 @@ def explain(world: ClosedWorld, moves: list[Move], violation: Violation) -> list
 def _step(world: ClosedWorld, before: World, after: World, move: Move, taken: list[Transition]) -> TraceStep:
     if move.session == CONTROLLER:
         sent = _sent(world, before, after)
-        what = "starts" if move.kind == "own" and not move.device else f"receives {move.name}"
+        what = f"takes {move.name}" if move.kind == "own" else f"receives {move.name}"
         text = f"controller {what}" + (f"; sends {', '.join(sent)}" if sent else "")
         return TraceStep(text, _task_where(world, before))
     i = world.devices_index(move.session)

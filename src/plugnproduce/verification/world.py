@@ -139,7 +139,7 @@ class ClosedWorld:
             for n, pending in enumerate(snap.delayed):
                 yield Move("timer", device.id, device.id, pending.event.name, n)
         for i, device in enumerate(self.devices):
-            if world.events[i]:
+            if world.events[i] and not world.controller.external:  # what a session sent itself comes first
                 yield Move("event", CONTROLLER, device.id, f"{device.id}.{world.events[i][0].name}")
 
     def apply(self, world: World, move: Move) -> tuple[World, Violation | None]:
