@@ -7,6 +7,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from decimal import Decimal
@@ -21,12 +22,15 @@ from plugnproduce.description.charts import device_chart, process_regions
 from plugnproduce.description.model import (
     Cell,
     DeviceDescription,
+    Link,
+    Output,
     Parameter,
     ProcessDescription,
     Role,
     Step,
     Task,
     Where,
+    plain_value,
 )
 from plugnproduce.description.rdf import term_line
 from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
@@ -44,6 +48,7 @@ from plugnproduce.safeio import (
 from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}")
 
 
 @dataclass(frozen=True)
@@ -209,6 +214,7 @@ def process_from(loaded: Loaded) -> ProcessDescription:
     params = tuple(
         sorted((_parameter(loaded, p) for p in loaded.graph.objects(s, PNP.hasParameter)), key=lambda p: p.name)
     )
+    outputs = tuple(sorted((_output(loaded, o) for o in loaded.graph.objects(s, PNP.hasOutput)), key=lambda o: o.name))
     label = _opt(loaded, s, RDFS.label)
     comment = _opt(loaded, s, RDFS.comment)
     return ProcessDescription(
@@ -222,6 +228,7 @@ def process_from(loaded: Loaded) -> ProcessDescription:
         chart_file=str(chart_file),
         where=loaded.where(str(s)),
         chart=chart,
+        outputs=outputs,
     )
 
 
@@ -266,6 +273,20 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
         maximum=_finite(loaded, p, _opt(loaded, p, PNP.maxValue), "maximum"),
         default=_default(default),
         where=loaded.where(str(p)),
+    )
+
+
+def _output(loaded: Loaded, o: rdflib.term.Node) -> Output:
+    role = _one(loaded, o, PNP.forRole, "role")
+    role_name = _opt(loaded, role, PNP.roleName)
+    return Output(
+        name=str(_one(loaded, o, PNP.outputName, "output name")),
+        iri=str(o),
+        role=str(role_name) if role_name is not None else local_name(str(role)),
+        quantity=str(_one(loaded, o, PNP.quantity, "quantity")),
+        datatype=str(_one(loaded, o, PNP.datatype, "datatype")),
+        unit=str(_opt(loaded, o, PNP.unit) or ""),
+        where=loaded.where(str(o)),
     )
 
 
@@ -336,10 +357,11 @@ def parse_task(data: bytes, source: str | Path) -> Task:
                                f"{len(steps_node.value) * repeat}; at most {Task.MAX_STEPS} are accepted",
                                p, steps_node.start_mark.line + 1)
     one_round: list[Step] = []
+    names: set[str] = set()
     for i, node in enumerate(steps_node.value):
         line = node.start_mark.line + 1
         m = _mapping(node, p, "step")
-        _unknown_keys(m, {"command", "bind", "params"}, p, "step")
+        _unknown_keys(m, {"name", "command", "bind", "params"}, p, "step")
         if "command" not in m or not isinstance(_plain(m["command"]), str):
             raise DescriptionError("a step needs 'command': the name of a process command", p, line)
         bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
@@ -347,9 +369,36 @@ def parse_task(data: bytes, source: str | Path) -> Task:
         lines = {}
         if isinstance(params, yaml.MappingNode):
             lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value}
-        one_round.append(Step(i + 1, str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
+        values = {n: _link(v, p, lines.get(n, line)) for n, v in _str_map(params, p, "params").items()}
+        name = _step_name(m.get("name"), names, p)
+        one_round.append(Step(i + 1, str(_plain(m["command"])), bind, values, line, lines, name))
     description = _plain(top["description"]) if "description" in top else ""
     return Task.repeated(str(_plain(top["task"])), one_round, str(p), str(description or ""), repeat)
+
+
+def _step_name(node: yaml.Node | None, seen: set[str], path: Path) -> str | None:
+    """A step's ``name:``: a plain name, unique in the task."""
+    if node is None:
+        return None
+    name = _plain(node)
+    line = node.start_mark.line + 1
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise DescriptionError(f"a step name must be a plain name such as localize; found {excerpt(repr(name))}",
+                               path, line)
+    if name in seen:
+        raise DescriptionError(f"step name {name!r} appears twice; each step needs its own name", path, line)
+    seen.add(name)
+    return name
+
+
+def _link(value: object, path: Path, line: int) -> object:
+    """A parameter value, or the earlier step's output it takes (``{from: STEP, output: NAME}``)."""
+    if not isinstance(value, dict):
+        return value
+    if set(value) != {"from", "output"} or not all(isinstance(v, str) for v in value.values()):
+        raise DescriptionError("a parameter taken from an earlier step reads {from: STEP, output: NAME}; found "
+                               f"{excerpt(repr(value))}", path, line)
+    return Link(str(value["from"]), str(value["output"]))
 
 
 def task_to_yaml(task: Task, block: bool = False) -> str:
@@ -359,11 +408,12 @@ def task_to_yaml(task: Task, block: bool = False) -> str:
     """
     steps = []
     for s in task.one_round():
-        entry: dict[str, object] = {"command": s.command}
+        entry: dict[str, object] = {"name": s.name} if s.name else {}
+        entry["command"] = s.command
         if s.bind:
             entry["bind"] = dict(s.bind)
         if s.params:
-            entry["params"] = dict(s.params)
+            entry["params"] = {n: plain_value(v) for n, v in s.params.items()}
         steps.append(entry)
     doc: dict[str, object] = {"task": task.name}
     if task.description:

@@ -163,6 +163,19 @@ class Parameter:
 
 
 @dataclass(frozen=True)
+class Output:
+    """A value a process gives back (``pnp:hasOutput``): its role's device reports it as an event payload."""
+
+    name: str
+    iri: str
+    role: str
+    quantity: str
+    datatype: str
+    unit: str
+    where: Where
+
+
+@dataclass(frozen=True)
 class ProcessDescription:
     """A process: roles, parameters and its General Process State Chart."""
 
@@ -177,6 +190,8 @@ class ProcessDescription:
     where: Where
     chart: Chart = field(default_factory=Chart, compare=False, repr=False)
     """The parsed General Process State Chart."""
+    outputs: tuple[Output, ...] = ()
+    """The values the process gives back, which later steps of a task may take as parameters."""
 
     def role(self, name: str) -> Role:
         """The role called ``name``."""
@@ -192,6 +207,31 @@ class ProcessDescription:
                 return p
         raise KeyError(f"process {self.id} has no parameter {name!r}")
 
+    def output(self, name: str) -> Output:
+        """The output called ``name``."""
+        for o in self.outputs:
+            if o.name == name:
+                return o
+        raise KeyError(f"process {self.id} has no output {name!r}")
+
+
+@dataclass(frozen=True)
+class Link:
+    """A parameter value taken from an earlier step's output (``{from: localize, output: part_pose}``)."""
+
+    step: str
+    """The ``name:`` of the step that produces the value."""
+    output: str
+
+    def to_plain(self) -> dict[str, str]:
+        """The link as the task file writes it."""
+        return {"from": self.step, "output": self.output}
+
+
+def plain_value(value: object) -> object:
+    """A parameter value as YAML and JSON hold it (a link becomes its mapping)."""
+    return value.to_plain() if isinstance(value, Link) else value
+
 
 @dataclass(frozen=True)
 class Step:
@@ -205,6 +245,16 @@ class Step:
     line: int | None = None
     param_lines: dict[str, int] = field(default_factory=dict, compare=False)
     """Line of each parameter value in the task file."""
+    name: str | None = None
+    """The step's name (``name:``), by which later steps take its outputs."""
+
+    def links(self) -> dict[str, Link]:
+        """The parameters whose values come from earlier steps' outputs."""
+        return {n: v for n, v in self.params.items() if isinstance(v, Link)}
+
+    def values(self) -> dict[str, object]:
+        """The parameters given as values (links left out)."""
+        return {n: v for n, v in self.params.items() if not isinstance(v, Link)}
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
+from plugnproduce.reasoning.dataflow import link_problems
 from plugnproduce.reasoning.facts import fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program, context
 from plugnproduce.reasoning.results import CheckResult, Problem, StepCheck, StepExplanation
@@ -64,6 +65,7 @@ def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proces
     steps, final = _steps(model, task)
     parameters = {p.id: {x.name: x for x in p.parameters} for p in processes}
     lost = list(not_accepted(task, cell, steps, parameters, taxonomy))
+    lost += link_problems(task, {p.id: p for p in processes}, taxonomy)
     plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not lost
     problems = sorted(_problems(model, ctx) + lost, key=lambda p: (p.step, p.kind, p.parameter or ""))
     return CheckResult(task.name, cell.name, plausible, tuple(problems), steps, final)
