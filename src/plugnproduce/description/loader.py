@@ -6,6 +6,7 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
+import keyword
 import math
 import re
 from collections.abc import Callable, Mapping
@@ -48,7 +49,8 @@ from plugnproduce.safeio import (
 from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
-_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}")
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")
+_OUTPUT_NAME = re.compile(r"[a-z][a-z0-9_]{0,63}")
 
 
 @dataclass(frozen=True)
@@ -279,8 +281,12 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
 def _output(loaded: Loaded, o: rdflib.term.Node) -> Output:
     role = _one(loaded, o, PNP.forRole, "role")
     role_name = _opt(loaded, role, PNP.roleName)
+    name = str(_one(loaded, o, PNP.outputName, "output name"))
+    if not _OUTPUT_NAME.fullmatch(name) or keyword.iskeyword(name):
+        raise DescriptionError(f"output name {excerpt(repr(name))} must be a lower_snake_case name such as part_pose",
+                               loaded.path, loaded.line(str(o)))
     return Output(
-        name=str(_one(loaded, o, PNP.outputName, "output name")),
+        name=name,
         iri=str(o),
         role=str(role_name) if role_name is not None else local_name(str(role)),
         quantity=str(_one(loaded, o, PNP.quantity, "quantity")),

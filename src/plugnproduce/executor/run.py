@@ -30,7 +30,7 @@ from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
 from plugnproduce.statechart.model import StateNode
-from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, MacroStep, MetaEvent
+from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, EventData, MacroStep, MetaEvent
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
 
@@ -214,7 +214,7 @@ class TaskRun:
         protocol = self.cell.device(device).protocol
         event = f"{device}.{protocol}.event.{name}"
         self._record("event", step=self.step, device=device, event=name, params=dict(params))
-        self._loop.queue(event, dict(params))
+        self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too
 
     def _on_lost(self, device: str, reason: str) -> None:
         self._fail(self._fault("lost", device, reason))
