@@ -22,6 +22,7 @@ from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.statechart.model import Send, walk
 from plugnproduce.statechart.runtime.events import Event
 from plugnproduce.statechart.runtime.interpreter import Interpreter
@@ -72,10 +73,12 @@ class SimulatedDevice:
     """One device running its chart behind its protocol; ``async with`` starts and stops it."""
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
-                 faults: xirp.Faults | None = None) -> None:
+                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
+        """``bin``: the simulated bin the device works on, if any."""
         self.description = device
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
+        self.bin = bin
         self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
         self._loop = ChartLoop(self.interpreter)
@@ -163,6 +166,8 @@ class SimulatedDevice:
         waits = {t.event for t in self.description.transitions if t.source == self.state}
         if event not in waits:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
+        if self.bin is not None:
+            self.bin.on_request(self.description, params, self.interpreter.dm)
         self._loop.queue(event, dict(params))
 
     def _on_xirp_request(self, request: xirp.Request) -> None:
