@@ -123,6 +123,9 @@ class RegionState:
     """Parameter names consumed on the way into this state (``pnp:params``)."""
     waits_for: str | None = None
     """State id of another region this state waits for (``In('...')``) before it is entered."""
+    outcomes: tuple[str, ...] = ()
+    """Outcome concepts a region's final state may be reached with (``pnp:outcomes``), which its device
+    reports as the ``outcome`` value of the event that ends it."""
 
 
 @dataclass(frozen=True)
@@ -207,6 +210,15 @@ class ProcessDescription:
                 return p
         raise KeyError(f"process {self.id} has no parameter {name!r}")
 
+    @property
+    def outcomes(self) -> tuple[str, ...]:
+        """The outcome concepts the process may end with (each leaves its roles' devices in their end states)."""
+        return tuple(o for r in self.roles for o in r.region[-1].outcomes)
+
+    def outcome_role(self) -> Role | None:
+        """The role whose device reports the outcome, if the process has outcomes."""
+        return next((r for r in self.roles if r.region[-1].outcomes), None)
+
     def output(self, name: str) -> Output:
         """The output called ``name``."""
         for o in self.outputs:
@@ -258,8 +270,35 @@ class Step:
 
 
 @dataclass(frozen=True)
+class Loop:
+    """A loop of a task: its body runs again and again until one of its steps ends with ``until``
+    (the rest of that iteration is skipped), at most ``max`` times.
+
+    The task's steps hold the body twice: the first iteration (steps ``entry`` to ``first - 1``) and
+    the iterations after it (``first`` to ``last``), which start from the states the first one left
+    and which the generated chart repeats without unrolling. Indices are 1-based positions in the task.
+    """
+
+    entry: int
+    first: int
+    last: int
+    until: str | None
+    """The outcome concept (IRI) that ends the loop."""
+    max: int | None
+    line: int | None = None
+
+    def path(self, index: int) -> str | None:
+        """Which iteration a step position belongs to (``loop iteration 1`` / ``loop iteration 2 and later``)."""
+        if self.entry <= index < self.first:
+            return "loop iteration 1"
+        if self.first <= index <= self.last:
+            return "loop iteration 2 and later"
+        return None
+
+
+@dataclass(frozen=True)
 class Task:
-    """A task description: an ordered list of process commands."""
+    """A task description: an ordered list of process commands, some of them in loops."""
 
     MAX_STEPS = 10_000
     """Most steps a task may have once its repeats are expanded."""
@@ -269,6 +308,7 @@ class Task:
     file: str
     description: str = ""
     repeat: int = 1
+    loops: tuple[Loop, ...] = ()
 
     @classmethod
     def repeated(cls, name: str, one_round: Sequence[Step], file: str, description: str = "",
@@ -285,6 +325,10 @@ class Task:
     def one_round(self) -> tuple[Step, ...]:
         """The steps as written once, before the repeats."""
         return self.steps[: len(self.steps) // max(self.repeat, 1)]
+
+    def loop_at(self, index: int) -> Loop | None:
+        """The loop whose body (either copy) holds step position ``index``, if any."""
+        return next((lp for lp in self.loops if lp.entry <= index <= lp.last), None)
 
     def where(self, step: Step, parameter: str | None = None) -> Where:
         """The place of a step (or of one of its parameter values) in the task file."""

@@ -21,7 +21,6 @@ from plugnproduce.reasoning.results import Problem, Reason
 def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[Problem]:
     """One problem per link of the task's first round that cannot get its value."""
     one_round = task.steps[: len(task.steps) // max(task.repeat, 1)]
-    named = {s.name: s for s in one_round if s.name}
     for step in one_round:
         process = processes.get(step.command)
         if process is None:
@@ -29,11 +28,19 @@ def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy
         for name, link in sorted(step.links().items()):
             if name not in {p.name for p in process.parameters}:
                 continue  # an unknown parameter is a problem of its own
+            named = _named_before(one_round, step)
             text, iris = _link_text(step, link, named, processes, process.parameter(name), taxonomy)
             if text:
                 where = task.where(step, name)
                 yield Problem(step.index, step.command, "bad_link", Reason("bad_link", text, iris, (where,)), where,
                               parameter=name)
+
+
+def _named_before(steps: tuple[Step, ...], step: Step) -> dict[str, Step]:
+    """Each step name → the last step of that name before ``step`` (else its first after it)."""
+    named = {s.name: s for s in reversed(steps) if s.name}
+    named.update({s.name: s for s in steps[: step.index - 1] if s.name})
+    return named
 
 
 def _link_text(step: Step, link: Link, named: dict[str, Step], processes: dict[str, ProcessDescription],

@@ -1,12 +1,13 @@
 """The simulated bin: N parts at seeded random poses that the simulated devices see, pick and place.
 
 The bin is the world the simulated devices share. A device that can localise parts
-reports the pose and type of a part still in the bin (into its chart's ``part_pose`` and
-``part_type`` variables, which its event carries); with the bin empty it refuses to
-localise. A robot moving into the bin to where no part lies is refused with a fault that
-says so. A gripper that grips (a request carrying a grip force) while the robot is at a
-part's pose takes that part out of the bin; its other requests let it go (placed). The
-same seed gives the same bin.
+reports the pose and type of a part still in the bin (into its chart's ``outcome``
+(``PartFound``), ``part_pose`` and ``part_type`` variables, which its event carries);
+with the bin empty its outcome is ``BinEmpty`` and the pose stays the last one. A robot
+moving into the bin to where no part lies is refused with a fault that says so. A
+gripper that grips (a request carrying a grip force) while the robot is at a part's pose
+takes that part out of the bin; its other requests let it go (placed). The same seed
+gives the same bin.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ class Part:
 
 
 class BinError(LookupError):
-    """A request the bin cannot let happen (nothing to localise, no part where the robot goes)."""
+    """A request the bin cannot let happen (no part where the robot goes)."""
 
 
 class SimulatedBin:
@@ -74,9 +75,10 @@ class SimulatedBin:
 
     def _localize(self, datamodel: dict[str, Any]) -> None:
         if not self.parts:
-            raise BinError(f"the bin is empty ({len(self.taken)} part(s) taken): no part to localise")
+            datamodel["outcome"] = "BinEmpty"
+            return
         part = max(self.parts, key=lambda p: p.pose[2])  # the one on top
-        datamodel["part_pose"], datamodel["part_type"] = list(part.pose), part.type
+        datamodel["outcome"], datamodel["part_pose"], datamodel["part_type"] = "PartFound", list(part.pose), part.type
 
     def _move(self, pose: list[float]) -> None:
         if _in_bin(pose) and self._part_at(pose) is None:
