@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from plugnproduce.codegen.flow import OUTCOME, flow_data, flow_transitions
 from plugnproduce.codegen.specific import (
     PLAN,
     STEP,
@@ -132,12 +133,17 @@ def consumed_outputs(task: Task) -> dict[str, set[str]]:
     return out
 
 
-def _produces(step: Step, process: ProcessDescription,
+def _produces(task: Task, step: Step, process: ProcessDescription,
               consumed: dict[str, set[str]]) -> tuple[tuple[str, str, str], ...]:
-    """(role, output, variable) of each output of this step that a later step takes."""
+    """(role, output, variable) of each output of this step that a later step takes, and of the
+    outcome when a loop of the task ends on it."""
     wanted = consumed.get(step.name or "", set())
-    return tuple((o.role, o.name, output_variable(step.name or "", o.name))
-                 for o in process.outputs if o.name in wanted)
+    out = tuple((o.role, o.name, output_variable(step.name or "", o.name))
+                for o in process.outputs if o.name in wanted)
+    loop, role = task.loop_at(step.index), process.outcome_role()
+    if loop is not None and role is not None and loop.until in process.outcomes:
+        out += ((role.name, "outcome", OUTCOME),)
+    return out
 
 
 _Key = tuple[str, tuple[tuple[str, str], ...], tuple[tuple[str, str], ...], tuple[tuple[str, str], ...],
@@ -196,7 +202,7 @@ def _plan(
         process = processes[step.command]
         values.append(step_values(step, process))
         flows = tuple(sorted((n, v.variable if isinstance(v, Flow) else "") for n, v in values[-1].items()))
-        produces = _produces(step, process, consumed)
+        produces = _produces(task, step, process, consumed)
         key = (process.id, tuple(sorted(binding.items())), tuple(sorted(current.items())), flows, produces)
         if key not in after:
             placeholders: dict[str, object] = {n: Varying(n) for n in values[-1]}
@@ -222,13 +228,14 @@ def _task_chart(task: Task, steps: list[StepChart]) -> Chart:
     """The task chart: each distinct step chart once, the plan of which runs when, and the values that vary."""
     bodies = [s for s in steps if s.body == s.step.index]
     plan = [s.body for s in steps] + [0]
-    pick = State(id=NEXT, transitions=[Transition(cond=f"{PLAN}[{STEP}] == {b.body}", targets=[f"s{b.body}"])
-                                       for b in bodies])
+    pick = State(id=NEXT, transitions=flow_transitions(task, NEXT))
+    pick.transitions += [Transition(cond=f"{PLAN}[{STEP}] == {b.body}", targets=[f"s{b.body}"]) for b in bodies]
     pick.transitions.append(Transition(cond=f"{PLAN}[{STEP}] == 0", targets=[DONE]))
     body = State(id="task", initial=[NEXT], transitions=[Transition(event="timeout error", targets=[FAILED])],
                  children=[pick, *(b.element for b in bodies)])
     data = [Data(id=PLAN, expr="[" + ", ".join(map(str, plan)) + "]"), Data(id=STEP, expr="0")]
-    data += [Data(id=v, expr="None") for v in sorted({var for b in bodies for _, _, var in b.produces})]
+    data += [Data(id=v, expr="None") for v in sorted({var for b in bodies for _, _, var in b.produces} - {OUTCOME})]
+    data += flow_data(task)
     if any(s.varying for s in steps):
         data.append(values_data([s.varying for s in steps]))
     return Chart(name=f"task-{task.name}", initial=["task"], datamodel="python", data=data,
