@@ -19,10 +19,13 @@ from plugnproduce.reasoning.results import Problem, Reason
 
 
 def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[Problem]:
-    """One problem per link of the task's first round that cannot get its value."""
+    """One problem per link of the task's first round (a loop's first iteration) that cannot get its value."""
     one_round = task.steps[: len(task.steps) // max(task.repeat, 1)]
+    later = {i for lp in task.loops for i in range(lp.first, lp.last + 1)}  # a loop's body is written once
     for step in one_round:
         process = processes.get(step.command)
+        if step.index in later:
+            continue
         if process is None:
             continue  # an unknown command is a problem of its own
         for name, link in sorted(step.links().items()):
