@@ -94,7 +94,7 @@ def test_task_yaml_round_trip(tmp_path: Path, name: str) -> None:
         ("task: t\nsteps:\n  - command: pick\n    colour: red\n", 4, "unknown key 'colour'"),
         ("task: t\ntask: u\nsteps: []\n", 2, "appears twice"),
         ("task: t\nrepeat: 1000\nsteps:\n" + "  - command: pick\n" * 11, 4,
-         "the task makes 11000 steps; at most 10000 are accepted"),
+         "11 steps repeated 1000 times make 11000; at most 10000 are accepted"),
         ("task: t\nsteps:\n  - loop:\n      steps:\n        - command: pick\n", 4,
          "a loop needs a way out: 'until: OUTCOME', 'max: N' or both"),
         ("task: t\nsteps:\n  - loop:\n      max: 2\n      steps:\n        - loop: {max: 2, steps: []}\n", 6,
