@@ -38,6 +38,12 @@ def test_the_task_empties_a_simulated_bin_picking_each_part_where_it_was_found(t
         after = records[records.index(reported) + 1:]
         move = next(r for r in after if r["kind"] == "command" and r["device"] == "robot")
         assert move["command"] == "MoveTo" and move["params"]["TargetPose"] == reported["params"]["part_pose"]
+    flows = [r for r in records if r["kind"] == "value" and r["value"] == "localize.part_pose"]
+    used = [r for r in flows if "used" in r]
+    assert len(used) == parts and all(u["device"] == "robot" and u["parameter"] == "pick_pose" for u in used)
+    for u in used:  # the journal says where each pose came from and where it went
+        source = [r for r in flows[: flows.index(u)] if "produced" in r][-1]
+        assert source["device"] == "binpicking-pc" and source["produced"] == u["used"]
     placed = sorted(p.pose for p in SimulatedBin(parts, seed).parts)
     assert sorted(r["params"]["part_pose"] for r in found[:-1]) == placed  # each part once: the bin is empty
     last = records.index(found[-1])
