@@ -393,17 +393,21 @@ async def run_task(
     discovery_timeout: float = 10.0,
     progress: Callable[[str], None] | None = None,
     knowledge: Knowledge | None = None,
+    bin_parts: int | None = None,
+    bin_seed: int = 0,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
     With ``simulate`` the cell's devices are simulated for the run, on a private SSDP network,
-    with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`). ``started`` is
+    with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`), working on a
+    simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given. ``started`` is
     given the run once it exists (to stop it); ``progress`` is told each phase as it begins
     (checking, generating, starting devices, discovering, running). Raises :class:`ImplausibleTask`
     before anything runs.
     """
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env, private_network
+    from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     say = progress or (lambda _: None)
@@ -415,7 +419,8 @@ async def run_task(
     async with contextlib.AsyncExitStack() as stack:
         if simulate:
             say(f"starting {len(the_cell.devices)} simulated device(s) on loopback")
-            sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices))
+            parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
+            sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices), bin=parts)
             await stack.enter_async_context(sim)
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         wanted = [d.id for d in the_cell.devices]

@@ -78,8 +78,11 @@ def test_task_yaml_round_trip(tmp_path: Path, name: str) -> None:
     again = tmp_path / name
     again.write_text(task_to_yaml(task))
     back = load_task(again)
-    assert [(s.command, s.bind, s.params) for s in back.steps] == [(s.command, s.bind, s.params) for s in task.steps]
+    assert [(s.name, s.command, s.bind, s.params) for s in back.steps] == \
+        [(s.name, s.command, s.bind, s.params) for s in task.steps]
     assert (back.name, back.description, back.repeat) == (task.name, task.description, task.repeat)
+    assert [(lp.entry, lp.first, lp.last, lp.until, lp.max) for lp in back.loops] == \
+        [(lp.entry, lp.first, lp.last, lp.until, lp.max) for lp in task.loops]
 
 
 @pytest.mark.parametrize(
@@ -92,6 +95,16 @@ def test_task_yaml_round_trip(tmp_path: Path, name: str) -> None:
         ("task: t\ntask: u\nsteps: []\n", 2, "appears twice"),
         ("task: t\nrepeat: 1000\nsteps:\n" + "  - command: pick\n" * 11, 4,
          "11 steps repeated 1000 times make 11000; at most 10000 are accepted"),
+        ("task: t\nsteps:\n  - loop:\n      steps:\n        - command: pick\n", 4,
+         "a loop needs a way out: 'until: OUTCOME', 'max: N' or both"),
+        ("task: t\nsteps:\n  - loop:\n      max: 2\n      steps:\n        - loop: {max: 2, steps: []}\n", 6,
+         "a loop inside a loop is not supported"),
+        ("task: t\nrepeat: 2\nsteps:\n  - loop: {max: 2, steps: [{command: pick}]}\n", 4,
+         "a task with a loop cannot also repeat"),
+        ("task: t\nsteps:\n  - command: pick\n    params:\n      pick_pose: {from: a}\n", 5,
+         "a parameter taken from an earlier step reads {from: STEP, output: NAME}"),
+        ("task: t\nsteps:\n  - name: a\n    command: pick\n  - name: a\n    command: place\n", 5,
+         "step name 'a' appears twice"),
     ],
 )
 def test_bad_task_names_file_and_line(tmp_path: Path, text: str, line: int, needle: str) -> None:

@@ -134,6 +134,9 @@ def sim_up(
                                help="Faults to inject: DEVICE:KIND[:NAME[:SECONDS]],... "
                                     "e.g. 'gripper:drop-response:Close'."),
     state_file: Path | None = typer.Option(None, metavar="FILE", help="Where to record the control address."),
+    bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
+                                         help="A simulated bin of N parts at random poses for the devices to work on."),
+    bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
 
@@ -141,12 +144,14 @@ def sim_up(
     PNP_SSDP_PORT chooses a private SSDP port.
     """
     from plugnproduce.protocols.upnp import network_from_env
+    from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults, run_simulated_cell
 
     the_cell = service.cell(cell, knowledge())
     k = knowledge(cell)
     sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=k), network=network_from_env(),
-                        faults=parse_faults(faults, the_cell.devices), taxonomy=k.taxonomy)
+                        faults=parse_faults(faults, the_cell.devices), taxonomy=k.taxonomy,
+                        bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None)
     try:
         asyncio.run(run_simulated_cell(sim, state_file or control.default_state_file(), echo=typer.echo))
     except KeyboardInterrupt:

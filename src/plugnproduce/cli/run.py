@@ -31,6 +31,9 @@ def run(
     sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices for this run (on loopback)."),
     faults: str = typer.Option("", "--faults", metavar="SPEC",
                                help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
+    bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
+                                         help="With --sim: a simulated bin of N parts at random poses."),
+    bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
     journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
                                         help="Journal file (default: a new file in PNP_RUNS)."),
     json_out: bool = JSON_OPTION,
@@ -44,6 +47,8 @@ def run(
         if not sim:
             raise typer.BadParameter("give --cell CELL, or --sim to run on the simulated bin-picking cell")
         cell = service.builtin("cells", "bin-picking.yaml")
+    if bin_parts is not None and not sim:
+        raise typer.BadParameter("--bin-parts works on simulated devices: add --sim")
 
     phases = Phases(on_a_terminal(json_out))
 
@@ -62,7 +67,7 @@ def run(
         with phases:
             report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
                                                   observer=show, started=started, progress=phases,
-                                                  knowledge=knowledge(cell)))
+                                                  knowledge=knowledge(cell), bin_parts=bin_parts, bin_seed=bin_seed))
             phases.close(last_done=True)
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)

@@ -13,11 +13,24 @@ it; it reaches ``done`` when the program works against the device models.
 from __future__ import annotations
 
 import copy
+import dataclasses
 
 from plugnproduce.codegen.task import DONE, FAILED, GeneratedTask
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.statechart.io.writer import write_chart
-from plugnproduce.statechart.model import Cancel, Chart, Final, History, Parallel, Send, State, Transition, walk
+from plugnproduce.statechart.model import (
+    Cancel,
+    Chart,
+    Data,
+    Final,
+    History,
+    Parallel,
+    Param,
+    Send,
+    State,
+    Transition,
+    walk,
+)
 
 _TARGETS = {DONE: f"controller_{DONE}", FAILED: f"controller_{FAILED}"}
 
@@ -34,17 +47,27 @@ def closed_world_chart(generated: GeneratedTask, cell: Cell) -> bytes:
             node.targets = [_TARGETS.get(t, t) for t in node.targets]
     controller.children += [Final(id=_TARGETS[DONE]), Final(id=_TARGETS[FAILED])]
     world = Parallel(id="world", children=[controller])
-    world.children += [_device_region(device) for device in sorted(cell.devices, key=lambda d: d.id)]
+    data = copy.deepcopy(task.data)
+    for device in sorted(cell.devices, key=lambda d: d.id):
+        region, device_data = _device_region(device)
+        world.children.append(region)
+        data += device_data
     world.transitions = [Transition(event="done.state.controller", cond=f"In('controller_{DONE}')", targets=[DONE]),
                          Transition(event="done.state.controller", targets=[FAILED])]
     root = Chart(name=f"closed-world-{generated.task.name}", initial=["world"], datamodel="python",
-                 data=copy.deepcopy(task.data), children=[world, Final(id=DONE), Final(id=FAILED)])
+                 data=data, children=[world, Final(id=DONE), Final(id=FAILED)])
     return write_chart(root)
 
 
-def _device_region(device: DeviceDescription) -> State:
-    """A device's own chart as a region: ids and events prefixed with the device id."""
+def _device_region(device: DeviceDescription) -> tuple[State, list[Data]]:
+    """A device's own chart as a region: ids and events prefixed with the device id.
+
+    The device's datamodel joins the chart's, its variables prefixed too; an event parameter that
+    reads one of them (``<param name="part_pose" expr="part_pose"/>``) reads the prefixed one.
+    """
     prefix = device.id.replace("-", "_")
+    variables = {d.id: f"{prefix}__{d.id}" for d in device.chart.data}
+    data = [dataclasses.replace(copy.deepcopy(d), id=variables[d.id]) for d in device.chart.data]
     region = State(id=f"device_{prefix}", initial=[f"{prefix}__{device.initial}"])
     for state in device.chart.children:
         if not isinstance(state, State | Final):
@@ -61,5 +84,7 @@ def _device_region(device: DeviceDescription) -> State:
                 node.type = node.target = node.delay = node.delayexpr = None
             elif isinstance(node, Cancel) and node.sendid:
                 node.sendid = f"{prefix}__{node.sendid}"
+            elif isinstance(node, Param) and node.expr in variables:
+                node.expr = variables[node.expr]
         region.children.append(s)
-    return region
+    return region, data

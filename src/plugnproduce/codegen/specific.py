@@ -36,6 +36,23 @@ class Varying:
         return f"{VALUES}[{STEP}][{self.name!r}]"
 
 
+@dataclass(frozen=True)
+class Flow:
+    """A parameter value taken from an earlier step's output: a variable of the task chart's datamodel."""
+
+    variable: str
+
+    @property
+    def expr(self) -> str:
+        """The expression that reads it at run time."""
+        return self.variable
+
+
+def output_variable(step_name: str, output: str) -> str:
+    """The datamodel variable that holds a named step's output (``pnp_out_localize_part_pose``)."""
+    return f"pnp_out_{step_name}_{output}"
+
+
 @dataclass
 class RegionResult:
     """One role's region of a Specific Process State Chart, bound to its device."""
@@ -150,7 +167,7 @@ def _request(
     for name, value in sorted(values.items()):
         quantity = process.parameter(name).quantity
         if quantity in accepts:
-            expr = value.expr if isinstance(value, Varying) else literal(value)
+            expr = value.expr if isinstance(value, Varying | Flow) else literal(value)
             send.params.append(Param(name=local_name(quantity), expr=expr))
     return send
 

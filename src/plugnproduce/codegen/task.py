@@ -12,17 +12,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from plugnproduce.codegen.flow import OUTCOME, flow_data, flow_transitions
 from plugnproduce.codegen.specific import (
     PLAN,
     STEP,
     VALUES,
+    Flow,
     RegionResult,
     Varying,
     controller_ids,
     literal,
+    output_variable,
     specific_region,
 )
-from plugnproduce.description.model import Cell, ChartTransition, Command, ProcessDescription, Step, Task
+from plugnproduce.description.model import Cell, ChartTransition, Command, Link, ProcessDescription, Step, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
@@ -74,6 +77,8 @@ class StepChart:
     body: int
     varying: dict[str, object] = field(default_factory=dict)
     """This step's values of the parameters that differ between the steps sharing its chart."""
+    produces: tuple[tuple[str, str, str], ...] = ()
+    """(role, output, datamodel variable) of each output this step keeps for later steps."""
 
 
 @dataclass
@@ -109,13 +114,40 @@ def specific_name(body: int, process: str) -> str:
 
 
 def step_values(step: Step, process: ProcessDescription) -> dict[str, object]:
-    """Parameter values of a step: the task's, and the process defaults for the rest."""
+    """Parameter values of a step: the task's, and the process defaults for the rest.
+
+    A value taken from an earlier step's output becomes a :class:`Flow`: the datamodel variable holding it.
+    """
     values: dict[str, object] = {p.name: p.default for p in process.parameters if p.default is not None}
-    values.update(step.params)
+    values.update({n: Flow(output_variable(v.step, v.output)) if isinstance(v, Link) else v
+                   for n, v in step.params.items()})
     return values
 
 
-_Key = tuple[str, tuple[tuple[str, str], ...], tuple[tuple[str, str], ...], tuple[str, ...]]
+def consumed_outputs(task: Task) -> dict[str, set[str]]:
+    """Per named step, the outputs later steps take from it."""
+    out: dict[str, set[str]] = {}
+    for step in task.steps:
+        for link in step.links().values():
+            out.setdefault(link.step, set()).add(link.output)
+    return out
+
+
+def _produces(task: Task, step: Step, process: ProcessDescription,
+              consumed: dict[str, set[str]]) -> tuple[tuple[str, str, str], ...]:
+    """(role, output, variable) of each output of this step that a later step takes, and of the
+    outcome when a loop of the task ends on it."""
+    wanted = consumed.get(step.name or "", set())
+    out = tuple((o.role, o.name, output_variable(step.name or "", o.name))
+                for o in process.outputs if o.name in wanted)
+    loop, role = task.loop_at(step.index), process.outcome_role()
+    if loop is not None and role is not None and loop.until in process.outcomes:
+        out += ((role.name, "outcome", OUTCOME),)
+    return out
+
+
+_Key = tuple[str, tuple[tuple[str, str], ...], tuple[tuple[str, str], ...], tuple[tuple[str, str], ...],
+             tuple[tuple[str, str, str], ...]]
 
 
 def generate_task(
@@ -132,7 +164,8 @@ def generate_task(
     runs at each step) and the parameter values that differ between the steps sharing a
     chart; nothing is unrolled.
     """
-    keys, values = _plan(task, cell, bindings, processes, taxonomy)
+    consumed = consumed_outputs(task)
+    keys, values = _plan(task, cell, bindings, processes, taxonomy, consumed)
     groups: dict[_Key, list[dict[str, object]]] = {}
     for key, row in zip(keys, values, strict=True):
         groups.setdefault(key, []).append(row)
@@ -144,10 +177,10 @@ def generate_task(
         key, process = keys[i], processes[step.command]
         if key not in charts:
             bound = {n: Varying(n) if n in varying[key] else v for n, v in values[i].items()}
-            charts[key] = _step(step, process, binding, cell, dict(current), taxonomy, bound)
+            charts[key] = _step(step, process, binding, cell, dict(current), taxonomy, bound, key[4])
         first = charts[key]
         row = {n: v for n, v in values[i].items() if n in varying[key]}
-        steps.append(StepChart(step, process, binding, first.regions, first.element, first.body, row))
+        steps.append(StepChart(step, process, binding, first.regions, first.element, first.body, row, first.produces))
         current.update({r.device.id: r.end_state for r in first.regions})
     return GeneratedTask(task, steps, _task_chart(task, steps), current)
 
@@ -158,6 +191,7 @@ def _plan(
     bindings: list[dict[str, str]],
     processes: dict[str, ProcessDescription],
     taxonomy: Taxonomy,
+    consumed: dict[str, set[str]],
 ) -> tuple[list[_Key], list[dict[str, object]]]:
     """Each step's key (what its chart depends on: process, bindings, device states, parameters) and values."""
     current = {d.id: d.initial for d in cell.devices}
@@ -167,10 +201,12 @@ def _plan(
     for step, binding in zip(task.steps, bindings, strict=True):
         process = processes[step.command]
         values.append(step_values(step, process))
-        key = (process.id, tuple(sorted(binding.items())), tuple(sorted(current.items())), tuple(sorted(values[-1])))
+        flows = tuple(sorted((n, v.variable if isinstance(v, Flow) else "") for n, v in values[-1].items()))
+        produces = _produces(task, step, process, consumed)
+        key = (process.id, tuple(sorted(binding.items())), tuple(sorted(current.items())), flows, produces)
         if key not in after:
             placeholders: dict[str, object] = {n: Varying(n) for n in values[-1]}
-            _step(step, process, binding, cell, current, taxonomy, placeholders)
+            _step(step, process, binding, cell, current, taxonomy, placeholders, produces)
             after[key] = dict(current)
         keys.append(key)
         current = dict(after[key])
@@ -192,12 +228,14 @@ def _task_chart(task: Task, steps: list[StepChart]) -> Chart:
     """The task chart: each distinct step chart once, the plan of which runs when, and the values that vary."""
     bodies = [s for s in steps if s.body == s.step.index]
     plan = [s.body for s in steps] + [0]
-    pick = State(id=NEXT, transitions=[Transition(cond=f"{PLAN}[{STEP}] == {b.body}", targets=[f"s{b.body}"])
-                                       for b in bodies])
+    pick = State(id=NEXT, transitions=flow_transitions(task, NEXT))
+    pick.transitions += [Transition(cond=f"{PLAN}[{STEP}] == {b.body}", targets=[f"s{b.body}"]) for b in bodies]
     pick.transitions.append(Transition(cond=f"{PLAN}[{STEP}] == 0", targets=[DONE]))
     body = State(id="task", initial=[NEXT], transitions=[Transition(event="timeout error", targets=[FAILED])],
                  children=[pick, *(b.element for b in bodies)])
     data = [Data(id=PLAN, expr="[" + ", ".join(map(str, plan)) + "]"), Data(id=STEP, expr="0")]
+    data += [Data(id=v, expr="None") for v in sorted({var for b in bodies for _, _, var in b.produces} - {OUTCOME})]
+    data += flow_data(task)
     if any(s.varying for s in steps):
         data.append(values_data([s.varying for s in steps]))
     return Chart(name=f"task-{task.name}", initial=["task"], datamodel="python", data=data,
@@ -212,8 +250,13 @@ def _step(
     current: dict[str, str],
     taxonomy: Taxonomy,
     values: dict[str, object],
+    produces: tuple[tuple[str, str, str], ...] = (),
 ) -> StepChart:
-    """Generate one step's chart from the device states in ``current`` (which it advances)."""
+    """Generate one step's chart from the device states in ``current`` (which it advances).
+
+    Each output in ``produces`` is kept, from the payload of the last event its role's device sends,
+    in a datamodel variable.
+    """
     sid = f"s{step.index}"
     ids = controller_ids(step.index, process, binding)
     regions = []
@@ -225,6 +268,7 @@ def _step(
             raise ImplausibleStep(step, device.id, state, role.start_concept)
         region = specific_region(step.index, process, role, device, state, values, ids, taxonomy)
         _add_timeouts(region)
+        _keep_outputs(step, region, [(o, v) for r, o, v in produces if r == role.name])
         current[device.id] = region.end_state
         regions.append(region)
     used = {r.device.id for r in regions}
@@ -235,7 +279,20 @@ def _step(
                       actions=[Assign(location=STEP, expr=f"{STEP} + 1")])
     element = Parallel(id=sid, children=list(children), transitions=[done],
                        extra_attrs={pnp("command"): process.id, pnp("chart"): specific_name(step.index, process.id)})
-    return StepChart(step, process, binding, regions, element, step.index)
+    return StepChart(step, process, binding, regions, element, step.index, produces=produces)
+
+
+def _keep_outputs(step: Step, region: RegionResult, outputs: list[tuple[str, str]]) -> None:
+    """Assign each output from the payload of the last device event the region waits for."""
+    if not outputs:
+        return
+    prefix = f"{region.device.id}."
+    waits = [t for s in region.element.children if isinstance(s, State) for t in s.transitions
+             if (t.event or "").startswith(prefix)]
+    if not waits:
+        raise PlugNProduceError(f"step {step.index} ({step.command}): device {region.device.id} reports no event, "
+                                f"so it cannot give back {', '.join(o for o, _ in outputs)}")
+    waits[-1].actions.extend(Assign(location=v, expr=f"_event.data.{o}") for o, v in outputs)
 
 
 def _idle_region(index: int, device: str, state: str, cell: Cell) -> State:

@@ -8,6 +8,7 @@ has parsed. Schema validity is checked separately (:mod:`plugnproduce.statechart
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Iterable
 from pathlib import Path
@@ -29,7 +30,7 @@ from plugnproduce.statechart.model import (
     walk,
 )
 
-ACCEPTS, ROLE, PARAMS = pnp("accepts"), pnp("role"), pnp("params")
+ACCEPTS, ROLE, PARAMS, OUTCOMES = pnp("accepts"), pnp("role"), pnp("params"), pnp("outcomes")
 _IN = re.compile(r"""In\(\s*['"]([^'"]+)['"]\s*\)""")
 
 
@@ -122,6 +123,9 @@ def _region_sequence(region: State, path: str | Path) -> tuple[RegionState, ...]
             raise DescriptionError(f"transition leaves region {region.id!r}", path, t.line)
     if not seq or not isinstance(by_id[seq[-1].id], Final):
         raise DescriptionError(f"region {region.id!r} must end in a <final> state", path, region.line)
+    final = by_id[seq[-1].id]
+    outcomes = tuple(concept_iri(o) for o in final.extra_attrs.get(OUTCOMES, "").split())
+    seq[-1] = dataclasses.replace(seq[-1], outcomes=outcomes)
     return tuple(seq)
 
 

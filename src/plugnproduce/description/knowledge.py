@@ -84,7 +84,7 @@ class KnowledgeGraph:
                 continue
             self.graph.add((node, PNP.command, rdflib.URIRef(process.iri)))
             params = {p.name: p for p in process.parameters}
-            for name, value in sorted(step.params.items()):
+            for name, value in sorted(step.values().items()):  # a link is checked by the data flow check
                 if name not in params:
                     continue
                 pv = rdflib.URIRef(f"{base}step{step.index}-{name}")

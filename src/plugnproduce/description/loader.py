@@ -6,7 +6,10 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
+import dataclasses
+import keyword
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from decimal import Decimal
@@ -21,18 +24,22 @@ from plugnproduce.description.charts import device_chart, process_regions
 from plugnproduce.description.model import (
     Cell,
     DeviceDescription,
+    Link,
+    Loop,
+    Output,
     Parameter,
     ProcessDescription,
     Role,
     Step,
     Task,
     Where,
+    plain_value,
 )
 from plugnproduce.description.rdf import term_line
 from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
 from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP, local_name
+from plugnproduce.ontology.vocabulary import PNP, concept_iri, concept_value, local_name
 from plugnproduce.safeio import (
     PlainDumper,
     parse_turtle,
@@ -44,6 +51,8 @@ from plugnproduce.safeio import (
 from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")
+_OUTPUT_NAME = re.compile(r"[a-z][a-z0-9_]{0,63}")
 
 
 @dataclass(frozen=True)
@@ -209,6 +218,7 @@ def process_from(loaded: Loaded) -> ProcessDescription:
     params = tuple(
         sorted((_parameter(loaded, p) for p in loaded.graph.objects(s, PNP.hasParameter)), key=lambda p: p.name)
     )
+    outputs = tuple(sorted((_output(loaded, o) for o in loaded.graph.objects(s, PNP.hasOutput)), key=lambda o: o.name))
     label = _opt(loaded, s, RDFS.label)
     comment = _opt(loaded, s, RDFS.comment)
     return ProcessDescription(
@@ -222,6 +232,7 @@ def process_from(loaded: Loaded) -> ProcessDescription:
         chart_file=str(chart_file),
         where=loaded.where(str(s)),
         chart=chart,
+        outputs=outputs,
     )
 
 
@@ -266,6 +277,24 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
         maximum=_finite(loaded, p, _opt(loaded, p, PNP.maxValue), "maximum"),
         default=_default(default),
         where=loaded.where(str(p)),
+    )
+
+
+def _output(loaded: Loaded, o: rdflib.term.Node) -> Output:
+    role = _one(loaded, o, PNP.forRole, "role")
+    role_name = _opt(loaded, role, PNP.roleName)
+    name = str(_one(loaded, o, PNP.outputName, "output name"))
+    if not _OUTPUT_NAME.fullmatch(name) or keyword.iskeyword(name):
+        raise DescriptionError(f"output name {excerpt(repr(name))} must be a lower_snake_case name such as part_pose",
+                               loaded.path, loaded.line(str(o)))
+    return Output(
+        name=name,
+        iri=str(o),
+        role=str(role_name) if role_name is not None else local_name(str(role)),
+        quantity=str(_one(loaded, o, PNP.quantity, "quantity")),
+        datatype=str(_one(loaded, o, PNP.datatype, "datatype")),
+        unit=str(_opt(loaded, o, PNP.unit) or ""),
+        where=loaded.where(str(o)),
     )
 
 
@@ -335,21 +364,117 @@ def parse_task(data: bytes, source: str | Path) -> Task:
         raise DescriptionError(f"{len(steps_node.value)} steps repeated {repeat} times make "
                                f"{len(steps_node.value) * repeat}; at most {Task.MAX_STEPS} are accepted",
                                p, steps_node.start_mark.line + 1)
+    names: set[str] = set()
     one_round: list[Step] = []
-    for i, node in enumerate(steps_node.value):
-        line = node.start_mark.line + 1
-        m = _mapping(node, p, "step")
-        _unknown_keys(m, {"command", "bind", "params"}, p, "step")
-        if "command" not in m or not isinstance(_plain(m["command"]), str):
-            raise DescriptionError("a step needs 'command': the name of a process command", p, line)
-        bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
-        params = m.get("params")
-        lines = {}
-        if isinstance(params, yaml.MappingNode):
-            lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value}
-        one_round.append(Step(i + 1, str(_plain(m["command"])), bind, _str_map(params, p, "params"), line, lines))
+    loops: list[Loop] = []
+    for node in steps_node.value:
+        if isinstance(node, yaml.MappingNode) and "loop" in _mapping(node, p, "step"):
+            if repeat != 1:
+                raise DescriptionError("a task with a loop cannot also repeat; put its steps in the loop", p,
+                                       node.start_mark.line + 1)
+            loops.append(_loop(_mapping(node, p, "step"), p, names, one_round))
+        else:
+            one_round.append(_step(node, p, names, len(one_round) + 1))
+    if len(one_round) * repeat > Task.MAX_STEPS:
+        raise DescriptionError(f"the task makes {len(one_round) * repeat} steps; at most {Task.MAX_STEPS} are "
+                               "accepted", p, steps_node.start_mark.line + 1)
     description = _plain(top["description"]) if "description" in top else ""
-    return Task.repeated(str(_plain(top["task"])), one_round, str(p), str(description or ""), repeat)
+    task = Task.repeated(str(_plain(top["task"])), one_round, str(p), str(description or ""), repeat)
+    return dataclasses.replace(task, loops=tuple(loops)) if loops else task
+
+
+def _step(node: yaml.Node, p: Path, names: set[str], index: int) -> Step:
+    """One step of a task file."""
+    line = node.start_mark.line + 1
+    m = _mapping(node, p, "step")
+    _unknown_keys(m, {"name", "command", "bind", "params"}, p, "step")
+    if "command" not in m or not isinstance(_plain(m["command"]), str):
+        raise DescriptionError("a step needs 'command': the name of a process command (or 'loop')", p, line)
+    bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
+    params = m.get("params")
+    lines = {}
+    if isinstance(params, yaml.MappingNode):
+        lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value}
+    values = {n: _link(v, p, lines.get(n, line)) for n, v in _str_map(params, p, "params").items()}
+    name = _step_name(m.get("name"), names, p)
+    return Step(index, str(_plain(m["command"])), bind, values, line, lines, name)
+
+
+def _loop(item: dict[str, yaml.Node], p: Path, names: set[str], steps: list[Step]) -> Loop:
+    """A ``loop:`` item: its body goes into ``steps`` twice (the first iteration, then the ones after it)."""
+    _unknown_keys(item, {"loop"}, p, "step")
+    node = item["loop"]
+    line = node.start_mark.line + 1
+    m = _mapping(node, p, "loop")
+    _unknown_keys(m, {"until", "max", "steps"}, p, "loop")
+    until = _plain(m["until"]) if "until" in m else None
+    if until is not None and (not isinstance(until, str) or not _NAME.fullmatch(until)):
+        raise DescriptionError(f"until names an outcome such as BinEmpty; found {excerpt(repr(until))}", p,
+                               m["until"].start_mark.line + 1)
+    most = _plain(m["max"]) if "max" in m else None
+    if most is not None and (not isinstance(most, int) or isinstance(most, bool) or not 1 <= most <= 1_000_000):
+        raise DescriptionError(f"max must be a whole number from 1 to 1000000; found {excerpt(repr(most))}", p,
+                               m["max"].start_mark.line + 1)
+    if until is None and most is None:
+        raise DescriptionError("a loop needs a way out: 'until: OUTCOME', 'max: N' or both", p, line)
+    body_node = m.get("steps")
+    if not isinstance(body_node, yaml.SequenceNode) or not body_node.value:
+        raise DescriptionError("a loop needs 'steps', a non-empty list", p, line)
+    for b in body_node.value:
+        if isinstance(b, yaml.MappingNode) and "loop" in _mapping(b, p, "step"):
+            raise DescriptionError("a loop inside a loop is not supported; flatten the inner one", p,
+                                   b.start_mark.line + 1)
+    entry = len(steps) + 1
+    body = [_step(b, p, names, entry + i) for i, b in enumerate(body_node.value)]
+    steps += body
+    first = len(steps) + 1
+    steps += [dataclasses.replace(s, index=first + i) for i, s in enumerate(body)]
+    return Loop(entry, first, len(steps), concept_iri(until) if until else None, most, line)
+
+
+def _step_name(node: yaml.Node | None, seen: set[str], path: Path) -> str | None:
+    """A step's ``name:``: a plain name, unique in the task."""
+    if node is None:
+        return None
+    name = _plain(node)
+    line = node.start_mark.line + 1
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise DescriptionError(f"a step name must be a plain name such as localize; found {excerpt(repr(name))}",
+                               path, line)
+    if name in seen:
+        raise DescriptionError(f"step name {name!r} appears twice; each step needs its own name", path, line)
+    seen.add(name)
+    return name
+
+
+def _link(value: object, path: Path, line: int) -> object:
+    """A parameter value, or the earlier step's output it takes (``{from: STEP, output: NAME}``)."""
+    if not isinstance(value, dict):
+        return value
+    if set(value) != {"from", "output"} or not all(isinstance(v, str) for v in value.values()):
+        raise DescriptionError("a parameter taken from an earlier step reads {from: STEP, output: NAME}; found "
+                               f"{excerpt(repr(value))}", path, line)
+    return Link(str(value["from"]), str(value["output"]))
+
+
+def _step_entry(s: Step) -> dict[str, object]:
+    entry: dict[str, object] = {"name": s.name} if s.name else {}
+    entry["command"] = s.command
+    if s.bind:
+        entry["bind"] = dict(s.bind)
+    if s.params:
+        entry["params"] = {n: plain_value(v) for n, v in s.params.items()}
+    return entry
+
+
+def _loop_entry(task: Task, loop: Loop) -> dict[str, object]:
+    out: dict[str, object] = {}
+    if loop.until:
+        out["until"] = concept_value(loop.until)
+    if loop.max is not None:
+        out["max"] = loop.max
+    out["steps"] = [_step_entry(s) for s in task.steps[loop.first - 1 : loop.last]]
+    return out
 
 
 def task_to_yaml(task: Task, block: bool = False) -> str:
@@ -359,12 +484,11 @@ def task_to_yaml(task: Task, block: bool = False) -> str:
     """
     steps = []
     for s in task.one_round():
-        entry: dict[str, object] = {"command": s.command}
-        if s.bind:
-            entry["bind"] = dict(s.bind)
-        if s.params:
-            entry["params"] = dict(s.params)
-        steps.append(entry)
+        loop = task.loop_at(s.index)
+        if loop is not None and s.index < loop.first:
+            continue  # the first iteration: written once, as the loop
+        if loop is None or s.index == loop.first:
+            steps.append(_step_entry(s) if loop is None else {"loop": _loop_entry(task, loop)})
     doc: dict[str, object] = {"task": task.name}
     if task.description:
         doc["description"] = task.description

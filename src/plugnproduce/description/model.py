@@ -123,6 +123,9 @@ class RegionState:
     """Parameter names consumed on the way into this state (``pnp:params``)."""
     waits_for: str | None = None
     """State id of another region this state waits for (``In('...')``) before it is entered."""
+    outcomes: tuple[str, ...] = ()
+    """Outcome concepts a region's final state may be reached with (``pnp:outcomes``), which its device
+    reports as the ``outcome`` value of the event that ends it."""
 
 
 @dataclass(frozen=True)
@@ -163,6 +166,19 @@ class Parameter:
 
 
 @dataclass(frozen=True)
+class Output:
+    """A value a process gives back (``pnp:hasOutput``): its role's device reports it as an event payload."""
+
+    name: str
+    iri: str
+    role: str
+    quantity: str
+    datatype: str
+    unit: str
+    where: Where
+
+
+@dataclass(frozen=True)
 class ProcessDescription:
     """A process: roles, parameters and its General Process State Chart."""
 
@@ -177,6 +193,8 @@ class ProcessDescription:
     where: Where
     chart: Chart = field(default_factory=Chart, compare=False, repr=False)
     """The parsed General Process State Chart."""
+    outputs: tuple[Output, ...] = ()
+    """The values the process gives back, which later steps of a task may take as parameters."""
 
     def role(self, name: str) -> Role:
         """The role called ``name``."""
@@ -192,6 +210,40 @@ class ProcessDescription:
                 return p
         raise KeyError(f"process {self.id} has no parameter {name!r}")
 
+    @property
+    def outcomes(self) -> tuple[str, ...]:
+        """The outcome concepts the process may end with (each leaves its roles' devices in their end states)."""
+        return tuple(o for r in self.roles for o in r.region[-1].outcomes)
+
+    def outcome_role(self) -> Role | None:
+        """The role whose device reports the outcome, if the process has outcomes."""
+        return next((r for r in self.roles if r.region[-1].outcomes), None)
+
+    def output(self, name: str) -> Output:
+        """The output called ``name``."""
+        for o in self.outputs:
+            if o.name == name:
+                return o
+        raise KeyError(f"process {self.id} has no output {name!r}")
+
+
+@dataclass(frozen=True)
+class Link:
+    """A parameter value taken from an earlier step's output (``{from: localize, output: part_pose}``)."""
+
+    step: str
+    """The ``name:`` of the step that produces the value."""
+    output: str
+
+    def to_plain(self) -> dict[str, str]:
+        """The link as the task file writes it."""
+        return {"from": self.step, "output": self.output}
+
+
+def plain_value(value: object) -> object:
+    """A parameter value as YAML and JSON hold it (a link becomes its mapping)."""
+    return value.to_plain() if isinstance(value, Link) else value
+
 
 @dataclass(frozen=True)
 class Step:
@@ -205,11 +257,48 @@ class Step:
     line: int | None = None
     param_lines: dict[str, int] = field(default_factory=dict, compare=False)
     """Line of each parameter value in the task file."""
+    name: str | None = None
+    """The step's name (``name:``), by which later steps take its outputs."""
+
+    def links(self) -> dict[str, Link]:
+        """The parameters whose values come from earlier steps' outputs."""
+        return {n: v for n, v in self.params.items() if isinstance(v, Link)}
+
+    def values(self) -> dict[str, object]:
+        """The parameters given as values (links left out)."""
+        return {n: v for n, v in self.params.items() if not isinstance(v, Link)}
+
+
+@dataclass(frozen=True)
+class Loop:
+    """A loop of a task: its body runs again and again until one of its steps ends with ``until``
+    (the rest of that iteration is skipped), at most ``max`` times.
+
+    The task's steps hold the body twice: the first iteration (steps ``entry`` to ``first - 1``) and
+    the iterations after it (``first`` to ``last``), which start from the states the first one left
+    and which the generated chart repeats without unrolling. Indices are 1-based positions in the task.
+    """
+
+    entry: int
+    first: int
+    last: int
+    until: str | None
+    """The outcome concept (IRI) that ends the loop."""
+    max: int | None
+    line: int | None = None
+
+    def path(self, index: int) -> str | None:
+        """Which iteration a step position belongs to (``loop iteration 1`` / ``loop iteration 2 and later``)."""
+        if self.entry <= index < self.first:
+            return "loop iteration 1"
+        if self.first <= index <= self.last:
+            return "loop iteration 2 and later"
+        return None
 
 
 @dataclass(frozen=True)
 class Task:
-    """A task description: an ordered list of process commands."""
+    """A task description: an ordered list of process commands, some of them in loops."""
 
     MAX_STEPS = 10_000
     """Most steps a task may have once its repeats are expanded."""
@@ -219,6 +308,7 @@ class Task:
     file: str
     description: str = ""
     repeat: int = 1
+    loops: tuple[Loop, ...] = ()
 
     @classmethod
     def repeated(cls, name: str, one_round: Sequence[Step], file: str, description: str = "",
@@ -235,6 +325,10 @@ class Task:
     def one_round(self) -> tuple[Step, ...]:
         """The steps as written once, before the repeats."""
         return self.steps[: len(self.steps) // max(self.repeat, 1)]
+
+    def loop_at(self, index: int) -> Loop | None:
+        """The loop whose body (either copy) holds step position ``index``, if any."""
+        return next((lp for lp in self.loops if lp.entry <= index <= lp.last), None)
 
     def where(self, step: Step, parameter: str | None = None) -> Where:
         """The place of a step (or of one of its parameter values) in the task file."""

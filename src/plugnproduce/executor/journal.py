@@ -20,7 +20,7 @@ from typing import Any, TextIO
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 
-KINDS = ("start", "step", "command", "event", "state", "fault", "end")
+KINDS = ("start", "step", "command", "event", "value", "state", "fault", "end")
 
 
 class JournalInUse(PlugNProduceError):
@@ -134,6 +134,11 @@ def describe(record: dict[str, Any]) -> str:
         return f"← {record.get('device') or 'chart'}: {record.get('event')}"
     if kind == "state":
         return f"  {record.get('device')} is {record.get('state')}"
+    if kind == "value" and "produced" in record:
+        return f"  value {record.get('value')} = {record.get('produced')} (from {record.get('device')})"
+    if kind == "value":
+        return (f"  value {record.get('value')} → {record.get('device')} as {record.get('parameter')}"
+                f" = {record.get('used')}")
     if kind == "fault":
         return f"FAULT {record.get('fault')}: {record.get('message')}"
     return f"end: {record.get('outcome')}" + (f" ({record.get('reason')})" if record.get("reason") else "")

@@ -67,7 +67,10 @@ class XirpLink:
 
 
 class UpnpLink:
-    """A device driven over UPnP: requests are SOAP actions, events are changes of evented counters."""
+    """A device driven over UPnP: requests are SOAP actions, events are changes of evented counters.
+
+    The values an event carries are its ``EVENT__NAME`` variables (JSON), changed in the same notification.
+    """
 
     def __init__(self, device: str, client: upnp.UpnpDeviceClient) -> None:
         self.device = device
@@ -79,7 +82,11 @@ class UpnpLink:
         """Read the device's UPnP description (where it was discovered) and subscribe to its events."""
         host = urlparse(device.endpoint).hostname or ""
         client = await upnp.UpnpDeviceClient.connect(device.endpoint, host, timeout=device.command_timeout)
-        await client.subscribe(lambda variable, _value: on_event(device.id, variable, {}))
+        def changed(variable: str, _value: Any) -> None:
+            if not upnp.is_payload_variable(variable):  # a value an event carries comes with its counter
+                on_event(device.id, variable, upnp.payload_of(client.values, variable))
+
+        await client.subscribe(changed)
         return cls(device.id, client)
 
     async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:

@@ -26,11 +26,12 @@ from plugnproduce.codegen import DONE, GeneratedTask
 from plugnproduce.codegen.task import STEP
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
+from plugnproduce.executor import values
 from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
 from plugnproduce.statechart.model import StateNode
-from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, MacroStep, MetaEvent
+from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, EventData, MacroStep, MetaEvent
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
 
@@ -193,6 +194,8 @@ class TaskRun:
             raise PlugNProduceError(f"cannot send {event.name!r} to {target!r}: not a request to a device of the cell")
         params = dict(event.data or {})
         self._record("command", step=self.step, device=target, command=command.name, params=params)
+        for value in values.used(self.generated, self.step, target, params, self.interpreter.dm):
+            self._record("value", **value)
         task = asyncio.get_running_loop().create_task(self._request(target, command.name, params))
         self._commands.add(task)
         task.add_done_callback(self._commands.discard)
@@ -214,7 +217,9 @@ class TaskRun:
         protocol = self.cell.device(device).protocol
         event = f"{device}.{protocol}.event.{name}"
         self._record("event", step=self.step, device=device, event=name, params=dict(params))
-        self._loop.queue(event, dict(params))
+        for value in values.produced(self.generated, self.step, device, params):
+            self._record("value", **value)
+        self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too
 
     def _on_lost(self, device: str, reason: str) -> None:
         self._fail(self._fault("lost", device, reason))

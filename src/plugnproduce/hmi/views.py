@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from plugnproduce import service
-from plugnproduce.description.model import Cell, DeviceDescription, Parameter, ProcessDescription, Task
+from plugnproduce.description.model import Cell, DeviceDescription, Parameter, ProcessDescription, Task, plain_value
 from plugnproduce.executor.journal import describe
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
@@ -84,7 +84,8 @@ def task_json(task: Task) -> dict[str, Any]:
         "name": task.name,
         "description": task.description,
         "repeat": task.repeat,
-        "steps": [{"command": s.command, "bind": dict(s.bind), "params": dict(s.params)} for s in task.one_round()],
+        "steps": [{"command": s.command, "bind": dict(s.bind),
+                   "params": {n: plain_value(v) for n, v in s.params.items()}} for s in task.one_round()],
     }
 
 

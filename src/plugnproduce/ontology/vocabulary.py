@@ -22,6 +22,7 @@ class PNP(DefinedNamespace):
     Process: URIRef
     Role: URIRef
     Parameter: URIRef
+    Output: URIRef
     Quantity: URIRef
     Protocol: URIRef
     Task: URIRef
@@ -41,6 +42,8 @@ class PNP(DefinedNamespace):
     requiresSkill: URIRef
     hasParameter: URIRef
     parameterName: URIRef
+    hasOutput: URIRef
+    outputName: URIRef
     forRole: URIRef
     quantity: URIRef
     datatype: URIRef

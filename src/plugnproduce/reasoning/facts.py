@@ -147,7 +147,7 @@ def task_facts(task: Task, name: str) -> list[Atom]:
         i = step.index
         out.append(s.StepFact(name, i, step.command))
         out += [s.Bind(name, i, r, d) for r, d in sorted(step.bind.items())]
-        for n, v in sorted(step.params.items()):
+        for n, v in sorted(step.values().items()):  # links: see reasoning.dataflow
             out.append(s.Given(name, i, n))
             out += [s.ValueKind(name, i, n, k) for k in value_kinds(v)]
             num = milli(v)

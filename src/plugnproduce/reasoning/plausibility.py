@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections import defaultdict
 from collections.abc import Sequence
 
@@ -10,6 +11,8 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
+from plugnproduce.reasoning.controlflow import loop_problems, on_path
+from plugnproduce.reasoning.dataflow import link_problems, unreported
 from plugnproduce.reasoning.facts import fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program, context
 from plugnproduce.reasoning.results import CheckResult, Problem, StepCheck, StepExplanation
@@ -59,14 +62,24 @@ def run_check(task: Task, cell: Cell, taxonomy: Taxonomy,
 
 
 def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> CheckResult:
-    """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems."""
+    """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems.
+
+    A task with loops is checked on every path: see :mod:`plugnproduce.reasoning.controlflow`.
+    """
     model, ctx = run_check(task, cell, taxonomy, processes)
     steps, final = _steps(model, task)
     parameters = {p.id: {x.name: x for x in p.parameters} for p in processes}
     lost = list(not_accepted(task, cell, steps, parameters, taxonomy))
-    plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not lost
-    problems = sorted(_problems(model, ctx) + lost, key=lambda p: (p.step, p.kind, p.parameter or ""))
-    return CheckResult(task.name, cell.name, plausible, tuple(problems), steps, final)
+    lost += link_problems(task, {p.id: p for p in processes}, taxonomy)
+    lost += unreported(task, cell, steps, {p.id: p for p in processes})
+    problems = [on_path(p, task) for p in _problems(model, ctx) + lost]
+    plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not problems
+    result = CheckResult(task.name, cell.name, plausible, (), steps, final)
+    if task.loops:
+        problems += loop_problems(task, result, {p.id: p for p in processes},
+                                  lambda straight: check(straight, cell, taxonomy, processes))
+    problems = sorted(problems, key=lambda p: (p.step, p.kind, p.parameter or ""))
+    return dataclasses.replace(result, plausible=result.plausible and not problems, problems=tuple(problems))
 
 
 def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,

@@ -137,8 +137,9 @@ def repaired_task(model: Model, task: Task) -> Task:
             continue
         old = task.steps[run.i - 1]
         params = {k: v for k, v in old.params.items() if (run.i, k) not in resets}
-        steps.append(Step(index, run.p, bind, params, old.line, dict(old.param_lines)))
-    return Task(task.name, tuple(steps), task.file, task.description, folded_repeat(steps, task.repeat))
+        steps.append(Step(index, run.p, bind, params, old.line, dict(old.param_lines), old.name))
+    loops = task.loops if len(steps) == len(task.steps) else ()  # a loop's steps kept in place: still the loop
+    return Task(task.name, tuple(steps), task.file, task.description, folded_repeat(steps, task.repeat), loops)
 
 
 def folded_repeat(steps: list[Step], most: int) -> int:

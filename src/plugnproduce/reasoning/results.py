@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from plugnproduce.description.model import Task, Where
+from plugnproduce.description.model import Task, Where, plain_value
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,7 @@ class Problem:
     command: str
     kind: str
     """``wrong_state``, ``stuck``, ``no_device``, ``ambiguous``, ``absent``, ``cannot_play``, ``unknown_role``,
-    ``unknown_command``, ``bad_type``, ``too_low``, ``too_high``, ``unknown_param``."""
+    ``unknown_command``, ``bad_type``, ``too_low``, ``too_high``, ``unknown_param``, ``bad_link``."""
     reason: Reason
     where: Where
     """The step (or parameter value) in the task file."""
@@ -237,6 +237,7 @@ class Repair:
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict (the task as its steps)."""
         steps = [{"command": s.command, **({"bind": dict(s.bind)} if s.bind else {}),
-                  **({"params": dict(s.params)} if s.params else {})} for s in self.task.steps]
+                  **({"params": {n: plain_value(v) for n, v in s.params.items()}} if s.params else {})}
+                 for s in self.task.steps]
         return {"rank": self.rank, "cost": self.cost, "edits": [e.to_json() for e in self.edits],
                 "added_devices": list(self.added_devices), "task": {"task": self.task.name, "steps": steps}}

@@ -15,6 +15,7 @@ from plugnproduce.errors import DescriptionError, PlugNProduceError, ProtocolErr
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.sim import control
+from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.sim.device import SimulatedDevice
 
 
@@ -58,9 +59,11 @@ class SimulatedCell:
 
     def __init__(self, cell: Cell, *, catalogue: Iterable[DeviceDescription] = (),
                  network: upnp.SsdpNetwork = upnp.LOOPBACK, faults: dict[str, xirp.Faults] | None = None,
-                 taxonomy: Taxonomy | None = None) -> None:
-        """``taxonomy`` reads device description files plugged in by path (default: the built-in ontology)."""
+                 taxonomy: Taxonomy | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
+        """``taxonomy`` reads device description files plugged in by path (default: the built-in ontology);
+        ``bin`` is the simulated bin the devices work on (none: they report their charts' fixed values)."""
         self.cell = cell
+        self.bin = bin
         self.taxonomy = taxonomy
         self.network = network
         self.faults = faults or {}
@@ -92,7 +95,8 @@ class SimulatedCell:
             raise ProtocolError(f"device {device_id!r} is plugged in already")
         if device_id not in self.catalogue:
             raise ProtocolError(f"no device {device_id!r} to plug in; known: {', '.join(sorted(self.catalogue))}")
-        device = SimulatedDevice(self.catalogue[device_id], network=self.network, faults=self.faults.get(device_id))
+        device = SimulatedDevice(self.catalogue[device_id], network=self.network, faults=self.faults.get(device_id),
+                                 bin=self.bin)
         await device.start()
         self.devices[device_id] = device
         return sorted(self.devices)

@@ -22,6 +22,8 @@ from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.sim.bin import SimulatedBin
+from plugnproduce.statechart.model import Send, walk
 from plugnproduce.statechart.runtime.events import Event
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
@@ -39,6 +41,18 @@ def served_description(device: DeviceDescription, endpoint: str) -> tuple[str, s
     # The chart is served beside the Turtle whatever folder it sits in, so the reference is its name.
     turtle = _CHART.sub(lambda m: f"{m.group(1)}<{Path(device.chart_file).name}>", turtle, count=1)
     return turtle, Path(device.chart_file).read_text(encoding="utf-8")
+
+
+def event_payloads(device: DeviceDescription) -> dict[str, list[str]]:
+    """The values each protocol event of the chart carries (the names of its ``<param>`` elements)."""
+    out: dict[str, list[str]] = {}
+    for node in walk(device.chart):
+        if isinstance(node, Send) and node.event is not None and node.params:
+            command = Command.parse(node.event)
+            if command is not None and command.kind == "event":
+                names = out.setdefault(command.name, [])
+                names.extend(p.name for p in node.params if p.name not in names)
+    return out
 
 
 def requests_and_events(device: DeviceDescription) -> tuple[dict[str, list[str]], list[str]]:
@@ -59,10 +73,12 @@ class SimulatedDevice:
     """One device running its chart behind its protocol; ``async with`` starts and stops it."""
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
-                 faults: xirp.Faults | None = None) -> None:
+                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
+        """``bin``: the simulated bin the device works on, if any."""
         self.description = device
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
+        self.bin = bin
         self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
         self._loop = ChartLoop(self.interpreter)
@@ -111,7 +127,7 @@ class SimulatedDevice:
             spec = upnp.service_spec_from_chart_events({}, [])
             files = self._xirp.files = self._files(self._xirp.endpoint)
         else:
-            spec = upnp.service_spec_from_chart_events(requests, events)
+            spec = upnp.service_spec_from_chart_events(requests, events, payloads=event_payloads(d))
             files = self._files(d.endpoint)
         self._upnp = upnp.UpnpDeviceServer(d.id, d.label, upnp.device_type_for(device_class), spec,
                                            self._on_upnp_action, files=files, network=self.network)
@@ -150,6 +166,8 @@ class SimulatedDevice:
         waits = {t.event for t in self.description.transitions if t.source == self.state}
         if event not in waits:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
+        if self.bin is not None:
+            self.bin.on_request(self.description, params, self.interpreter.dm)
         self._loop.queue(event, dict(params))
 
     def _on_xirp_request(self, request: xirp.Request) -> None:
@@ -175,6 +193,6 @@ class SimulatedDevice:
         if self._xirp is not None:
             self._xirp.emit(command.name, dict(event.data or {}))
         elif self._upnp is not None:
-            task = asyncio.get_running_loop().create_task(self._upnp.emit(command.name))
+            task = asyncio.get_running_loop().create_task(self._upnp.emit(command.name, dict(event.data or {})))
             self._pending.add(task)
             task.add_done_callback(self._pending.discard)

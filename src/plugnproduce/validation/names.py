@@ -28,7 +28,7 @@ TERM_PROPERTIES = {PNP.hasSkill: "Skill", PNP.requiresSkill: "Skill", PNP.quanti
                    PNP.mandatoryState: "StateConcept"}
 """Properties whose objects must be terms of a kind."""
 
-DESCRIPTION_CLASSES = {str(PNP.Process), str(PNP.Role), str(PNP.Parameter)}
+DESCRIPTION_CLASSES = {str(PNP.Process), str(PNP.Role), str(PNP.Parameter), str(PNP.Output)}
 
 
 def chart_name_problems(path: Path, taxonomy: Taxonomy) -> Iterator[Problem]:

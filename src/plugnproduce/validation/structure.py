@@ -46,6 +46,11 @@ def process_problems(process: ProcessDescription, taxonomy: Taxonomy) -> Iterato
             yield Problem(p.where.file, p.where.line or 0, f"parameter {p.name!r} is for role {p.role!r}, "
                           f"which process {process.id} does not have")
     for role in process.roles:
+        for o in role.region[-1].outcomes:
+            if not taxonomy.is_kind(o, "Outcome"):
+                yield Problem(file, role.region[-1].line or 0, f"state {role.region[-1].id!r} names outcome "
+                              f"{local_name(o)}, which is not an outcome of the ontology"
+                              + did_you_mean(o, taxonomy.classes_of_kind("Outcome")))
         for s in role.region:
             if not taxonomy.is_kind(s.concept, "StateConcept"):
                 yield Problem(file, s.line or 0, f"state {s.id!r} is annotated with {local_name(s.concept)}, "
@@ -63,8 +68,23 @@ def process_problems(process: ProcessDescription, taxonomy: Taxonomy) -> Iterato
                               "which is not a state of another region")
 
 
+def loop_problems(task: Task, processes: dict[str, ProcessDescription]) -> Iterator[Problem]:
+    """A loop whose ``until`` no step of its body can end with: it would never end that way."""
+    for loop in task.loops:
+        if loop.until is None:
+            continue
+        body = task.steps[loop.first - 1 : loop.last]
+        outcomes = sorted({local_name(o) for s in body if s.command in processes
+                           for o in processes[s.command].outcomes})
+        if local_name(loop.until) not in outcomes:
+            known = ", ".join(outcomes) or "none"
+            yield Problem(task.file, loop.line or 0, f"loop until {local_name(loop.until)}: no step of its body can "
+                          f"end with that outcome, so the loop never ends on it; its steps' outcomes: {known}")
+
+
 def task_problems(task: Task, processes: dict[str, ProcessDescription]) -> Iterator[Problem]:
-    """Problems of a task that need no cell: unknown commands, roles and parameters."""
+    """Problems of a task that need no cell: unknown commands, roles, parameters and loop outcomes."""
+    yield from loop_problems(task, processes)
     n = len(task.steps) // task.repeat
     for step in task.steps[:n]:
         line = step.line or 0

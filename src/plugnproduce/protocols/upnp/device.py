@@ -17,6 +17,7 @@ device is built, and stopped completely.
 from __future__ import annotations
 
 import asyncio
+import json
 import logging
 import socket
 import xml.etree.ElementTree as ET
@@ -55,6 +56,7 @@ from plugnproduce.protocols.upnp.spec import (
     ActionSpec,
     ArgumentSpec,
     ServiceSpec,
+    payload_variable,
     udn_for,
 )
 
@@ -354,6 +356,11 @@ class UpnpDeviceServer:
         A value outside the variable's type or allowed values raises
         :class:`~plugnproduce.errors.ProtocolError` naming the allowed values.
         """
+        if self._store(name, value):
+            await self._send_events()
+
+    def _store(self, name: str, value: Any) -> bool:
+        """Change a state variable without notifying; whether its value changed."""
         variable = self._variable(name)
         previous = variable.value
         try:
@@ -367,11 +374,16 @@ class UpnpDeviceServer:
                 f"device {self.device_id!r}: value {value!r} for state variable {name!r} is refused; "
                 f"expected {expected}"
             ) from exc
-        if variable.value != previous:
-            await self._send_events()
+        return bool(variable.value != previous)
 
-    async def emit(self, event: str) -> int:
-        """Count one occurrence of a chart event (a ``ui4`` counter variable) and notify; return the new count."""
+    async def emit(self, event: str, payload: Mapping[str, Any] | None = None) -> int:
+        """Count one occurrence of a chart event (a ``ui4`` counter variable) and notify; return the new count.
+
+        The values the event carries (``payload``) go as JSON into its ``EVENT__NAME`` variables,
+        sent in the same notification as the counter.
+        """
+        for name, value in (payload or {}).items():
+            self._store(payload_variable(event, name), json.dumps(value))
         count = int(self.value(event) or 0) + 1
         await self.set_variable(event, count)
         return count

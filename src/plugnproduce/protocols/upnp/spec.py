@@ -10,10 +10,12 @@ is written down.
 
 from __future__ import annotations
 
+import json
 import re
 import uuid
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from async_upnp_client.const import STATE_VARIABLE_TYPE_MAPPING
 
@@ -164,10 +166,38 @@ class ServiceSpec:
         raise KeyError(name)
 
 
+PAYLOAD_SEPARATOR = "__"
+"""Between an event's name and a value it carries, in the name of the variable holding that value."""
+
+
+def payload_variable(event: str, name: str) -> str:
+    """The evented string variable holding value ``name`` of event ``event`` (``PartLocalized__part_pose``)."""
+    return f"{event}{PAYLOAD_SEPARATOR}{name}"
+
+
+def is_payload_variable(variable: str) -> bool:
+    """Whether a variable holds a value an event carries (not an event counter)."""
+    return PAYLOAD_SEPARATOR in variable
+
+
+def payload_of(values: Mapping[str, Any], event: str) -> dict[str, Any]:
+    """The values event ``event`` carried, from the device's variables (JSON text; other text kept as it is)."""
+    prefix = event + PAYLOAD_SEPARATOR
+    out: dict[str, Any] = {}
+    for variable, text in values.items():
+        if variable.startswith(prefix):
+            try:
+                out[variable[len(prefix):]] = json.loads(text) if isinstance(text, str) else text
+            except ValueError:
+                out[variable[len(prefix):]] = text
+    return out
+
+
 def service_spec_from_chart_events(
     requests: Mapping[str, Sequence[str]],
     events: Sequence[str],
     argument_types: Mapping[str, str] | None = None,
+    payloads: Mapping[str, Sequence[str]] | None = None,
 ) -> ServiceSpec:
     """Build the UPnP service of a device from the protocol events of its state chart.
 
@@ -184,6 +214,10 @@ def service_spec_from_chart_events(
 
     Arguments are strings (their lexical form, e.g. a pose ``"0.4 0.1 0.2 0 180 0"``)
     unless ``argument_types`` gives a UPnP type for a parameter name.
+
+    ``payloads`` names the values each event carries (its ``<param>`` names); each becomes an
+    evented string variable ``EVENT__NAME`` holding the value as JSON, changed in the same
+    notification as the event's counter.
     """
     types = dict(argument_types or {})
     actions = tuple(
@@ -191,6 +225,8 @@ def service_spec_from_chart_events(
         for name, params in sorted(requests.items())
     )
     variables = tuple(VariableSpec(name, "ui4", default="0") for name in sorted(set(events)))
+    variables += tuple(VariableSpec(payload_variable(event, name), "string", default="null")
+                       for event, names in sorted((payloads or {}).items()) for name in _unique(names))
     return ServiceSpec(actions, variables)
 
 
