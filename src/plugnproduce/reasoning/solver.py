@@ -24,6 +24,7 @@ PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
     "batch": (("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_batch.lp"),
     "cheapest": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_cheapest.lp"),
     "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
+    "window": (("roles.lp", "chain.lp", "params.lp", "repair.lp", "window.lp"), "show_window.lp"),
 }
 """The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
 
@@ -34,8 +35,8 @@ def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
     return concerns + (shown,) if show else concerns
 
 
-CAPABILITIES, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR = (
-    rules(p) for p in ("capabilities", "offered", "check", "batch", "cheapest", "repair"))
+CAPABILITIES, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR, WINDOW = (
+    rules(p) for p in ("capabilities", "offered", "check", "batch", "cheapest", "repair", "window"))
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""

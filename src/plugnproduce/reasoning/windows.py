@@ -1,0 +1,297 @@
+"""Repair of a long task window by window (window.lp with repair.lp): cost linear in the task's length.
+
+The plausibility check gives, for every step of the task as written, the chart state of every
+device when the step starts (a broken step leaves its devices where it would have left them,
+``recovers/4``). Each problem spans the steps from the one that last used its device to the
+step that fails; a *window* is such a span widened by ``margin`` unbroken steps on each side,
+overlapping windows merged. Each window is repaired on its own by repair.lp, with
+
+- the devices *entering* the window in the states the check found there (the steps before it
+  are unbroken, or earlier windows left every device a later step uses in its original state), and
+- every device a step after the window uses *leaving* it in the state the check found after
+  it (window.lp's ``exit_state/2``), so the unbroken steps that follow run exactly as written.
+
+Why the combination is optimal. Write the task as ``G0 W1 G1 ... Wm Gm``: windows ``Wk`` and the
+unbroken stretches ``Gk`` between them. (1) *Feasible*: by the exit condition, every ``Gk`` starts
+in the states the check found, in which it was plausible; so the stitched task is plausible.
+(2) *No cheaper repair*: edits are priced per edit, not by where they are made, so a repair's cost
+is the sum over the windows of the edits it makes in each, plus those it makes in the stretches.
+Take any repair ``R`` that leaves every stretch as written (an edit in a stretch touches steps that
+were plausible; the steps at a window's borders fix the device states the window starts from and
+must end in, so such an edit either does nothing for a problem or moves a window's border).
+Restricted to ``Wk``, ``R`` starts in the states ``G(k-1)`` leaves and ends in the ones ``Gk``
+starts from: a feasible repair of window ``Wk`` alone, so it costs at least ``Wk``'s optimum, and
+``cost(R) >= sum of the window optima`` = the cost of the stitched repair. When a window has no
+repair with these borders (a fix needs steps beyond them), every margin is doubled and the
+windows are solved again; at worst one window covers the task and this is the whole-task repair
+of :mod:`.repairs`. ``tests/reasoning/test_windows.py`` compares both optima on random tasks.
+
+Devices from a catalogue are shared by all windows (one purchase fixes several): each window is
+first solved with the catalogue allowed; the device sets they add (each, and all together) are
+then tried as fixed additions to the cell, priced once, and the cheapest total wins.
+The ``top`` best repairs combine the windows' own best repairs (k-best sums, distinct because
+the windows are).
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, replace
+
+import clingo
+
+from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.reasoning import repairs, solver
+from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
+from plugnproduce.reasoning.offers import cell_program
+from plugnproduce.reasoning.plausibility import TASK, check
+from plugnproduce.reasoning.results import CheckResult, Repair, RepairCosts
+from plugnproduce.reasoning.terms import Model, program
+
+WHOLE_UP_TO = 40
+"""Tasks of at most this many steps are repaired whole (:func:`.repairs.repair`): fast enough, and
+their next-best repairs then follow the whole-task order exactly."""
+
+MARGIN = 2
+"""Unbroken steps first added on each side of a problem's span."""
+
+
+@dataclass(frozen=True, order=True)
+class Window:
+    """Original steps ``first`` to ``last`` (1-based, inclusive)."""
+
+    first: int
+    last: int
+
+
+@dataclass(frozen=True)
+class _Part:
+    """One repair of one window: its cost (hundredths), edits (original step numbers), steps, end states."""
+
+    window: Window
+    cost: int
+    edits: tuple[clingo.Symbol, ...]
+    steps: tuple[Step, ...]
+    left_in: tuple[tuple[str, str], ...]
+
+
+def shifted(term: clingo.Symbol, offset: int) -> clingo.Symbol:
+    """An ``edit/1`` term of a window with its step number made the original step's."""
+    if term.name == "add" or not offset:
+        return term
+    first, *rest = term.arguments
+    return clingo.Function(term.name, [clingo.Number(first.number + offset), *rest])
+
+
+def k_best(options: Sequence[Sequence[_Part]], k: int) -> list[tuple[_Part, ...]]:
+    """The ``k`` cheapest ways to pick one part per window (each window's parts sorted by cost)."""
+    def total(ix: tuple[int, ...]) -> int:
+        return sum(options[w][i].cost for w, i in enumerate(ix))
+
+    first = (0,) * len(options)
+    heap, seen = [(total(first), first)], {first}
+    out: list[tuple[_Part, ...]] = []
+    while heap and len(out) < k:
+        _, ix = heapq.heappop(heap)
+        out.append(tuple(options[w][i] for w, i in enumerate(ix)))
+        for w in range(len(ix)):
+            nxt = ix[:w] + (ix[w] + 1,) + ix[w + 1:]
+            if nxt[w] < len(options[w]) and nxt not in seen:
+                seen.add(nxt)
+                heapq.heappush(heap, (total(nxt), nxt))
+    return out
+
+
+class _Chain:
+    """The task as checked: device states before each step, and where each device is last used."""
+
+    def __init__(self, task: Task, result: CheckResult):
+        self.task, self.result = task, result
+        self.n = len(task.steps)
+        self.last_use: dict[str, int] = {}
+        self.used_before: dict[tuple[int, str], int] = {}
+        for st in result.steps:
+            for d in set(st.bindings.values()):
+                if d in self.last_use:
+                    self.used_before[(st.index, d)] = self.last_use[d]
+                self.last_use[d] = st.index
+
+    def spans(self) -> list[Window]:
+        """Per problem: from the step that last used its device (if any) to the failing step."""
+        out = []
+        for p in self.result.problems:
+            first = self.used_before.get((p.step, p.device), p.step) if p.device else p.step
+            out.append(Window(max(1, first), min(self.n, p.step)))
+        return out
+
+    def states(self, i: int) -> dict[str, str]:
+        """Every device's state before original step ``i`` (``n + 1``: after the task)."""
+        return dict(self.result.steps[i - 1].states) if i <= self.n else dict(self.result.final_states)
+
+    def exits(self, w: Window) -> dict[str, str]:
+        """The states the steps after ``w`` expect: of each device one of them uses."""
+        return {d: x for d, x in self.states(w.last + 1).items() if self.last_use.get(d, 0) > w.last}
+
+
+def windows(spans: Iterable[Window], n: int, margin: int) -> list[Window]:
+    """The spans widened by ``margin`` steps on each side (within 1..n), overlapping or touching ones merged."""
+    out: list[Window] = []
+    for w in sorted(Window(max(1, x.first - margin), min(n, x.last + margin)) for x in spans):
+        if out and w.first <= out[-1].last + 1:
+            out[-1] = Window(out[-1].first, max(out[-1].last, w.last))
+        else:
+            out.append(w)
+    return out
+
+
+def repair(
+    task: Task,
+    cell: Cell,
+    taxonomy: Taxonomy,
+    processes: Sequence[ProcessDescription],
+    catalogue: Sequence[DeviceDescription] | None = None,
+    top: int = 3,
+    costs: RepairCosts | None = None,
+    per_gap: int = repairs.PER_GAP,
+    max_inserts: int | None = None,
+) -> list[Repair]:
+    """The ``top`` cheapest distinct repairs of ``task`` in ``cell``: whole if short, else window by window."""
+    if len(task.steps) <= WHOLE_UP_TO or max_inserts is not None:
+        return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap, max_inserts)
+    return windowed_repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
+
+
+def windowed_repair(
+    task: Task,
+    cell: Cell,
+    taxonomy: Taxonomy,
+    processes: Sequence[ProcessDescription],
+    catalogue: Sequence[DeviceDescription] | None = None,
+    top: int = 3,
+    costs: RepairCosts | None = None,
+    per_gap: int = repairs.PER_GAP,
+) -> list[Repair]:
+    """The ``top`` cheapest distinct repairs, each window repaired on its own (see the module's docstring)."""
+    costs = costs or RepairCosts()
+    result = check(task, cell, taxonomy, processes)
+    if top < 1 or result.plausible:
+        return []
+    chain, book = _Chain(task, result), fact_book(taxonomy, processes)
+    present = {d.id for d in cell.devices}
+    extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
+    margin = MARGIN
+    while True:
+        wins = windows(chain.spans(), chain.n, margin)
+        if wins == [Window(1, chain.n)]:
+            return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
+        found = _Solver(book, chain, cell, costs, per_gap, top).best(wins, extra)
+        if found is not None:
+            return found
+        margin *= 2
+
+
+class _Solver:
+    """Solves the windows of one task in one cell and combines their repairs."""
+
+    def __init__(self, book: FactBook, chain: _Chain, cell: Cell, costs: RepairCosts, per_gap: int, top: int):
+        self.book, self.chain, self.cell, self.costs, self.per_gap, self.top = book, chain, cell, costs, per_gap, top
+
+    def best(self, wins: list[Window], extra: list[DeviceDescription]) -> list[Repair] | None:
+        """The top repairs (None when some window has no repair within its borders)."""
+        found = self.combined(wins, ())
+        cheapest = min((repairs.add_cost(self.costs, d) for d in extra), default=None)
+        if cheapest is not None and (len(found) < self.top or found[-1][0] > cheapest):
+            for added in self.purchases(wins, extra):
+                found += self.combined(wins, added)
+            found.sort(key=lambda c: c[0])
+        if not found:
+            return None
+        devices = {d.id: d for d in [*extra, *self.cell.devices]}
+        reader = repairs._EditReader(self.chain.task, self.book, devices, self.costs)
+        return [self.read(rank, c, reader) for rank, c in enumerate(found[:self.top], start=1)]
+
+    def purchases(self, wins: list[Window], extra: list[DeviceDescription]) -> list[tuple[DeviceDescription, ...]]:
+        """Device sets worth trying: what each window adds when it may buy, and all of them together."""
+        sets: list[frozenset[str]] = []
+        carried: dict[str, str] = {}
+        for w in wins:
+            models = self.solve(w, self.cell, extra, carried, 1)
+            if models:
+                bought = frozenset(e.e.arguments[0].string for e in models[0][s.Edit] if e.e.name == "add")
+                carried.update(self._carried(w, models[0]))
+                if bought and bought not in sets:
+                    sets.append(bought)
+        union = frozenset().union(*sets)
+        if len(sets) > 1:
+            sets.append(union)
+        by_id = {d.id: d for d in extra}
+        return [tuple(by_id[a] for a in sorted(x)) for x in sets]
+
+    def combined(self, wins: list[Window], added: tuple[DeviceDescription, ...]
+                 ) -> list[tuple[int, tuple[_Part, ...], tuple[str, ...]]]:
+        """The ``top`` cheapest combinations of the windows' repairs in the cell plus ``added``."""
+        cell = Cell(self.cell.name, self.cell.devices + added, self.cell.file)
+        price = sum(repairs.add_cost(self.costs, d) for d in added)
+        names = tuple(d.id for d in added)
+        per_window: list[list[_Part]] = []
+        carried: dict[str, str] = {}
+        for w in wins:
+            models = self.solve(w, cell, (), carried, self.top)
+            if not models:
+                return []
+            parts = [self.part(w, m) for m in models]
+            carried.update(self._carried(w, models[0]))
+            per_window.append(parts)
+        return [(price + sum(p.cost for p in combo), combo, names) for combo in k_best(per_window, self.top)]
+
+    def solve(self, w: Window, cell: Cell, extra: Sequence[DeviceDescription], carried: dict[str, str],
+              top: int) -> list[Model]:
+        """The window's best repairs, entering in the checked states (and those earlier windows left behind)."""
+        entry = {**self.chain.states(w.first), **carried}
+        entering = Cell(cell.name, tuple(replace(d, initial=entry.get(d.id, d.initial)) for d in cell.devices),
+                        cell.file)
+        bought = [replace(d, initial=entry.get(d.id, d.initial)) for d in extra]
+        steps = self.chain.task.steps[w.first - 1:w.last]
+        sub = Task(self.chain.task.name, tuple(replace(st, index=k) for k, st in enumerate(steps, start=1)),
+                   self.chain.task.file)
+        facts = (cell_program(self.book, entering, bought) + program(task_facts(sub, TASK))
+                 + program(repairs.horizon(sub, self.per_gap, None))
+                 + program(repairs.cost_facts(self.costs, self.book.processes, bought))
+                 + program(s.Catalogue(d.id) for d in bought)
+                 + program(s.ExitState(d, x) for d, x in sorted(self.chain.exits(w).items())))
+        return solver.optimise(solver.WINDOW, facts, top, repairs.forbid, lambda m: repairs.outcome(m, sub))
+
+    def _carried(self, w: Window, model: Model) -> dict[str, str]:
+        """States the window leaves devices in that no later original step uses (they stay so)."""
+        return {a.d: a.x for a in model[s.LeftIn] if self.chain.last_use.get(a.d, 0) <= w.last}
+
+    def part(self, w: Window, model: Model) -> _Part:
+        """A window's model with its edits renumbered to the original steps."""
+        steps = self.chain.task.steps[w.first - 1:w.last]
+        sub = Task(self.chain.task.name, tuple(replace(st, index=k) for k, st in enumerate(steps, start=1)),
+                   self.chain.task.file)
+        edits = tuple(shifted(e.e, w.first - 1) for e in model[s.Edit])
+        left = tuple(sorted((a.d, a.x) for a in model[s.LeftIn]))
+        return _Part(w, model.cost[0] if model.cost else 0, edits, repairs.repaired_task(model, sub).steps, left)
+
+    def read(self, rank: int, combo: tuple[int, tuple[_Part, ...], tuple[str, ...]],
+             reader: repairs._EditReader) -> Repair:
+        """One combination as a :class:`Repair` of the whole task."""
+        cost, parts, added = combo
+        terms = [t for p in parts for t in p.edits] + [clingo.Function("add", [clingo.String(a)]) for a in added]
+        edits = sorted((reader.read(t) for t in terms), key=lambda e: (e.step or 0, e.kind, e.text))
+        task = self.chain.task
+        steps: list[Step] = []
+        start = 1
+        for p in parts:
+            steps += task.steps[start - 1:p.window.first - 1]
+            steps += p.steps
+            start = p.window.last + 1
+        steps += task.steps[start - 1:]
+        steps = [replace(st, index=k) for k, st in enumerate(steps, start=1)]
+        repaired = Task(task.name, tuple(steps), task.file, task.description,
+                        repairs.folded_repeat(steps, task.repeat))
+        return Repair(rank, cost / 100, tuple(edits), repaired, added)
