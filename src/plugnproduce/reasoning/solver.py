@@ -18,7 +18,8 @@ from plugnproduce.reasoning.terms import Model, decode
 from plugnproduce.resources import rules_path
 
 PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
-    "capabilities": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
+    "capabilities": (("roles.lp", "offered.lp", "explain.lp"), "show_capabilities.lp"),
+    "bindings": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
     "offered": (("roles.lp", "offered.lp"), "show_capabilities.lp"),
     "check": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"), "show_check.lp"),
     "batch": (("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_batch.lp"),
@@ -35,8 +36,8 @@ def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
     return concerns + (shown,) if show else concerns
 
 
-CAPABILITIES, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR, WINDOW = (
-    rules(p) for p in ("capabilities", "offered", "check", "batch", "cheapest", "repair", "window"))
+CAPABILITIES, BINDINGS, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR, WINDOW = (
+    rules(p) for p in ("capabilities", "bindings", "offered", "check", "batch", "cheapest", "repair", "window"))
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""

@@ -26,9 +26,11 @@ repair with these borders (a fix needs steps beyond them), every margin is doubl
 windows are solved again; at worst one window covers the task and this is the whole-task repair
 of :mod:`.repairs`. ``tests/reasoning/test_windows.py`` compares both optima on random tasks.
 
-Devices from a catalogue are shared by all windows (one purchase fixes several): each window is
-first solved with the catalogue allowed; the device sets they add (each, and all together) are
-then tried as fixed additions to the cell, priced once, and the cheapest total wins.
+Devices from a catalogue are shared by all windows (one purchase may fix several), so their
+windows are not independent: each window is first solved with every catalogue device priced one
+hundredth; the device sets they would buy (each, and all together) are then tried as fixed
+additions to the cell, priced in full once, and the cheapest total (or none bought) wins. This is
+optimal over those purchases, not proven optimal over every subset of the catalogue.
 The ``top`` best repairs combine the windows' own best repairs (k-best sums, distinct because
 the windows are).
 """
@@ -173,8 +175,11 @@ def windowed_repair(
     top: int = 3,
     costs: RepairCosts | None = None,
     per_gap: int = repairs.PER_GAP,
+    margin: int = MARGIN,
 ) -> list[Repair]:
-    """The ``top`` cheapest distinct repairs, each window repaired on its own (see the module's docstring)."""
+    """The ``top`` cheapest distinct repairs, each window repaired on its own (see the module's docstring).
+
+    ``margin``: unbroken steps first added on each side of a problem (doubled while too few)."""
     costs = costs or RepairCosts()
     result = check(task, cell, taxonomy, processes)
     if top < 1 or result.plausible:
@@ -182,7 +187,6 @@ def windowed_repair(
     chain, book = _Chain(task, result), fact_book(taxonomy, processes)
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
-    margin = MARGIN
     while True:
         wins = windows(chain.spans(), chain.n, margin)
         if wins == [Window(1, chain.n)]:
@@ -190,7 +194,7 @@ def windowed_repair(
         found = _Solver(book, chain, cell, costs, per_gap, top).best(wins, extra)
         if found is not None:
             return found
-        margin *= 2
+        margin = 2 * margin or 1
 
 
 class _Solver:
@@ -204,31 +208,42 @@ class _Solver:
         found = self.combined(wins, ())
         cheapest = min((repairs.add_cost(self.costs, d) for d in extra), default=None)
         if cheapest is not None and (len(found) < self.top or found[-1][0] > cheapest):
-            for added in self.purchases(wins, extra):
-                found += self.combined(wins, added)
-            found.sort(key=lambda c: c[0])
+            sets, free = self.purchases(wins, extra)
+            if len(found) < self.top or found[-1][0] > cheapest + free:  # else no purchase can pay for itself
+                for added in sets:
+                    found += self.combined(wins, added)
+                found.sort(key=lambda c: c[0])
         if not found:
             return None
         devices = {d.id: d for d in [*extra, *self.cell.devices]}
         reader = repairs._EditReader(self.chain.task, self.book, devices, self.costs)
         return [self.read(rank, c, reader) for rank, c in enumerate(found[:self.top], start=1)]
 
-    def purchases(self, wins: list[Window], extra: list[DeviceDescription]) -> list[tuple[DeviceDescription, ...]]:
-        """Device sets worth trying: what each window adds when it may buy, and all of them together."""
+    def purchases(self, wins: list[Window], extra: list[DeviceDescription]
+                  ) -> tuple[list[tuple[DeviceDescription, ...]], int]:
+        """Device sets worth trying: what each window would buy were devices (nearly) free, and all together;
+        and a lower bound on the cost of the edits of any repair that buys (hundredths).
+
+        A purchase too dear for one window may pay for itself over several, so each window is asked
+        with every device priced one hundredth; each set is then priced in full, once, by :meth:`combined`.
+        Any repair that buys costs at least the cheapest device plus the windows' costs with free devices."""
         sets: list[frozenset[str]] = []
         carried: dict[str, str] = {}
+        free = replace(self.costs, add_device=0.01, add_device_per_price=0.0)
+        bound = 0
         for w in wins:
-            models = self.solve(w, self.cell, extra, carried, 1)
-            if models:
-                bought = frozenset(e.e.arguments[0].string for e in models[0][s.Edit] if e.e.name == "add")
-                carried.update(self._carried(w, models[0]))
-                if bought and bought not in sets:
-                    sets.append(bought)
-        union = frozenset().union(*sets)
+            models = self.solve(w, self.cell, extra, carried, 1, free)
+            if not models:
+                return [], 0
+            bought = frozenset(e.e.arguments[0].string for e in models[0][s.Edit] if e.e.name == "add")
+            bound += (models[0].cost[0] if models[0].cost else 0) - len(extra)  # at most one hundredth each
+            carried.update(self._carried(w, models[0]))
+            if bought and bought not in sets:
+                sets.append(bought)
         if len(sets) > 1:
-            sets.append(union)
+            sets.append(frozenset().union(*sets))
         by_id = {d.id: d for d in extra}
-        return [tuple(by_id[a] for a in sorted(x)) for x in sets]
+        return [tuple(by_id[a] for a in sorted(x)) for x in sets], bound
 
     def combined(self, wins: list[Window], added: tuple[DeviceDescription, ...]
                  ) -> list[tuple[int, tuple[_Part, ...], tuple[str, ...]]]:
@@ -248,7 +263,7 @@ class _Solver:
         return [(price + sum(p.cost for p in combo), combo, names) for combo in k_best(per_window, self.top)]
 
     def solve(self, w: Window, cell: Cell, extra: Sequence[DeviceDescription], carried: dict[str, str],
-              top: int) -> list[Model]:
+              top: int, costs: RepairCosts | None = None) -> list[Model]:
         """The window's best repairs, entering in the checked states (and those earlier windows left behind)."""
         entry = {**self.chain.states(w.first), **carried}
         entering = Cell(cell.name, tuple(replace(d, initial=entry.get(d.id, d.initial)) for d in cell.devices),
@@ -259,7 +274,7 @@ class _Solver:
                    self.chain.task.file)
         facts = (cell_program(self.book, entering, bought) + program(task_facts(sub, TASK))
                  + program(repairs.horizon(sub, self.per_gap, None))
-                 + program(repairs.cost_facts(self.costs, self.book.processes, bought))
+                 + program(repairs.cost_facts(costs or self.costs, self.book.processes, bought))
                  + program(s.Catalogue(d.id) for d in bought)
                  + program(s.ExitState(d, x) for d, x in sorted(self.chain.exits(w).items())))
         return solver.optimise(solver.WINDOW, facts, top, repairs.forbid, lambda m: repairs.outcome(m, sub))
