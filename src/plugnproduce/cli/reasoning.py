@@ -105,6 +105,7 @@ def repair(
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
 
+    A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
     result = service.check(task, cell, knowledge(cell))
