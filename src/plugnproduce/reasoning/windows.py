@@ -126,7 +126,7 @@ class _Chain:
         out = []
         for p in self.result.problems:
             first = self.used_before.get((p.step, p.device), p.step) if p.device else p.step
-            out.append(Window(max(1, first), min(self.n, p.step)))
+            out.append(Window(max(1, min(first, p.step)), min(self.n, max(1, p.step))))
         return out
 
     def states(self, i: int) -> dict[str, str]:
