@@ -12,19 +12,31 @@ overlapping windows merged. Each window is repaired on its own by repair.lp, wit
   it (window.lp's ``exit_state/2``), so the unbroken steps that follow run exactly as written.
 
 Why the combination is optimal. Write the task as ``G0 W1 G1 ... Wm Gm``: windows ``Wk`` and the
-unbroken stretches ``Gk`` between them. (1) *Feasible*: by the exit condition, every ``Gk`` starts
-in the states the check found, in which it was plausible; so the stitched task is plausible.
-(2) *No cheaper repair*: edits are priced per edit, not by where they are made, so a repair's cost
-is the sum over the windows of the edits it makes in each, plus those it makes in the stretches.
-Take any repair ``R`` that leaves every stretch as written (an edit in a stretch touches steps that
-were plausible; the steps at a window's borders fix the device states the window starts from and
-must end in, so such an edit either does nothing for a problem or moves a window's border).
-Restricted to ``Wk``, ``R`` starts in the states ``G(k-1)`` leaves and ends in the ones ``Gk``
-starts from: a feasible repair of window ``Wk`` alone, so it costs at least ``Wk``'s optimum, and
-``cost(R) >= sum of the window optima`` = the cost of the stitched repair. When a window has no
-repair with these borders (a fix needs steps beyond them), every margin is doubled and the
-windows are solved again; at worst one window covers the task and this is the whole-task repair
-of :mod:`.repairs`. ``tests/reasoning/test_windows.py`` compares both optima on random tasks.
+unbroken stretches ``Gk`` between them. A device changes state only when a step uses it, so the
+state a step finds a device in is the one its previous use left; every problem's span reaches back
+to that use, so no problem depends on a step of a stretch.
+
+(1) *Feasible.* By the exit condition every ``Gk`` starts in the states the check found, in which
+it was plausible; so the stitched task is plausible (and :func:`windowed_repair`'s tests check it).
+
+(2) *Optimal among repairs that leave the stretches as written.* Edits are priced per edit, not by
+position, so such a repair ``R`` costs the sum of the edits it makes in each window. Restricted to
+``Wk``, ``R`` enters in the states ``G(k-1)`` leaves and must leave every device a later step uses
+as ``Gk`` expects it (``Gk``'s steps are unchanged and each device's state changes only when used):
+a feasible repair of ``Wk`` alone, costing at least ``Wk``'s optimum. So ``cost(R) >=`` the sum of
+the window optima, which is what the stitched repair costs.
+
+(3) *Editing a stretch gains nothing* (an argument, not a proof): its steps are plausible, so an
+edit there only changes the states the next windows enter in; an insertion costs the same in the
+gap before a window's first step, where it has the same effect on the devices the window uses, and
+removing, swapping or rebinding plausible steps costs (with the default costs) at least as much as
+the cheapest insertion.
+``tests/reasoning/test_windows.py`` compares the windowed and the whole-task optimum on random
+tasks (property test); ``bench/bench_repair.py`` compares them on 100- and 1,000-step tasks.
+
+When a window has no repair within these borders (a fix needs steps beyond them), every margin is
+doubled and the windows are solved again; at worst one window covers the task and this is the
+whole-task repair of :mod:`.repairs`.
 
 Devices from a catalogue are shared by all windows (one purchase may fix several), so their
 windows are not independent: each window is first solved with every catalogue device priced one
