@@ -50,6 +50,7 @@ the windows are).
 from __future__ import annotations
 
 import heapq
+from collections import defaultdict
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 
@@ -60,9 +61,9 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import repairs, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
-from plugnproduce.reasoning.offers import cell_program
-from plugnproduce.reasoning.plausibility import TASK, check
-from plugnproduce.reasoning.results import CheckResult, Repair, RepairCosts
+from plugnproduce.reasoning.offers import CELL, cell_program
+from plugnproduce.reasoning.plausibility import TASK
+from plugnproduce.reasoning.results import Repair, RepairCosts
 from plugnproduce.reasoning.terms import Model, program
 
 WHOLE_UP_TO = 40
@@ -120,30 +121,46 @@ def k_best(options: Sequence[Sequence[_Part]], k: int) -> list[tuple[_Part, ...]
 
 
 class _Chain:
-    """The task as checked: device states before each step, and where each device is last used."""
+    """The task as checked (check.lp): device states before each step, its problems, each device's uses.
 
-    def __init__(self, task: Task, result: CheckResult):
-        self.task, self.result = task, result
-        self.n = len(task.steps)
+    Read from the check's raw atoms: a long task's model has an ``at/5`` atom per step and device."""
+
+    def __init__(self, task: Task, atoms: Iterable[clingo.Symbol]):
+        self.task, self.n, self.plausible = task, len(task.steps), False
+        self.at: dict[int, dict[str, str]] = defaultdict(dict)
+        users: dict[int, set[str]] = defaultdict(set)
+        self.problems: list[tuple[int, str | None]] = []
+        for a in atoms:
+            args = a.arguments
+            if a.name == s.At.asp:
+                self.at[args[2].number][args[3].string] = args[4].string
+            elif a.name == s.Bound.asp:
+                users[args[2].number].add(args[4].string)
+            elif a.name == s.Plausible.asp:
+                self.plausible = True
+            elif a.name != s.LeftBy.asp:
+                step = next(x.number for x in args if x.type == clingo.SymbolType.Number)
+                device = args[4].string if a.name in (s.WrongState.asp, s.Stuck.asp) else None
+                self.problems.append((step, device))
         self.last_use: dict[str, int] = {}
         self.used_before: dict[tuple[int, str], int] = {}
-        for st in result.steps:
-            for d in set(st.bindings.values()):
+        for i in sorted(users):
+            for d in users[i]:
                 if d in self.last_use:
-                    self.used_before[(st.index, d)] = self.last_use[d]
-                self.last_use[d] = st.index
+                    self.used_before[(i, d)] = self.last_use[d]
+                self.last_use[d] = i
 
     def spans(self) -> list[Window]:
         """Per problem: from the step that last used its device (if any) to the failing step."""
         out = []
-        for p in self.result.problems:
-            first = self.used_before.get((p.step, p.device), p.step) if p.device else p.step
-            out.append(Window(max(1, min(first, p.step)), min(self.n, max(1, p.step))))
+        for step, device in self.problems:
+            first = self.used_before.get((step, device), step) if device else step
+            out.append(Window(max(1, min(first, step)), min(self.n, max(1, step))))
         return out
 
     def states(self, i: int) -> dict[str, str]:
         """Every device's state before original step ``i`` (``n + 1``: after the task)."""
-        return dict(self.result.steps[i - 1].states) if i <= self.n else dict(self.result.final_states)
+        return dict(self.at.get(i, {}))
 
     def exits(self, w: Window) -> dict[str, str]:
         """The states the steps after ``w`` expect: of each device one of them uses."""
@@ -193,10 +210,11 @@ def windowed_repair(
 
     ``margin``: unbroken steps first added on each side of a problem (doubled while too few)."""
     costs = costs or RepairCosts()
-    result = check(task, cell, taxonomy, processes)
-    if top < 1 or result.plausible:
-        return []
-    chain, book = _Chain(task, result), fact_book(taxonomy, processes)
+    book = fact_book(taxonomy, processes)
+    facts = cell_program(book, cell) + program(task_facts(task, TASK)) + program([s.Check(CELL, TASK)])
+    chain = _Chain(task, solver.symbols(solver.CHECK, facts))
+    if top < 1 or chain.plausible:  # plausible to the encodings: whatever else check() finds, repair.lp cannot fix
+        return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap) if top >= 1 else []
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
     while True:
