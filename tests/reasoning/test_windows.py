@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription, Step, Task
-from plugnproduce.reasoning import repairs, windows
+from plugnproduce.reasoning import RepairCosts, repairs, windows
 from plugnproduce.reasoning.windows import Window
 from tests.reasoning.faulty_tasks import faulty_task
 
@@ -35,6 +35,20 @@ def test_windowed_repair_costs_what_the_whole_task_optimum_costs(cell: Cell, see
     best = windowed(task, cell, margin=margin)[0]
     assert best.cost == whole(task, cell)[0].cost
     assert service.check(best.task, cell).plausible
+
+
+def test_when_swapping_is_cheaper_than_inserting_the_windows_widen_until_the_cost_settles(cell: Cell) -> None:
+    costs = RepairCosts(insert=10, insert_per_role=1, remove=8, swap=1, rebind=1, reset=5)
+    assert not windows.edits_stay_local(costs, KNOWLEDGE.processes)
+    task = faulty_task(8, 1, 113371)  # with windows of the problem alone: remove a step (8), not swap two (1)
+    best = windows.windowed_repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs, top=1,
+                                   margin=0)[0]
+    assert best.cost == repairs.repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs,
+                                       top=1)[0].cost == 1
+
+
+def test_the_default_costs_keep_edits_local() -> None:
+    assert windows.edits_stay_local(RepairCosts(), KNOWLEDGE.processes)
 
 
 def test_a_long_task_keeps_its_unbroken_steps_and_is_plausible_after(cell: Cell) -> None:

@@ -30,13 +30,16 @@ the window optima, which is what the stitched repair costs.
 edit there only changes the states the next windows enter in; an insertion costs the same in the
 gap before a window's first step, where it has the same effect on the devices the window uses, and
 removing, swapping or rebinding plausible steps costs (with the default costs) at least as much as
-the cheapest insertion.
+the cheapest insertion, which has the same effect next to the window.
 ``tests/reasoning/test_windows.py`` compares the windowed and the whole-task optimum on random
 tasks (property test); ``bench/bench_repair.py`` compares them on 100- and 1,000-step tasks.
 
-When a window has no repair within these borders (a fix needs steps beyond them), every margin is
-doubled and the windows are solved again; at worst one window covers the task and this is the
-whole-task repair of :mod:`.repairs`.
+Where the costs break (3) (removing, swapping or rebinding a step cheaper than the cheapest
+insertion: :func:`edits_stay_local`), wider windows can find cheaper repairs, and random tasks show
+they do. Then the windows are solved with margin ``m`` and again with ``2m``, and the answer is
+taken when both cost the same, else the margins keep doubling: a check, not a proof. Margins also
+double when a window has no repair within its borders. At worst one window covers the task and
+this is the whole-task repair of :mod:`.repairs`.
 
 Devices from a catalogue are shared by all windows (one purchase may fix several), so their
 windows are not independent: each window is first solved with every catalogue device priced one
@@ -167,6 +170,12 @@ class _Chain:
         return {d: x for d, x in self.states(w.last + 1).items() if self.last_use.get(d, 0) > w.last}
 
 
+def edits_stay_local(costs: RepairCosts, processes: Sequence[ProcessDescription]) -> bool:
+    """Whether editing a plausible step costs at least the cheapest insertion (part 3 of the argument above)."""
+    cheapest = min((costs.insert + costs.insert_per_role * len(p.roles) for p in processes), default=0.0)
+    return min(costs.remove, costs.swap, costs.rebind) >= cheapest
+
+
 def windows(spans: Iterable[Window], n: int, margin: int) -> list[Window]:
     """The spans widened by ``margin`` steps on each side (within 1..n), overlapping or touching ones merged."""
     out: list[Window] = []
@@ -208,7 +217,8 @@ def windowed_repair(
 ) -> list[Repair]:
     """The ``top`` cheapest distinct repairs, each window repaired on its own (see the module's docstring).
 
-    ``margin``: unbroken steps first added on each side of a problem (doubled while too few)."""
+    ``margin``: unbroken steps first added on each side of a problem (doubled until doubling it
+    changes no cost)."""
     costs = costs or RepairCosts()
     book = fact_book(taxonomy, processes)
     facts = cell_program(book, cell) + program(task_facts(task, TASK)) + program([s.Check(CELL, TASK)])
@@ -217,13 +227,17 @@ def windowed_repair(
         return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap) if top >= 1 else []
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
+    narrower: list[Repair] | None = None
+    local = edits_stay_local(costs, processes)
     while True:
         wins = windows(chain.spans(), chain.n, margin)
         if wins == [Window(1, chain.n)]:
             return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
         found = _Solver(book, chain, cell, costs, per_gap, top).best(wins, extra)
-        if found is not None:
+        if found is not None and (local or (narrower is not None
+                                            and [r.cost for r in found] == [r.cost for r in narrower])):
             return found
+        narrower = found
         margin = 2 * margin or 1
 
 
