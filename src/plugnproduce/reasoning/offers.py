@@ -42,13 +42,12 @@ def _bindings(model: Model, processes: dict[str, ProcessDescription]) -> dict[st
     return out
 
 
-def role_players(model: Model, process: ProcessDescription) -> dict[str, tuple[str, ...]]:
-    """Per role of ``process`` (in role order), the devices of the configuration that can fill it, sorted."""
-    players: dict[str, set[str]] = {r.name: set() for r in process.roles}
+def role_players(model: Model, processes: Sequence[ProcessDescription]) -> dict[str, dict[str, tuple[str, ...]]]:
+    """Per process, per role (in role order), the devices of the configuration that can fill it, sorted."""
+    found: dict[tuple[str, str], set[str]] = defaultdict(set)
     for a in model[s.CanPlay]:
-        if a.p == process.id and a.r in players:
-            players[a.r].add(a.d)
-    return {r: tuple(sorted(ds)) for r, ds in players.items()}
+        found[(a.p, a.r)].add(a.d)
+    return {p.id: {r.name: tuple(sorted(found[(p.id, r.name)])) for r in p.roles} for p in processes}
 
 
 def binding_count(players: dict[str, tuple[str, ...]]) -> int:
@@ -85,9 +84,10 @@ def capabilities(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDesc
     listed, reasons = _bindings(model, ctx.processes), _reasons(model, ctx)
     offered = {a.p for a in model[s.Offered] if a.c == CELL}
     procs = sorted(book.processes, key=lambda p: p.id)
+    playing = role_players(model, procs)
 
     def offer(p: ProcessDescription) -> Offer:
-        players = role_players(model, p)
+        players = playing[p.id]
         bindings = tuple(listed[p.id]) if all_bindings else (witness(players),)
         return Offer(p.id, p.label, bindings, binding_count(players), players)
 
