@@ -12,10 +12,15 @@ KINDS = ("move-to", "swap", "force", "absent", "dropped", "unknown")
 range; a robot bound to a device not in the cell; a place left out; a parameter place does not declare."""
 
 
-def faulty_task(pairs: int, faults: int, seed: int, kinds: tuple[str, ...] = KINDS) -> Task:
-    """``pairs`` x (bin-pick, place) with ``faults`` faults of random kinds at random places (seeded)."""
+def faulty_task(pairs: int, faults: int, seed: int, kinds: tuple[str, ...] = KINDS, varied: bool = False) -> Task:
+    """``pairs`` x (bin-pick, place) with ``faults`` faults of random kinds at random places (seeded).
+
+    ``varied``: every place gets its own speed, so that no two stretches of the task are alike."""
     rnd = random.Random(seed)
     steps = [Step(0, c) for _ in range(pairs) for c in ("bin-pick", "place")]
+    if varied:
+        steps = [replace(st, params={"speed": 10 + n / 1000}) if st.command == "place" else st
+                 for n, st in enumerate(steps)]
     dropped = set()
     for pair in sorted(rnd.sample(range(1, pairs - 1), faults)):
         i = 2 * pair + 1  # a place

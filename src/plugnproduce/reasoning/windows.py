@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import heapq
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Hashable, Iterable, Sequence
 from dataclasses import dataclass, replace
 
 import clingo
@@ -228,12 +228,13 @@ def windowed_repair(
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
     narrower: list[Repair] | None = None
+    memo: dict[Hashable, list[Model]] = {}
     local = edits_stay_local(costs, processes)
     while True:
         wins = windows(chain.spans(), chain.n, margin)
         if wins == [Window(1, chain.n)]:
             return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
-        found = _Solver(book, chain, cell, costs, per_gap, top).best(wins, extra)
+        found = _Solver(book, chain, cell, costs, per_gap, top, memo).best(wins, extra)
         if found is not None and (local or (narrower is not None
                                             and [r.cost for r in found] == [r.cost for r in narrower])):
             return found
@@ -244,8 +245,10 @@ def windowed_repair(
 class _Solver:
     """Solves the windows of one task in one cell and combines their repairs."""
 
-    def __init__(self, book: FactBook, chain: _Chain, cell: Cell, costs: RepairCosts, per_gap: int, top: int):
+    def __init__(self, book: FactBook, chain: _Chain, cell: Cell, costs: RepairCosts, per_gap: int, top: int,
+                 memo: dict[Hashable, list[Model]]):
         self.book, self.chain, self.cell, self.costs, self.per_gap, self.top = book, chain, cell, costs, per_gap, top
+        self.memo = memo
 
     def best(self, wins: list[Window], extra: list[DeviceDescription]) -> list[Repair] | None:
         """The top repairs (None when some window has no repair within its borders)."""
@@ -321,7 +324,12 @@ class _Solver:
                  + program(repairs.cost_facts(costs or self.costs, self.book.processes, bought))
                  + program(s.Catalogue(d.id) for d in bought)
                  + program(s.ExitState(d, x) for d, x in sorted(self.chain.exits(w).items())))
-        return solver.optimise(solver.WINDOW, facts, top, repairs.forbid, lambda m: repairs.outcome(m, sub))
+        key = (facts, top, tuple((st.command, repr(sorted(st.bind.items())), repr(sorted(st.params.items())))
+                                 for st in steps))
+        if key not in self.memo:  # a repetitive task has many windows alike: solve each kind once
+            self.memo[key] = solver.optimise(solver.WINDOW, facts, top, repairs.forbid,
+                                             lambda m: repairs.outcome(m, sub))
+        return self.memo[key]
 
     def _carried(self, w: Window, model: Model) -> dict[str, str]:
         """States the window leaves devices in that no later original step uses (they stay so)."""
