@@ -28,10 +28,11 @@ def windowed(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None =
 
 
 @settings(max_examples=12, deadline=None, derandomize=True)
-@given(seed=st.integers(0, 10**6), pairs=st.integers(8, 40), faults=st.integers(1, 4), margin=st.sampled_from([0, 2]))
+@given(seed=st.integers(0, 10**6), pairs=st.integers(8, 40), faults=st.integers(1, 4), margin=st.sampled_from([0, 2]),
+       varied=st.booleans())
 def test_windowed_repair_costs_what_the_whole_task_optimum_costs(cell: Cell, seed: int, pairs: int, faults: int,
-                                                                 margin: int) -> None:
-    task = faulty_task(pairs, min(faults, pairs - 2), seed)
+                                                                 margin: int, varied: bool) -> None:
+    task = faulty_task(pairs, min(faults, pairs - 2), seed, varied=varied)
     best = windowed(task, cell, margin=margin)[0]
     assert best.cost == whole(task, cell)[0].cost
     assert service.check(best.task, cell).plausible
