@@ -100,8 +100,12 @@ def capabilities(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDesc
 
 def explain_process(cell: Cell, command: str, taxonomy: Taxonomy,
                     processes: Sequence[ProcessDescription]) -> ProcessExplanation:
-    """Why ``command`` is (not) offered in ``cell``: its bindings, or every reason with provenance."""
-    caps = capabilities(cell, taxonomy, processes, all_bindings=True)
+    """Why ``command`` is (not) offered in ``cell``: its bindings, or every reason with provenance.
+
+    Every binding is listed only for an offered command (on a big cell, why-not stays fast)."""
+    caps = capabilities(cell, taxonomy, processes)
+    if caps.offers(command):
+        caps = capabilities(cell, taxonomy, processes, all_bindings=True)
     for o in caps.offered:
         if o.command == command:
             return ProcessExplanation(o.command, o.label, True, o.bindings, ())
