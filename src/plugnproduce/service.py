@@ -162,10 +162,12 @@ def _devices(catalogue_or_folder: list[DeviceDescription] | str | Path | None, k
     return catalogue(catalogue_or_folder, k)
 
 
-def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.Capabilities:
-    """The process commands a cell offers, with every valid role binding; the others with reasons."""
+def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None,
+                 all_bindings: bool = False) -> reasoning.Capabilities:
+    """The process commands a cell offers, each with one valid role binding, how many there are and the
+    devices that can fill each role (every binding listed if ``all_bindings``); the others with reasons."""
     the_cell, k = _context(cell_or_path, knowledge)
-    return reasoning.capabilities(the_cell, k.taxonomy, k.processes)
+    return reasoning.capabilities(the_cell, k.taxonomy, k.processes, all_bindings)
 
 
 def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.CheckResult:

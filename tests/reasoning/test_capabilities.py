@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription
 
@@ -13,16 +15,41 @@ def test_the_paper_cell_offers_pick_place_pick_and_place_and_bin_pick(cell: Cell
 
 
 def test_every_valid_binding_is_listed(cell: Cell) -> None:
-    caps = service.capabilities(cell)
+    caps = service.capabilities(cell, all_bindings=True)
     bin_pick = next(o for o in caps.offered if o.command == "bin-pick")
     assert bin_pick.bindings == ({"gripper": "gripper", "localizer": "binpicking-pc", "robot": "robot",
                                   "sensor": "sensor3d"},)
 
 
 def test_a_second_gripper_doubles_the_bindings_of_pick(cell: Cell, device) -> None:
-    caps = service.capabilities(cell.with_device(device("vacuum-gripper")))
+    caps = service.capabilities(cell.with_device(device("vacuum-gripper")), all_bindings=True)
     pick = next(o for o in caps.offered if o.command == "pick")
     assert sorted(b["gripper"] for b in pick.bindings) == ["gripper", "vacuum-gripper"]
+    assert pick.binding_count == 2
+
+
+def _offer(caps, command: str):
+    return next(o for o in caps.offered if o.command == command)
+
+
+def test_by_default_one_binding_is_shown_with_the_number_of_bindings_and_who_can_play_each_role(
+        cell: Cell, device) -> None:
+    two = cell.with_device(device("vacuum-gripper")).with_device(device("scara"))
+    pick = _offer(service.capabilities(two), "pick")
+    assert pick.bindings == ({"gripper": "gripper", "robot": "robot"},)
+    assert pick.binding_count == 4
+    assert pick.role_devices == {"gripper": ("gripper", "vacuum-gripper"), "robot": ("robot", "scara")}
+
+
+def test_the_count_and_the_one_binding_agree_with_listing_them_all(cell: Cell, devices) -> None:
+    big = Cell("big", tuple(replace(d, id=f"{d.id}-{k}") for k in range(3) for d in devices))
+    default, listed = service.capabilities(big), service.capabilities(big, all_bindings=True)
+    assert default.commands() == listed.commands()
+    assert default.not_offered == listed.not_offered
+    for few, every in zip(default.offered, listed.offered, strict=True):
+        assert few.binding_count == len(every.bindings) == every.binding_count > 1
+        assert few.bindings == every.bindings[:1]
+        assert all(b[r] in few.role_devices[r] for b in every.bindings for r in b)
 
 
 def test_unplugging_the_gripper_removes_every_process_with_a_gripping_role(cell: Cell) -> None:

@@ -41,6 +41,22 @@ def test_capabilities_json() -> None:
     assert {"pick", "place", "pick-and-place", "bin-pick"} <= {o["command"] for o in doc["offered"]}
 
 
+def test_capabilities_shows_one_binding_and_their_number_unless_all_are_asked_for(tmp_path: Path) -> None:
+    cell = cell_file(tmp_path, "robot", "scara", "gripper", "vacuum-gripper")
+    few = pnp("capabilities", "--cell", cell)
+    assert "pick             gripper=gripper robot=robot  (1 of 4 bindings)" in few.stdout
+    every = pnp("capabilities", "--cell", cell, "--all-bindings")
+    assert ("pick             gripper=gripper robot=robot | gripper=gripper robot=scara | "
+            "gripper=vacuum-gripper robot=robot | gripper=vacuum-gripper robot=scara\n") in every.stdout
+    doc = json.loads(pnp("capabilities", "--cell", cell, "--json").stdout)
+    pick = next(o for o in doc["offered"] if o["command"] == "pick")
+    assert pick["bindings"] == [{"gripper": "gripper", "robot": "robot"}]
+    assert pick["binding_count"] == 4
+    assert pick["role_devices"] == {"gripper": ["gripper", "vacuum-gripper"], "robot": ["robot", "scara"]}
+    listed = json.loads(pnp("capabilities", "--cell", cell, "--json", "--all-bindings").stdout)
+    assert len(next(o for o in listed["offered"] if o["command"] == "pick")["bindings"]) == 4
+
+
 def test_explain_says_the_missing_skill_is_can_grip(tmp_path: Path) -> None:
     cell = cell_file(tmp_path, "robot", "sensor3d", "binpicking-pc")
     result = pnp("explain", "--cell", cell, "pick-and-place")

@@ -51,7 +51,7 @@ recovers(P,R,D,Y) :- leaves(P,R,D,_,Y).
 WORLD = GRIPPER + ROBOT + PROCESSES + LEAVES
 SECOND_GRIPPER = GRIPPER.replace('"g"', '"h"').replace("1000", "500")
 
-OFFERED = list(solver.rules("capabilities", show=False))
+OFFERED = list(solver.rules("bindings", show=False))
 CHECK = list(solver.rules("check", show=False))
 
 
@@ -239,6 +239,25 @@ REPAIR_CASES = {
 @pytest.mark.parametrize("facts, expected", REPAIR_CASES.values(), ids=REPAIR_CASES.keys())
 def test_repair(facts: str, expected: list[set[str]]) -> None:
     found = answer_sets(REPAIR, facts, ["edit/1"], ["--opt-mode=optN"])
+    assert sorted(map(sorted, found)) == sorted(map(sorted, expected))
+
+
+WINDOW = list(solver.rules("window", show=False))
+WINDOW_CASES = {
+    "no exit state: nothing to repair": (repair_case(("close",), ("g",)), [{'left_in("g","c")'}]),
+    "the gripper must leave open: the close goes": (
+        repair_case(("close",), ("g",), 'exit_state("g","o").'), [{"edit(remove(1))", 'left_in("g","o")'}]),
+    "the exit state the repair reaches anyway": (
+        repair_case(("close", "close"), ("g",), 'exit_state("g","c").'),
+        [{'edit(insert(2,1,"open"))', 'left_in("g","c")'}]),
+    "the window enters where the steps before left it": (
+        repair_case(("open",), ("g",)).replace('initial("g","o")', 'initial("g","c")'), [{'left_in("g","o")'}]),
+}
+
+
+@pytest.mark.parametrize("facts, expected", WINDOW_CASES.values(), ids=WINDOW_CASES.keys())
+def test_window(facts: str, expected: list[set[str]]) -> None:
+    found = answer_sets(WINDOW, facts, ["edit/1", "left_in/2"], ["--opt-mode=optN"])
     assert sorted(map(sorted, found)) == sorted(map(sorted, expected))
 
 

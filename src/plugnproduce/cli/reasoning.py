@@ -43,16 +43,23 @@ def _reasons(reasons: tuple[reasoning.Reason, ...], indent: str = "    ") -> Non
 
 @app.command()
 @boundary
-def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION) -> None:
-    """Show the process commands a cell offers (with every role binding) and why the others are not offered."""
-    caps = service.capabilities(cell, knowledge(cell))
+def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION,
+                 all_bindings: bool = typer.Option(False, "--all-bindings",
+                                                   help="List every valid role binding, not just one.")) -> None:
+    """Show the process commands a cell offers and why the others are not offered.
+
+    Each offered command shows one valid role binding and how many there are (every one with
+    --all-bindings); with --json also the devices that can fill each role.
+    """
+    caps = service.capabilities(cell, knowledge(cell), all_bindings)
     if json_out:
         emit_json(caps.to_json())
         return
     total = len(caps.offered) + len(caps.not_offered)
     typer.echo(f"cell {caps.cell}: {len(caps.offered)} of {total} process commands offered")
     for o in caps.offered:
-        typer.echo(f"  {o.command:<16} {_bindings(o.bindings)}")
+        more = "" if all_bindings or o.binding_count == 1 else f"  (1 of {o.binding_count:,} bindings)"
+        typer.echo(f"  {o.command:<16} {_bindings(o.bindings)}{more}")
     if caps.not_offered:
         typer.echo("not offered:")
     for n in caps.not_offered:
@@ -98,6 +105,7 @@ def repair(
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
 
+    A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
     result = service.check(task, cell, knowledge(cell))

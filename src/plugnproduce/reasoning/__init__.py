@@ -12,7 +12,6 @@ from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
 from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
 from plugnproduce.reasoning.offers import capabilities, explain_process
 from plugnproduce.reasoning.plausibility import check, explain_step
-from plugnproduce.reasoning.repairs import repair
 from plugnproduce.reasoning.results import (
     Capabilities,
     CheckResult,
@@ -27,6 +26,7 @@ from plugnproduce.reasoning.results import (
     StepCheck,
     StepExplanation,
 )
+from plugnproduce.reasoning.windows import repair
 
 __all__ = [
     "BATCH_CSV_HEADER",

@@ -72,7 +72,7 @@ def _cell(path: Path, k: Knowledge) -> tuple[Cell | None, Knowledge]:
 def _offers(cell: Cell | None, k: Knowledge) -> Bindings:
     if cell is None:
         return {}
-    caps = reasoning.capabilities(cell, k.taxonomy, k.processes)
+    caps = reasoning.capabilities(cell, k.taxonomy, k.processes, all_bindings=True)
     return {o.command: {" ".join(f"{r}={d}" for r, d in sorted(b.items())) for b in o.bindings} for o in caps.offered}
 
 

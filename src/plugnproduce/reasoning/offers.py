@@ -1,7 +1,8 @@
-"""Offered process commands of a cell, every valid role binding, and why-not answers (offered.lp, explain.lp)."""
+"""Offered process commands of a cell, role bindings, why-not answers (offered.lp, bindings.lp, explain.lp)."""
 
 from __future__ import annotations
 
+import math
 from collections import defaultdict
 from collections.abc import Sequence
 
@@ -41,6 +42,24 @@ def _bindings(model: Model, processes: dict[str, ProcessDescription]) -> dict[st
     return out
 
 
+def role_players(model: Model, processes: Sequence[ProcessDescription]) -> dict[str, dict[str, tuple[str, ...]]]:
+    """Per process, per role (in role order), the devices of the configuration that can fill it, sorted."""
+    found: dict[tuple[str, str], set[str]] = defaultdict(set)
+    for a in model[s.CanPlay]:
+        found[(a.p, a.r)].add(a.d)
+    return {p.id: {r.name: tuple(sorted(found[(p.id, r.name)])) for r in p.roles} for p in processes}
+
+
+def binding_count(players: dict[str, tuple[str, ...]]) -> int:
+    """How many valid role bindings there are: roles may share a device, so any player per role will do."""
+    return math.prod(len(ds) for ds in players.values())
+
+
+def witness(players: dict[str, tuple[str, ...]]) -> dict[str, str]:
+    """The first valid binding in the order all bindings are listed: each role's first player."""
+    return {r: ds[0] for r, ds in players.items()}
+
+
 def _reasons(model: Model, ctx: render.Context) -> dict[str, list[Reason]]:
     out: dict[str, list[Reason]] = defaultdict(list)
     for a in sorted(model[s.NoSkill], key=lambda a: (a.p, a.r)):
@@ -52,25 +71,41 @@ def _reasons(model: Model, ctx: render.Context) -> dict[str, list[Reason]]:
     return out
 
 
-def capabilities(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> Capabilities:
-    """What ``cell`` can do: offered commands with all valid role bindings; the others with reasons."""
+def capabilities(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
+                 all_bindings: bool = False) -> Capabilities:
+    """What ``cell`` can do: offered commands, each with the devices that can fill each role, how many
+    valid role bindings that makes and one of them (every one if ``all_bindings``); the others with reasons.
+
+    Roles may share a device (roles.lp), so the bindings are every choice of one player per role:
+    their number is a product, and only ``all_bindings`` lists them (bindings.lp)."""
     book = fact_book(taxonomy, processes)
-    model = solver.solve(solver.CAPABILITIES, cell_program(book, cell))
+    model = solver.solve(solver.BINDINGS if all_bindings else solver.CAPABILITIES, cell_program(book, cell))
     ctx = context(book, cell)
-    bindings, reasons = _bindings(model, ctx.processes), _reasons(model, ctx)
+    listed, reasons = _bindings(model, ctx.processes), _reasons(model, ctx)
     offered = {a.p for a in model[s.Offered] if a.c == CELL}
     procs = sorted(book.processes, key=lambda p: p.id)
+    playing = role_players(model, procs)
+
+    def offer(p: ProcessDescription) -> Offer:
+        players = playing[p.id]
+        bindings = tuple(listed[p.id]) if all_bindings else (witness(players),)
+        return Offer(p.id, p.label, bindings, binding_count(players), players)
+
     return Capabilities(
         cell.name,
-        tuple(Offer(p.id, p.label, tuple(bindings[p.id])) for p in procs if p.id in offered),
+        tuple(offer(p) for p in procs if p.id in offered),
         tuple(NotOffered(p.id, p.label, tuple(reasons[p.id])) for p in procs if p.id not in offered),
     )
 
 
 def explain_process(cell: Cell, command: str, taxonomy: Taxonomy,
                     processes: Sequence[ProcessDescription]) -> ProcessExplanation:
-    """Why ``command`` is (not) offered in ``cell``: its bindings, or every reason with provenance."""
+    """Why ``command`` is (not) offered in ``cell``: its bindings, or every reason with provenance.
+
+    Every binding is listed only for an offered command (on a big cell, why-not stays fast)."""
     caps = capabilities(cell, taxonomy, processes)
+    if caps.offers(command):
+        caps = capabilities(cell, taxonomy, processes, all_bindings=True)
     for o in caps.offered:
         if o.command == command:
             return ProcessExplanation(o.command, o.label, True, o.bindings, ())

@@ -29,15 +29,22 @@ class Reason:
 
 @dataclass(frozen=True)
 class Offer:
-    """An offered process command and every valid role binding (role → device)."""
+    """An offered process command: valid role bindings (role → device), how many there are, who can play each role."""
 
     command: str
     label: str
     bindings: tuple[dict[str, str], ...]
+    """One binding (a witness), or every one when asked for all."""
+    binding_count: int = 0
+    """How many valid role bindings there are (without listing them)."""
+    role_devices: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """Per role (in role order), the devices of the cell that can fill it."""
 
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
-        return {"command": self.command, "label": self.label, "bindings": [dict(b) for b in self.bindings]}
+        return {"command": self.command, "label": self.label, "bindings": [dict(b) for b in self.bindings],
+                "binding_count": self.binding_count,
+                "role_devices": {r: list(ds) for r, ds in self.role_devices.items()}}
 
 
 @dataclass(frozen=True)

@@ -18,12 +18,14 @@ from plugnproduce.reasoning.terms import Model, decode
 from plugnproduce.resources import rules_path
 
 PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
-    "capabilities": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
+    "capabilities": (("roles.lp", "offered.lp", "explain.lp"), "show_capabilities.lp"),
+    "bindings": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
     "offered": (("roles.lp", "offered.lp"), "show_capabilities.lp"),
     "check": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"), "show_check.lp"),
     "batch": (("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_batch.lp"),
     "cheapest": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_cheapest.lp"),
     "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
+    "window": (("roles.lp", "chain.lp", "params.lp", "repair.lp", "window.lp"), "show_window.lp"),
 }
 """The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
 
@@ -34,8 +36,8 @@ def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
     return concerns + (shown,) if show else concerns
 
 
-CAPABILITIES, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR = (
-    rules(p) for p in ("capabilities", "offered", "check", "batch", "cheapest", "repair"))
+CAPABILITIES, BINDINGS, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR, WINDOW = (
+    rules(p) for p in ("capabilities", "bindings", "offered", "check", "batch", "cheapest", "repair", "window"))
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""
@@ -80,6 +82,17 @@ def solve(rules: Sequence[str], facts: str) -> Model:
     if not result.satisfiable or not found:
         raise EncodingError(f"{', '.join(rules)} has no model for these facts; stratified encodings always have one")
     return found[-1]
+
+
+def symbols(rules: Sequence[str], facts: str) -> list[clingo.Symbol]:
+    """The shown atoms of the one model of a program that needs no search, undecoded (for large models)."""
+    ctl, messages = _control(["--warn=none"])
+    _ground(ctl, messages, rules, facts)
+    found: list[Sequence[clingo.Symbol]] = []
+    result = ctl.solve(on_model=lambda m: found.append(m.symbols(shown=True)))
+    if not result.satisfiable or not found:
+        raise EncodingError(f"{', '.join(rules)} has no model for these facts; stratified encodings always have one")
+    return list(found[-1])
 
 
 def optimise(

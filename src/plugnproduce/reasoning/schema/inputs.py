@@ -282,6 +282,14 @@ class Gap(Atom):
     j: int
 
 
+@predicate("exit_state")
+class ExitState(Atom):
+    """A repaired window must leave device ``d`` in chart state ``x`` (a later step expects it there)."""
+
+    d: str
+    x: str
+
+
 @predicate("edit_cost")
 class EditCost(Atom):
     """The cost of an edit kind (``insert`` per process, ``add`` per device), in hundredths."""

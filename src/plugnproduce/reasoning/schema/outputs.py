@@ -253,6 +253,14 @@ class Edit(Atom):
     e: clingo.Symbol
 
 
+@predicate("left_in")
+class LeftIn(Atom):
+    """A repaired window leaves device ``d`` in chart state ``x``."""
+
+    d: str
+    x: str
+
+
 @predicate("runs")
 class Runs(Atom):
     """In the repaired task, slot ``s`` runs process ``p``; ``i`` is the original step (0: inserted)."""

@@ -83,7 +83,7 @@ export function renderDeviceState(device, stateName, concept) {
 }
 
 function bindingsText(offer) {
-  if (offer.bindings.length !== 1) return `${offer.bindings.length} ways to bind its roles`;
+  if (offer.binding_count !== 1) return `${offer.binding_count.toLocaleString("en")} ways to bind its roles`;
   return Object.entries(offer.bindings[0]).map(([role, dev]) => `${role}: ${dev}`).join(", ");
 }
 

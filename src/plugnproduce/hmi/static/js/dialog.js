@@ -59,7 +59,7 @@ function paramField(p, value) {
 
 function roleField(process, role, step) {
   const o = offer(process.command);
-  const fitting = o ? [...new Set(o.bindings.map((b) => b[role.name]).filter(Boolean))]
+  const fitting = o ? [...(o.role_devices[role.name] || [])]
     : (state.cell ? state.cell.devices.map((d) => d.id) : []);
   const id = `role-${role.name}`;
   const chosen = step && step.bind ? step.bind[role.name] : undefined;

@@ -1,0 +1,108 @@
+"""Repair window by window: the same optimal cost as repairing the whole task at once, on random tasks."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from plugnproduce import service
+from plugnproduce.description.model import Cell, DeviceDescription, Step, Task
+from plugnproduce.reasoning import RepairCosts, repairs, windows
+from plugnproduce.reasoning.windows import Window
+from tests.reasoning.faulty_tasks import faulty_task
+
+KNOWLEDGE = service.knowledge()
+
+
+def whole(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None = None, top: int = 1) -> list:
+    return repairs.repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, catalogue, top=top)
+
+
+def windowed(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None = None, top: int = 1,
+             margin: int = windows.MARGIN) -> list:
+    return windows.windowed_repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, catalogue, top=top,
+                                   margin=margin)
+
+
+@settings(max_examples=12, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 10**6), pairs=st.integers(8, 40), faults=st.integers(1, 4), margin=st.sampled_from([0, 2]),
+       varied=st.booleans())
+def test_windowed_repair_costs_what_the_whole_task_optimum_costs(cell: Cell, seed: int, pairs: int, faults: int,
+                                                                 margin: int, varied: bool) -> None:
+    task = faulty_task(pairs, min(faults, pairs - 2), seed, varied=varied)
+    best = windowed(task, cell, margin=margin)[0]
+    assert best.cost == whole(task, cell)[0].cost
+    assert service.check(best.task, cell).plausible
+
+
+def test_when_swapping_is_cheaper_than_inserting_the_windows_widen_until_the_cost_settles(cell: Cell) -> None:
+    costs = RepairCosts(insert=10, insert_per_role=1, remove=8, swap=1, rebind=1, reset=5)
+    assert not windows.edits_stay_local(costs, KNOWLEDGE.processes)
+    task = faulty_task(8, 1, 113371)  # with windows of the problem alone: remove a step (8), not swap two (1)
+    best = windows.windowed_repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs, top=1,
+                                   margin=0)[0]
+    assert best.cost == repairs.repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs,
+                                       top=1)[0].cost == 1
+
+
+def test_the_default_costs_keep_edits_local() -> None:
+    assert windows.edits_stay_local(RepairCosts(), KNOWLEDGE.processes)
+
+
+def test_a_long_task_keeps_its_unbroken_steps_and_is_plausible_after(cell: Cell) -> None:
+    task = faulty_task(300, 12, 7)
+    best = windowed(task, cell)[0]
+    assert service.check(best.task, cell).plausible
+    edited = {e.step for e in best.edits}
+    problems = {p.step for p in service.check(task, cell).problems}
+    assert all(any(abs(s - p) <= 4 for p in problems) for s in edited)  # edits only near the problems
+
+
+def test_the_next_best_repairs_are_distinct_and_no_cheaper(cell: Cell) -> None:
+    task = faulty_task(30, 3, 3)
+    found = windowed(task, cell, top=3)
+    assert [r.rank for r in found] == [1, 2, 3]
+    assert [r.cost for r in found] == sorted(r.cost for r in found)
+    assert found[0].cost == whole(task, cell)[0].cost
+    assert len({tuple(e.text for e in r.edits) for r in found}) == 3
+    assert all(service.check(r.task, cell).plausible for r in found)
+
+
+def _screws(task: Task, at: tuple[int, ...]) -> Task:
+    steps = list(task.steps)
+    for i in sorted(at, reverse=True):
+        steps.insert(i, Step(0, "screw"))
+    return Task(task.name, tuple(replace(s, index=n) for n, s in enumerate(steps, start=1)), task.file)
+
+
+def test_one_device_bought_for_two_distant_windows_is_paid_once(cell: Cell, devices: list[DeviceDescription]) -> None:
+    task = _screws(faulty_task(25, 1, 5), (6, 42))  # two screw steps far apart, no screwdriver in the cell
+    best = windowed(task, cell, devices)[0]
+    assert best.added_devices == ("screwdriver",)
+    assert best.cost == whole(task, cell, devices)[0].cost
+    assert service.check(best.task, cell.with_device(_by_id(devices, best.added_devices[0]))).plausible
+
+
+def _by_id(devices: list[DeviceDescription], name: str) -> DeviceDescription:
+    return next(d for d in devices if d.id == name)
+
+
+def test_a_short_task_is_repaired_whole(cell: Cell) -> None:
+    task = faulty_task(10, 2, 1)
+    assert len(task.steps) <= windows.WHOLE_UP_TO
+    got = service.repair(task, cell, top=3)
+    assert [(r.cost, [e.text for e in r.edits]) for r in got] == [
+        (r.cost, [e.text for e in r.edits]) for r in whole(task, cell, top=3)]
+
+
+@pytest.mark.parametrize("spans, margin, expected", [
+    ([Window(10, 12)], 2, [Window(8, 14)]),
+    ([Window(1, 1), Window(99, 100)], 3, [Window(1, 4), Window(96, 100)]),
+    ([Window(10, 12), Window(17, 17)], 2, [Window(8, 19)]),  # 8-14 and 15-19 touch: one window
+    ([Window(10, 12), Window(18, 18)], 2, [Window(8, 14), Window(16, 20)]),
+])
+def test_windows_widen_and_merge(spans: list[Window], margin: int, expected: list[Window]) -> None:
+    assert windows.windows(spans, 100, margin) == expected
