@@ -114,7 +114,7 @@ class Hub:
 
     def on_run_record(self, run_id: str, record: JournalRecord) -> None:
         """Take in one journal record of a run: device states follow it, and every page hears of it."""
-        if record.get("kind") == "state" and record.get("device"):
+        if record.get("kind") in ("state", "stop") and record.get("device"):  # a stop record: the state reported
             device = str(record["device"])
             with self._lock:
                 if device in self._states:
