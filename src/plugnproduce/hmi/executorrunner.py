@@ -1,10 +1,10 @@
 """The executor as the HMI's :class:`~plugnproduce.hmi.interfaces.Runner`.
 
-A run takes the service's one path (:func:`plugnproduce.service.plan_run` checks the task for
-the cell as it is now, each device in the state it reports, and generates only its task chart; :func:`plugnproduce.service.start_run`
-runs it against the cell's devices at the endpoints discovery found), journalling into the
-runs folder. A device
-the cell source sees leave during the run is a lost device: the run stops with a fault.
+A run takes the service's one path: :func:`plugnproduce.service.plan_run` checks the task for
+the cell as it is now, each device in the state it reports, and generates only its task chart;
+:func:`plugnproduce.service.start_run` runs it against the cell's devices at the endpoints
+discovery found, journalling into the runs folder. A device the cell source sees leave during
+the run is a lost device: the run stops with a fault.
 One run at a time.
 """
 
