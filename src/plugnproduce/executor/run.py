@@ -168,7 +168,7 @@ class TaskRun:
             except ExecutionError as exc:  # the task chart itself broke down: a fault like any other
                 self._fail(Fault("chart", str(exc), self.step, self.command))
             finally:
-                if self.fault is not None:
+                if self.fault is not None or self.interpreter.final_state != DONE:
                     await self._safe_stop()
                 for task in self._commands:
                     task.cancel()

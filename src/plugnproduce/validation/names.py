@@ -19,12 +19,13 @@ from plugnproduce.ontology.names import unknown_class, unknown_term
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, concept_iri, local_name
 from plugnproduce.safeio import parse_xml
+from plugnproduce.statechart import SCXML_NS
 from plugnproduce.validation.findings import Problem
 
 CONCEPT = "{" + PNP_IRI + "}concept"
 ACCEPTS = "{" + PNP_IRI + "}accepts"
 ROLE = "{" + PNP_IRI + "}role"
-TRANSITION = "{http://www.w3.org/2005/07/scxml}transition"
+TRANSITION = "{" + SCXML_NS + "}transition"
 
 TERM_PROPERTIES = {PNP.hasSkill: "Skill", PNP.requiresSkill: "Skill", PNP.quantity: "Quantity",
                    PNP.mandatoryState: "StateConcept"}
