@@ -148,6 +148,7 @@ class TaskRun:
         self._links: dict[str, DeviceLink] = {}
         self._commands: set[asyncio.Task[None]] = set()
         self.fault: Fault | None = None
+        self._faulted = asyncio.Event()
         self.step: int | None = None
         self.command: str | None = None
         self.device_states: dict[str, str] = {}
@@ -164,7 +165,7 @@ class TaskRun:
                 if self.fault is None:
                     await self._loop.run()
                 if self.fault is None:  # the chart is done; the commands not yet answered still may fail it
-                    await asyncio.gather(*self._commands)
+                    await self._answers()
             except ExecutionError as exc:  # the task chart itself broke down: a fault like any other
                 self._fail(Fault("chart", str(exc), self.step, self.command))
             finally:
@@ -229,6 +230,15 @@ class TaskRun:
             self._fail(replace(sent, kind="lost", message=f"command {name}: {exc}"))
         except PlugNProduceError as exc:
             self._fail(replace(sent, kind="refused", message=f"command {name}: {exc}"))
+
+    async def _answers(self) -> None:
+        """Wait until every command sent is answered (each bounded by its timeout) or a fault comes first."""
+        answered: asyncio.Future[Any] = asyncio.ensure_future(asyncio.gather(*self._commands,
+                                                                            return_exceptions=True))
+        faulted: asyncio.Future[Any] = asyncio.ensure_future(self._faulted.wait())
+        await asyncio.wait({answered, faulted}, return_when=asyncio.FIRST_COMPLETED)
+        faulted.cancel()
+        answered.cancel()
 
     async def _safe_stop(self) -> None:
         """Stop every connected device safely, at once, each answer bounded in time."""
@@ -313,6 +323,7 @@ class TaskRun:
         first = self.fault is None
         if first:
             self.fault = fault
+            self._faulted.set()
         self._record("fault", **fault.to_json(), first=first)
         if first and self.interpreter.running:
             self._loop.queue(FAULT_EVENT)
