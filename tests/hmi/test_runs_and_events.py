@@ -77,6 +77,10 @@ async def test_the_next_run_is_planned_from_where_the_last_left_the_devices(clie
     assert res.status_code == 409
     detail = res.json()["detail"]
     assert "device 'gripper'" in detail and "state 'closed'" in detail and "(the state it reports)" in detail
+    check = (await client.post("/api/task/check", json=TASK, headers=AUTH)).json()
+    assert not check["plausible"] and "(the state it reports)" in check["problems"][0]["text"]
+    repair = (await client.post("/api/task/repair", json=TASK, headers=AUTH)).json()
+    assert [e["text"] for e in repair["repairs"][0]["edits"]] == ["insert open-gripper before step 1 (pick-and-place)"]
 
 
 async def test_a_second_run_waits_for_the_first(client: httpx.AsyncClient) -> None:
