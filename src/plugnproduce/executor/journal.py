@@ -94,8 +94,8 @@ class RunRecord:
     @property
     def safe_stop(self) -> str | None:
         """How the devices were left after a fault or a stop: ``stopped safely`` when every device that takes a
-        safe-stop request accepted it, else which did not; ``crashed`` with no end record; None after a run with no
-        safe stop."""
+        safe-stop request accepted it, else which did not (or could not be asked); that no safe stop is known
+        when the journal has no end record (a crash); None after a run that needed none."""
         if self.end is None:
             return "no end record: no safe stop is known to have been sent"
         stops = list(self.of_kind("stop"))
