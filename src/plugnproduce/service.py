@@ -397,6 +397,7 @@ async def run_task(
     knowledge: Knowledge | None = None,
     bin_parts: int | None = None,
     bin_seed: int = 0,
+    assume_initial: bool = False,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
@@ -404,8 +405,10 @@ async def run_task(
     with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`), working on a
     simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given. ``started`` is
     given the run once it exists (to stop it); ``progress`` is told each phase as it begins
-    (checking, generating, starting devices, discovering, running). Raises :class:`ImplausibleTask`
-    before anything runs.
+    (checking, generating, starting devices, discovering, running). The task is checked and generated
+    from the state each device reports once discovered (:func:`reported_states`), or, with
+    ``assume_initial``, from the charts' initial states before discovery. Raises :class:`ImplausibleTask`
+    before any command goes out.
     """
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env, private_network
@@ -413,9 +416,11 @@ async def run_task(
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     say = progress or (lambda _: None)
-    say("checking the task in the cell")
     the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
-    generated = plan_run(the_task, the_cell, k, progress=say)
+    generated: GeneratedTask | None = None
+    if assume_initial:
+        say("checking the task in the cell")
+        generated = plan_run(the_task, the_cell, k, progress=say)
     journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
     network = private_network() if simulate else network_from_env()
     async with contextlib.AsyncExitStack() as stack:
@@ -429,6 +434,9 @@ async def run_task(
         live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
                                                         expected=wanted))
         devices = await find_devices(live, wanted, discovery_timeout)
+        if generated is None:
+            say("asking each device its state; checking the task from there")
+            generated = plan_run(the_task, the_cell.reported(await reported_states(devices)), k, progress=say)
         say("running")
         run = start_run(generated, devices, journal, observer)
         if started is not None:
@@ -438,6 +446,44 @@ async def run_task(
             return await run.run()
         finally:
             follow.cancel()
+
+
+class StateNotReported(PlugNProduceError):
+    """A device of a live cell did not report its state."""
+
+
+async def reported_states(devices: Cell, timeout: float | None = None) -> dict[str, str]:
+    """Ask every device of a live cell (``devices``: their real endpoints) its current state over its protocol,
+    all at once; each answer bounded by ``timeout`` (default: the device's command timeout)."""
+    from plugnproduce.executor.links import query_state
+
+    async def one(device: DeviceDescription) -> str:
+        try:
+            state = await query_state(device, timeout or device.command_timeout)
+        except PlugNProduceError as exc:
+            raise StateNotReported(f"device {device.id} did not report its state ({exc}); to plan from its chart's "
+                                   "initial state instead, give --assume-initial") from None
+        if state not in {s.id for s in device.states}:
+            raise StateNotReported(f"device {device.id} reports state {state!r}, which its device state chart "
+                                   f"{Path(device.chart_file).name} does not have")
+        return state
+
+    states = await asyncio.gather(*(one(d) for d in devices.devices))
+    return {d.id: x for d, x in zip(devices.devices, states, strict=True)}
+
+
+async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
+                    discovery_timeout: float = 10.0) -> Cell:
+    """The cell with each device in the state it reports: its devices found by discovery (on the network
+    ``PNP_SSDP_PORT`` names) and asked their states. For ``check``, ``repair`` and ``explain`` on a live cell."""
+    from plugnproduce.discovery import LiveCell
+    from plugnproduce.protocols.upnp import network_from_env
+
+    the_cell, k = _context(cell_or_path, knowledge)
+    wanted = [d.id for d in the_cell.devices]
+    async with LiveCell(k.taxonomy, network=network_from_env(), name=the_cell.name, expected=wanted) as live:
+        devices = await find_devices(live, wanted, discovery_timeout)
+        return the_cell.reported(await reported_states(devices))
 
 
 def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None,

@@ -97,7 +97,7 @@ def test_report_without_a_run_shows_the_latest(past_runs: Path) -> None:
     result = runner.invoke(app, ["report"])
     assert result.exit_code == 0
     assert result.stdout.splitlines()[0] == "start task task-a-third on cell bin-picking"
-    assert result.stdout.rstrip().endswith("status: crashed")
+    assert result.stdout.rstrip().endswith("status: crashed; no end record: no safe stop is known to have been sent")
 
 
 def test_report_without_any_run_is_bad_input(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

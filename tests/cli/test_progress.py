@@ -53,8 +53,9 @@ def run_with_terminal_stderr(*args: str) -> tuple[int, str, str]:
 def test_run_on_a_terminal_says_what_it_is_doing(tmp_path: Path) -> None:
     code, out, terminal = run_with_terminal_stderr("run", TASK, "--sim", "--journal", str(tmp_path / "run.jsonl"))
     assert code == 0, terminal
-    for phase in ("checking the task in the cell", "generating the charts of 6 step(s)",
-                  "starting 4 simulated device(s) on loopback", "discovering devices: robot", "running"):
+    for phase in ("starting 4 simulated device(s) on loopback", "discovering devices: robot",
+                  "asking each device its state; checking the task from there", "generating the charts of 6 step(s)",
+                  "running"):
         assert f"✓ {phase}" in terminal, phase
     assert "✓" not in out and out.startswith("start task bin-picking")
 

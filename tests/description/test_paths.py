@@ -47,3 +47,25 @@ def test_no_path_names_device_state_and_concept(catalogue, taxonomy) -> None:
 def test_path_search_is_deterministic(catalogue, taxonomy) -> None:
     paths = {find_path(catalogue["cnc"], "door_closed", P + "MachineIdle", taxonomy) for _ in range(5)}
     assert len(paths) == 1
+
+
+MOVING = ("robot", "cobot", "scara", "conveyor", "cnc", "screwdriver")
+
+
+def test_every_built_in_device_that_moves_declares_a_safe_stop(catalogue) -> None:
+    for name in MOVING:
+        stops = catalogue[name].stops
+        assert stops and all(t.request is not None and t.request.name == "Halt" for t in stops), name
+    robot = catalogue["robot"]
+    assert {s.id for s in robot.states} == {t.source for t in robot.stops}  # the robot can be stopped in any state
+
+
+def test_a_safe_stop_is_never_planned_with(catalogue, taxonomy) -> None:
+    """Halt leaves 'moving' for 'at_pose' as motion.done does, but a plan only ever waits for the motion."""
+    for name in MOVING:
+        assert all(t.request is None or t.request.name != "Halt" for t in catalogue[name].transitions), name
+    path = find_path(catalogue["robot"], "moving", P + "AtPose", taxonomy)
+    assert [t.event for t in path.steps] == ["motion.done"]
+    commands = service.generate(service.builtin("tasks", "bin-picking.yaml"),
+                                service.builtin("cells", "bin-picking.yaml")).task.commands()
+    assert "Halt" not in {c.name for _, _, c in commands}

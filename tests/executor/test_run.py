@@ -61,6 +61,40 @@ async def test_each_fault_stops_the_run_safely_with_a_report(spec: str, tmp_path
     first_fault = kinds.index("fault")
     assert "command" not in kinds[first_fault:], "no command may go out after the fault"
     assert run.end is not None and str(fault) == run.end["reason"]
+    stops = {r["device"]: r for r in run.of_kind("stop")}
+    assert set(stops) == {"robot", "gripper", "sensor3d", "binpicking-pc"}  # each device's answer and final state
+    assert (stops["robot"]["request"], stops["robot"]["answer"]) == ("Halt", "accepted")
+    assert stops["robot"]["state"] in {"home", "at_pose"} and run.end["device_states"]["robot"] == stops["robot"]["state"]
+    assert kinds.index("stop") > first_fault
+    if kind == "lost":  # a device the controller cannot reach any more is said so, not called stopped
+        assert stops["gripper"]["answer"].startswith("no state reported")
+        assert run.safe_stop is not None and run.safe_stop.startswith("safe stop incomplete: gripper")
+    else:
+        assert run.safe_stop == "stopped safely"
+
+
+async def test_an_unanswered_command_fails_the_run_at_the_step_that_sent_it(tmp_path: Path) -> None:
+    """The robot's first MoveTo is carried out but never answered: the run does not end ``succeeded``."""
+    report = await service.run_task(TASK, CELL, simulate=True, faults="robot:drop-response:MoveTo",
+                                    journal=tmp_path / "run.jsonl")
+    assert report.outcome == "failed"
+    fault = report.fault
+    assert fault is not None
+    assert (fault.kind, fault.step, fault.command, fault.device, fault.request, fault.state) == \
+        ("timeout", 1, "bin-pick", "robot", "MoveTo", "home")
+    run = read_journal(report.journal)
+    kinds = [r["kind"] for r in run.records]
+    assert "command" not in kinds[kinds.index("fault"):], "nothing may go out after the timeout"
+    assert next(run.of_kind("stop"))["kind"] == "stop" and kinds[-1] == "end"
+
+
+async def test_after_an_unanswered_close_the_fault_names_the_step_that_sent_it(tmp_path: Path) -> None:
+    report = await service.run_task(TASK, CELL, simulate=True, faults="gripper:drop-response:Close",
+                                    journal=tmp_path / "run.jsonl")
+    run = read_journal(report.journal)
+    close = next(r for r in run.of_kind("command") if r["command"] == "Close")
+    assert report.fault is not None and report.fault.request == "Close"
+    assert (report.fault.step, report.fault.state) == (close["step"], "open")
 
 
 async def test_a_device_unplugged_mid_task_stops_the_run(tmp_path: Path, taxonomy) -> None:
@@ -90,4 +124,6 @@ async def test_an_operator_stop_ends_the_run_as_stopped(tmp_path: Path) -> None:
                                     observer=stop_at_step_2, started=runs.append)
     assert report.outcome == "stopped"
     assert report.fault is not None and report.fault.step == 2
-    assert read_journal(report.journal).status == "stopped"
+    run = read_journal(report.journal)
+    assert run.status == "stopped" and run.safe_stop == "stopped safely"
+    assert {(r["device"], r["request"]) for r in run.of_kind("stop")} >= {("robot", "Halt")}

@@ -66,6 +66,20 @@ def test_sigterm_stops_the_run_safely_and_the_journal_ends(tmp_path: Path) -> No
     assert "Traceback" not in err
     shown = service.report(journal)
     assert shown.status == "stopped"
+    assert [r["request"] for r in shown.of_kind("stop") if r["device"] == "robot"] == ["Halt"]
+    report = pnp("report", str(journal))
+    assert report.stdout.rstrip().endswith("status: stopped; stopped safely")
+
+
+def test_report_tells_a_crash_from_a_safe_stop(tmp_path: Path) -> None:
+    journal = tmp_path / "run.jsonl"
+    assert pnp("run", str(TASKS / "bin-picking.yaml"), "--sim", "--journal", str(journal)).returncode == 0
+    crashed = tmp_path / "crashed.jsonl"
+    crashed.write_text("".join(journal.read_text().splitlines(keepends=True)[:5]))  # the controller died mid-run
+    shown = pnp("report", str(crashed))
+    assert shown.returncode == 0
+    assert shown.stdout.rstrip().splitlines()[-1] == ("status: crashed; no end record: no safe stop is known to "
+                                                      "have been sent")
 
 
 def test_two_runs_never_share_a_journal(tmp_path: Path) -> None:

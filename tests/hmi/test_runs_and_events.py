@@ -62,6 +62,25 @@ async def test_a_run_can_be_stopped(client: httpx.AsyncClient) -> None:
     run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
     run = (await client.post(f"/api/runs/{run_id}/stop", headers=AUTH)).json()
     assert run["status"] == "stopped" and run["end"]["reason"].endswith(": stopped by the operator")
+    journal = (await client.get(f"/api/runs/{run_id}/journal")).json()
+    stops = {r["device"]: r for r in journal if r["kind"] == "stop"}
+    assert (stops["robot"]["request"], stops["robot"]["answer"]) == ("Halt", "accepted")
+    assert journal[-1]["kind"] == "end"
+
+
+async def test_the_next_run_is_planned_from_where_the_last_left_the_devices(client: httpx.AsyncClient,
+                                                                            hmi: Hmi) -> None:
+    close = {"name": "close", "steps": [{"command": "close-gripper"}]}
+    run_id = (await client.post("/api/runs", json={"task": close}, headers=AUTH)).json()["run"]
+    assert (await _until_end(client, hmi, run_id))["status"] == "succeeded"
+    res = await client.post("/api/runs", json={"task": TASK}, headers=AUTH)
+    assert res.status_code == 409
+    detail = res.json()["detail"]
+    assert "device 'gripper'" in detail and "state 'closed'" in detail and "(the state it reports)" in detail
+    check = (await client.post("/api/task/check", json=TASK, headers=AUTH)).json()
+    assert not check["plausible"] and "(the state it reports)" in check["problems"][0]["text"]
+    repair = (await client.post("/api/task/repair", json=TASK, headers=AUTH)).json()
+    assert [e["text"] for e in repair["repairs"][0]["edits"]] == ["insert open-gripper before step 1 (pick-and-place)"]
 
 
 async def test_a_second_run_waits_for_the_first(client: httpx.AsyncClient) -> None:

@@ -47,6 +47,17 @@ def test_the_valid_task_runs_to_the_end_in_simulation(tmp_path: Path) -> None:
     assert "end: succeeded" in report.stdout
 
 
+def test_a_fault_stops_the_library_robot_with_the_library_s_own_stop_request(tmp_path: Path) -> None:
+    """The library's robot declares its stop with its own concept, below pnp:SafeStop."""
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(MT / "tasks" / "machine-tending.yaml"), "--cell", str(CELL), "--sim",
+                 "--faults", "mt-robot:error-response:MoveTo", "--journal", str(journal))
+    assert result.returncode == 1, result.stdout + result.stderr
+    stops = {r["device"]: r for r in service.report(journal).of_kind("stop")}
+    assert (stops["mt-robot"]["request"], stops["mt-robot"]["answer"]) == ("ProtectiveStop", "accepted")
+    assert pnp("report", str(journal)).stdout.rstrip().endswith("stopped safely")
+
+
 def test_machining_with_the_door_open_is_refused_at_its_step_naming_the_door_state() -> None:
     result = pnp("check", str(MT / "tasks" / "machining-door-open.yaml"), "--cell", str(CELL))
     assert result.returncode == 1

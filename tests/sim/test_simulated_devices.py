@@ -6,7 +6,7 @@ import pytest
 
 from plugnproduce import service
 from plugnproduce.discovery import LiveCell
-from plugnproduce.errors import ProtocolError
+from plugnproduce.errors import ProtocolError, ProtocolTimeout
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.sim.cell import FaultSpecError, SimulatedCell, parse_faults
 from plugnproduce.sim.device import SimulatedDevice
@@ -40,6 +40,35 @@ async def test_gripper_closes_on_request_and_reports_it_over_xirp(network) -> No
             event = await client.next_event(WAIT)
             assert event.name == "gripper_closed"
             assert gripper.state == "closed"
+
+
+async def test_devices_report_their_state_over_xirp_and_upnp(network) -> None:
+    async with SimulatedDevice(device("gripper"), network=network) as gripper, \
+            SimulatedDevice(device("sensor3d"), network=network) as sensor:
+        async with await xirp.XirpClient.connect_endpoint(gripper.endpoint) as client:
+            assert await client.state() == "open"
+            await client.request("Close", {"GripForce": 40.0})
+            await client.next_event(WAIT)
+            assert await client.state() == "closed"
+        client2 = await upnp.UpnpDeviceClient.connect(sensor.endpoint, "127.0.0.1")
+        try:
+            answer = await client2.invoke(upnp.STATE_ACTION, {})
+        finally:
+            await client2.close()
+        assert answer == {upnp.STATE_ARGUMENT: sensor.state}
+
+
+async def test_a_moving_robot_takes_its_safe_stop_and_holds_where_it_is(network) -> None:
+    robot_description = device("robot")
+    assert {(t.source, t.target) for t in robot_description.stops} >= {("moving", "at_pose"), ("home", "home")}
+    async with SimulatedDevice(robot_description, network=network) as robot:
+        async with await xirp.XirpClient.connect_endpoint(robot.endpoint) as client:
+            await client.request("MoveTo", {"TargetPose": [0.4, 0.1, 0.2, 0, 180, 0], "Speed": 50.0})
+            assert await client.state() == "moving"
+            await client.request("Halt")
+            assert await client.state() == "at_pose"
+            with pytest.raises(ProtocolTimeout):  # the motion it was making never reports done
+                await client.next_event(1.0)
 
 
 async def test_a_request_the_chart_does_not_wait_for_is_refused_and_changes_nothing(network) -> None:

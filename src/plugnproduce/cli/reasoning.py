@@ -22,12 +22,24 @@ from plugnproduce.lazy import lazy_module
 if TYPE_CHECKING:
     from plugnproduce import reasoning, service
     from plugnproduce.description import loader
+    from plugnproduce.description.model import Cell
 else:
     loader = lazy_module("plugnproduce.description.loader")
     reasoning = lazy_module("plugnproduce.reasoning")
     service = lazy_module("plugnproduce.service")
 
 CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
+LIVE_OPTION = typer.Option(False, "--live", help="Find the cell's devices on the network and start from the state "
+                                                 "each reports, not from its chart's initial state.")
+
+
+def _cell(cell: Path, live: bool) -> Path | Cell:
+    """The cell file, or with ``live`` the cell with each device in the state it reports."""
+    if not live:
+        return cell
+    import asyncio
+
+    return asyncio.run(service.live_cell(cell, knowledge(cell)))
 
 
 def _bindings(bindings: tuple[dict[str, str], ...]) -> str:
@@ -77,12 +89,12 @@ def _print_problems(result: reasoning.CheckResult) -> None:
 @app.command()
 @boundary
 def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
-          json_out: bool = JSON_OPTION) -> None:
+          live: bool = LIVE_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Check that a task is plausible: each step finds its devices in the states it starts from.
 
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
     """
-    result = service.check(task, cell, knowledge(cell))
+    result = service.check(task, _cell(cell, live), knowledge(cell))
     if json_out:
         emit_json(result.to_json())
     else:
@@ -101,6 +113,7 @@ def repair(
     catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
                                           help="Devices a repair may add (a folder)."),
     top: int = typer.Option(3, "--top", min=1, max=20, metavar="K", help="How many distinct repairs, cheapest first."),
+    live: bool = LIVE_OPTION,
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
@@ -108,8 +121,9 @@ def repair(
     A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
-    result = service.check(task, cell, knowledge(cell))
-    repairs = [] if result.plausible else service.repair(task, cell, catalogue, top, knowledge=knowledge(cell))
+    the_cell = _cell(cell, live)
+    result = service.check(task, the_cell, knowledge(cell))
+    repairs = [] if result.plausible else service.repair(task, the_cell, catalogue, top, knowledge=knowledge(cell))
     players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,

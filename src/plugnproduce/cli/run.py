@@ -36,12 +36,17 @@ def run(
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
     journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
                                         help="Journal file (default: a new file in PNP_RUNS)."),
+    assume_initial: bool = typer.Option(False, "--assume-initial",
+                                        help="Plan from the charts' initial states, not the states the devices "
+                                             "report."),
     json_out: bool = JSON_OPTION,
 ) -> None:
-    """Check and generate the task, find the devices, run it, and journal every command and event.
+    """Find the devices, ask each its state, check and generate the task from there, run it, and journal every
+    command and event.
 
     Exit 0 the task succeeded, 1 it failed or is implausible (with the report), 2 bad input.
-    Ctrl-C or SIGTERM stops the run safely: no further command, and the journal ends with the stop.
+    A fault, Ctrl-C or SIGTERM stops the run safely: no further task command; each device is sent the safe-stop
+    request its state takes, and the journal ends with each device's answer and state, then the end record.
     """
     if cell is None:
         if not sim:
@@ -67,7 +72,8 @@ def run(
         with phases:
             report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
                                                   observer=show, started=started, progress=phases,
-                                                  knowledge=knowledge(cell), bin_parts=bin_parts, bin_seed=bin_seed))
+                                                  knowledge=knowledge(cell), bin_parts=bin_parts, bin_seed=bin_seed,
+                                                  assume_initial=assume_initial))
             phases.close(last_done=True)
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)
@@ -89,8 +95,9 @@ def report(run_id: str | None = typer.Argument(None, metavar="RUN", help="A run 
     """Print a run from its journal: every step, command, event and state, and how it ended (or that it crashed)."""
     record = service.report(run_id)
     if json_out:
-        emit_json({"journal": str(record.path), "status": record.status, "records": record.records})
+        emit_json({"journal": str(record.path), "status": record.status, "safe_stop": record.safe_stop,
+                   "records": record.records})
         return
     for r in record.records:
         typer.echo(describe(r))
-    typer.echo(f"status: {record.status}")
+    typer.echo(f"status: {record.status}" + (f"; {record.safe_stop}" if record.safe_stop else ""))

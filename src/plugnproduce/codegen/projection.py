@@ -17,7 +17,7 @@ from plugnproduce.codegen.task import NEXT, PLAN, STEP, GeneratedTask
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.vocabulary import concept_value
 from plugnproduce.statechart.io.writer import write_chart
-from plugnproduce.statechart.model import Assign, Chart, Data, Final, State, Transition, pnp
+from plugnproduce.statechart.model import Assign, Chart, Data, Final, Send, State, Transition, pnp, walk
 
 END = "end"
 
@@ -62,6 +62,9 @@ def _visit(device: DeviceDescription, sid: str, state_id: str, *, entry: bool) -
     original = _chart_state(device, state_id)
     if entry and original is not None:
         state.onentry = copy.deepcopy(original.onentry[:1])
+        for node in walk(state, into_charts=False):  # a send id is an XML ID: one per visit
+            if isinstance(node, Send) and node.id:
+                node.id = f"{sid}__{node.id}"
     return state
 
 

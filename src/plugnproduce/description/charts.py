@@ -75,7 +75,7 @@ def device_chart(chart: Chart, path: str | Path) -> tuple[str, tuple[ChartState,
             for target in t.targets or [s.id or ""]:
                 sends = tuple(_sends([t])) + tuple(entry.get(target, ()))
                 accepts = tuple(concept_iri(a) for a in t.extra_attrs.get(ACCEPTS, "").split())
-                transitions.append(ChartTransition(s.id or "", target, t.event, sends, accepts, t.line))
+                transitions.append(ChartTransition(s.id or "", target, t.event, sends, accepts, t.line, _concept(t)))
     return initial, chart_states, tuple(transitions)
 
 

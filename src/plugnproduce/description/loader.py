@@ -50,6 +50,9 @@ from plugnproduce.safeio import (
 )
 from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
+SAFE_STOP = str(PNP.SafeStop)
+"""A device state chart's transition annotated with this concept (or one below it) is its safe-stop request."""
+
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")
 _OUTPUT_NAME = re.compile(r"[a-z][a-z0-9_]{0,63}")
@@ -157,7 +160,9 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         raise DescriptionError(f"{local_name(str(s))} names chart {chart_file.name}; expected one of "
                                f"{', '.join(sorted(c.name for c in charts)) or 'none'}",
                                loaded.path, loaded.line(str(s)))
-    initial, states, transitions = device_chart(chart, chart_file)
+    initial, states, every = device_chart(chart, chart_file)
+    stops = tuple(t for t in every if t.concept is not None and taxonomy.is_a(t.concept, SAFE_STOP))
+    transitions = tuple(t for t in every if t not in stops)
     timeout = _opt(loaded, s, PNP.commandTimeout)
     cost = _opt(loaded, s, PNP.cost)
     label = _opt(loaded, s, RDFS.label)
@@ -178,6 +183,7 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         cost=_or(_finite(loaded, s, cost, "cost"), 0.0),
         skills=tuple(sorted(taxonomy.device_skills(classes, declared))),
         chart=chart,
+        stops=stops,
     )
 
 

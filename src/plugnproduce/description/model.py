@@ -73,6 +73,8 @@ class ChartTransition:
     accepts: tuple[str, ...]
     """Quantity concept IRIs a request carries (``pnp:accepts``)."""
     line: int | None
+    concept: str | None = None
+    """The concept the transition is annotated with (``pnp:concept``), e.g. ``pnp:SafeStop``."""
 
     @property
     def request(self) -> Command | None:
@@ -103,6 +105,21 @@ class DeviceDescription:
     """Every skill of the device after reasoning (declared, implied by class, super-skills)."""
     chart: Chart = field(default_factory=Chart, compare=False, repr=False)
     """The parsed Device State Chart (``chart_file`` as read by the one SCXML reader)."""
+    reported_state: bool = False
+    """Whether :attr:`initial` is the state the device reported (a live cell), not its chart's initial state."""
+    stops: tuple[ChartTransition, ...] = ()
+    """The safe-stop transitions (a request annotated ``pnp:SafeStop``): sent only to stop the device,
+    never planned with, so they are not among :attr:`transitions`."""
+
+    def stop_from(self, state_id: str) -> ChartTransition | None:
+        """The safe-stop request the device takes in state ``state_id``, if it takes one there."""
+        return next((t for t in self.stops if t.source == state_id and t.request is not None), None)
+
+    def reported(self, state_id: str) -> DeviceDescription:
+        """The device as it reports itself to be now: in state ``state_id`` (replacing its chart's initial state
+        wherever a plan starts from it)."""
+        self.state(state_id)
+        return dataclasses.replace(self, initial=state_id, reported_state=True)
 
     def state(self, state_id: str) -> ChartState:
         """The chart state called ``state_id``."""
@@ -353,6 +370,12 @@ class Cell:
     def without(self, device_id: str) -> Cell:
         """The same cell with one device unplugged."""
         return Cell(self.name, tuple(d for d in self.devices if d.id != device_id), self.file)
+
+    def reported(self, states: dict[str, str]) -> Cell:
+        """The same cell with each device named in ``states`` in the state it reported
+        (:meth:`DeviceDescription.reported`)."""
+        return Cell(self.name, tuple(d.reported(states[d.id]) if d.id in states else d for d in self.devices),
+                    self.file)
 
     def with_device(self, device: DeviceDescription) -> Cell:
         """The same cell with one more device plugged in (replacing one of the same id)."""

@@ -2,7 +2,8 @@
 
 Every run writes one record per line: ``start`` (task, cell, chart digest, number of
 steps), then ``command`` (sent to a device), ``event`` (from a device or the chart), ``state``
-(a device region entered a state), ``step`` (a step began, with its role bindings), ``fault`` and finally
+(a device region entered a state), ``step`` (a step began, with its role bindings), ``fault``, after a fault
+one ``stop`` per device (the safe-stop request sent, its answer, the state the device reports) and finally
 ``end`` (outcome). A line is flushed and fsynced before the run goes on, so after a
 crash the journal holds everything up to the crash, and a run without ``end`` is
 told apart from a finished one. Nothing is ever rewritten.
@@ -20,7 +21,7 @@ from typing import Any, TextIO
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 
-KINDS = ("start", "step", "command", "event", "value", "state", "fault", "end")
+KINDS = ("start", "step", "command", "event", "value", "state", "fault", "stop", "end")
 
 
 class JournalInUse(PlugNProduceError):
@@ -90,6 +91,20 @@ class RunRecord:
             return "crashed"
         return str(self.end.get("outcome", "failed"))
 
+    @property
+    def safe_stop(self) -> str | None:
+        """How the devices were left after a fault or a stop: ``stopped safely`` when every device that takes a
+        safe-stop request accepted it, else which did not (or could not be asked); that no safe stop is known
+        when the journal has no end record (a crash); None after a run that needed none."""
+        if self.end is None:
+            return "no end record: no safe stop is known to have been sent"
+        stops = list(self.of_kind("stop"))
+        if not stops:
+            return None
+        failed = [f"{r.get('device')} ({r.get('request') or 'state'}: {r.get('answer')})" for r in stops
+                  if r.get("answer") not in (None, "accepted")]
+        return "stopped safely" if not failed else f"safe stop incomplete: {', '.join(failed)}"
+
     def of_kind(self, kind: str) -> Iterator[dict[str, Any]]:
         """The records of one kind, in order."""
         return (r for r in self.records if r["kind"] == kind)
@@ -141,4 +156,10 @@ def describe(record: dict[str, Any]) -> str:
                 f" = {record.get('used')}")
     if kind == "fault":
         return f"FAULT {record.get('fault')}: {record.get('message')}"
+    if kind == "stop":
+        if record.get("request") is None:
+            why = f" ({record['answer']})" if record.get("answer") else " (takes no stop request there)"
+            return f"stop {record.get('device')}: left in state {record.get('state')}{why}"
+        return (f"stop {record.get('device')}: {record.get('request')} {record.get('answer')}; "
+                f"now in state {record.get('state')}")
     return f"end: {record.get('outcome')}" + (f" ({record.get('reason')})" if record.get("reason") else "")

@@ -30,6 +30,10 @@ class DeviceLink(Protocol):
         """Send a request and wait for the device to accept it (ProtocolError if it does not)."""
         ...
 
+    async def state(self, timeout: float) -> str:
+        """The device's current state as it reports it: the id of its device state chart's state."""
+        ...
+
     async def close(self) -> None:
         """End the connection politely."""
         ...
@@ -60,6 +64,9 @@ class XirpLink:
 
     async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:
         await self._client.request(name, dict(params), timeout=timeout)
+
+    async def state(self, timeout: float) -> str:
+        return await self._client.state(timeout=timeout)
 
     async def close(self) -> None:
         self._watch.cancel()
@@ -92,6 +99,13 @@ class UpnpLink:
     async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:
         await self._client.invoke(name, {k: _lexical(v) for k, v in params.items()}, timeout=timeout)
 
+    async def state(self, timeout: float) -> str:
+        results = await self._client.invoke(upnp.STATE_ACTION, {}, timeout=timeout)
+        value = results.get(upnp.STATE_ARGUMENT)
+        if not isinstance(value, str) or not value:
+            raise ProtocolError(f"device {self.device}: {upnp.STATE_ACTION} answered no {upnp.STATE_ARGUMENT}")
+        return value
+
     async def close(self) -> None:
         await self._client.close()
 
@@ -101,6 +115,15 @@ def _lexical(value: Any) -> str:
     if isinstance(value, list | tuple):
         return " ".join(str(v) for v in value)
     return str(value)
+
+
+async def query_state(device: DeviceDescription, timeout: float) -> str:
+    """Connect to a device, ask its current state (the id of its device state chart's state), disconnect."""
+    link = await open_link(device, lambda *_: None, lambda *_: None, lambda *_: None)
+    try:
+        return await link.state(timeout)
+    finally:
+        await link.close()
 
 
 async def open_link(device: DeviceDescription, on_event: EventCallback, on_lost: ProblemCallback,

@@ -10,15 +10,24 @@ A fault stops the run: a device that does not answer or does not report in time
 sends a malformed or duplicated message, or sends an event the task does not wait
 for. The chart is then sent ``error.fault`` and leaves every state for ``failed``;
 no further command goes out, and the report names the step, device, the state the
-controller last saw it in, and the message.
+controller last saw it in, and the message. A command's answer is a fault of the step
+that sent it, with the state its device was in then: a response that never comes is
+found even when the chart has already reached its end (the run waits for every
+answer, each bounded by its device's command timeout).
+
+A run that ends by a fault or a stop (the operator's, SIGINT, SIGTERM) stops the
+devices safely: each device is asked its state, sent the safe-stop request its chart
+takes there (a transition annotated ``pnp:SafeStop``), and asked its state again;
+each answer is journalled (``stop`` records) before the ``end`` record.
 """
 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import hashlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +49,9 @@ RecordObserver = Callable[[dict[str, Any]], None]
 
 FAULT_EVENT = "error.fault"
 
+STOP_TIMEOUT = 5.0
+"""The longest wait, in seconds, for each answer of the safe stop (a device's command timeout if shorter)."""
+
 _COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("command", "device", "deviceState"))
 
 
@@ -57,17 +69,20 @@ class Fault:
     command: str | None = None
     device: str | None = None
     state: str | None = None
-    """The device's chart state as the controller last saw it."""
+    """The device's chart state as the controller last saw it (for a request: when it was sent)."""
+    request: str | None = None
+    """The device request the fault concerns, if any."""
 
     def __str__(self) -> str:
         where = f"step {self.step} ({self.command})" if self.step is not None else "before the first step"
         device = f", device {self.device} in state {self.state}" if self.device else ""
-        return f"{self.kind} at {where}{device}: {self.message}"
+        request = f", request {self.request}" if self.request else ""
+        return f"{self.kind} at {where}{device}{request}: {self.message}"
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict."""
         return {"fault": self.kind, "message": self.message, "step": self.step, "command": self.command,
-                "device": self.device, "state": self.state}
+                "device": self.device, "state": self.state, "request": self.request}
 
 
 @dataclass
@@ -134,6 +149,7 @@ class TaskRun:
         self._links: dict[str, DeviceLink] = {}
         self._commands: set[asyncio.Task[None]] = set()
         self.fault: Fault | None = None
+        self._faulted = asyncio.Event()
         self.step: int | None = None
         self.command: str | None = None
         self.device_states: dict[str, str] = {}
@@ -149,9 +165,13 @@ class TaskRun:
                 await self._connect()
                 if self.fault is None:
                     await self._loop.run()
+                if self.fault is None:  # the chart is done; the commands not yet answered still may fail it
+                    await self._answers()
             except ExecutionError as exc:  # the task chart itself broke down: a fault like any other
                 self._fail(Fault("chart", str(exc), self.step, self.command))
             finally:
+                if self.fault is not None or self.interpreter.final_state != DONE:
+                    await self._safe_stop()
                 for task in self._commands:
                     task.cancel()
                 await asyncio.gather(*self._commands, return_exceptions=True)
@@ -196,20 +216,62 @@ class TaskRun:
         self._record("command", step=self.step, device=target, command=command.name, params=params)
         for value in values.used(self.generated, self.step, target, params, self.interpreter.dm):
             self._record("value", **value)
-        task = asyncio.get_running_loop().create_task(self._request(target, command.name, params))
+        # Whatever becomes of the command is told of the step that sent it and the state its device was in then.
+        sent = Fault("", "", self.step, self.command, target, self.device_states.get(target), command.name)
+        task = asyncio.get_running_loop().create_task(self._request(sent, params))
         self._commands.add(task)
         task.add_done_callback(self._commands.discard)
 
-    async def _request(self, device: str, name: str, params: Mapping[str, Any]) -> None:
+    async def _request(self, sent: Fault, params: Mapping[str, Any]) -> None:
+        device, name = sent.device or "", sent.request or ""
         timeout = self.cell.device(device).command_timeout
         try:
             await self._links[device].request(name, params, timeout)
         except ProtocolTimeout:
-            self._fail(self._fault("timeout", device, f"command {name}: no answer within {timeout:g} s"))
+            self._fail(replace(sent, kind="timeout", message=f"command {name}: no answer within {timeout:g} s"))
         except ProtocolConnectionError as exc:
-            self._fail(self._fault("lost", device, f"command {name}: {exc}"))
+            self._fail(replace(sent, kind="lost", message=f"command {name}: {exc}"))
         except PlugNProduceError as exc:
-            self._fail(self._fault("refused", device, f"command {name}: {exc}"))
+            self._fail(replace(sent, kind="refused", message=f"command {name}: {exc}"))
+
+    async def _answers(self) -> None:
+        """Wait until every command sent is answered (each bounded by its timeout) or a fault comes first."""
+        answered: asyncio.Future[Any] = asyncio.ensure_future(asyncio.gather(*self._commands,
+                                                                            return_exceptions=True))
+        faulted: asyncio.Future[Any] = asyncio.ensure_future(self._faulted.wait())
+        await asyncio.wait({answered, faulted}, return_when=asyncio.FIRST_COMPLETED)
+        faulted.cancel()
+        answered.cancel()
+
+    async def _safe_stop(self) -> None:
+        """Stop every connected device safely, at once, each answer bounded in time."""
+        await asyncio.gather(*(self._stop_device(d) for d in self._links))
+
+    async def _stop_device(self, device_id: str) -> None:
+        device, link = self.cell.device(device_id), self._links[device_id]
+        timeout = min(device.command_timeout, STOP_TIMEOUT)
+        seen = self.device_states.get(device_id, device.initial)
+        try:
+            state = await link.state(timeout)
+        except PlugNProduceError as exc:
+            self._record("stop", device=device_id, state=seen, request=None, answer=f"no state reported: {exc}")
+            return
+        stop = device.stop_from(state)
+        if stop is None or stop.request is None:
+            self._record("stop", device=device_id, state=state, request=None, answer=None)
+        else:
+            request = stop.request.name
+            try:
+                await link.request(request, {}, timeout)
+                answer = "accepted"
+            except ProtocolTimeout:
+                answer = f"no answer within {timeout:g} s"
+            except PlugNProduceError as exc:
+                answer = f"refused: {exc}"
+            with contextlib.suppress(PlugNProduceError):
+                state = await link.state(timeout)
+            self._record("stop", device=device_id, state=state, request=request, answer=answer)
+        self.device_states[device_id] = state
 
     def _on_event(self, device: str, name: str, params: Mapping[str, Any]) -> None:
         if self.fault is not None:
@@ -266,6 +328,7 @@ class TaskRun:
         first = self.fault is None
         if first:
             self.fault = fault
+            self._faulted.set()
         self._record("fault", **fault.to_json(), first=first)
         if first and self.interpreter.running:
             self._loop.queue(FAULT_EVENT)

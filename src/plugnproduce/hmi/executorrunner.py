@@ -1,10 +1,10 @@
 """The executor as the HMI's :class:`~plugnproduce.hmi.interfaces.Runner`.
 
-A run takes the service's one path (:func:`plugnproduce.service.plan_run` checks the task for
-the cell as it is now and generates only its task chart; :func:`plugnproduce.service.start_run`
-runs it against the cell's devices at the endpoints discovery found), journalling into the
-runs folder. A device
-the cell source sees leave during the run is a lost device: the run stops with a fault.
+A run takes the service's one path: :func:`plugnproduce.service.plan_run` checks the task for
+the cell as it is now, each device in the state it reports, and generates only its task chart;
+:func:`plugnproduce.service.start_run` runs it against the cell's devices at the endpoints
+discovery found, journalling into the runs folder. A device the cell source sees leave during
+the run is a lost device: the run stops with a fault.
 One run at a time.
 """
 
@@ -60,8 +60,11 @@ class ExecutorRunner:
         active = self.active()
         if active is not None:
             raise RunRefused(f"run {active} is still running; stop it first")
-        try:
-            generated = await asyncio.to_thread(service.plan_run, task, cell, self._knowledge)
+        try:  # planned from the state each device reports, not its chart's initial state
+            reported = cell.reported(await service.reported_states(cell))
+            generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)
+        except service.StateNotReported as exc:
+            raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
         except service.ImplausibleTask as exc:
             first = exc.result.problems[0]
             raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc

@@ -35,6 +35,8 @@ class Hub:
         self.runner = runner
         self.catalogue = catalogue
         self._states = {d.id: d.initial for d in source.cell.devices}
+        self._reported: set[str] = set()
+        """Devices whose state came from a run (its journal), not from their chart's initial state."""
         self._subscribers: set[asyncio.Queue[str | None]] = set()
         self._loop: asyncio.AbstractEventLoop | None = None
         self._unsubscribe: Callable[[], None] | None = None
@@ -66,6 +68,14 @@ class Hub:
         """The cell as it is now."""
         return self.source.cell
 
+    @property
+    def planning_cell(self) -> Cell:
+        """The cell to check, repair, explain and generate in: each device that took part in a run in the state
+        the run left it in (as its journal reports), the others in their chart's initial state."""
+        with self._lock:
+            reported = {d: x for d, x in self._states.items() if d in self._reported}
+        return self.cell.reported(reported)
+
     def states(self) -> dict[str, str]:
         """Each device's current chart state."""
         with self._lock:
@@ -90,8 +100,10 @@ class Hub:
         with self._lock:
             if update.kind == "plug":
                 self._states[update.device] = update.cell.device(update.device).initial
+                self._reported.discard(update.device)
             elif update.kind == "unplug":
                 self._states.pop(update.device, None)
+                self._reported.discard(update.device)
             elif update.kind == "state" and update.state is not None:
                 self._states[update.device] = update.state
         if update.kind == "state":
@@ -114,11 +126,12 @@ class Hub:
 
     def on_run_record(self, run_id: str, record: JournalRecord) -> None:
         """Take in one journal record of a run: device states follow it, and every page hears of it."""
-        if record.get("kind") == "state" and record.get("device"):
+        if record.get("kind") in ("state", "stop") and record.get("device"):  # a stop record: the state reported
             device = str(record["device"])
             with self._lock:
                 if device in self._states:
                     self._states[device] = str(record.get("state"))
+                    self._reported.add(device)
             self.publish("device-state", self._state_event(self.cell, device))
         self.publish("run", {"run": run_id, "record": record, "text": describe(record)})
 

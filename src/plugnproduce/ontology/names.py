@@ -11,6 +11,7 @@ KIND_WORDS = {
     "Device": "device class",
     "Skill": "skill",
     "StateConcept": "state concept",
+    "RequestConcept": "request concept",
     "Quantity": "quantity",
 }
 

@@ -19,6 +19,7 @@ class PNP(DefinedNamespace):
     Device: URIRef
     Skill: URIRef
     StateConcept: URIRef
+    SafeStop: URIRef
     Process: URIRef
     Role: URIRef
     Parameter: URIRef

@@ -96,11 +96,14 @@ def unreachable(ctx: Context, a: s.Unreachable) -> Reason:
 # ------------------------------------------------------------------ why a step is not plausible
 
 
-def since(ctx: Context, j: int | None) -> str:
-    """Where a device's state came from: a step, or power-up."""
+def since(ctx: Context, j: int | None, d: str) -> str:
+    """Where a device's state came from: a step, the device's own report (a live cell), or power-up."""
     if j is None:
         return ""
-    return " (its initial state)" if j == 0 else f", left there by step {j} ({ctx.step_command(j)})"
+    if j == 0:
+        device = ctx.devices.get(d)
+        return " (the state it reports)" if device is not None and device.reported_state else " (its initial state)"
+    return f", left there by step {j} ({ctx.step_command(j)})"
 
 
 def wrong_state(ctx: Context, a: s.WrongState, left_by: int | None) -> Problem:
@@ -108,7 +111,7 @@ def wrong_state(ctx: Context, a: s.WrongState, left_by: int | None) -> Problem:
     concept = ctx.state_concept(a.d, a.x)
     now = f"{ctx.term(concept)}" if concept else "no concept"
     text = (f"step {a.i} ({ctx.step_command(a.i)}): device '{a.d}' (role '{a.r}') is in state "
-            f"'{a.x}' [{now}]{since(ctx, left_by)}; the step needs it {ctx.term(a.need)}")
+            f"'{a.x}' [{now}]{since(ctx, left_by, a.d)}; the step needs it {ctx.term(a.need)}")
     p = ctx.step_command(a.i)
     rests = (ctx.state_where(a.d, a.x), ctx.region_where(p, a.r, 1)) if p in ctx.processes else ()
     reason = Reason("wrong_state", text, tuple(x for x in (concept, a.need) if x), rests)
@@ -192,6 +195,6 @@ def device_state(ctx: Context, i: int, r: str, d: str, x: str, left_by: int | No
     need = ctx.processes[p].role(r).start_concept if p in ctx.processes else None
     ok = need is not None and concept is not None and ctx.taxonomy.is_a(concept, need)
     needs = f"; role '{r}' needs it {ctx.term(need)}: {'satisfied' if ok else 'not satisfied'}" if need else ""
-    text = f"device '{d}' is in state '{x}' [{now}]{since(ctx, left_by)}{needs}"
+    text = f"device '{d}' is in state '{x}' [{now}]{since(ctx, left_by, d)}{needs}"
     rests = (ctx.state_where(d, x),) + ((ctx.region_where(p, r, 1),) if need else ())
     return Reason("device_state", text, tuple(c for c in (concept, need) if c), rests)

@@ -59,7 +59,7 @@ def requests_and_events(device: DeviceDescription) -> tuple[dict[str, list[str]]
     """The requests the chart waits for (with the quantities they carry) and the events it sends."""
     requests: dict[str, list[str]] = {}
     events: list[str] = []
-    for t in device.transitions:
+    for t in (*device.transitions, *device.stops):
         if t.request is not None:
             names = requests.setdefault(t.request.name, [])
             names.extend(local_name(q) for q in t.accepts if local_name(q) not in names)
@@ -127,7 +127,8 @@ class SimulatedDevice:
             spec = upnp.service_spec_from_chart_events({}, [])
             files = self._xirp.files = self._files(self._xirp.endpoint)
         else:
-            spec = upnp.service_spec_from_chart_events(requests, events, payloads=event_payloads(d))
+            spec = upnp.with_state_query(upnp.service_spec_from_chart_events(requests, events,
+                                                                              payloads=event_payloads(d)))
             files = self._files(d.endpoint)
         self._upnp = upnp.UpnpDeviceServer(d.id, d.label, upnp.device_type_for(device_class), spec,
                                            self._on_upnp_action, files=files, network=self.network)
@@ -163,20 +164,26 @@ class SimulatedDevice:
     def _accept(self, request: str, params: Mapping[str, Any]) -> None:
         """Feed a request to the chart, or refuse it if the current state does not wait for it."""
         event = Command(self.description.protocol, "request", request).event
-        waits = {t.event for t in self.description.transitions if t.source == self.state}
+        d = self.description
+        waits = {t.event for t in (*d.transitions, *d.stops) if t.source == self.state}
         if event not in waits:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
         if self.bin is not None:
             self.bin.on_request(self.description, params, self.interpreter.dm)
         self._loop.queue(event, dict(params))
 
-    def _on_xirp_request(self, request: xirp.Request) -> None:
+    def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
+        if request.name == xirp.STATE:
+            return {xirp.STATE_RESULT: self.state}
         try:
             self._accept(request.name, request.params)
         except LookupError as exc:
             raise xirp.RequestFailed(str(exc), xirp.NOT_ACCEPTED) from None
+        return None
 
     async def _on_upnp_action(self, action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
+        if action == upnp.STATE_ACTION:
+            return {upnp.STATE_ARGUMENT: self.state}
         try:
             self._accept(action, arguments)
         except LookupError as exc:

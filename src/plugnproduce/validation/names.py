@@ -1,8 +1,9 @@
 """Names are checked, never dropped: every ontology term a description uses must be known.
 
-A chart's ``pnp:concept`` must name a state concept and its ``pnp:accepts`` quantities;
-a Turtle description's classes, skills and quantities must be terms of the loaded
-ontology. Each unknown name is a finding at its line with the nearest known names.
+A chart's ``pnp:concept`` must name a state concept (on a transition: a request
+concept, e.g. ``pnp:SafeStop``) and its ``pnp:accepts`` quantities; a Turtle
+description's classes, skills and quantities must be terms of the loaded ontology.
+Each unknown name is a finding at its line with the nearest known names.
 """
 
 from __future__ import annotations
@@ -18,11 +19,13 @@ from plugnproduce.ontology.names import unknown_class, unknown_term
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, concept_iri, local_name
 from plugnproduce.safeio import parse_xml
+from plugnproduce.statechart import SCXML_NS
 from plugnproduce.validation.findings import Problem
 
 CONCEPT = "{" + PNP_IRI + "}concept"
 ACCEPTS = "{" + PNP_IRI + "}accepts"
 ROLE = "{" + PNP_IRI + "}role"
+TRANSITION = "{" + SCXML_NS + "}transition"
 
 TERM_PROPERTIES = {PNP.hasSkill: "Skill", PNP.requiresSkill: "Skill", PNP.quantity: "Quantity",
                    PNP.mandatoryState: "StateConcept"}
@@ -40,7 +43,8 @@ def chart_name_problems(path: Path, taxonomy: Taxonomy) -> Iterator[Problem]:
             continue
         concept = el.get(CONCEPT)
         if concept and not process_chart:  # a process chart's concepts: see structure.process_problems
-            message = unknown_term(concept_iri(concept), "StateConcept", taxonomy)
+            kind = "RequestConcept" if el.tag == TRANSITION else "StateConcept"
+            message = unknown_term(concept_iri(concept), kind, taxonomy)
             if message:
                 yield Problem(str(path), el.sourceline or 0, f"pnp:concept: {message}")
         for name in (el.get(ACCEPTS) or "").split():

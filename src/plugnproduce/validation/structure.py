@@ -24,7 +24,7 @@ def device_problems(device: DeviceDescription) -> Iterator[Problem]:
     ids = {s.id for s in device.states}
     if device.initial not in ids:
         yield Problem(file, 1, f"initial state {device.initial!r} is not a state of the chart")
-    for t in device.transitions:
+    for t in (*device.transitions, *device.stops):
         commands = [c for c in (Command.parse(t.event) if t.event else None, *t.sends) if c is not None]
         for c in commands:
             if c.protocol != device.protocol:

@@ -42,7 +42,7 @@ def validate(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 @router.post("/check", summary="Is the task plausible in the cell as it is now?")
 def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.check``: per step its bindings and device states, and every problem at its step."""
-    result = service.check(task.to_task(), hub.cell, hub.knowledge).to_json()
+    result = service.check(task.to_task(), hub.planning_cell, hub.knowledge).to_json()
     problems = result["problems"]
     if not isinstance(problems, list):
         raise TypeError(f"a check result's problems are a list; found {type(problems).__name__}")
@@ -53,7 +53,7 @@ def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 @router.post("/repair", summary="Ranked minimal repairs of an implausible task")
 def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.repair`` with the catalogue: each repair's edits, cost and resulting task (ready to apply)."""
-    model, cell = task.to_task(), hub.cell
+    model, cell = task.to_task(), hub.planning_cell
     result = service.check(model, cell, hub.knowledge)
     repairs = [] if result.plausible else service.repair(model, cell, hub.catalogue, top, knowledge=hub.knowledge)
     return {
@@ -67,7 +67,7 @@ def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hu
 def explain(task: TaskIn, step: int = Query(..., ge=1, description="The step, from 1 in the repeated order"),
             hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """``service.explain_step``: each device's state before the step, where it came from, what the step needs."""
-    return service.explain_step(task.to_task(), hub.cell, step, hub.knowledge).to_json()
+    return service.explain_step(task.to_task(), hub.planning_cell, step, hub.knowledge).to_json()
 
 
 @router.post("/generate", summary="Generate the SCXML charts of a plausible task")
@@ -76,7 +76,7 @@ def generate(task: TaskIn, request: Request, hub: Hub = Depends(hub_of)) -> dict
 
     ``service.generation``: an implausible task is a result (its problems, no charts), not an error.
     """
-    result = service.generation(task.to_task(), hub.cell, knowledge=hub.knowledge)
+    result = service.generation(task.to_task(), hub.planning_cell, knowledge=hub.knowledge)
     out: dict[str, Any] = {"plausible": result.check.plausible,
                            "problems": _rows([p.to_json() for p in result.check.problems], task),
                            "generation": None, "charts": []}

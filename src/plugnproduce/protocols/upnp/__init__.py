@@ -37,6 +37,8 @@ from plugnproduce.protocols.upnp.spec import (
     EVENT_PREFIX,
     REQUEST_PREFIX,
     SERVICE_TYPE,
+    STATE_ACTION,
+    STATE_ARGUMENT,
     ActionSpec,
     ArgumentSpec,
     RemoteFiles,
@@ -48,6 +50,7 @@ from plugnproduce.protocols.upnp.spec import (
     payload_variable,
     service_spec_from_chart_events,
     udn_for,
+    with_state_query,
 )
 
 __all__ = [
@@ -56,6 +59,8 @@ __all__ = [
     "NOT_ACCEPTED_NOW",
     "REQUEST_PREFIX",
     "SERVICE_TYPE",
+    "STATE_ACTION",
+    "STATE_ARGUMENT",
     "ActionFailed",
     "ActionHandler",
     "ActionSpec",
@@ -86,4 +91,5 @@ __all__ = [
     "private_network",
     "service_spec_from_chart_events",
     "udn_for",
+    "with_state_query",
 ]

@@ -42,6 +42,12 @@ EVENT_PREFIX = "upnp.event."
 RESULT_ARGUMENT = "Result"
 """Name of the one out-argument a chart-derived action returns."""
 
+STATE_ACTION = "GetDeviceState"
+"""The action that answers the device's current state (its device state chart's state id) in ``State``."""
+
+STATE_ARGUMENT = "State"
+"""The out-argument of :data:`STATE_ACTION`."""
+
 ARG_TYPE_PREFIX = "A_ARG_TYPE_"
 """Prefix of the (non-evented) state variables that type action arguments (UPnP convention)."""
 
@@ -228,6 +234,14 @@ def service_spec_from_chart_events(
     variables += tuple(VariableSpec(payload_variable(event, name), "string", default="null")
                        for event, names in sorted((payloads or {}).items()) for name in _unique(names))
     return ServiceSpec(actions, variables)
+
+
+def with_state_query(spec: ServiceSpec) -> ServiceSpec:
+    """The service with the state query :data:`STATE_ACTION` added (a chart request of that name is refused)."""
+    if any(a.name == STATE_ACTION for a in spec.actions):
+        raise DescriptionError(f"action {STATE_ACTION!r} is the state query; a device chart cannot wait for it")
+    query = ActionSpec(STATE_ACTION, outputs=(ArgumentSpec(STATE_ARGUMENT),))
+    return ServiceSpec((*spec.actions, query), spec.variables)
 
 
 def _unique(items: Sequence[str]) -> list[str]:

@@ -12,7 +12,7 @@ See ``docs/xirp.md``.
 from __future__ import annotations
 
 from plugnproduce.protocols.files import DeviceFiles
-from plugnproduce.protocols.xirp.answer import RequestFailed, RequestHandler
+from plugnproduce.protocols.xirp.answer import RequestFailed, RequestHandler, Results
 from plugnproduce.protocols.xirp.client import RemoteFailure, XirpClient
 from plugnproduce.protocols.xirp.codec import MAX_FRAME, encode, encode_frame, frame
 from plugnproduce.protocols.xirp.decoding import decode, schema
@@ -25,6 +25,8 @@ from plugnproduce.protocols.xirp.messages import (
     MALFORMED,
     NAMESPACE,
     NOT_ACCEPTED,
+    STATE,
+    STATE_RESULT,
     TOO_LARGE,
     UNEXPECTED,
     UNKNOWN_REQUEST,
@@ -56,6 +58,8 @@ __all__ = [
     "MAX_FRAME",
     "NAMESPACE",
     "NOT_ACCEPTED",
+    "STATE",
+    "STATE_RESULT",
     "TOO_LARGE",
     "UNEXPECTED",
     "UNKNOWN_REQUEST",
@@ -81,6 +85,7 @@ __all__ = [
     "Request",
     "RequestFailed",
     "RequestHandler",
+    "Results",
     "Response",
     "Value",
     "XirpClient",

@@ -25,6 +25,8 @@ from plugnproduce.protocols.xirp.decoding import decode
 from plugnproduce.protocols.xirp.inbox import EventCallback, EventInbox, LinkStats
 from plugnproduce.protocols.xirp.messages import (
     DESCRIBE,
+    STATE,
+    STATE_RESULT,
     TOO_LARGE,
     UNEXPECTED,
     VERSION,
@@ -207,6 +209,15 @@ class XirpClient:
             code, text = response.failure.code, response.failure.text
             raise RemoteFailure(f"{DESCRIBE} of {self._what} failed: {code}: {text}", code, text, DESCRIBE)
         return files_from_documents(response.documents, f"{DESCRIBE} of {self._what}")
+
+    async def state(self, *, timeout: float | None = None) -> str:
+        """The device's current state: the id of its device state chart's state (the ``state`` request)."""
+        results = await self.request(STATE, timeout=timeout)
+        value = results.get(STATE_RESULT)
+        if not isinstance(value, str) or not value:
+            raise ProtocolError(f"{STATE} of {self._what}: expected a string result {STATE_RESULT}; got "
+                                f"{sorted(results) or 'none'}")
+        return value
 
     async def _exchange(self, name: str, params: Params, timeout: float | None) -> Response:
         if self._lost is not None or self._closing:

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from plugnproduce.protocols.xirp.messages import CODE_PATTERN, FAILED, INVALID_VALUE, MessageError
+from plugnproduce.protocols.xirp.messages import CODE_PATTERN, FAILED, INVALID_VALUE, STATE, MessageError
 
 
 class FaultKind(StrEnum):
@@ -53,7 +53,8 @@ MALFORMED_PAYLOAD = b'<response xmlns="urn:plugnproduce-org:xirp:1" id="'
 
 @dataclass
 class Fault:
-    """One rule: do ``kind`` to the request or event called ``name`` (``None``: any), ``times`` times."""
+    """One rule: do ``kind`` to the request or event called ``name`` (``None``: any but the state query
+    ``state``, which a rule hits only by its name), ``times`` times."""
 
     kind: FaultKind
     name: str | None = None
@@ -81,7 +82,8 @@ class Fault:
 
     def matches(self, kinds: frozenset[FaultKind], name: str) -> bool:
         """Whether the rule applies to a message of one of ``kinds`` called ``name``."""
-        return self.kind in kinds and (self.name is None or self.name == name) and self.times != 0
+        named = self.name == name if self.name is not None else name != STATE
+        return self.kind in kinds and named and self.times != 0
 
 
 @dataclass

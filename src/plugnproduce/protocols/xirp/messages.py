@@ -29,6 +29,13 @@ VERSION = 1
 DESCRIBE = "describe"
 """The request every device answers with its Turtle description and SCXML chart."""
 
+STATE = "state"
+"""The request a device answers with its current state: the id of its device state chart's state, as the
+string result :data:`STATE_RESULT`."""
+
+STATE_RESULT = "State"
+"""The result of a :data:`STATE` response."""
+
 TURTLE = "text/turtle"
 """Media type of the Turtle description in a ``describe`` response."""
 
