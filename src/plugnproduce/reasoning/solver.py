@@ -24,6 +24,7 @@ PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
     "batch": (("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_batch.lp"),
     "cheapest": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_cheapest.lp"),
     "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
+    "derivation": (("roles.lp", "offered.lp", "explain.lp"), "show_derivation.lp"),
 }
 """The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
 
