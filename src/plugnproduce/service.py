@@ -218,6 +218,44 @@ def explain_step(task_or_path: TaskArg, cell_or_path: CellArg, n: int,
     return reasoning.explain_step(_as_task(task_or_path), the_cell, n, k.taxonomy, k.processes)
 
 
+def explain_offered(cell_or_path: CellArg, command: str, knowledge: Knowledge | None = None,
+                    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+                    language: str = "en") -> reasoning.Explanation:
+    """Why a process command is (not) offered: the derivation tree (rules, ontology axioms, chart states) and
+    the counterfactuals the reasoner confirms (devices of the catalogue to add or swap in; for a "yes", the
+    devices it rests on)."""
+    the_cell, k = _context(cell_or_path, knowledge)
+    ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
+    return reasoning.explain_offered(command, the_cell, k.taxonomy, ontology, k.processes,
+                                     _devices(catalogue_or_folder, k), language)
+
+
+def explain_plausible(task_or_path: TaskArg, cell_or_path: CellArg, n: int, knowledge: Knowledge | None = None,
+                      language: str = "en") -> reasoning.Explanation:
+    """Why step ``n`` (1-based) of a task is (not) plausible: the derivation tree and, for a "no", the states its
+    devices would have to be in (each confirmed by the reasoner)."""
+    the_cell, k = _context(cell_or_path, knowledge)
+    ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
+    return reasoning.explain_plausible(_as_task(task_or_path), n, the_cell, k.taxonomy, ontology, k.processes,
+                                       language)
+
+
+def assessed_repairs(
+    task_or_path: TaskArg,
+    cell_or_path: CellArg,
+    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+    top: int = 3,
+    knowledge: Knowledge | None = None,
+) -> list[reasoning.AssessedRepair]:
+    """The repairs of :func:`repair`, each confirmed by checking it again and with its side effects; those that
+    lose a held part or move a device a later step relies on rank below those that do not."""
+    the_cell, k = _context(cell_or_path, knowledge)
+    the_task = _as_task(task_or_path)
+    devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
+    repairs = reasoning.repair(the_task, the_cell, k.taxonomy, k.processes, catalogue=devices, top=top)
+    return reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
+
+
 def batch(
     configurations: list[reasoning.Configuration] | str | Path,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,

@@ -8,11 +8,14 @@ Infeasible and implausible are results, never exceptions.
 
 from __future__ import annotations
 
+from plugnproduce.reasoning.axioms import ontology_of
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
 from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
 from plugnproduce.reasoning.offers import capabilities, explain_process
 from plugnproduce.reasoning.plausibility import check, explain_step
 from plugnproduce.reasoning.repairs import repair
+from plugnproduce.reasoning.counterfactuals import Counterfactual
+from plugnproduce.reasoning.derivation import Node
 from plugnproduce.reasoning.results import (
     Capabilities,
     CheckResult,
@@ -27,8 +30,19 @@ from plugnproduce.reasoning.results import (
     StepCheck,
     StepExplanation,
 )
+from plugnproduce.reasoning.sideeffects import AssessedRepair, SideEffect, assess
+from plugnproduce.reasoning.why import Explanation, explain_offered, explain_plausible
 
 __all__ = [
+    "AssessedRepair",
+    "Counterfactual",
+    "Explanation",
+    "Node",
+    "SideEffect",
+    "assess",
+    "explain_offered",
+    "explain_plausible",
+    "ontology_of",
     "BATCH_CSV_HEADER",
     "BatchRow",
     "Capabilities",

@@ -178,3 +178,14 @@ def load_ontology(files: Iterable[Path], taxonomy: Taxonomy) -> Ontology:
         graph += g
     return Ontology(sorted(axioms, key=lambda a: (a.where.file, a.where.line or 0)),
                     Labels.from_graph(graph, taxonomy.labels))
+
+
+_LOADED: dict[tuple[tuple[str, ...], str], Ontology] = {}
+
+
+def ontology_of(files: Iterable[Path], taxonomy: Taxonomy) -> Ontology:
+    """:func:`load_ontology`, read once per set of files and closure (the TBox does not change while it runs)."""
+    key = (tuple(str(f) for f in files), taxonomy.digest)
+    if key not in _LOADED:
+        _LOADED[key] = load_ontology([Path(f) for f in key[0]], taxonomy)
+    return _LOADED[key]

@@ -3,18 +3,23 @@ rule instances of ``rules/*.lp`` (ASP), the ontology axioms (OWL) and the chart 
 
 from __future__ import annotations
 
+import re
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Where
+from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task, Where
 from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.reasoning import counterfactuals, solver
 from plugnproduce.reasoning import schema as s
-from plugnproduce.reasoning import solver
 from plugnproduce.reasoning.axioms import Axiom, Ontology
+from plugnproduce.reasoning.counterfactuals import Counterfactual
 from plugnproduce.reasoning.derivation import Node, asp
 from plugnproduce.reasoning.facts import fact_book
 from plugnproduce.reasoning.offers import CELL, cell_program
+from plugnproduce.reasoning.plausibility import TASK, check
+from plugnproduce.reasoning.results import CheckResult
 from plugnproduce.reasoning.schema.derivations import Skilled, Walk
 from plugnproduce.reasoning.terms import Model
 
@@ -231,3 +236,137 @@ def not_offered_tree(w: Words, model: Model, p: str) -> Node:
                                  f"{w.devices[c.d].chart_file} state {c.x}", w.state_where(c.d, c.x)))))
     return Node("answer", f"{proc.label} is not offered in cell '{w.cell}': some role cannot be filled",
                 f"not offered({CELL},{p})", proc.where, children=tuple(reasons))
+
+
+_CURIE = re.compile(r" \((?:[A-Za-z][\w-]*:[\w-]+|https?://[^)\s]+)\)")
+
+
+def plain(text: str) -> str:
+    """A reason's sentence without the ``(prefix:Term)`` the engineer's view adds to each label."""
+    return _CURIE.sub("", text)
+
+
+def _left_by(result: CheckResult, n: int, d: str) -> int:
+    return max((j for j in range(1, n) if d in result.steps[j - 1].bindings.values()), default=0)
+
+
+def _since(result: CheckResult, n: int, d: str) -> Node:
+    j = _left_by(result, n, d)
+    x = result.steps[n - 1].states.get(d, "?")
+    text = (f"device '{d}' starts in state '{x}' (its initial state)" if j == 0 else
+            f"step {j} ({result.steps[j - 1].command}) left device '{d}' in state '{x}'")
+    return asp("provenance.lp", "left_by", text, {"C": CELL, "T": TASK, "I": n - 1 if j else 1, "D": d, "J": j},
+               nth=0 if j == 0 else 1)
+
+
+def device_at_step(w: Words, result: CheckResult, task: Task, n: int, r: str, d: str) -> Node:
+    """Device ``d``'s state when step ``n`` starts, where it came from, and whether role ``r`` may start there."""
+    step = result.steps[n - 1]
+    x = step.states.get(d, "?")
+    concept = w.concept(d, x)
+    proc = w.processes.get(step.command)
+    need = proc.role(r).start_concept if proc else None
+    ok = need is not None and concept is not None and w.taxonomy.is_a(concept, need)
+    below: list[Node] = [_since(result, n, d)]
+    if proc is not None and need is not None:
+        rs = proc.role(r).region[0]
+        below.append(Node("chart", f"role '{r}' of {proc.label} starts '{w.label(need)}'",
+                          f"{proc.chart_file} state {rs.id}", Where(proc.chart_file, rs.line)))
+        if ok and concept is not None:
+            below += subsumed(w, concept, need)
+        elif concept is not None:
+            below.append(Node("owl", f"'{w.label(concept)}' is not a kind of '{w.label(need)}'",
+                              f"{local_name(concept)} ⋢ {local_name(need)}", inferred=True))
+    verdict = "" if need is None else (f", which role '{r}' may start from" if ok else
+                                       f"; role '{r}' needs it '{w.label(need)}'")
+    return Node("chart", f"device '{d}' is in state '{x}' ('{w.label(concept)}'){verdict}",
+                f"{w.devices[d].chart_file} state {x}" if d in w.devices else "",
+                w.state_where(d, x) if d in w.devices else None, children=tuple(below))
+
+
+def step_tree(w: Words, result: CheckResult, task: Task, n: int) -> Node:
+    """The derivation of "step ``n`` is (not) plausible": each device it uses, and each problem found."""
+    step = result.steps[n - 1]
+    problems = [p for p in result.problems if p.step == n]
+    children: list[Node] = []
+    for p in problems:
+        if p.kind == "wrong_state" and p.device and p.role:
+            children.append(asp("chain.lp", "wrong_state", f"device '{p.device}' is not in a state role "
+                                                           f"'{p.role}' may start from",
+                                {"C": CELL, "T": TASK, "I": n, "R": p.role, "D": p.device, "X": p.state,
+                                 "P": step.command, "K": p.needed},
+                                (device_at_step(w, result, task, n, p.role, p.device),)))
+        else:
+            children.append(Node("answer", plain(p.text), p.reason.text, p.where,
+                                 children=tuple(Node("chart", "the problem rests on this line", str(x), x)
+                                                for x in p.reason.where)))
+    troubled = {p.device for p in problems}
+    children += [device_at_step(w, result, task, n, r, d) for r, d in step.bindings.items() if d not in troubled]
+    verdict = "is not plausible" if problems else "is plausible: every device it uses is where it may start"
+    where = task.where(task.steps[n - 1]) if 1 <= n <= len(task.steps) else None
+    return Node("answer", f"step {n} ({step.command}) {verdict}", "", where, children=tuple(children))
+
+
+@dataclass(frozen=True)
+class Explanation:
+    """An answer of the reasoner, its derivation, and the counterfactuals that would turn it around."""
+
+    question: str
+    """``offered`` (is a process command offered?) or ``plausible`` (is a step plausible?)."""
+    subject: str
+    answer: bool
+    derivation: Node
+    counterfactuals: tuple[Counterfactual, ...] = ()
+    none_exists: str | None = None
+    """When no counterfactual exists (or none could be confirmed): a sentence that says so."""
+
+    def to_json(self) -> dict[str, object]:
+        """A JSON-ready dict."""
+        return {"question": self.question, "subject": self.subject, "answer": self.answer,
+                "derivation": self.derivation.to_json(),
+                "counterfactuals": [c.to_json() for c in self.counterfactuals], "none_exists": self.none_exists}
+
+
+def words(cell: Cell, taxonomy: Taxonomy, ontology: Ontology, processes: Sequence[ProcessDescription],
+          language: str = "en") -> Words:
+    """What sentences about ``cell`` may name."""
+    return Words(taxonomy, ontology, {p.id: p for p in processes}, {d.id: d for d in cell.devices}, cell.name,
+                 language)
+
+
+def explain_offered(command: str, cell: Cell, taxonomy: Taxonomy, ontology: Ontology,
+                    processes: Sequence[ProcessDescription], catalogue: Sequence[DeviceDescription],
+                    language: str = "en") -> Explanation:
+    """Why ``command`` is (not) offered in ``cell``: the derivation, and the confirmed counterfactuals — devices
+    to add or swap in for a "no", the devices a "yes" rests on."""
+    if command not in {p.id for p in processes}:
+        raise KeyError(f"process command {command!r} (known: {', '.join(sorted(p.id for p in processes))})")
+    w = words(cell, taxonomy, ontology, processes, language)
+    model = derivation_model(cell, taxonomy, processes)
+    if any(a.p == command for a in model[s.Offered]):
+        flips = counterfactuals.make_not_offered(command, cell, taxonomy, processes)
+        return Explanation("offered", command, True, offered_tree(w, model, command), tuple(flips),
+                           None if flips else f"no single device of the cell is needed for {command}: "
+                                              f"another can stand in for each")
+    fixes = counterfactuals.make_offered(command, cell, catalogue, taxonomy, processes)
+    return Explanation("offered", command, False, not_offered_tree(w, model, command), tuple(fixes),
+                       None if fixes else f"no device of the catalogue, added alone or in pairs or swapped in, "
+                                          f"makes the cell offer {command}")
+
+
+def explain_plausible(task: Task, n: int, cell: Cell, taxonomy: Taxonomy, ontology: Ontology,
+                      processes: Sequence[ProcessDescription], language: str = "en") -> Explanation:
+    """Why step ``n`` of ``task`` is (not) plausible: the derivation, and for a "no" the confirmed states its
+    devices would have to be in (the repairs, with their side effects, are :func:`sideeffects.assess`'s)."""
+    if not 1 <= n <= len(task.steps):
+        raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+    result = check(task, cell, taxonomy, processes)
+    w = words(cell, taxonomy, ontology, processes, language)
+    tree = step_tree(w, result, task, n)
+    ok = not any(p.step == n for p in result.problems)
+    if ok:
+        return Explanation("plausible", f"step {n}", True, tree)
+    states = counterfactuals.needed_states(result, task, n, cell, taxonomy, processes)
+    return Explanation("plausible", f"step {n}", False, tree, tuple(states),
+                       None if states else f"no state of its devices alone makes step {n} plausible; "
+                                           f"see the repairs")
