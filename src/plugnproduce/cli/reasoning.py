@@ -101,7 +101,7 @@ def repair(
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
     result = service.check(task, cell, knowledge(cell))
-    repairs = [] if result.plausible else service.repair(task, cell, catalogue, top, knowledge=knowledge(cell))
+    repairs = [] if result.plausible else service.assessed_repairs(task, cell, catalogue, top, knowledge(cell))
     players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
@@ -118,13 +118,27 @@ def repair(
                                                        if devices else "no catalogue device (built-in or library) "
                                                        "can play it"))
         for r in repairs:
-            typer.echo(f"\nrepair {r.rank} (cost {r.cost:g}):")
-            for e in r.edits:
+            typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}):")
+            for e in r.repair.edits:
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
+            for x in r.side_effects:
+                typer.echo(f"  side effect: {x.text}")
             typer.echo("  resulting task:")
-            typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.task).splitlines()), nl=False)
+            typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.repair.task).splitlines()), nl=False)
     if not result.plausible and not repairs:
         raise typer.Exit(1)
+
+
+def _tree(ex: reasoning.Explanation, depth: int | None, verbose: bool) -> None:
+    for level, sentence in ex.derivation.sentences(depth, verbose):
+        typer.echo(f"{'  ' * level}{'- ' if level else ''}{sentence}")
+    if ex.counterfactuals:
+        typer.echo("what would turn the answer around (each confirmed by the reasoner):" if ex.answer is False
+                   else "what it rests on (each confirmed by the reasoner):")
+        for c in ex.counterfactuals:
+            typer.echo(f"  - {c.text}")
+    elif ex.none_exists:
+        typer.echo(f"no counterfactual: {ex.none_exists}")
 
 
 @app.command()
@@ -134,31 +148,31 @@ def explain(
     cell: Path = CELL_OPTION,
     step: int | None = typer.Option(None, "--step", metavar="N",
                                     help="Explain this step (1-based) of the task TARGET."),
+    depth: int | None = typer.Option(None, "--depth", min=0, metavar="N",
+                                     help="Print the derivation this many levels deep (default: all)."),
+    verbose: bool = typer.Option(False, "--verbose", "-v",
+                                 help="The engineer's view: rule instances, axioms, IRIs and file:line."),
+    catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
+                                          help="Devices a counterfactual may add (default: the libraries' devices)."),
+    language: str = typer.Option("en", "--lang", metavar="TAG", help="Language of the ontology labels."),
     json_out: bool = JSON_OPTION,
 ) -> None:
-    """Why a process command is (not) offered, or why a task's step is (not) plausible. Exit 1 when it is not."""
+    """Why a process command is (not) offered, or why a task's step is (not) plausible: a derivation through the
+    rules, the ontology and the state charts, printed as sentences (deepest cause last), and the changes the
+    reasoner confirms would turn the answer around. Exit 1 when the answer is no."""
     if step is None:
         ex = service.explain_process(cell, target, knowledge(cell))
-        name = service.cell(cell, knowledge()).name
-        if json_out:
-            emit_json(ex.to_json())
-        elif ex.offered:
-            typer.echo(f"{ex.command} is offered in cell {name}: {_bindings(ex.bindings)}")
-        else:
-            typer.echo(f"{ex.command} is not offered in cell {name}:")
-            _reasons(ex.reasons, "  ")
-        ok = ex.offered
+        why = service.explain_offered(cell, target, knowledge(cell), catalogue, language)
+        payload = {**ex.to_json(), **why.to_json()}
     else:
         st = service.explain_step(Path(target), cell, step, knowledge(cell))
-        if json_out:
-            emit_json(st.to_json())
-        else:
-            typer.echo(f"step {st.step} ({st.command}): {'plausible' if st.plausible else 'not plausible'}")
-            _reasons(st.states, "  ")
-            for p in st.problems:
-                typer.echo(f"  problem: {p}")
-        ok = st.plausible
-    if not ok:
+        why = service.explain_plausible(Path(target), cell, step, knowledge(cell), language)
+        payload = {**st.to_json(), **why.to_json()}
+    if json_out:
+        emit_json(payload)
+    else:
+        _tree(why, depth, verbose)
+    if not why.answer:
         raise typer.Exit(1)
 
 

@@ -11,11 +11,11 @@ from __future__ import annotations
 from plugnproduce.reasoning.axioms import ontology_of
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
 from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
+from plugnproduce.reasoning.counterfactuals import Counterfactual
+from plugnproduce.reasoning.derivation import Node
 from plugnproduce.reasoning.offers import capabilities, explain_process
 from plugnproduce.reasoning.plausibility import check, explain_step
 from plugnproduce.reasoning.repairs import repair
-from plugnproduce.reasoning.counterfactuals import Counterfactual
-from plugnproduce.reasoning.derivation import Node
 from plugnproduce.reasoning.results import (
     Capabilities,
     CheckResult,

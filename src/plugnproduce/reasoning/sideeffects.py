@@ -138,11 +138,12 @@ def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: T
     out: list[SideEffect] = []
     held: dict[str, int] = {}
     for i, step in enumerate(result.steps, start=1):
-        for role, d in step.bindings.items():
+        for d in step.bindings.values():
             after = _concept(cell, d, _after(result, i).get(d))
             if d in held and k.is_a(after, "Open") and not k.process_is(step.command, "PlaceProcess"):
+                picker = f"step {held[d]} ({result.steps[held[d] - 1].command})"
                 out.append(SideEffect("drops_part", f"step {i} ({step.command}) opens device '{d}', which holds the "
-                                                    f"part step {held[d]} ({result.steps[held[d] - 1].command}) picked: the part would be released "
+                                                    f"part {picker} picked: the part would be released "
                                                     f"{_mover(k, result, i, cell)}, not placed", i, d))
             if k.is_a(after, "Open"):
                 held.pop(d, None)

@@ -20,7 +20,7 @@ from plugnproduce.reasoning.facts import fact_book
 from plugnproduce.reasoning.offers import CELL, cell_program
 from plugnproduce.reasoning.plausibility import TASK, check
 from plugnproduce.reasoning.results import CheckResult
-from plugnproduce.reasoning.schema.derivations import Skilled, Walk
+from plugnproduce.reasoning.schema.derivations import Walk
 from plugnproduce.reasoning.terms import Model
 
 DERIVATION = solver.rules("derivation")
@@ -85,8 +85,8 @@ def skill_evidence(w: Words, dev: DeviceDescription, skill: str) -> tuple[Node, 
     for c in dev.classes:
         chain = w.ontology.implied_skill(c, skill, w.taxonomy)
         if chain is not None:
-            member = Node("owl", f"device '{dev.id}' is of the class '{w.label(c)}'", f"{dev.id} : {c.rsplit('#', 1)[-1]}",
-                          dev.where)
+            member = Node("owl", f"device '{dev.id}' is of the class '{w.label(c)}'",
+                          f"{dev.id} : {local_name(c)}", dev.where)
             out.append(Node("owl", f"every '{w.label(c)}' has the skill '{w.label(skill)}'",
                             ", ".join(a.formula() for a in chain), None, len(chain) > 1,
                             (member, *(axiom_node(w, a) for a in chain))))
