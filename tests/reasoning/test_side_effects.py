@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from plugnproduce import service
 from plugnproduce.description.model import Cell, Step, Task
 from plugnproduce.reasoning.sideeffects import new_steps
@@ -45,3 +47,15 @@ def test_an_inserted_step_is_found_before_the_steps_it_shifts() -> None:
     repaired = Task(original.name, (steps[0], Step(2, "place"), *steps[1:]), original.file)
     assert new_steps(original, repaired) == {2}
     assert new_steps(original, original) == set()
+
+
+def test_a_dropped_part_rests_on_the_pick_process_and_the_gripper_states(cell: Cell) -> None:
+    repairs = service.assessed_repairs(INVALID, cell)
+    opening = next(r for r in repairs if any(e.command == "open-gripper" for e in r.repair.edits))
+    tree = opening.derivation
+    assert tree.text.endswith("makes the task plausible") and tree.children[0].where is not None
+    drop = next(n for n in tree.children if n.detail == "drops_part")
+    assert [n.kind for n in drop.children] == ["owl", "chart", "chart", "owl"]
+    lines = [Path(n.where.file).read_text(encoding="utf-8").splitlines()[(n.where.line or 0) - 1]
+             for n in drop.children if n.where]
+    assert "proc:bin-pick a pnp:PickProcess" in lines[0] and 'id="closed"' in lines[1] and 'id="open"' in lines[2]

@@ -13,10 +13,12 @@ import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
+from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task, Where
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP_IRI
-from plugnproduce.reasoning.plausibility import check
+from plugnproduce.reasoning.derivation import Node, asp
+from plugnproduce.reasoning.offers import CELL
+from plugnproduce.reasoning.plausibility import TASK, check
 from plugnproduce.reasoning.results import CheckResult, Repair
 
 SEVERITY = {"drops_part": 2, "moves_device": 1, "ends_holding": 1, "default_values": 0}
@@ -33,6 +35,8 @@ class SideEffect:
     step: int
     """The step of the repaired task it happens at."""
     device: str | None = None
+    evidence: tuple[Node, ...] = ()
+    """What the side effect rests on: the processes' classes and the chart states (a derivation's nodes)."""
 
     @property
     def severity(self) -> int:
@@ -42,7 +46,7 @@ class SideEffect:
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         return {"kind": self.kind, "text": self.text, "step": self.step, "device": self.device,
-                "severity": self.severity}
+                "severity": self.severity, "evidence": [n.to_json() for n in self.evidence]}
 
 
 @dataclass(frozen=True)
@@ -60,10 +64,22 @@ class AssessedRepair:
         """The weight of its worst side effect (0 when it has none that matter)."""
         return max((e.severity for e in self.side_effects), default=0)
 
+    @property
+    def derivation(self) -> Node:
+        """Why this repair is offered: the repaired task checked again, and each side effect with its evidence."""
+        edits = "; ".join(e.text for e in self.repair.edits)
+        checked = (asp("resolve.lp", "plausible", "checking the repaired task again finds no problem at any step",
+                       {"C": CELL, "T": TASK}),) if self.confirmed else ()
+        effects = tuple(Node("task", e.text, e.kind, children=e.evidence) for e in self.side_effects)
+        verdict = "makes the task plausible" if self.confirmed else "does not make the task plausible"
+        return Node("answer", f"repair {self.rank} ({edits}) {verdict}", children=checked + effects)
+
     def to_json(self) -> dict[str, object]:
-        """The repair's JSON with its rank after side effects, the solver's rank, and the side effects."""
+        """The repair's JSON with its rank after side effects, the solver's rank, the side effects and the
+        derivation."""
         return {**self.repair.to_json(), "rank": self.rank, "solver_rank": self.repair.rank,
-                "confirmed": self.confirmed, "side_effects": [e.to_json() for e in self.side_effects]}
+                "confirmed": self.confirmed, "side_effects": [e.to_json() for e in self.side_effects],
+                "derivation": self.derivation.to_json()}
 
 
 @dataclass(frozen=True)
@@ -133,6 +149,32 @@ def _mover(k: _Cell, result: CheckResult, i: int, cell: Cell) -> str:
     return f"where device '{d}' stands (state '{x}', {k.taxonomy.label(_concept(cell, d, x) or '')})"
 
 
+def _state_node(cell: Cell, d: str, x: str | None, text: str) -> Node:
+    dev = next(v for v in cell.devices if v.id == d)
+    line = next((st.line for st in dev.states if st.id == x), None)
+    return Node("chart", text, f"{dev.chart_file} state {x}", Where(dev.chart_file, line))
+
+
+def _drop_evidence(k: _Cell, result: CheckResult, cell: Cell, j: int, i: int, d: str) -> tuple[Node, ...]:
+    """Why step ``i`` drops the part step ``j`` picked: ``j`` is a pick process that left ``d`` closed, ``i``
+    leaves it open and is no place process."""
+    picker, opener = result.steps[j - 1].command, result.steps[i - 1].command
+    held, opened = _after(result, j).get(d), _after(result, i).get(d)
+    label = k.taxonomy.label
+    out = []
+    if picker in k.processes:
+        out.append(Node("owl", f"{picker} is a '{label(PNP_IRI + 'PickProcess')}': it leaves a part in the gripper",
+                        f"{picker} : PickProcess", k.processes[picker].where))
+    out.append(_state_node(cell, d, held, f"step {j} ({picker}) left device '{d}' in state '{held}' "
+                                          f"('{label(_concept(cell, d, held) or '')}')"))
+    out.append(_state_node(cell, d, opened, f"step {i} ({opener}) leaves device '{d}' in state '{opened}' "
+                                            f"('{label(_concept(cell, d, opened) or '')}')"))
+    if opener in k.processes:
+        out.append(Node("owl", f"{opener} is not a '{label(PNP_IRI + 'PlaceProcess')}'", f"{opener} ⋢ PlaceProcess",
+                        k.processes[opener].where, True))
+    return tuple(out)
+
+
 def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: Task,
              original: Task) -> list[SideEffect]:
     out: list[SideEffect] = []
@@ -144,7 +186,8 @@ def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: T
                 picker = f"step {held[d]} ({result.steps[held[d] - 1].command})"
                 out.append(SideEffect("drops_part", f"step {i} ({step.command}) opens device '{d}', which holds the "
                                                     f"part {picker} picked: the part would be released "
-                                                    f"{_mover(k, result, i, cell)}, not placed", i, d))
+                                                    f"{_mover(k, result, i, cell)}, not placed", i, d,
+                                      _drop_evidence(k, result, cell, held[d], i, d)))
             if k.is_a(after, "Open"):
                 held.pop(d, None)
             elif k.is_a(after, "HoldingPart") or (k.process_is(step.command, "PickProcess")
