@@ -252,7 +252,7 @@ def assessed_repairs(
     the_cell, k = _context(cell_or_path, knowledge)
     the_task = _as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
-    repairs = reasoning.repair(the_task, the_cell, k.taxonomy, k.processes, catalogue=devices, top=top)
+    repairs = repair(the_task, the_cell, devices, top, knowledge=k)
     return reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
 
 
