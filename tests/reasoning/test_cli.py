@@ -33,7 +33,9 @@ def test_capabilities_lists_offered_commands_and_reasons() -> None:
     assert result.exit_code == 0, result.output
     assert "9 of 12 process commands offered" in result.stdout
     assert "pick-and-place   gripper=gripper robot=robot" in result.stdout
-    assert "pnp:CanScrew" in result.stdout and "screw.ttl:" in result.stdout
+    assert "needs a device that can screw;" in result.stdout and "pnp:" not in result.stdout
+    verbose = pnp("capabilities", "--cell", CELL, "--verbose").stdout
+    assert "pnp:CanScrew" in verbose and "screw.ttl:" in verbose
 
 
 def test_capabilities_json() -> None:
@@ -81,7 +83,10 @@ def test_check_exits_1_naming_step_gripper_state_and_need() -> None:
     assert result.exit_code == 1
     line = next(x for x in result.stdout.splitlines() if "step 2" in x)
     assert "bin-picking-invalid.yaml:8:" in line
-    assert "'gripper'" in line and "'closed'" in line and "needs it open (pnp:Open)" in line
+    assert "'gripper'" in line and "'closed'" in line and line.endswith("the step needs it open")
+    assert "pnp:" not in result.stdout and "rests on" not in result.stdout
+    verbose = pnp("check", INVALID, "--cell", CELL, "--verbose").stdout
+    assert "needs it open (pnp:Open)" in verbose and "rests on:" in verbose and "gripper.scxml:" in verbose
 
 
 def test_check_of_the_bin_picking_task_exits_0() -> None:

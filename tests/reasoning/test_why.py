@@ -112,3 +112,9 @@ def test_labels_follow_the_language_asked_for() -> None:
 def test_an_unknown_process_is_a_key_error(cell: Cell) -> None:
     with pytest.raises(KeyError):
         service.explain_offered(cell, "teleport")
+
+
+def test_a_reason_in_plain_words_drops_the_terms(cell: Cell) -> None:
+    (problem,) = service.check(INVALID, cell).problems
+    assert "(pnp:Closed)" in problem.reason.text and "pnp:" not in problem.reason.plain
+    assert "is in state 'closed' [closed], left there by step 1 (bin-pick)" in problem.reason.plain

@@ -28,22 +28,24 @@ else:
     service = lazy_module("plugnproduce.service")
 
 CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
+VERBOSE_OPTION = typer.Option(False, "--verbose", "-v",
+                              help="The engineer's view: ontology terms, rule instances, axioms and file:line.")
 
 
 def _bindings(bindings: tuple[dict[str, str], ...]) -> str:
     return " | ".join(" ".join(f"{r}={d}" for r, d in b.items()) for b in bindings)
 
 
-def _reasons(reasons: tuple[reasoning.Reason, ...], indent: str = "    ") -> None:
+def _reasons(reasons: tuple[reasoning.Reason, ...], verbose: bool, indent: str = "    ") -> None:
     for r in reasons:
-        typer.echo(f"{indent}- {r.text}")
-        if r.where:
+        typer.echo(f"{indent}- {r.text if verbose else r.plain}")
+        if r.where and verbose:
             typer.echo(f"{indent}  rests on: {', '.join(str(w) for w in r.where)}")
 
 
 @app.command()
 @boundary
-def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION) -> None:
+def capabilities(cell: Path = CELL_OPTION, verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Show the process commands a cell offers (with every role binding) and why the others are not offered."""
     caps = service.capabilities(cell, knowledge(cell))
     if json_out:
@@ -57,20 +59,20 @@ def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION) -> None
         typer.echo("not offered:")
     for n in caps.not_offered:
         typer.echo(f"  {n.command}")
-        _reasons(n.reasons)
+        _reasons(n.reasons, verbose)
 
 
-def _print_problems(result: reasoning.CheckResult) -> None:
+def _print_problems(result: reasoning.CheckResult, verbose: bool) -> None:
     for p in result.problems:
-        typer.echo(str(p))
-        if p.reason.where:
+        typer.echo(str(p) if verbose else f"{p.where}: {p.reason.plain}")
+        if p.reason.where and verbose:
             typer.echo(f"    rests on: {', '.join(str(w) for w in p.reason.where)}")
 
 
 @app.command()
 @boundary
 def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
-          json_out: bool = JSON_OPTION) -> None:
+          verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Check that a task is plausible: each step finds its devices in the states it starts from.
 
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
@@ -81,7 +83,7 @@ def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (
     else:
         verdict = "plausible" if result.plausible else f"implausible ({len(result.problems)} problem(s))"
         typer.echo(f"task {result.task} in cell {result.cell}: {verdict}")
-        _print_problems(result)
+        _print_problems(result, verbose)
     if not result.plausible:
         raise typer.Exit(1)
 
@@ -94,6 +96,7 @@ def repair(
     catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
                                           help="Devices a repair may add (a folder)."),
     top: int = typer.Option(3, "--top", min=1, max=20, metavar="K", help="How many distinct repairs, cheapest first."),
+    verbose: bool = VERBOSE_OPTION,
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
@@ -111,7 +114,7 @@ def repair(
         typer.echo(f"task {result.task} in cell {result.cell}: plausible; nothing to repair")
     else:
         typer.echo(f"task {result.task} in cell {result.cell}: implausible; {len(repairs)} repair(s)")
-        _print_problems(result)
+        _print_problems(result, verbose)
         for (i, role), devices in players.items():
             typer.echo(f"step {i}, role '{role}': " + (f"catalogue device(s) that could play it: {', '.join(devices)}"
                                                        + ("" if catalogue else " (repair with --catalogue to add one)")
@@ -150,8 +153,7 @@ def explain(
                                     help="Explain this step (1-based) of the task TARGET."),
     depth: int | None = typer.Option(None, "--depth", min=0, metavar="N",
                                      help="Print the derivation this many levels deep (default: all)."),
-    verbose: bool = typer.Option(False, "--verbose", "-v",
-                                 help="The engineer's view: rule instances, axioms, IRIs and file:line."),
+    verbose: bool = VERBOSE_OPTION,
     catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
                                           help="Devices a counterfactual may add (default: the libraries' devices)."),
     language: str = typer.Option("en", "--lang", metavar="TAG", help="Language of the ontology labels."),

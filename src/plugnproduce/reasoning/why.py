@@ -3,7 +3,6 @@ rule instances of ``rules/*.lp`` (ASP), the ontology axioms (OWL) and the chart 
 
 from __future__ import annotations
 
-import re
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -238,14 +237,6 @@ def not_offered_tree(w: Words, model: Model, p: str) -> Node:
                 f"not offered({CELL},{p})", proc.where, children=tuple(reasons))
 
 
-_CURIE = re.compile(r" \((?:[A-Za-z][\w-]*:[\w-]+|https?://[^)\s]+)\)")
-
-
-def plain(text: str) -> str:
-    """A reason's sentence without the ``(prefix:Term)`` the engineer's view adds to each label."""
-    return _CURIE.sub("", text)
-
-
 def _left_by(result: CheckResult, n: int, d: str) -> int:
     return max((j for j in range(1, n) if d in result.steps[j - 1].bindings.values()), default=0)
 
@@ -297,7 +288,7 @@ def step_tree(w: Words, result: CheckResult, task: Task, n: int) -> Node:
                                  "P": step.command, "K": p.needed},
                                 (device_at_step(w, result, task, n, p.role, p.device),)))
         else:
-            children.append(Node("answer", plain(p.text), p.reason.text, p.where,
+            children.append(Node("answer", p.reason.plain, p.reason.text, p.where,
                                  children=tuple(Node("chart", "the problem rests on this line", str(x), x)
                                                 for x in p.reason.where)))
     troubled = {p.device for p in problems}

@@ -132,7 +132,7 @@ function problemItem(p, i) {
   const button = h("button", { type: "button", class: "quiet", "aria-expanded": "false", "aria-controls": id,
     onclick: () => why(p, box, button) }, "Why?");
   const round = p.round > 1 ? ` (round ${p.round})` : "";
-  return h("li", { class: "problem", dataset: { kind: p.kind } }, h("span", {}, p.text + round), " ", button, box);
+  return h("li", { class: "problem", dataset: { kind: p.kind } }, h("span", {}, (p.plain || p.text) + round), " ", button, box);
 }
 
 function applyRepair(repair) {
@@ -180,7 +180,7 @@ export function renderCheck() {
     ? h("p", { class: "ok" }, `Plausible: every step finds its devices in the states it starts from.`)
     : h("p", { class: "bad" }, `Not plausible: ${c.problems.length} problem${c.problems.length === 1 ? "" : "s"}`,
       c.repairs.length ? `; ${c.repairs.length} repair${c.repairs.length === 1 ? "" : "s"} below.` : "; no repair found."),
-  unplaced.map((p) => h("p", { class: "error" }, p.text)));
+  unplaced.map((p) => h("p", { class: "error" }, p.plain || p.text)));
   $("#repairs").hidden = c.plausible || c.repairs.length === 0;
   fill($("#repair-list"), c.repairs.map(repairItem));
 }
