@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import dataclasses
 import os
 import secrets
 import time
@@ -233,11 +234,17 @@ def explain_offered(cell_or_path: CellArg, command: str, knowledge: Knowledge | 
 def explain_plausible(task_or_path: TaskArg, cell_or_path: CellArg, n: int, knowledge: Knowledge | None = None,
                       language: str = "en") -> reasoning.Explanation:
     """Why step ``n`` (1-based) of a task is (not) plausible: the derivation tree and, for a "no", the states its
-    devices would have to be in (each confirmed by the reasoner)."""
+    devices would have to be in and the repairs (steps to insert, remove or reorder, with their side effects),
+    each confirmed by the reasoner."""
     the_cell, k = _context(cell_or_path, knowledge)
+    the_task = _as_task(task_or_path)
     ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
-    return reasoning.explain_plausible(_as_task(task_or_path), n, the_cell, k.taxonomy, ontology, k.processes,
-                                       language)
+    ex = reasoning.explain_plausible(the_task, n, the_cell, k.taxonomy, ontology, k.processes, language)
+    if ex.answer:
+        return ex
+    edits = reasoning.counterfactuals_from_repairs(assessed_repairs(the_task, the_cell, None, 3, k))
+    return dataclasses.replace(ex, counterfactuals=ex.counterfactuals + tuple(edits),
+                               none_exists=None if ex.counterfactuals or edits else ex.none_exists)
 
 
 def assessed_repairs(

@@ -89,7 +89,10 @@ def test_a_step_that_is_not_plausible_says_where_the_state_came_from(cell: Cell)
     assert ex.answer is False
     assert "step 1 (bin-pick) left device 'gripper' in state 'closed'" in sentences
     assert "'closed' is not a kind of 'open'" in sentences
-    assert [(c.kind, c.devices, c.state) for c in ex.counterfactuals] == [("state", ("gripper",), "open")]
+    assert [(c.kind, c.devices, c.state) for c in ex.counterfactuals][0] == ("state", ("gripper",), "open")
+    edits = [c for c in ex.counterfactuals if c.kind == "edit_task"]
+    assert edits and all(c.confirmed for c in edits)
+    assert edits[-1].text == "insert open-gripper before step 2 (bin-pick)" and "holds the part" in edits[-1].side_effects[0]
 
 
 def test_a_library_device_is_explained_through_the_librarys_axiom() -> None:

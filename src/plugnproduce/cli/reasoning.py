@@ -140,6 +140,8 @@ def _tree(ex: reasoning.Explanation, depth: int | None, verbose: bool) -> None:
                    else "what it rests on (each confirmed by the reasoner):")
         for c in ex.counterfactuals:
             typer.echo(f"  - {c.text}")
+            for effect in c.side_effects:
+                typer.echo(f"    side effect: {effect}")
     elif ex.none_exists:
         typer.echo(f"no counterfactual: {ex.none_exists}")
 

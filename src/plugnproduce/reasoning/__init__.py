@@ -12,6 +12,7 @@ from plugnproduce.reasoning.axioms import ontology_of
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
 from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
 from plugnproduce.reasoning.counterfactuals import Counterfactual
+from plugnproduce.reasoning.counterfactuals import from_repairs as counterfactuals_from_repairs
 from plugnproduce.reasoning.derivation import Node
 from plugnproduce.reasoning.offers import capabilities, explain_process
 from plugnproduce.reasoning.plausibility import check, explain_step
@@ -40,6 +41,7 @@ __all__ = [
     "Node",
     "SideEffect",
     "assess",
+    "counterfactuals_from_repairs",
     "explain_offered",
     "explain_plausible",
     "ontology_of",

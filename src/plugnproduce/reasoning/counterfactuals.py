@@ -17,6 +17,7 @@ from plugnproduce.reasoning.facts import FactBook, fact_book
 from plugnproduce.reasoning.offers import CELL, cell_program
 from plugnproduce.reasoning.plausibility import check
 from plugnproduce.reasoning.results import CheckResult
+from plugnproduce.reasoning.sideeffects import AssessedRepair
 
 MAX_PAIRS = 400
 """At most this many pairs of catalogue devices are tried when no single device makes a process offered."""
@@ -27,7 +28,8 @@ class Counterfactual:
     """One change, and what the reasoner answers once it is made."""
 
     kind: str
-    """``add_device``, ``swap_device``, ``remove_device`` or ``state``."""
+    """``add_device``, ``swap_device``, ``remove_device``, ``state`` or ``edit_task`` (a repair: steps to insert,
+    remove or reorder)."""
     text: str
     confirmed: bool
     """The reasoner, run again with the change, gives the opposite answer."""
@@ -39,6 +41,8 @@ class Counterfactual:
     step: int | None = None
     loses: tuple[str, ...] = ()
     """Process commands the cell offers now and would no longer offer after the change."""
+    side_effects: tuple[str, ...] = ()
+    """What else the change does (a repair's side effects)."""
 
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
@@ -128,3 +132,11 @@ def needed_states(result: CheckResult, task: Task, n: int, cell: Cell, taxonomy:
                                                    f"step {n} starts, the step would be plausible", True,
                                           (p.device,), state=st.id, step=n))
     return out
+
+
+def from_repairs(repairs: Sequence[AssessedRepair]) -> list[Counterfactual]:
+    """Repairs as counterfactuals of a step that is not plausible: the edits, confirmed when checking the repaired
+    task again finds it plausible, with their side effects, in the repairs' rank."""
+    return [Counterfactual("edit_task", "; ".join(e.text for e in r.repair.edits), r.confirmed,
+                           r.repair.added_devices, side_effects=tuple(e.text for e in r.side_effects))
+            for r in repairs]

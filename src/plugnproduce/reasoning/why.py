@@ -348,7 +348,8 @@ def explain_offered(command: str, cell: Cell, taxonomy: Taxonomy, ontology: Onto
 def explain_plausible(task: Task, n: int, cell: Cell, taxonomy: Taxonomy, ontology: Ontology,
                       processes: Sequence[ProcessDescription], language: str = "en") -> Explanation:
     """Why step ``n`` of ``task`` is (not) plausible: the derivation, and for a "no" the confirmed states its
-    devices would have to be in (the repairs, with their side effects, are :func:`sideeffects.assess`'s)."""
+    devices would have to be in (the service adds the repairs, with their side effects, from
+    :func:`sideeffects.assess`)."""
     if not 1 <= n <= len(task.steps):
         raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
     result = check(task, cell, taxonomy, processes)

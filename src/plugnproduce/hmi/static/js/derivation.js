@@ -71,7 +71,7 @@ export function explanationView(ex, apply, canApply = () => false) {
     const head = ex.answer ? "It rests on (checked by the reasoner):" : "What would make it work (checked by the reasoner):";
     after = h("div", { class: "counterfactuals" }, h("p", {}, head), h("ul", {}, ex.counterfactuals.map((c) =>
       h("li", {}, canApply(c) ? h("button", { type: "button", class: "counterfactual", onclick: () => apply(c) },
-        c.text) : c.text))));
+        c.text) : c.text, (c.side_effects || []).map((e) => h("p", { class: "side-effect" }, `Side effect: ${e}`))))));
   } else if (ex.none_exists) {
     after = h("p", { class: "hint none-exists" }, `Nothing to change: ${ex.none_exists}.`);
   }
