@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import dataclasses
 import os
 import secrets
 import time
@@ -219,6 +220,50 @@ def explain_step(task_or_path: TaskArg, cell_or_path: CellArg, n: int,
     """Why step ``n`` (1-based) of a task is (not) plausible in a cell."""
     the_cell, k = _context(cell_or_path, knowledge)
     return reasoning.explain_step(_as_task(task_or_path), the_cell, n, k.taxonomy, k.processes)
+
+
+def explain_offered(cell_or_path: CellArg, command: str, knowledge: Knowledge | None = None,
+                    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+                    language: str = "en") -> reasoning.Explanation:
+    """Why a process command is (not) offered: the derivation tree (rules, ontology axioms, chart states) and
+    the counterfactuals the reasoner confirms (devices of the catalogue to add or swap in; for a "yes", the
+    devices it rests on)."""
+    the_cell, k = _context(cell_or_path, knowledge)
+    ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
+    return reasoning.explain_offered(command, the_cell, k.taxonomy, ontology, k.processes,
+                                     _devices(catalogue_or_folder, k), language)
+
+
+def explain_plausible(task_or_path: TaskArg, cell_or_path: CellArg, n: int, knowledge: Knowledge | None = None,
+                      language: str = "en") -> reasoning.Explanation:
+    """Why step ``n`` (1-based) of a task is (not) plausible: the derivation tree and, for a "no", the states its
+    devices would have to be in and the repairs (steps to insert, remove or reorder, with their side effects),
+    each confirmed by the reasoner."""
+    the_cell, k = _context(cell_or_path, knowledge)
+    the_task = _as_task(task_or_path)
+    ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
+    ex = reasoning.explain_plausible(the_task, n, the_cell, k.taxonomy, ontology, k.processes, language)
+    if ex.answer:
+        return ex
+    edits = reasoning.counterfactuals_from_repairs(assessed_repairs(the_task, the_cell, None, 3, k))
+    return dataclasses.replace(ex, counterfactuals=ex.counterfactuals + tuple(edits),
+                               none_exists=None if ex.counterfactuals or edits else ex.none_exists)
+
+
+def assessed_repairs(
+    task_or_path: TaskArg,
+    cell_or_path: CellArg,
+    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+    top: int = 3,
+    knowledge: Knowledge | None = None,
+) -> list[reasoning.AssessedRepair]:
+    """The repairs of :func:`repair`, each confirmed by checking it again and with its side effects; those that
+    lose a held part or move a device a later step relies on rank below those that do not."""
+    the_cell, k = _context(cell_or_path, knowledge)
+    the_task = _as_task(task_or_path)
+    devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
+    repairs = repair(the_task, the_cell, devices, top, knowledge=k)
+    return reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
 
 
 def batch(

@@ -195,6 +195,28 @@ async def test_a_command_not_offered_is_explained(client: httpx.AsyncClient) -> 
     assert any("pnp:CanScrew" in r["text"] for r in ex["reasons"])
 
 
+async def test_the_explanation_carries_the_derivation_and_the_counterfactuals(client: httpx.AsyncClient) -> None:
+    ex = (await client.get("/api/commands/screw/explanation")).json()
+    assert ex["derivation"]["text"] == "screw is not offered in cell 'bin-picking': some role cannot be filled"
+    assert [c["devices"] for c in ex["counterfactuals"]] == [["screwdriver"]]
+
+
+async def test_a_source_line_an_explanation_cites_is_served(client: httpx.AsyncClient) -> None:
+    ex = (await client.get("/api/commands/screw/explanation")).json()
+    file, line = ex["derivation"]["where"].rsplit(":", 1)
+    src = (await client.get("/api/source", params={"file": file, "line": line})).json()
+    assert src["name"] == "screw.ttl" and any(x["number"] == int(line) and "proc:screw" in x["text"]
+                                              for x in src["lines"])
+
+
+async def test_no_other_file_is_served_as_a_source(client: httpx.AsyncClient, tmp_path) -> None:
+    secret = tmp_path / "secret.ttl"
+    secret.write_text("secret\n")
+    for file in (str(secret), "/etc/passwd", str(service.builtin("cells", "bin-picking.yaml")) + "/../../x"):
+        res = await client.get("/api/source", params={"file": file, "line": 1})
+        assert res.status_code == 404 and res.json()["detail"] == "error: not a description file of this cell"
+
+
 async def test_unplugging_the_gripper_withdraws_pick(client: httpx.AsyncClient) -> None:
     res = await client.delete("/api/cell/devices/gripper", headers=AUTH)
     assert res.status_code == 200
@@ -217,11 +239,14 @@ async def test_check_puts_the_problem_at_its_step(client: httpx.AsyncClient) -> 
 
 async def test_repairs_are_ranked_tasks_ready_to_apply(client: httpx.AsyncClient) -> None:
     result = (await client.post("/api/task/repair?top=2", json=INVALID)).json()
-    first = result["repairs"][0]
-    assert first["rank"] == 1 and first["edits"][0]["text"] == "insert open-gripper before step 2 (bin-pick)"
-    assert [s["command"] for s in first["task"]["steps"]] == ["bin-pick", "open-gripper", "bin-pick", "place"]
-    fixed = (await client.post("/api/task/check", json=first["task"])).json()
-    assert fixed["plausible"] is True
+    first, second = result["repairs"]
+    assert first["rank"] == 1 and first["edits"][0]["text"] == "swap step 2 (bin-pick) with step 3 (place)"
+    assert second["edits"][0]["text"] == "insert open-gripper before step 2 (bin-pick)"
+    assert second["solver_rank"] == 1 and [e["kind"] for e in second["side_effects"]] == ["drops_part"]
+    assert [s["command"] for s in second["task"]["steps"]] == ["bin-pick", "open-gripper", "bin-pick", "place"]
+    for repair in (first, second):
+        fixed = (await client.post("/api/task/check", json=repair["task"])).json()
+        assert fixed["plausible"] is True
 
 
 async def test_explain_a_step(client: httpx.AsyncClient) -> None:

@@ -17,7 +17,7 @@ import pytest
 from fastapi.dependencies.models import Dependant
 from fastapi.routing import APIRoute
 
-from plugnproduce.hmi.routes import cell, charts, runs, task
+from plugnproduce.hmi.routes import cell, charts, runs, sources, task
 from plugnproduce.hmi.security import allow_read, require_token
 from tests.hmi.conftest import TOKEN, Hmi
 
@@ -57,7 +57,7 @@ def _app_requests(hmi: Hmi) -> set[tuple[str, str]]:
 def _guards() -> dict[tuple[str, str], set[Callable[..., object]]]:
     """Each route of the HMI's routers with every dependency it declares (its router's included)."""
     out: dict[tuple[str, str], set[Callable[..., object]]] = {}
-    for module in (cell, task, charts, runs):
+    for module in (cell, task, charts, runs, sources):
         router = module.router
         shared = {d.dependency for d in router.dependencies if d.dependency is not None}
         for route in router.routes:

@@ -89,13 +89,16 @@ def test_an_invalid_task_shows_its_problem_at_its_step_and_a_repair_fixes_it(pag
     expect(second.locator(".problem")).to_contain_text("device 'gripper' (role 'gripper') is in state 'closed'")
     expect(page.locator("#steps li.step[data-row='0'] .problem")).to_have_count(0)
     first_repair = page.locator("#repair-list li.repair").first
-    expect(first_repair).to_contain_text("insert open-gripper before step 2 (bin-pick)")
+    expect(first_repair).to_contain_text("insert place before step 2 (bin-pick)")
     second.get_by_role("button", name="Why?").click()
-    expect(second.locator(".why")).to_contain_text("left there by step 1")
+    second.locator(".why details.derivation > summary").click()
+    second.locator(".why summary", has_text="is not in a state role 'gripper' may start from").click()
+    second.locator(".why summary", has_text="device 'gripper' is in state 'closed'").click()
+    expect(second.locator(".why")).to_contain_text("step 1 (bin-pick) left device 'gripper' in state 'closed'")
     screenshot(page, "check-problem-and-repairs")
     first_repair.get_by_role("button", name="Apply").click()
     expect(page.locator("#verdict .ok")).to_contain_text("Plausible")
-    assert steps(page) == ["bin-pick", "open-gripper", "bin-pick", "place"]
+    assert steps(page) == ["bin-pick", "place", "bin-pick", "place"]
 
 
 def test_unplugging_the_gripper_takes_pick_away(page: Page, served: Served) -> None:
@@ -108,7 +111,10 @@ def test_unplugging_the_gripper_takes_pick_away(page: Page, served: Served) -> N
     expect(page.locator("#announce")).to_contain_text("gripper unplugged")
     screenshot(page, "cell-gripper-unplugged")
     page.get_by_role("button", name="Why is pick not offered?").click()
-    expect(page.locator("#why-pick")).to_contain_text("pnp:CanGrip")
+    why = page.locator("#why-pick")
+    why.locator("details.derivation > summary").click()
+    expect(why).to_contain_text("no device in cell 'bin-picking' has the skill 'can grip'")
+    expect(why.get_by_role("button", name="add device 'gripper' (Parallel gripper) to the cell")).to_be_visible()
 
 
 def test_a_device_plugged_in_elsewhere_shows_up_live(page: Page, served: Served) -> None:

@@ -33,7 +33,9 @@ def test_capabilities_lists_offered_commands_and_reasons() -> None:
     assert result.exit_code == 0, result.output
     assert "9 of 12 process commands offered" in result.stdout
     assert "pick-and-place   gripper=gripper robot=robot" in result.stdout
-    assert "pnp:CanScrew" in result.stdout and "screw.ttl:" in result.stdout
+    assert "needs a device that can screw;" in result.stdout and "pnp:" not in result.stdout
+    verbose = pnp("capabilities", "--cell", CELL, "--verbose").stdout
+    assert "pnp:CanScrew" in verbose and "screw.ttl:" in verbose
 
 
 def test_capabilities_json() -> None:
@@ -61,13 +63,35 @@ def test_explain_says_the_missing_skill_is_can_grip(tmp_path: Path) -> None:
     cell = cell_file(tmp_path, "robot", "sensor3d", "binpicking-pc")
     result = pnp("explain", "--cell", cell, "pick-and-place")
     assert result.exit_code == 1
-    assert "pick-and-place is not offered" in result.stdout and "pnp:CanGrip" in result.stdout
-    assert "pick-and-place.ttl:" in result.stdout
+    assert "pick and place is not offered" in result.stdout and "the skill 'can grip'" in result.stdout
+    assert "pnp:" not in result.stdout and ".ttl" not in result.stdout
+    assert "add device 'gripper' (Parallel gripper) to the cell" in result.stdout
+    verbose = pnp("explain", "--cell", cell, "pick-and-place", "--verbose").stdout
+    assert "pick-and-place.ttl:" in verbose and "requiresSkill CanGrip" in verbose and "explain.lp:" in verbose
 
 
 def test_explain_an_offered_process() -> None:
     result = pnp("explain", "--cell", CELL, "pick")
-    assert result.exit_code == 0 and "gripper=gripper robot=robot" in result.stdout
+    assert result.exit_code == 0
+    assert result.stdout.splitlines()[0] == "pick is offered in cell 'bin-picking': every role can be filled"
+    assert "  - role 'gripper' can be filled by device 'gripper'" in result.stdout
+    assert "every 'parallel gripper' has the skill 'can grip'" in result.stdout
+    assert "http" not in result.stdout and "pnp:" not in result.stdout
+
+
+def test_explain_depth_keeps_the_first_levels() -> None:
+    result = pnp("explain", "--cell", CELL, "pick", "--depth", "1")
+    assert result.stdout.splitlines()[1:3] == ["  - role 'gripper' can be filled by device 'gripper'",
+                                              "  - role 'robot' can be filled by device 'robot'"]
+    assert "parallel gripper" not in result.stdout
+
+
+def test_explain_json_gives_the_derivation_tree() -> None:
+    doc = json.loads(pnp("explain", "--cell", CELL, "pick", "--json").stdout)
+    assert doc["offered"] is True and doc["answer"] is True
+    flat = json.dumps(doc["derivation"], ensure_ascii=False)
+    assert "ParallelGripper \u2291 \u2203hasSkill.CanParallelGrip" in flat and "pnp.ttl:" in flat
+    assert "roles.lp:" in flat and "offered.lp:" in flat and "gripper.scxml:" in flat
 
 
 def test_check_exits_1_naming_step_gripper_state_and_need() -> None:
@@ -75,7 +99,10 @@ def test_check_exits_1_naming_step_gripper_state_and_need() -> None:
     assert result.exit_code == 1
     line = next(x for x in result.stdout.splitlines() if "step 2" in x)
     assert "bin-picking-invalid.yaml:8:" in line
-    assert "'gripper'" in line and "'closed'" in line and "needs it open (pnp:Open)" in line
+    assert "'gripper'" in line and "'closed'" in line and line.endswith("the step needs it open")
+    assert "pnp:" not in result.stdout and "rests on" not in result.stdout
+    verbose = pnp("check", INVALID, "--cell", CELL, "--verbose").stdout
+    assert "needs it open (pnp:Open)" in verbose and "rests on:" in verbose and "gripper.scxml:" in verbose
 
 
 def test_check_of_the_bin_picking_task_exits_0() -> None:
@@ -91,13 +118,16 @@ def test_check_json() -> None:
                                                                  "http://plugnproduce.org/ontology#Open")
 
 
-def test_repair_proposes_inserting_open_gripper_first() -> None:
-    result = pnp("repair", INVALID, "--cell", CELL, "--top", "2")
+def test_repair_ranks_inserting_open_gripper_last_for_it_drops_the_part() -> None:
+    result = pnp("repair", INVALID, "--cell", CELL, "--top", "3")
     assert result.exit_code == 0, result.output
-    first = result.stdout.split("repair 1 (cost 2):")[1].split("repair 2")[0]
-    assert "insert open-gripper before step 2 (bin-pick)" in first
-    body = "\n".join(line[4:] for line in first.split("resulting task:\n")[1].splitlines())
+    last = result.stdout.split("repair 3 (cost 2):")[1]
+    assert "insert open-gripper before step 2 (bin-pick)" in last
+    assert "side effect: step 2 (open-gripper) opens device 'gripper', which holds the part" in last
+    body = "\n".join(line[4:] for line in last.split("resulting task:\n")[1].splitlines())
     assert [s["command"] for s in yaml.safe_load(body)["steps"]] == ["bin-pick", "open-gripper", "bin-pick", "place"]
+    first = result.stdout.split("repair 1 (cost 3):")[1].split("repair 2")[0]
+    assert "insert place before step 2 (bin-pick)" in first and "drops" not in first
 
 
 def test_repair_json_with_a_catalogue(tmp_path: Path) -> None:
@@ -110,7 +140,8 @@ def test_repair_json_with_a_catalogue(tmp_path: Path) -> None:
 def test_explain_a_step() -> None:
     result = pnp("explain", INVALID, "--cell", CELL, "--step", "2")
     assert result.exit_code == 1
-    assert "device 'gripper' is in state 'closed'" in result.stdout and "not satisfied" in result.stdout
+    assert "device 'gripper' is in state 'closed' ('closed'); role 'gripper' needs it 'open'" in result.stdout
+    assert "if device 'gripper' were in state 'open' (open) when step 2 starts" in result.stdout
 
 
 def test_bad_input_is_one_line_and_exit_2(tmp_path: Path) -> None:

@@ -40,22 +40,24 @@ def _cell(cell: Path, live: bool) -> Path | Cell:
     import asyncio
 
     return asyncio.run(service.live_cell(cell, knowledge(cell)))
+VERBOSE_OPTION = typer.Option(False, "--verbose", "-v",
+                              help="The engineer's view: ontology terms, rule instances, axioms and file:line.")
 
 
 def _bindings(bindings: tuple[dict[str, str], ...]) -> str:
     return " | ".join(" ".join(f"{r}={d}" for r, d in b.items()) for b in bindings)
 
 
-def _reasons(reasons: tuple[reasoning.Reason, ...], indent: str = "    ") -> None:
+def _reasons(reasons: tuple[reasoning.Reason, ...], verbose: bool, indent: str = "    ") -> None:
     for r in reasons:
-        typer.echo(f"{indent}- {r.text}")
-        if r.where:
+        typer.echo(f"{indent}- {r.text if verbose else r.plain}")
+        if r.where and verbose:
             typer.echo(f"{indent}  rests on: {', '.join(str(w) for w in r.where)}")
 
 
 @app.command()
 @boundary
-def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION,
+def capabilities(cell: Path = CELL_OPTION, verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION,
                  all_bindings: bool = typer.Option(False, "--all-bindings",
                                                    help="List every valid role binding, not just one.")) -> None:
     """Show the process commands a cell offers and why the others are not offered.
@@ -76,20 +78,20 @@ def capabilities(cell: Path = CELL_OPTION, json_out: bool = JSON_OPTION,
         typer.echo("not offered:")
     for n in caps.not_offered:
         typer.echo(f"  {n.command}")
-        _reasons(n.reasons)
+        _reasons(n.reasons, verbose)
 
 
-def _print_problems(result: reasoning.CheckResult) -> None:
+def _print_problems(result: reasoning.CheckResult, verbose: bool) -> None:
     for p in result.problems:
-        typer.echo(str(p))
-        if p.reason.where:
+        typer.echo(str(p) if verbose else f"{p.where}: {p.reason.plain}")
+        if p.reason.where and verbose:
             typer.echo(f"    rests on: {', '.join(str(w) for w in p.reason.where)}")
 
 
 @app.command()
 @boundary
 def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
-          live: bool = LIVE_OPTION, json_out: bool = JSON_OPTION) -> None:
+          live: bool = LIVE_OPTION, verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Check that a task is plausible: each step finds its devices in the states it starts from.
 
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
@@ -100,7 +102,7 @@ def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (
     else:
         verdict = "plausible" if result.plausible else f"implausible ({len(result.problems)} problem(s))"
         typer.echo(f"task {result.task} in cell {result.cell}: {verdict}")
-        _print_problems(result)
+        _print_problems(result, verbose)
     if not result.plausible:
         raise typer.Exit(1)
 
@@ -114,6 +116,7 @@ def repair(
                                           help="Devices a repair may add (a folder)."),
     top: int = typer.Option(3, "--top", min=1, max=20, metavar="K", help="How many distinct repairs, cheapest first."),
     live: bool = LIVE_OPTION,
+    verbose: bool = VERBOSE_OPTION,
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
@@ -123,7 +126,7 @@ def repair(
     """
     the_cell = _cell(cell, live)
     result = service.check(task, the_cell, knowledge(cell))
-    repairs = [] if result.plausible else service.repair(task, the_cell, catalogue, top, knowledge=knowledge(cell))
+    repairs = [] if result.plausible else service.assessed_repairs(task, the_cell, catalogue, top, knowledge(cell))
     players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
@@ -133,20 +136,36 @@ def repair(
         typer.echo(f"task {result.task} in cell {result.cell}: plausible; nothing to repair")
     else:
         typer.echo(f"task {result.task} in cell {result.cell}: implausible; {len(repairs)} repair(s)")
-        _print_problems(result)
+        _print_problems(result, verbose)
         for (i, role), devices in players.items():
             typer.echo(f"step {i}, role '{role}': " + (f"catalogue device(s) that could play it: {', '.join(devices)}"
                                                        + ("" if catalogue else " (repair with --catalogue to add one)")
                                                        if devices else "no catalogue device (built-in or library) "
                                                        "can play it"))
         for r in repairs:
-            typer.echo(f"\nrepair {r.rank} (cost {r.cost:g}):")
-            for e in r.edits:
+            typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}):")
+            for e in r.repair.edits:
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
+            for x in r.side_effects:
+                typer.echo(f"  side effect: {x.text}")
             typer.echo("  resulting task:")
-            typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.task).splitlines()), nl=False)
+            typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.repair.task).splitlines()), nl=False)
     if not result.plausible and not repairs:
         raise typer.Exit(1)
+
+
+def _tree(ex: reasoning.Explanation, depth: int | None, verbose: bool) -> None:
+    for level, sentence in ex.derivation.sentences(depth, verbose):
+        typer.echo(f"{'  ' * level}{'- ' if level else ''}{sentence}")
+    if ex.counterfactuals:
+        typer.echo("what would turn the answer around (each confirmed by the reasoner):" if ex.answer is False
+                   else "what it rests on (each confirmed by the reasoner):")
+        for c in ex.counterfactuals:
+            typer.echo(f"  - {c.text}")
+            for effect in c.side_effects:
+                typer.echo(f"    side effect: {effect}")
+    elif ex.none_exists:
+        typer.echo(f"no counterfactual: {ex.none_exists}")
 
 
 @app.command()
@@ -156,31 +175,30 @@ def explain(
     cell: Path = CELL_OPTION,
     step: int | None = typer.Option(None, "--step", metavar="N",
                                     help="Explain this step (1-based) of the task TARGET."),
+    depth: int | None = typer.Option(None, "--depth", min=0, metavar="N",
+                                     help="Print the derivation this many levels deep (default: all)."),
+    verbose: bool = VERBOSE_OPTION,
+    catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
+                                          help="Devices a counterfactual may add (default: the libraries' devices)."),
+    language: str = typer.Option("en", "--lang", metavar="TAG", help="Language of the ontology labels."),
     json_out: bool = JSON_OPTION,
 ) -> None:
-    """Why a process command is (not) offered, or why a task's step is (not) plausible. Exit 1 when it is not."""
+    """Why a process command is (not) offered, or why a task's step is (not) plausible: a derivation through the
+    rules, the ontology and the state charts, printed as sentences (deepest cause last), and the changes the
+    reasoner confirms would turn the answer around. Exit 1 when the answer is no."""
     if step is None:
         ex = service.explain_process(cell, target, knowledge(cell))
-        name = service.cell(cell, knowledge()).name
-        if json_out:
-            emit_json(ex.to_json())
-        elif ex.offered:
-            typer.echo(f"{ex.command} is offered in cell {name}: {_bindings(ex.bindings)}")
-        else:
-            typer.echo(f"{ex.command} is not offered in cell {name}:")
-            _reasons(ex.reasons, "  ")
-        ok = ex.offered
+        why = service.explain_offered(cell, target, knowledge(cell), catalogue, language)
+        payload = {**ex.to_json(), **why.to_json()}
     else:
         st = service.explain_step(Path(target), cell, step, knowledge(cell))
-        if json_out:
-            emit_json(st.to_json())
-        else:
-            typer.echo(f"step {st.step} ({st.command}): {'plausible' if st.plausible else 'not plausible'}")
-            _reasons(st.states, "  ")
-            for p in st.problems:
-                typer.echo(f"  problem: {p}")
-        ok = st.plausible
-    if not ok:
+        why = service.explain_plausible(Path(target), cell, step, knowledge(cell), language)
+        payload = {**st.to_json(), **why.to_json()}
+    if json_out:
+        emit_json(payload)
+    else:
+        _tree(why, depth, verbose)
+    if not why.answer:
         raise typer.Exit(1)
 
 

@@ -18,7 +18,7 @@ from plugnproduce.hmi import errors
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.interfaces import CellSource, Runner
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
-from plugnproduce.hmi.routes import cell, charts, runs, task
+from plugnproduce.hmi.routes import cell, charts, runs, sources, task
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders
 from plugnproduce.knowledge import Knowledge
 from plugnproduce.safeio import MAX_BYTES
@@ -71,7 +71,7 @@ def create_app(
     app.state.pictures = Pictures()
     app.state.generated = GeneratedCharts()
     errors.install(app)
-    for router in (cell.router, task.router, charts.router, runs.router):
+    for router in (cell.router, task.router, charts.router, runs.router, sources.router):
         app.include_router(router)
     folder = static_folder()
     app.mount("/static", StaticFiles(directory=folder), name="static")

@@ -8,8 +8,12 @@ Infeasible and implausible are results, never exceptions.
 
 from __future__ import annotations
 
+from plugnproduce.reasoning.axioms import ontology_of
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
 from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
+from plugnproduce.reasoning.counterfactuals import Counterfactual
+from plugnproduce.reasoning.counterfactuals import from_repairs as counterfactuals_from_repairs
+from plugnproduce.reasoning.derivation import Node
 from plugnproduce.reasoning.offers import capabilities, explain_process
 from plugnproduce.reasoning.plausibility import check, explain_step
 from plugnproduce.reasoning.results import (
@@ -26,9 +30,21 @@ from plugnproduce.reasoning.results import (
     StepCheck,
     StepExplanation,
 )
+from plugnproduce.reasoning.sideeffects import AssessedRepair, SideEffect, assess
+from plugnproduce.reasoning.why import Explanation, explain_offered, explain_plausible
 from plugnproduce.reasoning.windows import repair
 
 __all__ = [
+    "AssessedRepair",
+    "Counterfactual",
+    "Explanation",
+    "Node",
+    "SideEffect",
+    "assess",
+    "counterfactuals_from_repairs",
+    "explain_offered",
+    "explain_plausible",
+    "ontology_of",
     "BATCH_CSV_HEADER",
     "BatchRow",
     "Capabilities",

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from plugnproduce.description.model import Task, Where, plain_value
+
+_CURIE = re.compile(r" \((?:[A-Za-z][\w-]*:[\w-]+|https?://[^)\s]+)\)")
+"""The ``(prefix:Term)`` a reason's text adds after each label for the engineer."""
 
 
 @dataclass(frozen=True)
@@ -22,9 +26,15 @@ class Reason:
     def __str__(self) -> str:
         return f"{self.where[0]}: {self.text}" if self.where else self.text
 
+    @property
+    def plain(self) -> str:
+        """The sentence in plain words: the labels without the ontology terms they stand for."""
+        return _CURIE.sub("", self.text)
+
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
-        return {"code": self.code, "text": self.text, "iris": list(self.iris), "where": [str(w) for w in self.where]}
+        return {"code": self.code, "text": self.text, "plain": self.plain, "iris": list(self.iris),
+                "where": [str(w) for w in self.where]}
 
 
 @dataclass(frozen=True)
@@ -114,7 +124,8 @@ class Problem:
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         return {"step": self.step, "command": self.command, "kind": self.kind, "text": self.reason.text,
-                "where": str(self.where), "role": self.role, "device": self.device, "state": self.state,
+                "plain": self.reason.plain, "where": str(self.where), "role": self.role, "device": self.device,
+                "state": self.state,
                 "state_concept": self.state_concept, "needed": self.needed, "parameter": self.parameter,
                 "iris": list(self.reason.iris), "rests_on": [str(w) for w in self.reason.where]}
 

@@ -26,6 +26,7 @@ PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
     "cheapest": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_cheapest.lp"),
     "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
     "window": (("roles.lp", "chain.lp", "params.lp", "repair.lp", "window.lp"), "show_window.lp"),
+    "derivation": (("roles.lp", "offered.lp", "explain.lp"), "show_derivation.lp"),
 }
 """The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
 

@@ -67,8 +67,11 @@ def get_commands(hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 @router.get("/commands/{command}/explanation", dependencies=read,
             summary="Why a process command is (not) offered")
 def explain_command(command: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
-    """``service.explain_process``: the bindings, or the reasons with the terms and lines they rest on."""
-    return service.explain_process(hub.cell, command, hub.knowledge).to_json()
+    """``service.explain_process`` and ``service.explain_offered``: the bindings or the reasons, the derivation
+    tree (rules, ontology axioms, chart states, each with its line) and the counterfactuals the reasoner
+    confirms (catalogue devices to plug in or swap in; for an offered command, the devices it rests on)."""
+    why = service.explain_offered(hub.cell, command, hub.knowledge, hub.catalogue)
+    return {**service.explain_process(hub.cell, command, hub.knowledge).to_json(), **why.to_json()}
 
 
 @router.get("/processes", dependencies=read, summary="Every known process with its roles and parameters")

@@ -52,22 +52,26 @@ def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 
 @router.post("/repair", summary="Ranked minimal repairs of an implausible task")
 def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hub_of)) -> dict[str, Any]:
-    """``service.repair`` with the catalogue: each repair's edits, cost and resulting task (ready to apply)."""
+    """``service.assessed_repairs`` with the catalogue: each repair's edits, cost, side effects (ranked by them)
+    and resulting task (ready to apply)."""
     model, cell = task.to_task(), hub.planning_cell
     result = service.check(model, cell, hub.knowledge)
-    repairs = [] if result.plausible else service.repair(model, cell, hub.catalogue, top, knowledge=hub.knowledge)
+    repairs = [] if result.plausible else service.assessed_repairs(model, cell, hub.catalogue, top, hub.knowledge)
     return {
         "plausible": result.plausible,
         "problems": _rows([p.to_json() for p in result.problems], task),
-        "repairs": [{**r.to_json(), "task": task_json(r.task)} for r in repairs],
+        "repairs": [{**r.to_json(), "task": task_json(r.repair.task)} for r in repairs],
     }
 
 
 @router.post("/explain", summary="Why a step is (not) plausible")
 def explain(task: TaskIn, step: int = Query(..., ge=1, description="The step, from 1 in the repeated order"),
             hub: Hub = Depends(hub_of)) -> dict[str, Any]:
-    """``service.explain_step``: each device's state before the step, where it came from, what the step needs."""
-    return service.explain_step(task.to_task(), hub.planning_cell, step, hub.knowledge).to_json()
+    """``service.explain_step`` and ``service.explain_plausible``: each device's state before the step, where it
+    came from, what the step needs, the derivation tree and the states that would make the step plausible."""
+    model = task.to_task()
+    why = service.explain_plausible(model, hub.planning_cell, step, hub.knowledge)
+    return {**service.explain_step(model, hub.planning_cell, step, hub.knowledge).to_json(), **why.to_json()}
 
 
 @router.post("/generate", summary="Generate the SCXML charts of a plausible task")

@@ -1,6 +1,7 @@
 // The cell (devices with class, skills, protocol, state; plug and unplug) and the process commands.
 
 import { ApiError, del, get, post } from "./api.js";
+import { explanationView } from "./derivation.js";
 import { $, announce, fill, h } from "./dom.js";
 import { changed, state } from "./state.js";
 
@@ -96,16 +97,26 @@ async function toggleWhy(button, box, command) {
   try {
     const ex = await get(`/api/commands/${encodeURIComponent(command)}/explanation`);
     box.dataset.loaded = "1";
-    fill(box, h("ul", { class: "reasons" }, ex.reasons.map((r) => h("li", {}, r.text,
-      r.where.length ? h("span", { class: "where" }, ` (rests on ${r.where.map(shortWhere).join(", ")})`) : null))));
+    fill(box, explanationView(ex, applyCounterfactual, canApply));
   } catch (err) {
     fill(box, h("p", { class: "error" }, err.message));
   }
 }
 
-/** A description file and line, without its folder. */
-export function shortWhere(where) {
-  return String(where).split(/[\\/]/).pop();
+/** A counterfactual the page can carry out: plug a catalogue device in (after unplugging the one it replaces). */
+function canApply(c) {
+  return state.pluggable && (c.kind === "add_device" || c.kind === "swap_device");
+}
+
+async function applyCounterfactual(c) {
+  try {
+    if (c.replaces) await del(`/api/cell/devices/${encodeURIComponent(c.replaces)}`, { auth: true });
+    for (const device of c.devices) await post("/api/cell/devices", { device }, { auth: true });
+    announce(`Applied: ${c.text}.`);
+  } catch (err) {
+    announce(err.message);
+    alertError(err);
+  }
 }
 
 /** Show the offered process commands and, behind "Why not?", the others. */

@@ -2,7 +2,7 @@
 // ranked repairs applied with one click; why a step is (not) plausible; YAML in and out.
 
 import { api, post } from "./api.js";
-import { shortWhere } from "./cell.js";
+import { explanationView } from "./derivation.js";
 import { editStep } from "./dialog.js";
 import { $, announce, fill, h, showValue } from "./dom.js";
 import { changed, offer, saveTask, state, taskBody } from "./state.js";
@@ -120,8 +120,7 @@ async function why(problem, box, button) {
   if (open) return;
   try {
     const ex = await post(`/api/task/explain?step=${problem.step}`, taskBody());
-    fill(box, h("ul", { class: "reasons" }, ex.states.map((r) => h("li", {}, r.text,
-      r.where.length ? h("span", { class: "where" }, ` (rests on ${r.where.map(shortWhere).join(", ")})`) : null))));
+    fill(box, explanationView(ex));
   } catch (err) {
     fill(box, h("p", { class: "error" }, err.message));
   }
@@ -133,7 +132,7 @@ function problemItem(p, i) {
   const button = h("button", { type: "button", class: "quiet", "aria-expanded": "false", "aria-controls": id,
     onclick: () => why(p, box, button) }, "Why?");
   const round = p.round > 1 ? ` (round ${p.round})` : "";
-  return h("li", { class: "problem", dataset: { kind: p.kind } }, h("span", {}, p.text + round), " ", button, box);
+  return h("li", { class: "problem", dataset: { kind: p.kind } }, h("span", {}, (p.plain || p.text) + round), " ", button, box);
 }
 
 function applyRepair(repair) {
@@ -148,7 +147,8 @@ function repairItem(r) {
   return h("li", { class: "repair", dataset: { rank: r.rank } },
     h("div", { class: "repair-text" },
       h("ul", { class: "edits" }, r.edits.map((e) => h("li", {}, e.text))),
-      h("span", { class: "cost" }, `cost ${r.cost}`), added),
+      h("span", { class: "cost" }, `cost ${r.cost}`), added,
+      (r.side_effects || []).map((e) => h("p", { class: "side-effect", dataset: { kind: e.kind } }, `Side effect: ${e.text}`))),
     h("button", { type: "button", class: "apply primary", "aria-label": `Apply repair ${r.rank}: ${r.edits.map((e) => e.text).join("; ")}`,
       onclick: () => applyRepair(r) }, "Apply"));
 }
@@ -180,7 +180,7 @@ export function renderCheck() {
     ? h("p", { class: "ok" }, `Plausible: every step finds its devices in the states it starts from.`)
     : h("p", { class: "bad" }, `Not plausible: ${c.problems.length} problem${c.problems.length === 1 ? "" : "s"}`,
       c.repairs.length ? `; ${c.repairs.length} repair${c.repairs.length === 1 ? "" : "s"} below.` : "; no repair found."),
-  unplaced.map((p) => h("p", { class: "error" }, p.text)));
+  unplaced.map((p) => h("p", { class: "error" }, p.plain || p.text)));
   $("#repairs").hidden = c.plausible || c.repairs.length === 0;
   fill($("#repair-list"), c.repairs.map(repairItem));
 }

@@ -3,6 +3,7 @@
 import { get, onTokenNeeded, setToken, token, tokenFromAddress } from "./api.js";
 import { initCell, takeCell } from "./cell.js";
 import { initCharts, renderChartChoices, showChart } from "./charts.js";
+import { initDerivations } from "./derivation.js";
 import { $ } from "./dom.js";
 import { addStep, initEditor, renderTask, scheduleCheck } from "./editor.js";
 import { initRun, renderRun, renderStart, takeDeviceState, takeRecord } from "./run.js";
@@ -74,6 +75,7 @@ async function boot() {
   state.pluggable = cell.pluggable;
   state.catalogue = catalogue;
   initCell({ onAdd: addStep, onChart: showChart });
+  initDerivations();
   initEditor();
   initCharts();
   initZoom();

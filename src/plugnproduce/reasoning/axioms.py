@@ -1,0 +1,191 @@
+"""OWL evidence for explanations: the asserted TBox axioms with the ``file:line`` they are written at, labels in
+plain words (rdfs:label, by language tag), and minimal justifications of what the reasoner derived.
+
+HermiT (through owlready2) answers *whether* a class is subsumed or implies a skill, but gives no justification.
+A justification is therefore computed here: the shortest chain of asserted axioms (named subclass and
+equivalence axioms, and ``C ⊑ ∃hasSkill.S`` restrictions) that entails the fact. A chain of one axiom means the
+fact is asserted; a longer one means the reasoner inferred it. Every justification is offered only when the
+reasoner's closure agrees with it.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import deque
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import rdflib
+from rdflib.namespace import OWL, RDFS
+
+from plugnproduce.description.model import Where
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import PNP, local_name
+from plugnproduce.safeio import parse_turtle
+
+DEFAULT_LANGUAGE = "en"
+"""The language of an untagged rdfs:label."""
+
+
+@dataclass(frozen=True)
+class Axiom:
+    """One asserted TBox axiom: ``sub ⊑ sup`` (kind ``subclass``), ``sub ≡ sup`` (``equivalent``) or
+    ``sub ⊑ ∃hasSkill.sup`` (``has_skill``), and where it is written."""
+
+    kind: str
+    sub: str
+    sup: str
+    where: Where
+
+    def formula(self) -> str:
+        """The axiom in DL notation with local names, e.g. ``ParallelGripper ⊑ ∃hasSkill.CanParallelGrip``."""
+        a, b = local_name(self.sub), local_name(self.sup)
+        return {"subclass": f"{a} ⊑ {b}", "equivalent": f"{a} ≡ {b}"}.get(self.kind, f"{a} ⊑ ∃hasSkill.{b}")
+
+
+class Labels:
+    """rdfs:label of every term, by language tag; an untagged label counts as :data:`DEFAULT_LANGUAGE`."""
+
+    def __init__(self, labels: dict[tuple[str, str], str], fallback: dict[str, str] | None = None):
+        self._labels = labels
+        self._fallback = fallback or {}
+
+    @classmethod
+    def from_graph(cls, g: rdflib.Graph, fallback: dict[str, str] | None = None) -> Labels:
+        """The labels a graph states."""
+        out: dict[tuple[str, str], str] = {}
+        for s, o in g.subject_objects(RDFS.label):
+            if isinstance(s, rdflib.URIRef) and isinstance(o, rdflib.Literal):
+                out.setdefault((str(s), (o.language or DEFAULT_LANGUAGE).lower()), str(o))
+        return cls(out, fallback)
+
+    def label(self, iri: str, language: str = DEFAULT_LANGUAGE) -> str:
+        """The label of ``iri`` in ``language``, else in the default language, else its local name in words."""
+        for lang in (language.lower(), DEFAULT_LANGUAGE):
+            if (iri, lang) in self._labels:
+                return self._labels[(iri, lang)]
+        if iri in self._fallback:
+            return self._fallback[iri]
+        return re.sub(r"(?<=[a-z0-9])(?=[A-Z])", " ", local_name(iri)).lower()
+
+    def languages(self) -> list[str]:
+        """The language tags some label is given in."""
+        return sorted({lang for _, lang in self._labels})
+
+
+class Ontology:
+    """The asserted axioms of the TBox files, indexed for justification search, and their labels."""
+
+    def __init__(self, axioms: Iterable[Axiom], labels: Labels):
+        self.axioms = tuple(axioms)
+        self.labels = labels
+        self._out: dict[str, list[Axiom]] = {}
+        for a in self.axioms:
+            self._out.setdefault(a.sub, []).append(a)
+            if a.kind == "equivalent":
+                self._out.setdefault(a.sup, []).append(Axiom("equivalent", a.sup, a.sub, a.where))
+
+    def subsumption(self, sub: str, sup: str, taxonomy: Taxonomy) -> tuple[Axiom, ...] | None:
+        """The shortest chain of named subclass/equivalence axioms entailing ``sub ⊑ sup`` (empty when equal),
+        or None when the reasoner does not derive it or no such chain is asserted."""
+        if not taxonomy.is_a(sub, sup):
+            return None
+        if sub == sup:
+            return ()
+        return self._search(sub, lambda a, _: a.kind != "has_skill", (sup, 0))
+
+    def implied_skill(self, cls: str, skill: str, taxonomy: Taxonomy) -> tuple[Axiom, ...] | None:
+        """The shortest chain ``cls ⊑ … ⊑ ∃hasSkill.S1``, ``S1 ⊑ … ⊑ skill``, when the reasoner derives that a
+        device of class ``cls`` has ``skill``."""
+        if skill not in taxonomy.implied_skills.get(cls, frozenset()):
+            return None
+        return self._search(cls, lambda a, phase: a.kind != "has_skill" or phase == 0, (skill, 1))
+
+    def _search(self, start: str, usable: Callable[[Axiom, int], bool],
+                goal: tuple[str, int]) -> tuple[Axiom, ...] | None:
+        """Breadth first over (class, phase): phase 0 walks the start's superclasses, phase 1 (after a
+        ``∃hasSkill`` restriction) walks skills."""
+        seen = {(start, 0)}
+        queue: deque[tuple[tuple[str, int], tuple[Axiom, ...]]] = deque([((start, 0), ())])
+        while queue:
+            (iri, phase), chain = queue.popleft()
+            for a in self._out.get(iri, []):
+                if not usable(a, phase):
+                    continue
+                nxt = (a.sup, 1 if a.kind == "has_skill" else phase)
+                if nxt == goal:
+                    return (*chain, a)
+                if nxt not in seen:
+                    seen.add(nxt)
+                    queue.append((nxt, (*chain, a)))
+        return None
+
+
+def _curies(g: rdflib.Graph, iri: str) -> list[str]:
+    out = [f"<{iri}>"]
+    for prefix, ns in g.namespaces():
+        if prefix and iri.startswith(str(ns)):
+            out.append(f"{prefix}:{iri[len(str(ns)):]}")
+    return out
+
+
+def _line(lines: list[str], g: rdflib.Graph, subject: str, obj: str) -> int | None:
+    """The line of the statement about ``subject`` that names ``obj`` (or the subject's first line)."""
+    start = re.compile(r"^\s*(" + "|".join(re.escape(c) for c in _curies(g, subject)) + r")(\s|$)")
+    named = re.compile("|".join(re.escape(c) + r"(?![\w-])" for c in _curies(g, obj)))
+    for n, text in enumerate(lines):
+        if not start.match(text):
+            continue
+        for m in range(n, len(lines)):
+            if named.search(lines[m] if m > n else lines[m][start.match(text).end():]):  # type: ignore[union-attr]
+                return m + 1
+            if lines[m].rstrip().endswith(" ."):
+                break
+        return n + 1
+    return None
+
+
+def _file_axioms(path: Path) -> tuple[list[Axiom], rdflib.Graph]:
+    g, _ = parse_turtle(path)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    out: list[Axiom] = []
+
+    def add(kind: str, s: str, o: str, named: str) -> None:
+        out.append(Axiom(kind, s, o, Where(str(path), _line(lines, g, s, named))))
+
+    for s, o in g.subject_objects(RDFS.subClassOf):
+        if not isinstance(s, rdflib.URIRef):
+            continue
+        if isinstance(o, rdflib.URIRef):
+            add("subclass", str(s), str(o), str(o))
+        elif g.value(o, OWL.onProperty) == PNP.hasSkill and isinstance(g.value(o, OWL.someValuesFrom), rdflib.URIRef):
+            skill = str(g.value(o, OWL.someValuesFrom))
+            add("has_skill", str(s), skill, skill)
+    for s, o in g.subject_objects(OWL.equivalentClass):
+        if isinstance(s, rdflib.URIRef) and isinstance(o, rdflib.URIRef):
+            add("equivalent", str(s), str(o), str(o))
+    return out, g
+
+
+def load_ontology(files: Iterable[Path], taxonomy: Taxonomy) -> Ontology:
+    """The asserted axioms and labels of the TBox ``files`` (labels the files lack come from ``taxonomy``)."""
+    axioms: list[Axiom] = []
+    graph = rdflib.Graph()
+    for path in files:
+        found, g = _file_axioms(path)
+        axioms += found
+        graph += g
+    return Ontology(sorted(axioms, key=lambda a: (a.where.file, a.where.line or 0)),
+                    Labels.from_graph(graph, taxonomy.labels))
+
+
+_LOADED: dict[tuple[tuple[str, ...], str], Ontology] = {}
+
+
+def ontology_of(files: Iterable[Path], taxonomy: Taxonomy) -> Ontology:
+    """:func:`load_ontology`, read once per set of files and closure (the TBox does not change while it runs)."""
+    key = (tuple(str(f) for f in files), taxonomy.digest)
+    if key not in _LOADED:
+        _LOADED[key] = load_ontology([Path(f) for f in key[0]], taxonomy)
+    return _LOADED[key]
