@@ -11,7 +11,7 @@ import contextlib
 import os
 import secrets
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -219,21 +219,26 @@ def explain_step(task_or_path: TaskArg, cell_or_path: CellArg, n: int,
 
 
 def batch(
-    configurations: list[reasoning.Configuration] | str | Path,
+    configurations: Iterable[reasoning.Configuration] | str | Path,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     tasks: list[Task | str | Path] | None = None,
     workers: int = 2,
     progress: Callable[[int], None] | None = None,
     knowledge: Knowledge | None = None,
+    top: int = 1,
+    cluster: str | None = None,
 ) -> Iterator[reasoning.BatchRow]:
-    """Feasibility of many configurations (a list, or a JSONL/CSV file of device lists) of catalogue devices:
-    per configuration the offered processes, the plausible tasks, and for the others the cheapest device to add."""
+    """Feasibility of many configurations (an iterable, or a JSONL/CSV file of device lists) of catalogue
+    devices, streamed in order: per configuration the offered processes, the plausible tasks, and when
+    some task is not, the ``top`` cheapest sets of catalogue devices to add (or why none suffices).
+    ``cluster``: a Dask scheduler address (``tcp://host:8786``) or ``local:N`` (N local worker processes)."""
     k = _k(knowledge)
     devices = _devices(catalogue_or_folder, k)
-    configs = (configurations if isinstance(configurations, list)
-               else reasoning.read_configurations(configurations))
+    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+               else configurations)
+    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
     return reasoning.batch(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
-                           workers=workers, progress=progress)
+                           workers=workers, progress=progress, top=top, mapper=mapper)
 
 
 def generate_configurations(
@@ -242,8 +247,8 @@ def generate_configurations(
     seed: int,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     knowledge: Knowledge | None = None,
-) -> list[reasoning.Configuration]:
-    """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices."""
+) -> Iterator[reasoning.Configuration]:
+    """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices, generated lazily."""
     return reasoning.generate(_devices(catalogue_or_folder, _k(knowledge)), count, sizes, seed)
 
 

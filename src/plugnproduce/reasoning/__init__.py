@@ -9,8 +9,11 @@ Infeasible and implausible are results, never exceptions.
 from __future__ import annotations
 
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
-from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
+from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, engine, generate, read_configurations
+from plugnproduce.reasoning.cluster import check_address as check_cluster_address
+from plugnproduce.reasoning.cluster import cluster_mapper
 from plugnproduce.reasoning.offers import capabilities, explain_process
+from plugnproduce.reasoning.purchases import Purchase
 from plugnproduce.reasoning.plausibility import check, explain_step
 from plugnproduce.reasoning.repairs import repair
 from plugnproduce.reasoning.results import (
@@ -38,6 +41,7 @@ __all__ = [
     "NotOffered",
     "Offer",
     "Problem",
+    "Purchase",
     "ProcessExplanation",
     "Reason",
     "Repair",
@@ -47,6 +51,9 @@ __all__ = [
     "batch",
     "capabilities",
     "check",
+    "check_cluster_address",
+    "cluster_mapper",
+    "engine",
     "explain_process",
     "explain_step",
     "generate",

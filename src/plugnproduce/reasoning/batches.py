@@ -1,42 +1,45 @@
-"""Feasibility of many cell configurations against all processes and given tasks (batch.lp).
+"""Feasibility of many cell configurations: offered processes, plausible tasks, cheapest purchases.
 
-No search is needed, so many configurations are grounded together in one ``Control``
-(a chunk), and chunks run on a pool of worker processes. Configurations are sets of
-catalogue devices: equal sets are reasoned about once. For a task that is not plausible,
-stage 1 finds the catalogue devices that fill every missing role; stage 2 checks the
-configuration plus each of them and keeps the cheapest that makes the task plausible
-("none" when one device is not enough).
+What depends on one device is reasoned once (:mod:`.abilities`); each configuration only
+combines those answers (:mod:`.feasibility`, :mod:`.purchases`). Configurations stream in and
+rows stream out in input order: chunks of configurations go to worker processes (or a Dask
+cluster, :mod:`.cluster`) with a bounded number in flight, so memory does not grow with the
+number of configurations.
 """
 
 from __future__ import annotations
 
 import csv
+import itertools
 import json
 import random
-from collections import Counter, defaultdict
+from collections import defaultdict, deque
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.reasoning import schema as s
-from plugnproduce.reasoning import solver
-from plugnproduce.reasoning.facts import config_facts, fact_book, task_facts
-from plugnproduce.reasoning.terms import Atom, program
+from plugnproduce.reasoning.abilities import Abilities, abilities
+from plugnproduce.reasoning.feasibility import Feasibility
+from plugnproduce.reasoning.purchases import Purchase, purchase
 
-CHUNK = 400
-"""Configurations grounded together in one Control."""
+CHUNK = 2_000
+"""Configurations sent to a worker at a time."""
+MAX_LINE = 1 << 20
+"""Longest configuration line read (bytes)."""
 
 
 @dataclass(frozen=True)
 class Configuration:
-    """A candidate cell: a name and the catalogue devices plugged in."""
+    """A candidate cell: a name and the catalogue devices plugged in (and where it was read)."""
 
     name: str
     devices: tuple[str, ...]
+    file: str | None = field(default=None, compare=False)
+    line: int | None = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)
@@ -47,133 +50,152 @@ class BatchRow:
     devices: tuple[str, ...]
     offered: tuple[str, ...]
     plausible: tuple[str, ...]
-    cheapest: dict[str, str | None] = field(default_factory=dict)
-    """Each task that is not plausible → the cheapest catalogue device whose addition makes it plausible."""
+    purchase: Purchase | None = None
+    """The cheapest sets of devices to add so every task is plausible; None when they all are."""
 
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         return {"config": self.config, "devices": list(self.devices), "offered": list(self.offered),
-                "plausible": list(self.plausible), "cheapest_device": dict(self.cheapest)}
+                "plausible": list(self.plausible),
+                "purchase": self.purchase.to_json() if self.purchase is not None else None}
 
     def to_csv(self) -> list[str]:
         """A CSV row (see :data:`CSV_HEADER`); lists are space separated."""
-        cheapest = " ".join(f"{t}={d or '-'}" for t, d in self.cheapest.items())
-        return [self.config, " ".join(self.devices), " ".join(self.offered), " ".join(self.plausible), cheapest]
+        bought = self.purchase.text() if self.purchase is not None else ""
+        return [self.config, " ".join(self.devices), " ".join(self.offered), " ".join(self.plausible), bought]
 
 
-CSV_HEADER = ["config", "devices", "offered", "plausible", "cheapest_device"]
+CSV_HEADER = ["config", "devices", "offered", "plausible", "purchase"]
 
 
 # ------------------------------------------------------------------ configurations in
 
 
 def generate(catalogue: Sequence[DeviceDescription], count: int, sizes: tuple[int, int],
-             seed: int) -> list[Configuration]:
-    """``count`` random configurations of ``sizes[0]`` to ``sizes[1]`` distinct catalogue devices."""
+             seed: int) -> Iterator[Configuration]:
+    """``count`` random configurations of ``sizes[0]`` to ``sizes[1]`` distinct catalogue devices, lazily."""
     ids = sorted(d.id for d in catalogue)
     low, high = max(0, sizes[0]), min(len(ids), sizes[1])
     if low > high:
         raise ValueError(f"sizes {sizes[0]}-{sizes[1]} do not fit a catalogue of {len(ids)} devices")
+    return _generated(ids, count, low, high, seed)
+
+
+def _generated(ids: list[str], count: int, low: int, high: int, seed: int) -> Iterator[Configuration]:
     rng = random.Random(seed)
     width = len(str(count))
-    return [Configuration(f"g{n:0{width}d}", tuple(sorted(rng.sample(ids, rng.randint(low, high)))))
-            for n in range(1, count + 1)]
+    for n in range(1, count + 1):
+        yield Configuration(f"g{n:0{width}d}", tuple(sorted(rng.sample(ids, rng.randint(low, high)))))
 
 
-def read_configurations(path: str | Path) -> list[Configuration]:
-    """Configurations from JSONL (``{"config": name, "devices": [ids]}`` a line) or CSV (config, devices)."""
+def read_configurations(path: str | Path) -> Iterator[Configuration]:
+    """Configurations read one line at a time from JSONL (``{"config": name, "devices": [ids]}``) or CSV."""
     p = Path(path)
-    text = p.read_text(encoding="utf-8")
     if p.suffix.lower() == ".csv":
-        rows = list(csv.reader(text.splitlines()))
-        start = 1 if rows and rows[0] and rows[0][0].strip().lower() == "config" else 0
-        return [_config(p, n + 1, r[0], (r[1] if len(r) > 1 else "").replace(";", " ").split())
-                for n, r in enumerate(rows[start:], start=start) if r]
-    out = []
-    for n, line in enumerate(text.splitlines(), start=1):
+        return _csv(p)
+    return _jsonl(p)
+
+
+def _lines(path: Path) -> Iterator[tuple[int, str]]:
+    with path.open(encoding="utf-8") as f:
+        for n, line in enumerate(f, start=1):
+            if len(line) > MAX_LINE:
+                raise DescriptionError(f"line longer than {MAX_LINE} characters", path, n)
+            yield n, line
+
+
+def _jsonl(path: Path) -> Iterator[Configuration]:
+    for n, line in _lines(path):
         if not line.strip():
             continue
         try:
             doc = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise DescriptionError(f"not a JSON object: {exc.msg}", p, n) from exc
-        if not isinstance(doc, dict) or not isinstance(doc.get("devices"), list):
-            raise DescriptionError('expected {"config": NAME, "devices": [DEVICE-ID, ...]}', p, n)
-        out.append(_config(p, n, str(doc.get("config", f"c{n}")), [str(d) for d in doc["devices"]]))
-    return out
+        except (json.JSONDecodeError, RecursionError) as exc:
+            raise DescriptionError(f"not a JSON object: {getattr(exc, 'msg', 'nested too deep')}", path, n) from exc
+        if (not isinstance(doc, dict) or not isinstance(doc.get("devices"), list)
+                or not all(isinstance(d, str) for d in doc["devices"])):
+            raise DescriptionError('expected {"config": NAME, "devices": [DEVICE-ID, ...]}', path, n)
+        yield _config(path, n, str(doc.get("config", f"c{n}")), doc["devices"])
+
+
+def _csv(path: Path) -> Iterator[Configuration]:
+    with path.open(encoding="utf-8", newline="") as f:
+        reader = csv.reader(f)
+        try:
+            for row in reader:
+                n = reader.line_num
+                if not row or (n == 1 and row[0].strip().lower() == "config"):
+                    continue
+                yield _config(path, n, row[0], (row[1] if len(row) > 1 else "").replace(";", " ").split())
+        except csv.Error as exc:
+            raise DescriptionError(f"not a CSV row: {exc}", path, reader.line_num) from exc
 
 
 def _config(path: Path, line: int, name: str, devices: list[str]) -> Configuration:
     if len(set(devices)) != len(devices):
         raise DescriptionError(f"configuration {name!r} lists a device twice", path, line)
-    return Configuration(name, tuple(devices))
+    return Configuration(name, tuple(devices), str(path), line)
 
 
 # ------------------------------------------------------------------ the work of one chunk (in a worker)
 
-_STATIC = ""
-_TASKS: tuple[str, ...] = ()
+
+class Engine:
+    """Answers configurations from the per-device :class:`Abilities`; purchases are remembered like findings."""
+
+    def __init__(self, abilities: Abilities, top: int = 1) -> None:
+        self.feasibility = Feasibility(abilities)
+        self.top = top
+        self._bits = {d: 1 << n for n, d in enumerate(abilities.devices)}
+        relevant = 0
+        for r in self.feasibility.relevant:
+            relevant |= r
+        self._relevant = relevant
+        self._bought: dict[int, Purchase | None] = {}
+
+    def mask(self, config: Configuration) -> int:
+        """The configuration as a bit mask; an unknown device is bad input."""
+        out = 0
+        for d in config.devices:
+            bit = self._bits.get(d)
+            if bit is None:
+                raise DescriptionError(f"device {d!r} of configuration {config.name!r} is not in the catalogue",
+                                       config.file, config.line)
+            out |= bit
+        return out
+
+    def row(self, config: Configuration) -> BatchRow:
+        """The answer for one configuration."""
+        mask = self.mask(config)
+        f = self.feasibility
+        return BatchRow(config.name, config.devices, f.offered(mask), f.plausible(mask), self._purchase(mask))
+
+    def _purchase(self, mask: int) -> Purchase | None:
+        key = mask & self._relevant
+        if key not in self._bought:
+            if len(self._bought) >= 1 << 16:
+                self._bought.clear()
+            self._bought[key] = purchase(self.feasibility, mask, self.top)
+        return self._bought[key]
 
 
-def _init(static: str, tasks: tuple[str, ...]) -> None:
-    global _STATIC, _TASKS
-    _STATIC, _TASKS = static, tasks
+_ENGINE: Engine | None = None
 
 
-def _checks(names: Iterable[str]) -> list[Atom]:
-    return [s.Check(c, t) for c in names for t in _TASKS]
+def _start(engine: Engine) -> None:
+    global _ENGINE
+    _ENGINE = engine
 
 
-Chunk = list[tuple[str, tuple[str, ...]]]
-"""Configurations (key, device ids) grounded together."""
-Answer = tuple[str, list[str], list[str], dict[str, str | None]]
-"""Key, offered processes, plausible tasks, cheapest device per task that is not plausible."""
-
-
-def run_chunk(chunk: Chunk) -> list[Answer]:
-    """Offered processes, plausible tasks and cheapest additions for a chunk of (name, devices)."""
-    facts: list[Atom] = []
-    for name, devices in chunk:
-        facts += config_facts(name, devices)
-    model = solver.solve(solver.BATCH, _STATIC + program(facts + _checks(n for n, _ in chunk)))
-    offered: dict[str, list[str]] = defaultdict(list)
-    for o in model[s.Offered]:
-        offered[o.c].append(o.p)
-    plausible: dict[str, list[str]] = defaultdict(list)
-    for p in model[s.Plausible]:
-        plausible[p.c].append(p.t)
-    cheapest = _stage2(dict(chunk), model[s.Addable]) if _TASKS else {}
-    out = []
-    for name, _ in chunk:
-        missing = {t: cheapest.get((name, t)) for t in _TASKS if t not in plausible[name]}
-        out.append((name, sorted(offered[name]), sorted(plausible[name], key=_TASKS.index), missing))
-    return out
-
-
-def _stage2(devices: dict[str, tuple[str, ...]], addable: list[s.Addable]) -> dict[tuple[str, str], str]:
-    if not addable:
-        return {}
-    facts: list[Atom] = []
-    for n, a in enumerate(addable):
-        v = f"v{n}"
-        facts += config_facts(v, (*devices[a.c], a.a))
-        facts += [s.Variant(v, a.c, a.a), s.Check(v, a.t)]
-    model = solver.solve(solver.CHEAPEST, _STATIC + program(facts))
-    best: dict[tuple[str, str], str] = {}
-    for c in sorted(model[s.Cheapest], key=lambda x: x.a, reverse=True):
-        best[(c.c, c.t)] = c.a  # ties: the first id wins
-    return best
+def run_chunk(chunk: list[Configuration], engine: Engine | None = None) -> list[BatchRow]:
+    """The rows of a chunk of configurations (in a worker, the engine its start-up was given)."""
+    e = engine or _ENGINE
+    if e is None:
+        raise RuntimeError("run_chunk needs an engine")
+    return [e.row(c) for c in chunk]
 
 
 # ------------------------------------------------------------------ the batch
-
-
-def static_program(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]], taxonomy: Taxonomy,
-                   processes: Sequence[ProcessDescription]) -> str:
-    """Facts shared by every configuration: processes, catalogue devices, tasks."""
-    book = fact_book(taxonomy, processes)
-    return (book.process_text() + book.devices_text(catalogue)
-            + program(a for name, t in tasks for a in task_facts(t, name)))
 
 
 def task_names(tasks: Sequence[Task]) -> list[tuple[str, Task]]:
@@ -186,8 +208,18 @@ def task_names(tasks: Sequence[Task]) -> list[tuple[str, Task]]:
     return out
 
 
+def engine(catalogue: Sequence[DeviceDescription], tasks: Sequence[Task], taxonomy: Taxonomy,
+           processes: Sequence[ProcessDescription], top: int = 1) -> Engine:
+    """Reason once over the catalogue and tasks; the engine then answers any configuration of them."""
+    return Engine(abilities(catalogue, task_names(tasks), taxonomy, processes), top)
+
+
+Mapper = Callable[[Engine, Iterator[list[Configuration]]], Iterator[list[BatchRow]]]
+"""Runs chunks somewhere (here, a process pool, a Dask cluster) and yields their rows in chunk order."""
+
+
 def batch(
-    configurations: Sequence[Configuration],
+    configurations: Iterable[Configuration],
     catalogue: Sequence[DeviceDescription],
     tasks: Sequence[Task],
     taxonomy: Taxonomy,
@@ -195,36 +227,34 @@ def batch(
     workers: int = 2,
     chunk: int = CHUNK,
     progress: Callable[[int], None] | None = None,
+    top: int = 1,
+    mapper: Mapper | None = None,
 ) -> Iterator[BatchRow]:
     """One :class:`BatchRow` per configuration, in order; ``progress(n)`` is told as configurations finish."""
-    known = {d.id for d in catalogue}
-    for c in configurations:
-        unknown = sorted(set(c.devices) - known)
-        if unknown:
-            raise KeyError(f"device {unknown[0]!r} (configuration {c.name!r}); not in the catalogue")
-    named = task_names(tasks)
-    static = static_program(catalogue, named, taxonomy, processes)
-    names = tuple(n for n, _ in named)
-    weight = Counter(frozenset(c.devices) for c in configurations)
-    unique = sorted(weight, key=sorted)
-    keys = {u: f"u{n}" for n, u in enumerate(unique)}
-    sets = {k: u for u, k in keys.items()}
-    jobs = [[(keys[u], tuple(sorted(u))) for u in unique[i:i + chunk]] for i in range(0, len(unique), chunk)]
-    results: dict[str, tuple[list[str], list[str], dict[str, str | None]]] = {}
-    for part in _map(jobs, static, names, workers):
-        for key, offered, plausible, cheapest in part:
-            results[key] = (offered, plausible, cheapest)
+    e = engine(catalogue, tasks, taxonomy, processes, top)
+    chunks = _chunks(configurations, chunk)
+    run = mapper or (lambda eng, cs: _pool(eng, cs, workers))
+    for rows in run(e, chunks):
+        yield from rows
         if progress is not None:
-            progress(sum(weight[sets[key]] for key, *_ in part))
-    for c in configurations:
-        offered, plausible, cheapest = results[keys[frozenset(c.devices)]]
-        yield BatchRow(c.name, c.devices, tuple(offered), tuple(plausible), cheapest)
+            progress(len(rows))
 
 
-def _map(jobs: list[Chunk], static: str, names: tuple[str, ...], workers: int) -> Iterator[list[Answer]]:
-    if workers <= 1 or len(jobs) <= 1:
-        _init(static, names)
-        yield from (run_chunk(j) for j in jobs)
+def _chunks(configurations: Iterable[Configuration], size: int) -> Iterator[list[Configuration]]:
+    it = iter(configurations)
+    while part := list(itertools.islice(it, size)):
+        yield part
+
+
+def _pool(e: Engine, chunks: Iterator[list[Configuration]], workers: int) -> Iterator[list[BatchRow]]:
+    if workers <= 1:
+        yield from (run_chunk(c, e) for c in chunks)
         return
-    with ProcessPoolExecutor(workers, initializer=_init, initargs=(static, names)) as pool:
-        yield from pool.map(run_chunk, jobs)
+    with ProcessPoolExecutor(workers, initializer=_start, initargs=(e,)) as pool:
+        pending: deque[Future[list[BatchRow]]] = deque()
+        for c in chunks:
+            pending.append(pool.submit(run_chunk, c))
+            if len(pending) >= 2 * workers:
+                yield pending.popleft().result()
+        while pending:
+            yield pending.popleft().result()

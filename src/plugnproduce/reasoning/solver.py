@@ -21,8 +21,7 @@ PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
     "capabilities": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
     "offered": (("roles.lp", "offered.lp"), "show_capabilities.lp"),
     "check": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"), "show_check.lp"),
-    "batch": (("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_batch.lp"),
-    "cheapest": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_cheapest.lp"),
+    "abilities": (("roles.lp", "params.lp"), "show_abilities.lp"),
     "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
 }
 """The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
@@ -34,8 +33,8 @@ def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
     return concerns + (shown,) if show else concerns
 
 
-CAPABILITIES, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR = (
-    rules(p) for p in ("capabilities", "offered", "check", "batch", "cheapest", "repair"))
+CAPABILITIES, OFFERED, CHECK, ABILITIES, REPAIR = (
+    rules(p) for p in ("capabilities", "offered", "check", "abilities", "repair"))
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""

@@ -42,19 +42,17 @@ from plugnproduce.reasoning.schema.inputs import (
     StepFact,
     ValueKind,
     ValueNum,
-    Variant,
 )
 from plugnproduce.reasoning.schema.outputs import (
     Absent,
-    Addable,
     Ambiguous,
     At,
     BadType,
+    BadValue,
     Binding,
     Bound,
     CannotPlay,
     CanPlay,
-    Cheapest,
     Edit,
     LacksState,
     LeftBy,
@@ -76,10 +74,10 @@ from plugnproduce.reasoning.schema.outputs import (
 
 __all__ = [
     "Absent",
-    "Addable",
     "Ambiguous",
     "At",
     "BadType",
+    "BadValue",
     "Bind",
     "Binding",
     "Bound",
@@ -87,7 +85,6 @@ __all__ = [
     "CannotPlay",
     "Catalogue",
     "ChartState",
-    "Cheapest",
     "Check",
     "Config",
     "Cost",
@@ -134,6 +131,5 @@ __all__ = [
     "Unreachable",
     "ValueKind",
     "ValueNum",
-    "Variant",
     "WrongState",
 ]
