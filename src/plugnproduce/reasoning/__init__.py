@@ -9,12 +9,21 @@ Infeasible and implausible are results, never exceptions.
 from __future__ import annotations
 
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
-from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, engine, generate, read_configurations
+from plugnproduce.reasoning.batches import (
+    BatchRow,
+    Configuration,
+    batch,
+    bounded_lines,
+    configurations_from,
+    engine,
+    generate,
+    read_configurations,
+)
 from plugnproduce.reasoning.cluster import check_address as check_cluster_address
 from plugnproduce.reasoning.cluster import cluster_mapper
 from plugnproduce.reasoning.offers import capabilities, explain_process
-from plugnproduce.reasoning.purchases import Purchase
 from plugnproduce.reasoning.plausibility import check, explain_step
+from plugnproduce.reasoning.purchases import Purchase
 from plugnproduce.reasoning.repairs import repair
 from plugnproduce.reasoning.results import (
     Capabilities,
@@ -52,7 +61,9 @@ __all__ = [
     "capabilities",
     "check",
     "check_cluster_address",
+    "bounded_lines",
     "cluster_mapper",
+    "configurations_from",
     "engine",
     "explain_process",
     "explain_step",

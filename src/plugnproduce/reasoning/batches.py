@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TextIO
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import DescriptionError
@@ -91,31 +92,34 @@ def _generated(ids: list[str], count: int, low: int, high: int, seed: int) -> It
 def read_configurations(path: str | Path) -> Iterator[Configuration]:
     """Configurations read one line at a time from JSONL (``{"config": name, "devices": [ids]}``) or CSV."""
     p = Path(path)
-    if p.suffix.lower() == ".csv":
-        return _csv(p)
-    return _jsonl(p)
+    return _csv(p) if p.suffix.lower() == ".csv" else _jsonl_file(p)
 
 
-def _lines(path: Path) -> Iterator[tuple[int, str]]:
+def _jsonl_file(path: Path) -> Iterator[Configuration]:
     with path.open(encoding="utf-8") as f:
-        for n, line in enumerate(f, start=1):
-            if len(line) > MAX_LINE:
-                raise DescriptionError(f"line longer than {MAX_LINE} characters", path, n)
-            yield n, line
+        yield from configurations_from(bounded_lines(f), str(path))
 
 
-def _jsonl(path: Path) -> Iterator[Configuration]:
-    for n, line in _lines(path):
+def bounded_lines(stream: TextIO) -> Iterator[str]:
+    """The lines of a text stream, none read past :data:`MAX_LINE` characters (a longer one is cut there)."""
+    return iter(lambda: stream.readline(MAX_LINE + 1), "")
+
+
+def configurations_from(lines: Iterable[str], source: str) -> Iterator[Configuration]:
+    """Configurations from JSONL lines (a file, standard input); ``source`` names them in messages."""
+    for n, line in enumerate(lines, start=1):
         if not line.strip():
             continue
+        if len(line) > MAX_LINE:
+            raise DescriptionError(f"line longer than {MAX_LINE} characters", source, n)
         try:
             doc = json.loads(line)
         except (json.JSONDecodeError, RecursionError) as exc:
-            raise DescriptionError(f"not a JSON object: {getattr(exc, 'msg', 'nested too deep')}", path, n) from exc
+            raise DescriptionError(f"not a JSON object: {getattr(exc, 'msg', 'nested too deep')}", source, n) from exc
         if (not isinstance(doc, dict) or not isinstance(doc.get("devices"), list)
                 or not all(isinstance(d, str) for d in doc["devices"])):
-            raise DescriptionError('expected {"config": NAME, "devices": [DEVICE-ID, ...]}', path, n)
-        yield _config(path, n, str(doc.get("config", f"c{n}")), doc["devices"])
+            raise DescriptionError('expected {"config": NAME, "devices": [DEVICE-ID, ...]}', source, n)
+        yield _config(source, n, str(doc.get("config", f"c{n}")), doc["devices"])
 
 
 def _csv(path: Path) -> Iterator[Configuration]:
@@ -126,15 +130,15 @@ def _csv(path: Path) -> Iterator[Configuration]:
                 n = reader.line_num
                 if not row or (n == 1 and row[0].strip().lower() == "config"):
                     continue
-                yield _config(path, n, row[0], (row[1] if len(row) > 1 else "").replace(";", " ").split())
+                yield _config(str(path), n, row[0], (row[1] if len(row) > 1 else "").replace(";", " ").split())
         except csv.Error as exc:
             raise DescriptionError(f"not a CSV row: {exc}", path, reader.line_num) from exc
 
 
-def _config(path: Path, line: int, name: str, devices: list[str]) -> Configuration:
+def _config(source: str, line: int, name: str, devices: list[str]) -> Configuration:
     if len(set(devices)) != len(devices):
-        raise DescriptionError(f"configuration {name!r} lists a device twice", path, line)
-    return Configuration(name, tuple(devices), str(path), line)
+        raise DescriptionError(f"configuration {name!r} lists a device twice", source, line)
+    return Configuration(name, tuple(devices), source, line)
 
 
 # ------------------------------------------------------------------ the work of one chunk (in a worker)

@@ -51,11 +51,13 @@ def _client(address: str) -> Iterator[Client]:
 
     local = LOCAL.fullmatch(address)
     if local is None:
-        with Client(address) as client:
+        with Client(address) as client:  # type: ignore[no-untyped-call]
             yield client
         return
-    with LocalCluster(n_workers=int(local.group(1)), threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+    workers = int(local.group(1))
+    with (LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,  # type: ignore[no-untyped-call]
+                       dashboard_address=None) as cluster,
+          Client(cluster) as client):  # type: ignore[no-untyped-call]
         yield client
 
 
