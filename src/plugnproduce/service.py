@@ -241,6 +241,28 @@ def batch(
                            workers=workers, progress=progress, top=top, mapper=mapper)
 
 
+def batch_report(
+    configurations: Iterable[reasoning.Configuration] | str | Path,
+    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+    tasks: list[Task | str | Path] | None = None,
+    form: str = "jsonl",
+    workers: int = 2,
+    progress: Callable[[int], None] | None = None,
+    knowledge: Knowledge | None = None,
+    top: int = 1,
+    cluster: str | None = None,
+) -> Iterator[str]:
+    """:func:`batch`'s answers as report text (JSONL, or CSV rows with ``form`` "csv"), a chunk at a time,
+    made by the workers: what ``pnp batch`` writes."""
+    k = _k(knowledge)
+    devices = _devices(catalogue_or_folder, k)
+    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+               else configurations)
+    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
+    return reasoning.report(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+                            form=form, workers=workers, progress=progress, top=top, mapper=mapper)
+
+
 def generate_configurations(
     count: int,
     sizes: tuple[int, int],

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import json
 import random
 from pathlib import Path
 
@@ -160,3 +161,9 @@ def test_an_unknown_device_is_bad_input_at_its_line(tmp_path: Path) -> None:
     with pytest.raises(DescriptionError, match="hoverboard") as err:
         list(service.batch(path, DESCRIPTIONS / "devices", tasks(), workers=1))
     assert err.value.location_message().startswith(f"{path}:2:")
+
+
+def test_the_report_text_is_each_row_as_json() -> None:
+    configs = list(generate(service.catalogue(), 400, (0, 7), seed=8))
+    text = "".join(service.batch_report(configs, None, tasks(), workers=1, top=2))
+    assert text == "".join(json.dumps(r.to_json()) + "\n" for r in rows(configs, top=2))

@@ -8,9 +8,8 @@ from __future__ import annotations
 
 import contextlib
 import csv
-import json
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -227,35 +226,33 @@ def batch(
         configurations = reasoning.configurations_from(reasoning.bounded_lines(sys.stdin), "<stdin>")
     else:
         configurations = reasoning.read_configurations(configs)  # type: ignore[arg-type]
-    rows = service.batch(configurations, devices, list(tasks), workers, knowledge=knowledge(), top=top,
-                         cluster=cluster)
     as_csv = output is not None and output.suffix.lower() == ".csv"
     with contextlib.ExitStack() as stack:
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
-        written = _write(rows, out, as_csv, total)
+        if as_csv:
+            csv.writer(out, lineterminator="\n").writerow(reasoning.BATCH_CSV_HEADER)
+        written = _write(lambda progress: service.batch_report(
+            configurations, devices, list(tasks), "csv" if as_csv else "jsonl", workers, progress,
+            knowledge=knowledge(), top=top, cluster=cluster), out, total)
     if output is not None:
         typer.echo(f"wrote {written} configurations to {output}", err=True)
 
 
-def _write(rows: Iterator[reasoning.BatchRow], out: TextIO, as_csv: bool, total: int | None) -> int:
-    """Write rows as they come, with a progress bar on a terminal; the number written."""
+def _write(report: Callable[[Callable[[int], None]], Iterator[str]], out: TextIO, total: int | None) -> int:
+    """Write the report as it comes, with a progress bar on a terminal; the number of configurations written."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    writer = csv.writer(out, lineterminator="\n")
-    if as_csv:
-        writer.writerow(reasoning.BATCH_CSV_HEADER)
     columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     written = 0
     with Progress(*columns, console=Console(stderr=True), transient=True, disable=not on_a_terminal()) as bar:
         job = bar.add_task("batch", total=total)
-        for row in rows:
-            if as_csv:
-                writer.writerow(row.to_csv())
-            else:
-                out.write(json.dumps(row.to_json()) + "\n")
-            written += 1
-            if written % 1000 == 0:
-                bar.update(job, completed=written)
-        bar.update(job, completed=written)
+
+        def advance(n: int) -> None:
+            nonlocal written
+            written += n
+            bar.update(job, completed=written)
+
+        for text in report(advance):
+            out.write(text)
     return written

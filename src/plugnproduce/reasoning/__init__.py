@@ -18,6 +18,7 @@ from plugnproduce.reasoning.batches import (
     engine,
     generate,
     read_configurations,
+    report,
 )
 from plugnproduce.reasoning.cluster import check_address as check_cluster_address
 from plugnproduce.reasoning.cluster import cluster_mapper
@@ -70,4 +71,5 @@ __all__ = [
     "generate",
     "read_configurations",
     "repair",
+    "report",
 ]

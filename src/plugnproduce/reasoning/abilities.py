@@ -74,13 +74,12 @@ class Abilities:
     """(process, role, device) → start state → states playing the role leaves the device in."""
     recovers: dict[tuple[str, str, int], frozenset[str]]
     tasks: tuple[TaskSpec, ...]
+    bits: dict[str, int]
+    """Each catalogue device's bit."""
 
     def bit(self, device: str) -> int:
         """The bit of a catalogue device (0 when it is not in the catalogue)."""
-        try:
-            return 1 << self.devices.index(device)
-        except ValueError:
-            return 0
+        return self.bits.get(device, 0)
 
 
 def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]], taxonomy: Taxonomy,
@@ -109,6 +108,7 @@ def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str,
         recovers=_recovers(dev_atoms, index),
         tasks=tuple(_task(name, t, processes, bad, _refusing(devices, processes, taxonomy))
                     for name, t in tasks),
+        bits={d.id: 1 << n for n, d in enumerate(devices)},
     )
 
 

@@ -10,6 +10,7 @@ number of configurations.
 from __future__ import annotations
 
 import csv
+import io
 import itertools
 import json
 import random
@@ -18,13 +19,13 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO
+from typing import TextIO, cast
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.abilities import Abilities, abilities
-from plugnproduce.reasoning.feasibility import Feasibility
+from plugnproduce.reasoning.feasibility import MEMORY, Feasibility, Key
 from plugnproduce.reasoning.purchases import Purchase, purchase
 
 CHUNK = 2_000
@@ -150,12 +151,11 @@ class Engine:
     def __init__(self, abilities: Abilities, top: int = 1) -> None:
         self.feasibility = Feasibility(abilities)
         self.top = top
-        self._bits = {d: 1 << n for n, d in enumerate(abilities.devices)}
-        relevant = 0
-        for r in self.feasibility.relevant:
-            relevant |= r
-        self._relevant = relevant
-        self._bought: dict[int, Purchase | None] = {}
+        self._bits = abilities.bits
+        self._tasks = range(len(abilities.tasks))
+        self._bought: dict[tuple[Key, ...], Purchase | None] = {}
+        self._names = tuple(t.name for t in abilities.tasks)
+        self._json: dict[object, str] = {}
 
     def mask(self, config: Configuration) -> int:
         """The configuration as a bit mask; an unknown device is bad input."""
@@ -170,17 +170,44 @@ class Engine:
 
     def row(self, config: Configuration) -> BatchRow:
         """The answer for one configuration."""
-        mask = self.mask(config)
-        f = self.feasibility
-        return BatchRow(config.name, config.devices, f.offered(mask), f.plausible(mask), self._purchase(mask))
+        return BatchRow(config.name, config.devices, *self._answer(self.mask(config)))
 
-    def _purchase(self, mask: int) -> Purchase | None:
-        key = mask & self._relevant
-        if key not in self._bought:
-            if len(self._bought) >= 1 << 16:
+    def _answer(self, mask: int) -> tuple[tuple[str, ...], tuple[str, ...], Purchase | None]:
+        f = self.feasibility
+        keys = tuple(f.key(t, mask) for t in self._tasks)
+        plausible = tuple(self._names[t] for t in self._tasks if not f.findings(t, mask, keys[t]))
+        if len(plausible) == len(keys):
+            return f.offered(mask), plausible, None
+        # a purchase depends on the configuration only through its tasks' keys (see purchases.py)
+        if keys not in self._bought:
+            if len(self._bought) >= MEMORY:
                 self._bought.clear()
-            self._bought[key] = purchase(self.feasibility, mask, self.top)
-        return self._bought[key]
+            self._bought[keys] = purchase(f, mask, self.top)
+        return f.offered(mask), plausible, self._bought[keys]
+
+    def line(self, config: Configuration) -> str:
+        """The JSONL line of one configuration: ``json.dumps(row.to_json())``, answers' JSON remembered."""
+        offered, plausible, bought = self._answer(self.mask(config))
+        return (f'{{"config": {json.dumps(config.name)}, "devices": {json.dumps(list(config.devices))}, '
+                f'"offered": {self._dumped(offered)}, "plausible": {self._dumped(plausible)}, '
+                f'"purchase": {self._dumped(bought)}}}\n')
+
+    def _dumped(self, value: tuple[str, ...] | Purchase | None) -> str:
+        text = self._json.get(value)
+        if text is None:
+            if len(self._json) >= MEMORY:
+                self._json.clear()
+            data = value.to_json() if isinstance(value, Purchase) else list(value) if value is not None else None
+            text = self._json[value] = json.dumps(data)
+        return text
+
+    def text(self, configs: list[Configuration], form: str) -> str:
+        """The report of some configurations: JSONL lines, or CSV rows (``form`` "csv")."""
+        if form != "csv":
+            return "".join(self.line(c) for c in configs)
+        buf = io.StringIO()
+        csv.writer(buf, lineterminator="\n").writerows(self.row(c).to_csv() for c in configs)
+        return buf.getvalue()
 
 
 _ENGINE: Engine | None = None
@@ -191,12 +218,13 @@ def _start(engine: Engine) -> None:
     _ENGINE = engine
 
 
-def run_chunk(chunk: list[Configuration], engine: Engine | None = None) -> list[BatchRow]:
-    """The rows of a chunk of configurations (in a worker, the engine its start-up was given)."""
+def run_chunk(chunk: list[Configuration], form: str = "rows", engine: Engine | None = None) -> list[BatchRow] | str:
+    """Rows for a chunk of configurations, or their report text (``form`` "jsonl" or "csv"); in a worker,
+    with the engine its start-up was given."""
     e = engine or _ENGINE
     if e is None:
         raise RuntimeError("run_chunk needs an engine")
-    return [e.row(c) for c in chunk]
+    return [e.row(c) for c in chunk] if form == "rows" else e.text(chunk, form)
 
 
 # ------------------------------------------------------------------ the batch
@@ -218,8 +246,10 @@ def engine(catalogue: Sequence[DeviceDescription], tasks: Sequence[Task], taxono
     return Engine(abilities(catalogue, task_names(tasks), taxonomy, processes), top)
 
 
-Mapper = Callable[[Engine, Iterator[list[Configuration]]], Iterator[list[BatchRow]]]
-"""Runs chunks somewhere (here, a process pool, a Dask cluster) and yields their rows in chunk order."""
+Part = list[BatchRow] | str
+Mapper = Callable[[Engine, Iterator[list[Configuration]], str], Iterator[Part]]
+"""Runs chunks somewhere (here, a process pool, a Dask cluster) in a form ("rows", "jsonl", "csv") and
+yields their answers in chunk order."""
 
 
 def batch(
@@ -236,28 +266,57 @@ def batch(
 ) -> Iterator[BatchRow]:
     """One :class:`BatchRow` per configuration, in order; ``progress(n)`` is told as configurations finish."""
     e = engine(catalogue, tasks, taxonomy, processes, top)
-    chunks = _chunks(configurations, chunk)
-    run = mapper or (lambda eng, cs: _pool(eng, cs, workers))
-    for rows in run(e, chunks):
-        yield from rows
+    for part, n in _run(e, configurations, "rows", workers, chunk, mapper):
+        yield from cast(list[BatchRow], part)
         if progress is not None:
-            progress(len(rows))
+            progress(n)
 
 
-def _chunks(configurations: Iterable[Configuration], size: int) -> Iterator[list[Configuration]]:
-    it = iter(configurations)
-    while part := list(itertools.islice(it, size)):
-        yield part
+def report(
+    configurations: Iterable[Configuration],
+    catalogue: Sequence[DeviceDescription],
+    tasks: Sequence[Task],
+    taxonomy: Taxonomy,
+    processes: Sequence[ProcessDescription],
+    form: str = "jsonl",
+    workers: int = 2,
+    chunk: int = CHUNK,
+    progress: Callable[[int], None] | None = None,
+    top: int = 1,
+    mapper: Mapper | None = None,
+) -> Iterator[str]:
+    """The report of :func:`batch` as text, a chunk at a time: JSONL lines (``BatchRow.to_json``) or CSV rows
+    (``form`` "csv", without the header). The text is made where the chunk is answered (in the workers)."""
+    e = engine(catalogue, tasks, taxonomy, processes, top)
+    for part, n in _run(e, configurations, form, workers, chunk, mapper):
+        yield cast(str, part)
+        if progress is not None:
+            progress(n)
 
 
-def _pool(e: Engine, chunks: Iterator[list[Configuration]], workers: int) -> Iterator[list[BatchRow]]:
+def _run(e: Engine, configurations: Iterable[Configuration], form: str, workers: int, chunk: int,
+         mapper: Mapper | None) -> Iterator[tuple[Part, int]]:
+    sizes: deque[int] = deque()
+
+    def chunks() -> Iterator[list[Configuration]]:
+        it = iter(configurations)
+        while part := list(itertools.islice(it, chunk)):
+            sizes.append(len(part))
+            yield part
+
+    run = mapper or (lambda eng, cs, f: _pool(eng, cs, f, workers))
+    for part in run(e, chunks(), form):
+        yield part, sizes.popleft()
+
+
+def _pool(e: Engine, chunks: Iterator[list[Configuration]], form: str, workers: int) -> Iterator[Part]:
     if workers <= 1:
-        yield from (run_chunk(c, e) for c in chunks)
+        yield from (run_chunk(c, form, e) for c in chunks)
         return
     with ProcessPoolExecutor(workers, initializer=_start, initargs=(e,)) as pool:
-        pending: deque[Future[list[BatchRow]]] = deque()
+        pending: deque[Future[Part]] = deque()
         for c in chunks:
-            pending.append(pool.submit(run_chunk, c))
+            pending.append(pool.submit(run_chunk, c, form))
             if len(pending) >= 2 * workers:
                 yield pending.popleft().result()
         while pending:

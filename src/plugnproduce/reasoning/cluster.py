@@ -15,7 +15,7 @@ from collections import deque
 from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
-from plugnproduce.reasoning.batches import BatchRow, Configuration, Engine, Mapper, run_chunk
+from plugnproduce.reasoning.batches import Configuration, Engine, Mapper, Part, run_chunk
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -38,9 +38,9 @@ def cluster_mapper(address: str) -> Mapper:
     """A :data:`.batches.Mapper` that runs chunks on the cluster at ``address`` (see :func:`check_address`)."""
     check_address(address)
 
-    def run(engine: Engine, chunks: Iterator[list[Configuration]]) -> Iterator[list[BatchRow]]:
+    def run(engine: Engine, chunks: Iterator[list[Configuration]], form: str) -> Iterator[Part]:
         with _client(address) as client:
-            yield from _ordered(client, engine, chunks)
+            yield from _ordered(client, engine, chunks, form)
 
     return run
 
@@ -61,12 +61,12 @@ def _client(address: str) -> Iterator[Client]:
         yield client
 
 
-def _ordered(client: Client, engine: Engine, chunks: Iterator[list[Configuration]]) -> Iterator[list[BatchRow]]:
+def _ordered(client: Client, engine: Engine, chunks: Iterator[list[Configuration]], form: str) -> Iterator[Part]:
     shared = client.submit(_same, engine, pure=False)
     window = 2 * max(1, len(client.scheduler_info().get("workers", {})))
     pending: deque[Any] = deque()
     for chunk in chunks:
-        pending.append(client.submit(run_chunk, chunk, shared, retries=RETRIES, pure=False))
+        pending.append(client.submit(run_chunk, chunk, form, shared, retries=RETRIES, pure=False))
         if len(pending) >= window:
             yield pending.popleft().result()
     while pending:

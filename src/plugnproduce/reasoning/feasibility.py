@@ -14,8 +14,10 @@ those of ``offered.lp``, ``resolve.lp`` and ``chain.lp``, applied to the per-dev
 - a parameter value given to a bound device none of whose commands accepts its quantity is
   ``not_accepted`` (accepts.py).
 
-A task's answer depends only on which of the devices that could play one of its roles are
-present, so it is remembered by that part of the mask (bounded: the memory is cleared when full).
+A task's answer depends only on, for each role it leaves to the configuration, whether none, one
+(which) or several of the devices that can play it are present, and on whether each device it
+names is present: answers are remembered by that key, and offered processes by the set of roles
+the configuration's devices can fill (bounded: a memory is cleared when full).
 """
 
 from __future__ import annotations
@@ -28,7 +30,9 @@ Finding = tuple[str, int, str, str]
 """Why a task is not plausible: (kind, step, role, device); role and device are "" where they do not apply."""
 
 MEMORY = 1 << 16
-"""Answers remembered per task before the memory is cleared."""
+"""Answers remembered per task (and offered-process sets) before that memory is cleared."""
+
+Key = tuple[int, ...]
 
 
 class Feasibility:
@@ -36,25 +40,43 @@ class Feasibility:
 
     def __init__(self, abilities: Abilities) -> None:
         self.abilities = abilities
-        self._offer = [(p, tuple(abilities.players.get((p, r), 0) for r in roles))
-                       for p, roles in abilities.processes]
-        self.relevant = tuple(_relevant(abilities, t) for t in abilities.tasks)
-        """Per task, the devices (bit mask) whose presence can change its answer."""
-        self._memo: list[dict[int, tuple[Finding, ...]]] = [{} for _ in abilities.tasks]
+        index = {pr: n for n, pr in enumerate(sorted(abilities.players))}
+        self._fills = tuple(sum(1 << index[pr] for pr, m in abilities.players.items() if m >> d & 1)
+                            for d in range(len(abilities.devices)))
+        self._needs = tuple((p, sum(1 << index[(p, r)] for r in roles))
+                            for p, roles in abilities.processes if all((p, r) in index for r in roles))
+        self._offered: dict[int, tuple[str, ...]] = {}
+        self._keys = tuple(_key_masks(abilities, t) for t in abilities.tasks)
+        self._memo: list[dict[Key, tuple[Finding, ...]]] = [{} for _ in abilities.tasks]
 
     def offered(self, mask: int) -> tuple[str, ...]:
         """The processes a configuration offers, sorted."""
-        return tuple(p for p, roles in self._offer if all(mask & m for m in roles))
+        fill = 0
+        while mask:
+            low = mask & -mask
+            fill |= self._fills[low.bit_length() - 1]
+            mask ^= low
+        found = self._offered.get(fill)
+        if found is None:
+            if len(self._offered) >= MEMORY:
+                self._offered.clear()
+            found = self._offered[fill] = tuple(p for p, need in self._needs if fill & need == need)
+        return found
 
-    def findings(self, task: int, mask: int) -> tuple[Finding, ...]:
-        """Why task number ``task`` is not plausible in a configuration (empty: it is plausible)."""
-        key = mask & self.relevant[task]
+    def key(self, task: int, mask: int) -> Key:
+        """What task number ``task``'s answer depends on: per role the one present player, 0 or -1 (several)."""
+        return tuple(x if not x & (x - 1) else -1 for x in (mask & m for m in self._keys[task]))
+
+    def findings(self, task: int, mask: int, key: Key | None = None) -> tuple[Finding, ...]:
+        """Why task number ``task`` is not plausible in a configuration (empty: it is plausible);
+        ``key``: its :meth:`key` if already known."""
+        key = key if key is not None else self.key(task, mask)
         memo = self._memo[task]
         found = memo.get(key)
         if found is None:
             if len(memo) >= MEMORY:
                 memo.clear()
-            found = memo[key] = _findings(self.abilities, self.abilities.tasks[task], key)
+            found = memo[key] = _findings(self.abilities, self.abilities.tasks[task], mask)
         return found
 
     def plausible(self, mask: int) -> tuple[str, ...]:
@@ -62,12 +84,13 @@ class Feasibility:
         return tuple(t.name for n, t in enumerate(self.abilities.tasks) if not self.findings(n, mask))
 
 
-def _relevant(ab: Abilities, task: TaskSpec) -> int:
-    out = 0
+def _key_masks(ab: Abilities, task: TaskSpec) -> tuple[int, ...]:
+    """The player masks of the roles a task leaves to the configuration, and the bits of the devices it names."""
+    out: set[int] = set()
     for step in task.steps:
         for role, named in step.roles:
-            out |= ab.bit(named) if named is not None else ab.players.get((step.process or "", role), 0)
-    return out
+            out.add(ab.bit(named) if named is not None else ab.players.get((step.process or "", role), 0))
+    return tuple(sorted(out))
 
 
 Binding = tuple[tuple[str, int], ...]
