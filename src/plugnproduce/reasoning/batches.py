@@ -310,9 +310,11 @@ def _run(e: Engine, configurations: Iterable[Configuration], form: str, workers:
 
 
 def _pool(e: Engine, chunks: Iterator[list[Configuration]], form: str, workers: int) -> Iterator[Part]:
-    if workers <= 1:
-        yield from (run_chunk(c, form, e) for c in chunks)
+    first = list(itertools.islice(chunks, 1))
+    if workers <= 1 or not (second := list(itertools.islice(chunks, 1))):  # one chunk: no pool to start
+        yield from (run_chunk(c, form, e) for c in itertools.chain(first, chunks))
         return
+    chunks = itertools.chain(first, second, chunks)
     with ProcessPoolExecutor(workers, initializer=_start, initargs=(e,)) as pool:
         pending: deque[Future[Part]] = deque()
         for c in chunks:
