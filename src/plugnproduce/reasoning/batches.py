@@ -43,6 +43,10 @@ class Configuration:
     file: str | None = field(default=None, compare=False)
     line: int | None = field(default=None, compare=False)
 
+    def __reduce__(self) -> tuple[type[Configuration], tuple[str, tuple[str, ...], str | None, int | None]]:
+        """Pickled as its fields (half the time of a dataclass's default): chunks go to workers by pickle."""
+        return Configuration, (self.name, self.devices, self.file, self.line)
+
 
 @dataclass(frozen=True)
 class BatchRow:
