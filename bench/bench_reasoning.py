@@ -47,7 +47,7 @@ def bench_offered(runs: int = 200) -> None:
 
 def bench_batch(count: int, seed: int) -> float:
     """Throughput of batch(); returns the seconds per configuration of the processes-only run."""
-    configs = service.generate_configurations(count, (2, 6), seed)
+    configs = list(service.generate_configurations(count, (2, 6), seed))
     distinct = len({frozenset(c.devices) for c in configs})
     tasks = [service.task(service.builtin("tasks", f"{n}.yaml"))
              for n in ("bin-picking", "bin-picking-invalid", "pick-and-place")]
@@ -119,7 +119,7 @@ def _offered_class(g: rdflib.Graph, process: str, skills: list[str]) -> None:
 
 def bench_owl(sample: int, seed: int, asp_per_config: float) -> None:
     """HermiT per configuration on a sample, against the batch's time per configuration."""
-    configs = service.generate_configurations(sample, (2, 6), seed + 1)
+    configs = list(service.generate_configurations(sample, (2, 6), seed + 1))
     tbox = read_tbox(ontology_files())
     asp = {r.config: set(r.offered) for r in service.batch(configs, workers=1)}
     times, agree = [], 0

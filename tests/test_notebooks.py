@@ -24,6 +24,14 @@ EXPECTED: dict[str, list[str]] = {
         r"plausible: True",
         r"outcome: succeeded",
     ],
+    "batch-feasibility": [
+        r"256 configurations answered",
+        r"plausible for every task: 1\b",
+        r"binpicking-pc\+robot\+sensor3d: cheapest purchase gripper \(1800\)",
+        r"binpicking-pc\+sensor3d: cheapest purchase gripper\+robot \(33800\)",
+        r"\d+ cells: step 2 of bin-picking: several devices can play role gripper",
+        r"coverage 2: from cost 45800",
+    ],
     "cell-planner": [
         r"offered +pick +gripper=gripper robot=robot",
         r"not +screw +role 'screwdriver' of screw needs a device that can screw",

@@ -12,7 +12,7 @@ import dataclasses
 import os
 import secrets
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -267,21 +267,48 @@ def assessed_repairs(
 
 
 def batch(
-    configurations: list[reasoning.Configuration] | str | Path,
+    configurations: Iterable[reasoning.Configuration] | str | Path,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     tasks: list[Task | str | Path] | None = None,
     workers: int = 2,
     progress: Callable[[int], None] | None = None,
     knowledge: Knowledge | None = None,
+    top: int = 1,
+    cluster: str | None = None,
 ) -> Iterator[reasoning.BatchRow]:
-    """Feasibility of many configurations (a list, or a JSONL/CSV file of device lists) of catalogue devices:
-    per configuration the offered processes, the plausible tasks, and for the others the cheapest device to add."""
+    """Feasibility of many configurations (an iterable, or a JSONL/CSV file of device lists) of catalogue
+    devices, streamed in order: per configuration the offered processes, the plausible tasks, and when
+    some task is not, the ``top`` cheapest sets of catalogue devices to add (or why none suffices).
+    ``cluster``: a Dask scheduler address (``tcp://host:8786``) or ``local:N`` (N local worker processes)."""
     k = _k(knowledge)
     devices = _devices(catalogue_or_folder, k)
-    configs = (configurations if isinstance(configurations, list)
-               else reasoning.read_configurations(configurations))
+    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+               else configurations)
+    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
     return reasoning.batch(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
-                           workers=workers, progress=progress)
+                           workers=workers, progress=progress, top=top, mapper=mapper)
+
+
+def batch_report(
+    configurations: Iterable[reasoning.Configuration] | str | Path,
+    catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+    tasks: list[Task | str | Path] | None = None,
+    form: str = "jsonl",
+    workers: int = 2,
+    progress: Callable[[int], None] | None = None,
+    knowledge: Knowledge | None = None,
+    top: int = 1,
+    cluster: str | None = None,
+) -> Iterator[str]:
+    """:func:`batch`'s answers as report text (JSONL, or CSV rows with ``form`` "csv"), a chunk at a time,
+    made by the workers: what ``pnp batch`` writes."""
+    k = _k(knowledge)
+    devices = _devices(catalogue_or_folder, k)
+    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+               else configurations)
+    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
+    return reasoning.report(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+                            form=form, workers=workers, progress=progress, top=top, mapper=mapper)
 
 
 def generate_configurations(
@@ -290,8 +317,8 @@ def generate_configurations(
     seed: int,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     knowledge: Knowledge | None = None,
-) -> list[reasoning.Configuration]:
-    """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices."""
+) -> Iterator[reasoning.Configuration]:
+    """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices, generated lazily."""
     return reasoning.generate(_devices(catalogue_or_folder, _k(knowledge)), count, sizes, seed)
 
 

@@ -1,65 +1,169 @@
-"""Batch feasibility of many configurations."""
+"""Batch feasibility of many configurations: offered processes, plausible tasks, cheapest purchases."""
 
 from __future__ import annotations
 
+import itertools
+import json
+import random
 from pathlib import Path
 
 import pytest
 
 from plugnproduce import service
+from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
-from plugnproduce.reasoning import Configuration, generate, read_configurations
-from tests.reasoning.conftest import task, write
+from plugnproduce.reasoning import Configuration, engine, generate, read_configurations
+from tests.reasoning.conftest import DESCRIPTIONS, task, write
 
 PAPER = ("binpicking-pc", "gripper", "robot", "sensor3d")
+LIBRARY = Path(__file__).parent.parent / "data" / "libraries" / "machine-tending"
 
 
-def rows(configs: list[Configuration], workers: int = 1):
-    tasks = [task("bin-picking"), task("pick-and-place")]
-    return list(service.batch(configs, service.catalogue(), tasks, workers=workers))
+def tasks() -> list[Task]:
+    return [task("bin-picking"), task("pick-and-place")]
 
 
-def test_the_paper_cell_runs_both_tasks() -> None:
+def rows(configs: list[Configuration], workers: int = 1, top: int = 1, catalogue: list[DeviceDescription] | None = None):
+    return list(service.batch(configs, catalogue or service.catalogue(), tasks(), workers=workers, top=top))
+
+
+def cost(*ids: str) -> int:
+    return sum(round(d.cost) for d in service.catalogue() if d.id in ids)
+
+
+def test_the_paper_cell_runs_both_tasks_and_needs_no_purchase() -> None:
     (row,) = rows([Configuration("paper", PAPER)])
     assert {"pick", "place", "bin-pick"} <= set(row.offered)
-    assert row.plausible == ("bin-picking", "pick-and-place") and row.cheapest == {}
+    assert row.plausible == ("bin-picking", "pick-and-place") and row.purchase is None
 
 
-def test_the_cheapest_device_to_add_is_named() -> None:
+def test_the_cheapest_device_to_add_is_named_with_its_cost() -> None:
     (row,) = rows([Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d"))])
     assert row.plausible == ()
-    assert row.cheapest == {"bin-picking": "gripper", "pick-and-place": "magnetic-gripper"}
+    assert row.purchase is not None and row.purchase.options == ((("gripper",), cost("gripper")),)
 
 
-def test_none_when_one_device_is_not_enough() -> None:
-    (row,) = rows([Configuration("sensor-only", ("sensor3d",))])
-    assert row.cheapest == {"bin-picking": None, "pick-and-place": None}
+def test_two_missing_devices_are_bought_together() -> None:
+    (row,) = rows([Configuration("sensing-only", ("binpicking-pc", "sensor3d"))])
+    assert row.purchase is not None
+    assert row.purchase.options[0] == (("gripper", "robot"), cost("gripper", "robot"))
+
+
+def test_alternatives_come_cheapest_first() -> None:
+    (row,) = service.batch([Configuration("gripper-only", ("gripper",))], None, [task("pick-and-place")],
+                           workers=1, top=3)
+    assert row.purchase is not None
+    assert row.purchase.options == ((("scara",), cost("scara")), (("cobot",), cost("cobot")),
+                                    (("robot",), cost("robot")))
+    assert cost("scara") < cost("cobot") < cost("robot")
+
+
+def test_no_purchase_when_the_catalogue_lacks_a_skill_and_the_reason_names_it() -> None:
+    small = [d for d in service.catalogue() if d.id in ("robot", "sensor3d", "binpicking-pc")]
+    (row,) = service.batch([Configuration("no-grippers-to-buy", ("robot",))], small, [task("pick-and-place")],
+                           workers=1)
+    assert row.purchase is not None and row.purchase.options == ()
+    assert row.purchase.impossible is not None
+    assert "no device can play role gripper" in row.purchase.impossible and "CanGrip" in row.purchase.impossible
+
+
+def test_an_ambiguous_binding_cannot_be_bought_away() -> None:
+    (row,) = rows([Configuration("two-grippers", ("gripper", "magnetic-gripper", "robot"))])
+    assert row.purchase is not None and row.purchase.options == ()
+    assert "several devices can play role gripper" in (row.purchase.impossible or "")
+
+
+def _reasoner(configs: list[Configuration], the_tasks: list[Task],
+              k: service.Knowledge) -> list[tuple[tuple[str, ...], tuple[str, ...]]]:
+    by_id = {d.id: d for d in k.devices}
+    out = []
+    for c in configs:
+        cell = Cell(c.name, tuple(by_id[d] for d in c.devices))
+        out.append((tuple(service.capabilities(cell, k).commands()),
+                    tuple(t.name for t in the_tasks if service.check(t, cell, k).plausible)))
+    return out
+
+
+def _around(k: service.Knowledge, prefix: str, count: int) -> list[Configuration]:
+    """Configurations that hold most of the devices whose ids start with ``prefix``, and a few others."""
+    rng = random.Random(7)
+    own = sorted(d.id for d in k.devices if d.id.startswith(prefix))
+    others = sorted(d.id for d in k.devices if not d.id.startswith(prefix))
+    return [Configuration(f"a{n}", tuple(rng.sample(own, rng.randint(len(own) // 2, len(own)))
+                                         + rng.sample(others, rng.randint(0, 2)))) for n in range(count)]
+
+
+@pytest.mark.parametrize("library", [None, LIBRARY], ids=["built-in", "machine-tending"])
+def test_answers_agree_with_the_full_reasoner_on_random_configurations(library: Path | None) -> None:
+    k = service.knowledge((library,) if library else ())
+    the_tasks = ([service.task(p) for p in sorted((library / "tasks").glob("*.yaml"))] if library
+                 else [*tasks(), task("bin-picking-invalid")])
+    configs = list(generate(list(k.devices), 100, (0, 7), seed=11)) + _around(k, "mt-", 60)
+    found = list(service.batch(configs, list(k.devices), list(the_tasks), workers=1, knowledge=k))
+    assert [(r.offered, r.plausible) for r in found] == _reasoner(configs, the_tasks, k)
+    assert any(r.plausible for r in found) and any(not r.plausible for r in found)
+
+
+def test_purchases_are_the_cheapest_sets_an_exhaustive_search_finds() -> None:
+    catalogue = service.catalogue()
+    e = engine(catalogue, tasks(), service.knowledge().taxonomy, service.knowledge().processes, top=3)
+    devices = e.feasibility.abilities.devices
+    costs = e.feasibility.abilities.costs
+    rng = random.Random(5)
+    several = 0
+    for n in range(150):
+        config = Configuration(f"r{n}", tuple(rng.sample(devices, rng.randint(0, 4))))
+        mask = e.mask(config)
+        row = e.row(config)
+        if row.purchase is None:
+            assert len(row.plausible) == 2
+            continue
+        free = [i for i in range(len(devices)) if not mask >> i & 1]
+        plausible = {frozenset(s) for size in range(1, 5) for s in itertools.combinations(free, size)
+                     if len(e.feasibility.plausible(mask | sum(1 << i for i in s))) == 2}
+        minimal = [s for s in plausible if not any(o < s for o in plausible)]  # no device in it superfluous
+        works = sorted((sum(costs[i] for i in s), len(s), tuple(sorted(devices[i] for i in s))) for s in minimal)
+        assert [(k, len(a)) for a, k in row.purchase.options] == [(k, m) for k, m, _ in works[:3]], config
+        assert all((k, len(a), a) in works for a, k in row.purchase.options)
+        several += bool(row.purchase.options) and len(row.purchase.options[0][0]) >= 2
+    assert several >= 5  # the sample holds configurations that miss two devices or more
 
 
 def test_two_workers_give_the_same_rows_as_one() -> None:
-    configs = generate(service.catalogue(), 300, (2, 5), seed=3)
-    assert rows(configs, workers=2) == rows(configs, workers=1)
+    configs = list(generate(service.catalogue(), 5000, (2, 5), seed=3))
+    assert list(service.batch(configs, None, tasks(), workers=2)) == rows(configs, workers=1)
 
 
 def test_generation_is_deterministic_and_sized() -> None:
-    a = generate(service.catalogue(), 50, (2, 6), seed=1)
-    assert a == generate(service.catalogue(), 50, (2, 6), seed=1)
+    a = list(generate(service.catalogue(), 50, (2, 6), seed=1))
+    assert a == list(generate(service.catalogue(), 50, (2, 6), seed=1))
     assert all(2 <= len(c.devices) <= 6 and len(set(c.devices)) == len(c.devices) for c in a)
 
 
 def test_configurations_from_jsonl_and_csv(tmp_path: Path) -> None:
     jsonl = write(tmp_path, "c.jsonl", '{"config": "a", "devices": ["robot", "gripper"]}\n\n')
     table = write(tmp_path, "c.csv", "config,devices\na,robot gripper\n")
-    assert read_configurations(jsonl) == read_configurations(table) == [Configuration("a", ("robot", "gripper"))]
+    assert list(read_configurations(jsonl)) == list(read_configurations(table)) == [
+        Configuration("a", ("robot", "gripper"))]
 
 
-def test_a_bad_configuration_line_is_bad_input(tmp_path: Path) -> None:
+def test_configurations_stream_a_bad_line_is_found_when_it_is_reached(tmp_path: Path) -> None:
     bad = write(tmp_path, "c.jsonl", '{"config": "a", "devices": ["robot"]}\n{"config": "b"}\n')
+    configs = read_configurations(bad)
+    assert next(configs).name == "a"
     with pytest.raises(DescriptionError) as err:
-        read_configurations(bad)
-    assert err.value.line == 2
+        next(configs)
+    assert err.value.line == 2 and err.value.file == str(bad)
 
 
-def test_an_unknown_device_is_bad_input() -> None:
-    with pytest.raises(KeyError, match="hoverboard"):
-        rows([Configuration("x", ("hoverboard",))])
+def test_an_unknown_device_is_bad_input_at_its_line(tmp_path: Path) -> None:
+    path = write(tmp_path, "c.jsonl", '{"config": "a", "devices": ["robot"]}\n{"config": "x", "devices": ["hoverboard"]}\n')
+    with pytest.raises(DescriptionError, match="hoverboard") as err:
+        list(service.batch(path, DESCRIPTIONS / "devices", tasks(), workers=1))
+    assert err.value.location_message().startswith(f"{path}:2:")
+
+
+def test_the_report_text_is_each_row_as_json() -> None:
+    configs = list(generate(service.catalogue(), 400, (0, 7), seed=8))
+    text = "".join(service.batch_report(configs, None, tasks(), workers=1, top=2))
+    assert text == "".join(json.dumps(r.to_json()) + "\n" for r in rows(configs, top=2))

@@ -161,11 +161,26 @@ def test_batch_generates_and_writes_jsonl_and_csv(tmp_path: Path) -> None:
                  str(DESCRIPTIONS / "devices"), "-o", str(out), "--task", VALID, "--workers", "1")
     assert result.exit_code == 0, result.output
     rows = [json.loads(line) for line in out.read_text().splitlines()]
-    assert len(rows) == 40 and set(rows[0]) == {"config", "devices", "offered", "plausible", "cheapest_device"}
+    assert len(rows) == 40 and set(rows[0]) == {"config", "devices", "offered", "plausible", "purchase"}
     configs = write(tmp_path, "c.jsonl", json.dumps({"config": "paper", "devices": ["robot", "gripper"]}) + "\n")
     table = tmp_path / "out.csv"
     assert pnp("batch", str(configs), "-o", str(table), "--workers", "1").exit_code == 0
     assert table.read_text().splitlines()[1].startswith("paper,robot gripper,close-gripper")
+
+
+def test_batch_reads_configurations_from_standard_input() -> None:
+    lines = json.dumps({"config": "no-gripper", "devices": ["binpicking-pc", "robot", "sensor3d"]}) + "\n"
+    result = runner.invoke(app, ["batch", "-", "--task", VALID, "--workers", "1", "--top", "2"], input=lines)
+    assert result.exit_code == 0, result.output
+    (row,) = map(json.loads, result.stdout.splitlines())
+    assert row["config"] == "no-gripper" and row["plausible"] == []
+    assert [o["add"] for o in row["purchase"]["options"]][0] == ["gripper"]
+
+
+def test_batch_names_the_line_of_an_unknown_device(tmp_path: Path) -> None:
+    configs = write(tmp_path, "c.jsonl", '{"config": "a", "devices": ["robot"]}\n{"devices": ["hoverboard"]}\n')
+    result = pnp("batch", str(configs), "--workers", "1")
+    assert result.exit_code == 2 and result.stderr.startswith(f"{configs}:2: device 'hoverboard'")
 
 
 def test_the_real_command_line_exits_1_on_the_invalid_task() -> None:

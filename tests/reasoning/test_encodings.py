@@ -261,21 +261,16 @@ def test_window(facts: str, expected: list[set[str]]) -> None:
     assert sorted(map(sorted, found)) == sorted(map(sorted, expected))
 
 
-BATCH = list(solver.rules("batch", show=False))
+ABILITIES = list(solver.rules("abilities", show=False))
 
 
-def test_batch_stage1_proposes_devices_that_fill_every_missing_role() -> None:
-    facts = WORLD + SECOND_GRIPPER + cell("r") + task("pick")
-    (model,) = answer_sets(BATCH, facts, ["addable/3", "plausible/2"])
-    assert model == {'addable("c","t","g")', 'addable("c","t","h")'}
-
-
-def test_batch_stage2_keeps_the_cheapest_device_that_works() -> None:
-    facts = (WORLD + SECOND_GRIPPER + task("pick").replace('check("c","t").', "")
-             + 'config("v1"). member("v1","r"). member("v1","g"). variant("v1","c","g"). check("v1","t").'
-             + 'config("v2"). member("v2","r"). member("v2","h"). variant("v2","c","h"). check("v2","t").')
-    (model,) = answer_sets(BATCH, facts, ["cheapest/3"])
-    assert model == {'cheapest("c","t","h")'}
+def test_abilities_are_of_each_device_alone_and_bad_values_of_the_task_alone() -> None:
+    facts = WORLD + SECOND_GRIPPER + task("close") + ('given("t",1,"force"). value_kind("t",1,"force","integer"). '
+                                                      'value_num("t",1,"force",200000).')
+    (model,) = answer_sets(ABILITIES, facts, ["can_play/3", "bad_value/3"])
+    assert {'can_play("pick","gripper","g")', 'can_play("pick","gripper","h")', 'can_play("pick","robot","r")',
+            'bad_value("t",1,"force")'} <= model
+    assert not any('"r")' in a for a in model if a.startswith('can_play("pick","gripper"'))
 
 
 def test_every_encoding_file_belongs_to_a_program_and_every_program_names_files_that_exist() -> None:

@@ -6,12 +6,12 @@ task, process not offered, no repair found); 2 bad input, one ``file:line: messa
 
 from __future__ import annotations
 
+import contextlib
 import csv
-import io
-import json
 import sys
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TextIO
 
 import typer
 
@@ -210,11 +210,27 @@ def _sizes(text: str) -> tuple[int, int]:
         fail(f"--sizes: expected MIN-MAX such as 2-6; found {text!r}")
 
 
-@app.command()
+BATCH_HELP = """Feasibility of many cell configurations: offered processes, plausible tasks, cheapest purchases.
+
+CONFIGS is a JSONL file (or - for standard input), one configuration a line:
+{"config": "cell-1", "devices": ["robot", "gripper"]}, devices by their catalogue ids; or a CSV
+file with columns config, devices (space separated). Configurations are read and answered one
+chunk at a time, so a file of millions of lines needs no more memory than a small one.
+
+Output (stdout or -o FILE): one JSON line per configuration, in input order:
+{"config", "devices", "offered", "plausible", "purchase"}. "purchase" is null when every --task
+is plausible; otherwise {"options": [{"add": [DEVICE, ...], "cost": N}, ...]}, the --top cheapest
+sets of catalogue devices (pnp:cost; ties: fewer devices) whose addition makes every task
+plausible, or {"options": [], "impossible": "why"} when no set from the catalogue does.
+A .csv output file gets the same columns as CSV.
+"""
+
+
+@app.command(help=BATCH_HELP)
 @boundary
 def batch(
-    configs: Path | None = typer.Argument(None, metavar="CONFIGS",
-                                          help="Configurations: JSONL ({\"config\", \"devices\"}) or CSV."),
+    configs: str | None = typer.Argument(None, metavar="CONFIGS",
+                                         help="Configurations: JSONL ({\"config\", \"devices\"}), CSV, or - (stdin)."),
     generate: int | None = typer.Option(None, "--generate", metavar="N",
                                         help="Generate this many random configurations."),
     sizes: str = typer.Option("2-6", "--sizes", metavar="MIN-MAX",
@@ -224,43 +240,59 @@ def batch(
                                           help="Device folder (default: the libraries' devices)."),
     tasks: list[Path] = typer.Option([], "--task", metavar="TASK",
                                      help="A task to check in every configuration (repeatable)."),
+    top: int = typer.Option(1, "--top", min=1, max=100, metavar="K",
+                            help="Cheapest purchases to list per configuration."),
     output: Path | None = typer.Option(None, "-o", "--output", metavar="FILE",
-                                       help="Report file: .jsonl or .csv (default: stdout)."),
+                                       help="Report file: .jsonl or .csv (default: stdout, JSONL)."),
     workers: int = typer.Option(2, "--workers", min=1, metavar="N", help="Worker processes."),
+    cluster: str | None = typer.Option(None, "--cluster", metavar="ADDRESS",
+                                       help="Run on a Dask cluster: tcp://HOST:8786, or local:N worker processes."),
 ) -> None:
-    """Feasibility of many cell configurations: offered processes, plausible tasks, cheapest device to add."""
     if (configs is None) == (generate is None):
-        fail("give either CONFIGS (a JSONL or CSV file) or --generate N")
+        fail("give either CONFIGS (a JSONL or CSV file, or -) or --generate N")
+    if cluster is not None:
+        try:
+            reasoning.check_cluster_address(cluster)
+        except ValueError as exc:
+            fail(f"--cluster: {exc}")
     devices = service.catalogue(catalogue, knowledge())
+    total: int | None = generate
     if generate is not None:
         try:
             configurations = service.generate_configurations(generate, _sizes(sizes), seed, devices)
         except ValueError as exc:
             fail(f"--sizes: {exc}")
+    elif configs == "-":
+        configurations = reasoning.configurations_from(reasoning.bounded_lines(sys.stdin), "<stdin>")
     else:
         configurations = reasoning.read_configurations(configs)  # type: ignore[arg-type]
+    as_csv = output is not None and output.suffix.lower() == ".csv"
+    with contextlib.ExitStack() as stack:
+        out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
+        if as_csv:
+            csv.writer(out, lineterminator="\n").writerow(reasoning.BATCH_CSV_HEADER)
+        written = _write(lambda progress: service.batch_report(
+            configurations, devices, list(tasks), "csv" if as_csv else "jsonl", workers, progress,
+            knowledge=knowledge(), top=top, cluster=cluster), out, total)
+    if output is not None:
+        typer.echo(f"wrote {written} configurations to {output}", err=True)
+
+
+def _write(report: Callable[[Callable[[int], None]], Iterator[str]], out: TextIO, total: int | None) -> int:
+    """Write the report as it comes, with a progress bar on a terminal; the number of configurations written."""
     from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    err = Console(stderr=True)
-    columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=err, transient=True, disable=not on_a_terminal()) as bar:
-        job = bar.add_task("batch", total=len(configurations))
-        rows = list(service.batch(configurations, devices, list(tasks), workers,
-                                  progress=lambda n: bar.advance(job, n), knowledge=knowledge()))
-    text = _report(rows, output.suffix.lower() == ".csv" if output else False)
-    if output is None:
-        sys.stdout.write(text)
-    else:
-        output.write_text(text, encoding="utf-8")
-        typer.echo(f"wrote {len(rows)} configurations to {output}", err=True)
+    columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    written = 0
+    with Progress(*columns, console=Console(stderr=True), transient=True, disable=not on_a_terminal()) as bar:
+        job = bar.add_task("batch", total=total)
 
+        def advance(n: int) -> None:
+            nonlocal written
+            written += n
+            bar.update(job, completed=written)
 
-def _report(rows: list[reasoning.BatchRow], as_csv: bool) -> str:
-    if not as_csv:
-        return "".join(json.dumps(r.to_json()) + "\n" for r in rows)
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(reasoning.BATCH_CSV_HEADER)
-    writer.writerows(r.to_csv() for r in rows)
-    return buf.getvalue()
+        for text in report(advance):
+            out.write(text)
+    return written

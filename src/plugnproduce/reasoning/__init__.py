@@ -10,12 +10,25 @@ from __future__ import annotations
 
 from plugnproduce.reasoning.axioms import ontology_of
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
-from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
+from plugnproduce.reasoning.batches import (
+    BatchRow,
+    Configuration,
+    batch,
+    bounded_lines,
+    configurations_from,
+    engine,
+    generate,
+    read_configurations,
+    report,
+)
+from plugnproduce.reasoning.cluster import check_address as check_cluster_address
+from plugnproduce.reasoning.cluster import cluster_mapper
 from plugnproduce.reasoning.counterfactuals import Counterfactual
 from plugnproduce.reasoning.counterfactuals import from_repairs as counterfactuals_from_repairs
 from plugnproduce.reasoning.derivation import Node
 from plugnproduce.reasoning.offers import capabilities, explain_process
 from plugnproduce.reasoning.plausibility import check, explain_step
+from plugnproduce.reasoning.purchases import Purchase
 from plugnproduce.reasoning.results import (
     Capabilities,
     CheckResult,
@@ -54,6 +67,7 @@ __all__ = [
     "NotOffered",
     "Offer",
     "Problem",
+    "Purchase",
     "ProcessExplanation",
     "Reason",
     "Repair",
@@ -63,9 +77,15 @@ __all__ = [
     "batch",
     "capabilities",
     "check",
+    "check_cluster_address",
+    "bounded_lines",
+    "cluster_mapper",
+    "configurations_from",
+    "engine",
     "explain_process",
     "explain_step",
     "generate",
     "read_configurations",
     "repair",
+    "report",
 ]

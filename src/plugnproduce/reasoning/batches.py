@@ -1,42 +1,51 @@
-"""Feasibility of many cell configurations against all processes and given tasks (batch.lp).
+"""Feasibility of many cell configurations: offered processes, plausible tasks, cheapest purchases.
 
-No search is needed, so many configurations are grounded together in one ``Control``
-(a chunk), and chunks run on a pool of worker processes. Configurations are sets of
-catalogue devices: equal sets are reasoned about once. For a task that is not plausible,
-stage 1 finds the catalogue devices that fill every missing role; stage 2 checks the
-configuration plus each of them and keeps the cheapest that makes the task plausible
-("none" when one device is not enough).
+What depends on one device is reasoned once (:mod:`.abilities`); each configuration only
+combines those answers (:mod:`.feasibility`, :mod:`.purchases`). Configurations stream in and
+rows stream out in input order: chunks of configurations go to worker processes (or a Dask
+cluster, :mod:`.cluster`) with a bounded number in flight, so memory does not grow with the
+number of configurations.
 """
 
 from __future__ import annotations
 
 import csv
+import io
+import itertools
 import json
 import random
-from collections import Counter, defaultdict
+from collections import defaultdict, deque
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TextIO, cast
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.reasoning import schema as s
-from plugnproduce.reasoning import solver
-from plugnproduce.reasoning.facts import config_facts, fact_book, task_facts
-from plugnproduce.reasoning.terms import Atom, program
+from plugnproduce.reasoning.abilities import Abilities, abilities
+from plugnproduce.reasoning.feasibility import MEMORY, Feasibility, Key
+from plugnproduce.reasoning.purchases import Purchase, purchase
 
-CHUNK = 400
-"""Configurations grounded together in one Control."""
+CHUNK = 2_000
+"""Configurations sent to a worker at a time."""
+MAX_LINE = 1 << 20
+"""Longest configuration line read (bytes)."""
 
 
 @dataclass(frozen=True)
 class Configuration:
-    """A candidate cell: a name and the catalogue devices plugged in."""
+    """A candidate cell: a name and the catalogue devices plugged in (and where it was read)."""
 
     name: str
     devices: tuple[str, ...]
+    file: str | None = field(default=None, compare=False)
+    line: int | None = field(default=None, compare=False)
+
+    def __reduce__(self) -> tuple[type[Configuration], tuple[str, tuple[str, ...], str | None, int | None]]:
+        """Pickled as its fields (half the time of a dataclass's default): chunks go to workers by pickle."""
+        return Configuration, (self.name, self.devices, self.file, self.line)
 
 
 @dataclass(frozen=True)
@@ -47,133 +56,182 @@ class BatchRow:
     devices: tuple[str, ...]
     offered: tuple[str, ...]
     plausible: tuple[str, ...]
-    cheapest: dict[str, str | None] = field(default_factory=dict)
-    """Each task that is not plausible → the cheapest catalogue device whose addition makes it plausible."""
+    purchase: Purchase | None = None
+    """The cheapest sets of devices to add so every task is plausible; None when they all are."""
 
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         return {"config": self.config, "devices": list(self.devices), "offered": list(self.offered),
-                "plausible": list(self.plausible), "cheapest_device": dict(self.cheapest)}
+                "plausible": list(self.plausible),
+                "purchase": self.purchase.to_json() if self.purchase is not None else None}
 
     def to_csv(self) -> list[str]:
         """A CSV row (see :data:`CSV_HEADER`); lists are space separated."""
-        cheapest = " ".join(f"{t}={d or '-'}" for t, d in self.cheapest.items())
-        return [self.config, " ".join(self.devices), " ".join(self.offered), " ".join(self.plausible), cheapest]
+        bought = self.purchase.text() if self.purchase is not None else ""
+        return [self.config, " ".join(self.devices), " ".join(self.offered), " ".join(self.plausible), bought]
 
 
-CSV_HEADER = ["config", "devices", "offered", "plausible", "cheapest_device"]
+CSV_HEADER = ["config", "devices", "offered", "plausible", "purchase"]
 
 
 # ------------------------------------------------------------------ configurations in
 
 
 def generate(catalogue: Sequence[DeviceDescription], count: int, sizes: tuple[int, int],
-             seed: int) -> list[Configuration]:
-    """``count`` random configurations of ``sizes[0]`` to ``sizes[1]`` distinct catalogue devices."""
+             seed: int) -> Iterator[Configuration]:
+    """``count`` random configurations of ``sizes[0]`` to ``sizes[1]`` distinct catalogue devices, lazily."""
     ids = sorted(d.id for d in catalogue)
     low, high = max(0, sizes[0]), min(len(ids), sizes[1])
     if low > high:
         raise ValueError(f"sizes {sizes[0]}-{sizes[1]} do not fit a catalogue of {len(ids)} devices")
+    return _generated(ids, count, low, high, seed)
+
+
+def _generated(ids: list[str], count: int, low: int, high: int, seed: int) -> Iterator[Configuration]:
     rng = random.Random(seed)
     width = len(str(count))
-    return [Configuration(f"g{n:0{width}d}", tuple(sorted(rng.sample(ids, rng.randint(low, high)))))
-            for n in range(1, count + 1)]
+    for n in range(1, count + 1):
+        yield Configuration(f"g{n:0{width}d}", tuple(sorted(rng.sample(ids, rng.randint(low, high)))))
 
 
-def read_configurations(path: str | Path) -> list[Configuration]:
-    """Configurations from JSONL (``{"config": name, "devices": [ids]}`` a line) or CSV (config, devices)."""
+def read_configurations(path: str | Path) -> Iterator[Configuration]:
+    """Configurations read one line at a time from JSONL (``{"config": name, "devices": [ids]}``) or CSV."""
     p = Path(path)
-    text = p.read_text(encoding="utf-8")
-    if p.suffix.lower() == ".csv":
-        rows = list(csv.reader(text.splitlines()))
-        start = 1 if rows and rows[0] and rows[0][0].strip().lower() == "config" else 0
-        return [_config(p, n + 1, r[0], (r[1] if len(r) > 1 else "").replace(";", " ").split())
-                for n, r in enumerate(rows[start:], start=start) if r]
-    out = []
-    for n, line in enumerate(text.splitlines(), start=1):
+    return _csv(p) if p.suffix.lower() == ".csv" else _jsonl_file(p)
+
+
+def _jsonl_file(path: Path) -> Iterator[Configuration]:
+    with path.open(encoding="utf-8") as f:
+        yield from configurations_from(bounded_lines(f), str(path))
+
+
+def bounded_lines(stream: TextIO) -> Iterator[str]:
+    """The lines of a text stream, none read past :data:`MAX_LINE` characters (a longer one is cut there)."""
+    return iter(lambda: stream.readline(MAX_LINE + 1), "")
+
+
+def configurations_from(lines: Iterable[str], source: str) -> Iterator[Configuration]:
+    """Configurations from JSONL lines (a file, standard input); ``source`` names them in messages."""
+    for n, line in enumerate(lines, start=1):
         if not line.strip():
             continue
+        if len(line) > MAX_LINE:
+            raise DescriptionError(f"line longer than {MAX_LINE} characters", source, n)
         try:
             doc = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise DescriptionError(f"not a JSON object: {exc.msg}", p, n) from exc
-        if not isinstance(doc, dict) or not isinstance(doc.get("devices"), list):
-            raise DescriptionError('expected {"config": NAME, "devices": [DEVICE-ID, ...]}', p, n)
-        out.append(_config(p, n, str(doc.get("config", f"c{n}")), [str(d) for d in doc["devices"]]))
-    return out
+        except (json.JSONDecodeError, RecursionError) as exc:
+            raise DescriptionError(f"not a JSON object: {getattr(exc, 'msg', 'nested too deep')}", source, n) from exc
+        if (not isinstance(doc, dict) or not isinstance(doc.get("devices"), list)
+                or not all(isinstance(d, str) for d in doc["devices"])):
+            raise DescriptionError('expected {"config": NAME, "devices": [DEVICE-ID, ...]}', source, n)
+        yield _config(source, n, str(doc.get("config", f"c{n}")), doc["devices"])
 
 
-def _config(path: Path, line: int, name: str, devices: list[str]) -> Configuration:
+def _csv(path: Path) -> Iterator[Configuration]:
+    with path.open(encoding="utf-8", newline="") as f:
+        reader = csv.reader(f)
+        try:
+            for row in reader:
+                n = reader.line_num
+                if not row or (n == 1 and row[0].strip().lower() == "config"):
+                    continue
+                yield _config(str(path), n, row[0], (row[1] if len(row) > 1 else "").replace(";", " ").split())
+        except csv.Error as exc:
+            raise DescriptionError(f"not a CSV row: {exc}", path, reader.line_num) from exc
+
+
+def _config(source: str, line: int, name: str, devices: list[str]) -> Configuration:
     if len(set(devices)) != len(devices):
-        raise DescriptionError(f"configuration {name!r} lists a device twice", path, line)
-    return Configuration(name, tuple(devices))
+        raise DescriptionError(f"configuration {name!r} lists a device twice", source, line)
+    return Configuration(name, tuple(devices), source, line)
 
 
 # ------------------------------------------------------------------ the work of one chunk (in a worker)
 
-_STATIC = ""
-_TASKS: tuple[str, ...] = ()
+
+class Engine:
+    """Answers configurations from the per-device :class:`Abilities`; purchases are remembered like findings."""
+
+    def __init__(self, abilities: Abilities, top: int = 1) -> None:
+        self.feasibility = Feasibility(abilities)
+        self.top = top
+        self._bits = abilities.bits
+        self._tasks = range(len(abilities.tasks))
+        self._bought: dict[tuple[Key, ...], Purchase | None] = {}
+        self._names = tuple(t.name for t in abilities.tasks)
+        self._json: dict[object, str] = {}
+
+    def mask(self, config: Configuration) -> int:
+        """The configuration as a bit mask; an unknown device is bad input."""
+        out = 0
+        for d in config.devices:
+            bit = self._bits.get(d)
+            if bit is None:
+                raise DescriptionError(f"device {d!r} of configuration {config.name!r} is not in the catalogue",
+                                       config.file, config.line)
+            out |= bit
+        return out
+
+    def row(self, config: Configuration) -> BatchRow:
+        """The answer for one configuration."""
+        return BatchRow(config.name, config.devices, *self._answer(self.mask(config)))
+
+    def _answer(self, mask: int) -> tuple[tuple[str, ...], tuple[str, ...], Purchase | None]:
+        f = self.feasibility
+        keys = tuple(f.key(t, mask) for t in self._tasks)
+        plausible = tuple(self._names[t] for t in self._tasks if not f.findings(t, mask, keys[t]))
+        if len(plausible) == len(keys):
+            return f.offered(mask), plausible, None
+        # a purchase depends on the configuration only through its tasks' keys (see purchases.py)
+        if keys not in self._bought:
+            if len(self._bought) >= MEMORY:
+                self._bought.clear()
+            self._bought[keys] = purchase(f, mask, self.top)
+        return f.offered(mask), plausible, self._bought[keys]
+
+    def line(self, config: Configuration) -> str:
+        """The JSONL line of one configuration: ``json.dumps(row.to_json())``, answers' JSON remembered."""
+        offered, plausible, bought = self._answer(self.mask(config))
+        return (f'{{"config": {json.dumps(config.name)}, "devices": {json.dumps(list(config.devices))}, '
+                f'"offered": {self._dumped(offered)}, "plausible": {self._dumped(plausible)}, '
+                f'"purchase": {self._dumped(bought)}}}\n')
+
+    def _dumped(self, value: tuple[str, ...] | Purchase | None) -> str:
+        text = self._json.get(value)
+        if text is None:
+            if len(self._json) >= MEMORY:
+                self._json.clear()
+            data = value.to_json() if isinstance(value, Purchase) else list(value) if value is not None else None
+            text = self._json[value] = json.dumps(data)
+        return text
+
+    def text(self, configs: list[Configuration], form: str) -> str:
+        """The report of some configurations: JSONL lines, or CSV rows (``form`` "csv")."""
+        if form != "csv":
+            return "".join(self.line(c) for c in configs)
+        buf = io.StringIO()
+        csv.writer(buf, lineterminator="\n").writerows(self.row(c).to_csv() for c in configs)
+        return buf.getvalue()
 
 
-def _init(static: str, tasks: tuple[str, ...]) -> None:
-    global _STATIC, _TASKS
-    _STATIC, _TASKS = static, tasks
+_ENGINE: Engine | None = None
 
 
-def _checks(names: Iterable[str]) -> list[Atom]:
-    return [s.Check(c, t) for c in names for t in _TASKS]
+def _start(engine: Engine) -> None:
+    global _ENGINE
+    _ENGINE = engine
 
 
-Chunk = list[tuple[str, tuple[str, ...]]]
-"""Configurations (key, device ids) grounded together."""
-Answer = tuple[str, list[str], list[str], dict[str, str | None]]
-"""Key, offered processes, plausible tasks, cheapest device per task that is not plausible."""
-
-
-def run_chunk(chunk: Chunk) -> list[Answer]:
-    """Offered processes, plausible tasks and cheapest additions for a chunk of (name, devices)."""
-    facts: list[Atom] = []
-    for name, devices in chunk:
-        facts += config_facts(name, devices)
-    model = solver.solve(solver.BATCH, _STATIC + program(facts + _checks(n for n, _ in chunk)))
-    offered: dict[str, list[str]] = defaultdict(list)
-    for o in model[s.Offered]:
-        offered[o.c].append(o.p)
-    plausible: dict[str, list[str]] = defaultdict(list)
-    for p in model[s.Plausible]:
-        plausible[p.c].append(p.t)
-    cheapest = _stage2(dict(chunk), model[s.Addable]) if _TASKS else {}
-    out = []
-    for name, _ in chunk:
-        missing = {t: cheapest.get((name, t)) for t in _TASKS if t not in plausible[name]}
-        out.append((name, sorted(offered[name]), sorted(plausible[name], key=_TASKS.index), missing))
-    return out
-
-
-def _stage2(devices: dict[str, tuple[str, ...]], addable: list[s.Addable]) -> dict[tuple[str, str], str]:
-    if not addable:
-        return {}
-    facts: list[Atom] = []
-    for n, a in enumerate(addable):
-        v = f"v{n}"
-        facts += config_facts(v, (*devices[a.c], a.a))
-        facts += [s.Variant(v, a.c, a.a), s.Check(v, a.t)]
-    model = solver.solve(solver.CHEAPEST, _STATIC + program(facts))
-    best: dict[tuple[str, str], str] = {}
-    for c in sorted(model[s.Cheapest], key=lambda x: x.a, reverse=True):
-        best[(c.c, c.t)] = c.a  # ties: the first id wins
-    return best
+def run_chunk(chunk: list[Configuration], form: str = "rows", engine: Engine | None = None) -> list[BatchRow] | str:
+    """Rows for a chunk of configurations, or their report text (``form`` "jsonl" or "csv"); in a worker,
+    with the engine its start-up was given."""
+    e = engine or _ENGINE
+    if e is None:
+        raise RuntimeError("run_chunk needs an engine")
+    return [e.row(c) for c in chunk] if form == "rows" else e.text(chunk, form)
 
 
 # ------------------------------------------------------------------ the batch
-
-
-def static_program(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]], taxonomy: Taxonomy,
-                   processes: Sequence[ProcessDescription]) -> str:
-    """Facts shared by every configuration: processes, catalogue devices, tasks."""
-    book = fact_book(taxonomy, processes)
-    return (book.process_text() + book.devices_text(catalogue)
-            + program(a for name, t in tasks for a in task_facts(t, name)))
 
 
 def task_names(tasks: Sequence[Task]) -> list[tuple[str, Task]]:
@@ -186,8 +244,20 @@ def task_names(tasks: Sequence[Task]) -> list[tuple[str, Task]]:
     return out
 
 
+def engine(catalogue: Sequence[DeviceDescription], tasks: Sequence[Task], taxonomy: Taxonomy,
+           processes: Sequence[ProcessDescription], top: int = 1) -> Engine:
+    """Reason once over the catalogue and tasks; the engine then answers any configuration of them."""
+    return Engine(abilities(catalogue, task_names(tasks), taxonomy, processes), top)
+
+
+Part = list[BatchRow] | str
+Mapper = Callable[[Engine, Iterator[list[Configuration]], str], Iterator[Part]]
+"""Runs chunks somewhere (here, a process pool, a Dask cluster) in a form ("rows", "jsonl", "csv") and
+yields their answers in chunk order."""
+
+
 def batch(
-    configurations: Sequence[Configuration],
+    configurations: Iterable[Configuration],
     catalogue: Sequence[DeviceDescription],
     tasks: Sequence[Task],
     taxonomy: Taxonomy,
@@ -195,36 +265,65 @@ def batch(
     workers: int = 2,
     chunk: int = CHUNK,
     progress: Callable[[int], None] | None = None,
+    top: int = 1,
+    mapper: Mapper | None = None,
 ) -> Iterator[BatchRow]:
     """One :class:`BatchRow` per configuration, in order; ``progress(n)`` is told as configurations finish."""
-    known = {d.id for d in catalogue}
-    for c in configurations:
-        unknown = sorted(set(c.devices) - known)
-        if unknown:
-            raise KeyError(f"device {unknown[0]!r} (configuration {c.name!r}); not in the catalogue")
-    named = task_names(tasks)
-    static = static_program(catalogue, named, taxonomy, processes)
-    names = tuple(n for n, _ in named)
-    weight = Counter(frozenset(c.devices) for c in configurations)
-    unique = sorted(weight, key=sorted)
-    keys = {u: f"u{n}" for n, u in enumerate(unique)}
-    sets = {k: u for u, k in keys.items()}
-    jobs = [[(keys[u], tuple(sorted(u))) for u in unique[i:i + chunk]] for i in range(0, len(unique), chunk)]
-    results: dict[str, tuple[list[str], list[str], dict[str, str | None]]] = {}
-    for part in _map(jobs, static, names, workers):
-        for key, offered, plausible, cheapest in part:
-            results[key] = (offered, plausible, cheapest)
+    e = engine(catalogue, tasks, taxonomy, processes, top)
+    for part, n in _run(e, configurations, "rows", workers, chunk, mapper):
+        yield from cast(list[BatchRow], part)
         if progress is not None:
-            progress(sum(weight[sets[key]] for key, *_ in part))
-    for c in configurations:
-        offered, plausible, cheapest = results[keys[frozenset(c.devices)]]
-        yield BatchRow(c.name, c.devices, tuple(offered), tuple(plausible), cheapest)
+            progress(n)
 
 
-def _map(jobs: list[Chunk], static: str, names: tuple[str, ...], workers: int) -> Iterator[list[Answer]]:
-    if workers <= 1 or len(jobs) <= 1:
-        _init(static, names)
-        yield from (run_chunk(j) for j in jobs)
+def report(
+    configurations: Iterable[Configuration],
+    catalogue: Sequence[DeviceDescription],
+    tasks: Sequence[Task],
+    taxonomy: Taxonomy,
+    processes: Sequence[ProcessDescription],
+    form: str = "jsonl",
+    workers: int = 2,
+    chunk: int = CHUNK,
+    progress: Callable[[int], None] | None = None,
+    top: int = 1,
+    mapper: Mapper | None = None,
+) -> Iterator[str]:
+    """The report of :func:`batch` as text, a chunk at a time: JSONL lines (``BatchRow.to_json``) or CSV rows
+    (``form`` "csv", without the header). The text is made where the chunk is answered (in the workers)."""
+    e = engine(catalogue, tasks, taxonomy, processes, top)
+    for part, n in _run(e, configurations, form, workers, chunk, mapper):
+        yield cast(str, part)
+        if progress is not None:
+            progress(n)
+
+
+def _run(e: Engine, configurations: Iterable[Configuration], form: str, workers: int, chunk: int,
+         mapper: Mapper | None) -> Iterator[tuple[Part, int]]:
+    sizes: deque[int] = deque()
+
+    def chunks() -> Iterator[list[Configuration]]:
+        it = iter(configurations)
+        while part := list(itertools.islice(it, chunk)):
+            sizes.append(len(part))
+            yield part
+
+    run = mapper or (lambda eng, cs, f: _pool(eng, cs, f, workers))
+    for part in run(e, chunks(), form):
+        yield part, sizes.popleft()
+
+
+def _pool(e: Engine, chunks: Iterator[list[Configuration]], form: str, workers: int) -> Iterator[Part]:
+    first = list(itertools.islice(chunks, 1))
+    if workers <= 1 or not (second := list(itertools.islice(chunks, 1))):  # one chunk: no pool to start
+        yield from (run_chunk(c, form, e) for c in itertools.chain(first, chunks))
         return
-    with ProcessPoolExecutor(workers, initializer=_init, initargs=(static, names)) as pool:
-        yield from pool.map(run_chunk, jobs)
+    chunks = itertools.chain(first, second, chunks)
+    with ProcessPoolExecutor(workers, initializer=_start, initargs=(e,)) as pool:
+        pending: deque[Future[Part]] = deque()
+        for c in chunks:
+            pending.append(pool.submit(run_chunk, c, form))
+            if len(pending) >= 2 * workers:
+                yield pending.popleft().result()
+        while pending:
+            yield pending.popleft().result()

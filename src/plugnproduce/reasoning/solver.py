@@ -22,8 +22,7 @@ PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
     "bindings": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
     "offered": (("roles.lp", "offered.lp"), "show_capabilities.lp"),
     "check": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"), "show_check.lp"),
-    "batch": (("roles.lp", "offered.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_batch.lp"),
-    "cheapest": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "batch.lp"), "show_cheapest.lp"),
+    "abilities": (("roles.lp", "params.lp"), "show_abilities.lp"),
     "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
     "window": (("roles.lp", "chain.lp", "params.lp", "repair.lp", "window.lp"), "show_window.lp"),
     "derivation": (("roles.lp", "offered.lp", "explain.lp"), "show_derivation.lp"),
@@ -37,8 +36,8 @@ def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
     return concerns + (shown,) if show else concerns
 
 
-CAPABILITIES, BINDINGS, OFFERED, CHECK, BATCH, CHEAPEST, REPAIR, WINDOW = (
-    rules(p) for p in ("capabilities", "bindings", "offered", "check", "batch", "cheapest", "repair", "window"))
+CAPABILITIES, BINDINGS, OFFERED, CHECK, ABILITIES, REPAIR, WINDOW = (
+    rules(p) for p in ("capabilities", "bindings", "offered", "check", "abilities", "repair", "window"))
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""

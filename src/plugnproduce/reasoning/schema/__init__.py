@@ -43,19 +43,17 @@ from plugnproduce.reasoning.schema.inputs import (
     StepFact,
     ValueKind,
     ValueNum,
-    Variant,
 )
 from plugnproduce.reasoning.schema.outputs import (
     Absent,
-    Addable,
     Ambiguous,
     At,
     BadType,
+    BadValue,
     Binding,
     Bound,
     CannotPlay,
     CanPlay,
-    Cheapest,
     Edit,
     LacksState,
     LeftBy,
@@ -78,10 +76,10 @@ from plugnproduce.reasoning.schema.outputs import (
 
 __all__ = [
     "Absent",
-    "Addable",
     "Ambiguous",
     "At",
     "BadType",
+    "BadValue",
     "Bind",
     "Binding",
     "Bound",
@@ -89,7 +87,6 @@ __all__ = [
     "CannotPlay",
     "Catalogue",
     "ChartState",
-    "Cheapest",
     "Check",
     "Config",
     "Cost",
@@ -138,6 +135,5 @@ __all__ = [
     "Unreachable",
     "ValueKind",
     "ValueNum",
-    "Variant",
     "WrongState",
 ]

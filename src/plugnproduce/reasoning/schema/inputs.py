@@ -304,12 +304,3 @@ class MaxInserts(Atom):
     """At most ``m`` commands may be inserted."""
 
     m: int
-
-
-@predicate("variant")
-class Variant(Atom):
-    """Configuration ``v`` is ``c`` plus catalogue device ``a`` (batch, stage 2)."""
-
-    v: str
-    c: str
-    a: str

@@ -280,22 +280,13 @@ class Plays(Atom):
     explicit: int
 
 
-# ------------------------------------------------------------------ output: batch
+# ------------------------------------------------------------------ output: per-device abilities (batch)
 
 
-@predicate("addable")
-class Addable(Atom):
-    """Adding catalogue device ``a`` to ``c`` could make ``t`` plausible (it fills every missing role)."""
+@predicate("bad_value")
+class BadValue(Atom):
+    """Parameter ``n`` of step ``i`` of task ``t`` does not fit its process's declaration."""
 
-    c: str
     t: str
-    a: str
-
-
-@predicate("cheapest")
-class Cheapest(Atom):
-    """``a`` is a cheapest device whose addition makes ``t`` plausible in ``c``."""
-
-    c: str
-    t: str
-    a: str
+    i: int
+    n: str

@@ -1,0 +1,172 @@
+"""What each catalogue device can do, reasoned once per device and reused by every configuration.
+
+The reasoner (clingo over the taxonomy's HermiT closure facts, ``roles.lp``) decides which
+roles of which processes a device can play; ``params.lp`` decides which parameter values of
+the tasks are bad (they depend on the task alone). Code generation's path search gives, per
+device and role, where playing the role leaves the device (``leaves/5``, ``recovers/4``).
+All of it is compiled here into plain tables indexed by a device bit, so that a configuration
+is an integer (one bit per catalogue device) and :mod:`.feasibility` only does what depends
+on the combination of devices.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning import solver
+from plugnproduce.reasoning.accepts import accepts
+from plugnproduce.reasoning.facts import device_facts, process_facts, task_facts
+from plugnproduce.reasoning.terms import Atom, program
+
+PR = tuple[str, str]
+"""A role of a process: (process, role)."""
+
+
+@dataclass(frozen=True)
+class StepSpec:
+    """One step of a task as the batch sees it."""
+
+    index: int
+    process: str | None
+    """The process command, None when no process has that name."""
+    roles: tuple[tuple[str, str | None], ...]
+    """The process's roles in role order, each with the device the step names for it (or None)."""
+    unknown_roles: tuple[str, ...]
+    """Roles the step binds that the process does not have."""
+    bad_value: bool
+    refusals: tuple[tuple[str, int], ...] = ()
+    """Per parameter value given: the role it goes to, and the devices (bit mask) that accept no such quantity."""
+
+
+@dataclass(frozen=True)
+class TaskSpec:
+    """A task by its name unique in the batch, and its steps."""
+
+    name: str
+    steps: tuple[StepSpec, ...]
+
+
+@dataclass(frozen=True)
+class Abilities:
+    """The per-device tables of one catalogue, process set and task set (picklable, shipped to workers)."""
+
+    devices: tuple[str, ...]
+    """Catalogue device ids, sorted; device ``devices[i]`` is bit ``1 << i``."""
+    costs: tuple[int, ...]
+    processes: tuple[tuple[str, tuple[str, ...]], ...]
+    """Each process with its roles in role order, sorted by process id."""
+    players: dict[PR, int]
+    """The devices (bit mask) that can play each role."""
+    skills: dict[PR, str]
+    """The skill each role requires."""
+    first: dict[PR, str]
+    """The state concept each role's region starts in."""
+    initial: tuple[frozenset[str], ...]
+    """Each device's initial states."""
+    concepts: tuple[dict[str, frozenset[str]], ...]
+    """Each device's states → the concepts each state is (closed under superclasses)."""
+    leaves: dict[tuple[str, str, int], dict[str, frozenset[str]]]
+    """(process, role, device) → start state → states playing the role leaves the device in."""
+    recovers: dict[tuple[str, str, int], frozenset[str]]
+    tasks: tuple[TaskSpec, ...]
+    bits: dict[str, int]
+    """Each catalogue device's bit."""
+
+    def bit(self, device: str) -> int:
+        """The bit of a catalogue device (0 when it is not in the catalogue)."""
+        return self.bits.get(device, 0)
+
+
+def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]], taxonomy: Taxonomy,
+              processes: Sequence[ProcessDescription]) -> Abilities:
+    """Reason once over every catalogue device and task; compile the answers into :class:`Abilities`."""
+    devices = sorted({d.id: d for d in catalogue}.values(), key=lambda d: d.id)
+    index = {d.id: n for n, d in enumerate(devices)}
+    proc_atoms = [a for p in processes for a in process_facts(p)]
+    dev_atoms = [a for d in devices for a in device_facts(d, taxonomy, processes)]
+    task_atoms = [a for name, t in tasks for a in task_facts(t, name)]
+    model = solver.solve(solver.ABILITIES, program(proc_atoms + dev_atoms + task_atoms))
+    players: dict[PR, int] = defaultdict(int)
+    for c in model[s.CanPlay]:
+        players[(c.p, c.r)] |= 1 << index[c.d]
+    bad = {(b.t, b.i) for b in model[s.BadValue]}
+    return Abilities(
+        devices=tuple(d.id for d in devices),
+        costs=tuple(round(d.cost) for d in devices),
+        processes=tuple(sorted((p.id, tuple(r.name for r in p.roles)) for p in processes)),
+        players=dict(players),
+        skills={(p.id, r.name): r.required_skill for p in processes for r in p.roles},
+        first=_first_concepts(proc_atoms),
+        initial=_initial(dev_atoms, index),
+        concepts=_concepts(dev_atoms, index),
+        leaves=_leaves(dev_atoms, index),
+        recovers=_recovers(dev_atoms, index),
+        tasks=tuple(_task(name, t, processes, bad, _refusing(devices, processes, taxonomy))
+                    for name, t in tasks),
+        bits={d.id: 1 << n for n, d in enumerate(devices)},
+    )
+
+
+def _first_concepts(atoms: list[Atom]) -> dict[PR, str]:
+    return {(a.p, a.r): a.c for a in atoms if isinstance(a, s.RegionState) and a.i == 1}
+
+
+def _initial(atoms: list[Atom], index: dict[str, int]) -> tuple[frozenset[str], ...]:
+    out: list[set[str]] = [set() for _ in index]
+    for a in atoms:
+        if isinstance(a, s.Initial):
+            out[index[a.d]].add(a.x)
+    return tuple(frozenset(x) for x in out)
+
+
+def _concepts(atoms: list[Atom], index: dict[str, int]) -> tuple[dict[str, frozenset[str]], ...]:
+    out: list[dict[str, set[str]]] = [defaultdict(set) for _ in index]
+    for a in atoms:
+        if isinstance(a, s.StateIs):
+            out[index[a.d]][a.x].add(a.c)
+    return tuple({x: frozenset(c) for x, c in d.items()} for d in out)
+
+
+def _leaves(atoms: list[Atom], index: dict[str, int]) -> dict[tuple[str, str, int], dict[str, frozenset[str]]]:
+    out: dict[tuple[str, str, int], dict[str, set[str]]] = defaultdict(lambda: defaultdict(set))
+    for a in atoms:
+        if isinstance(a, s.Leaves):
+            out[(a.p, a.r, index[a.d])][a.x].add(a.y)
+    return {k: {x: frozenset(y) for x, y in v.items()} for k, v in out.items()}
+
+
+def _recovers(atoms: list[Atom], index: dict[str, int]) -> dict[tuple[str, str, int], frozenset[str]]:
+    out: dict[tuple[str, str, int], set[str]] = defaultdict(set)
+    for a in atoms:
+        if isinstance(a, s.Recovers):
+            out[(a.p, a.r, index[a.d])].add(a.y)
+    return {k: frozenset(v) for k, v in out.items()}
+
+
+def _refusing(devices: Sequence[DeviceDescription], processes: Sequence[ProcessDescription],
+              taxonomy: Taxonomy) -> dict[tuple[str, str], int]:
+    """(process, parameter) → the devices no command of which accepts the parameter's quantity (accepts.py)."""
+    return {(p.id, par.name): sum(1 << n for n, d in enumerate(devices) if not accepts(d, par.quantity, taxonomy))
+            for p in processes for par in p.parameters}
+
+
+def _task(name: str, task: Task, processes: Sequence[ProcessDescription], bad: set[tuple[str, int]],
+          refusing: dict[tuple[str, str], int]) -> TaskSpec:
+    by_id = {p.id: p for p in processes}
+    steps = []
+    for step in task.steps:
+        p = by_id.get(step.command)
+        roles = tuple((r.name, step.bind.get(r.name)) for r in p.roles) if p is not None else ()
+        known = {r for r, _ in roles}
+        unknown = tuple(sorted(r for r in step.bind if r not in known)) if p is not None else ()
+        declared = {par.name: par for par in p.parameters} if p is not None else {}
+        refusals = tuple((declared[n].role, refusing[(step.command, n)]) for n in sorted(step.params)
+                         if n in declared)
+        steps.append(StepSpec(step.index, p.id if p is not None else None, roles, unknown,
+                              (name, step.index) in bad, refusals))
+    return TaskSpec(name, tuple(steps))
