@@ -14,7 +14,7 @@ from fuzzing import Crash, InProcessHmi, Workspace, check_message, run_hmi, run_
 
 from plugnproduce import service
 from plugnproduce.description.loader import load_cell, load_device, load_task
-from plugnproduce.errors import DescriptionError, UnreadableError
+from plugnproduce.errors import MAX_EXCERPT, DescriptionError, UnreadableError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.protocols.xirp import MessageError, decode
 from plugnproduce.safeio import excerpt, parse_turtle, parse_yaml_node, tidy
@@ -231,3 +231,16 @@ def test_issue_15_a_served_chart_named_with_a_null_character_is_refused(workspac
     description = GRIPPER.replace("<gripper.scxml>", "<gripper\\u0000.scxml>").encode()
     assert run_served(workspace, "gripper", description, GRIPPER_CHART.encode(),
                       "http://127.0.0.1:8000/dev/description.xml") == "refused"
+
+
+@pytest.mark.parametrize("frame", [
+    b"<r><" + b"abcdefghij" * 20 + b"></" + b"klmnopqrst" * 20 + b"></r>",  # lxml names both tags, unquoted
+    b"<" + b"abcdefghij" * 30 + b' x="1">',
+    b"<a:" + b"qrstuvwxyz" * 20 + b"/>",
+])
+def test_issue_15_a_malformed_xirp_message_names_the_peer_s_tags_short(frame: bytes) -> None:
+    with pytest.raises(MessageError) as info:
+        decode(frame, "message from 127.0.0.1:9")
+    message = _one_line(info.value, frame)
+    assert message.startswith("message from 127.0.0.1:9: malformed XML:")
+    assert max(len(word) for word in message.split()) <= MAX_EXCERPT  # each name cut to an excerpt
