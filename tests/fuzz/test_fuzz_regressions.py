@@ -244,3 +244,12 @@ def test_issue_15_a_malformed_xirp_message_names_the_peer_s_tags_short(frame: by
     message = _one_line(info.value, frame)
     assert message.startswith("message from 127.0.0.1:9: malformed XML:")
     assert max(len(word) for word in message.split()) <= MAX_EXCERPT  # each name cut to an excerpt
+
+
+@pytest.mark.parametrize("value", ["a\\u1", "\\1", "\\g<0>", "x\\ny"])
+def test_issue_15_a_backslash_in_a_task_value_is_quoted_as_written(workspace: Workspace, value: str) -> None:
+    # pySHACL fills a shape's message in with re.sub: the value was read as a pattern's escapes
+    text = dict(seeds("task"))["tasks/bin-picking.yaml"].decode().replace("grip_force: 45", f"grip_force: '{value}'")
+    path = workspace.write("tasks/bin-picking.yaml", text.encode())
+    problems = [str(p) for p in service.validate([path]).sorted()]
+    assert any(p.endswith(f"parameter 'grip_force' takes a number; found {value}") for p in problems), problems
