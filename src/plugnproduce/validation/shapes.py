@@ -57,7 +57,7 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
             continue  # the detail of a result reported in its own words
         focus = results.value(result, SH.focusNode)
         message = tidy(str(results.value(result, SH.resultMessage) or "does not conform"))  # values quoted short
-        where = kg.places.get(str(focus))
+        where = kg.places.get(str(results.value(result, SH.value))) or kg.places.get(str(focus))  # the value's line
         if not message.startswith("step ") and local_name(str(focus)) not in message:
             message = f"{local_name(str(focus))}: {message}"
         problems.append(
