@@ -17,6 +17,7 @@ from plugnproduce.protocols.upnp import (
     UpnpDeviceServer,
     device_type_for,
     service_spec_from_chart_events,
+    udn_for,
 )
 from plugnproduce.resources import descriptions_path
 
@@ -149,3 +150,40 @@ async def test_a_device_is_read_from_the_files_it_serves_without_writing_them(ne
         device = live.cell.device("sensor3d")
         assert {s.id for s in device.states} == {"ready", "capturing", "captured"}
         assert device.chart.states() and device.initial == "ready"
+
+
+# --- an impostor announcing a device's UDN does not keep the device out ------------------
+
+
+def squatter_alive(network: SsdpNetwork, udn: str, location: str) -> None:
+    """One SSDP alive for ``udn`` pointing at ``location``, sent from a plain UDP socket."""
+    message = (f"NOTIFY * HTTP/1.1\r\nHOST: {network.group}:{network.port}\r\nCACHE-CONTROL: max-age=1800\r\n"
+               f"LOCATION: {location}\r\nNT: upnp:rootdevice\r\nNTS: ssdp:alive\r\nSERVER: squatter/1 UPnP/1.0 x/1\r\n"
+               f"USN: {udn}::upnp:rootdevice\r\n\r\n").encode()
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton("127.0.0.1"))
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        sock.sendto(message, (network.group, network.port))
+
+
+async def test_an_alive_squatting_a_device_s_udn_does_not_keep_the_device_out(network, taxonomy) -> None:
+    udn = udn_for("sensor3d")
+    async with LiveCell(taxonomy, network=network) as live:
+        squatter_alive(network, udn, f"http://127.0.0.1:{free_udp_port()}/description.xml")  # nobody answers there
+        refused = await live.next_change(WAIT)
+        assert (refused.kind, refused.device) == ("refused", udn)
+        async with sensor_server(network):
+            assert ("plug", "sensor3d") in await changes_until(live, "plug", "sensor3d")
+            assert [d.id for d in live.cell.devices] == ["sensor3d"]
+
+
+async def test_an_impostor_serving_a_bad_description_under_the_udn_is_refused_and_the_device_plugged(
+        network, taxonomy) -> None:
+    impostor = bad_sensor(network, ("pnp:protocol pnp:UPnP", "pnp:protocol pnp:UPnP ; ; ; ."), device_id="sensor3d")
+    async with LiveCell(taxonomy, network=network) as live:
+        async with impostor:  # announced first
+            assert await changes_until(live, "refused", udn_for("sensor3d")) == [("refused", udn_for("sensor3d"))]
+            async with sensor_server(network):
+                assert ("plug", "sensor3d") in await changes_until(live, "plug", "sensor3d")
+                assert [d.id for d in live.cell.devices] == ["sensor3d"]
+

@@ -5,6 +5,11 @@ awaited); those put what arrived into asyncio queues and wake waiters.
 Everything found carries ``source_host``, the address the SSDP message came
 from: the only host the device is trusted for (see
 :mod:`plugnproduce.protocols.upnp.boundary`).
+
+A UDN is predictable, so anyone may answer or announce with a device's UDN. The first
+message is not trusted blindly: every distinct place (description URL and source host)
+a UDN is announced at is a *candidate*, and the first candidate whose description reads
+is the device; the others are refused with their reasons.
 """
 
 from __future__ import annotations
@@ -34,6 +39,9 @@ from plugnproduce.protocols.upnp.spec import SERVICE_TYPE
 from plugnproduce.safeio import MAX_BYTES
 
 _LOGGER = logging.getLogger(__name__)
+
+MAX_CANDIDATES = 8
+"""Most places kept per UDN (an announcer cycling through description URLs costs no more)."""
 
 
 @dataclass(frozen=True)
@@ -105,6 +113,8 @@ class DeviceSearch:
         self.mx = mx
         self.hits: dict[str, SearchHit] = {}
         """The first answer of each device, by UDN."""
+        self.candidates: dict[str, list[SearchHit]] = {}
+        """Every distinct answer (description URL, source host) per UDN, in the order they came."""
         self._queue: asyncio.Queue[SearchHit] = asyncio.Queue()
         self._changed = ChangeSignal()
         self._listener: SsdpSearchListener | None = None
@@ -150,15 +160,20 @@ class DeviceSearch:
 
     def _on_response(self, headers: CaseInsensitiveDict) -> None:
         found = _headers_udn(headers)
-        if found is None or found[1] is None or found[0] in self.hits:
+        if found is None or found[1] is None:
             return
         hit = SearchHit(found[0], found[1], found[2])
-        self.hits[hit.udn] = hit
+        known = self.candidates.setdefault(hit.udn, [])
+        if hit in known or len(known) >= MAX_CANDIDATES:
+            return
+        known.append(hit)
+        self.hits.setdefault(hit.udn, hit)
         self._queue.put_nowait(hit)
         self._changed.notify()
 
     async def next_hit(self, timeout: float) -> SearchHit:
-        """The next device that answers; :class:`~plugnproduce.errors.ProtocolTimeout` if none does in time."""
+        """The next candidate (a device, or another place answering for a UDN already seen);
+        :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time."""
         try:
             async with asyncio.timeout(timeout):
                 return await self._queue.get()
@@ -225,12 +240,21 @@ async def discover(
                 await search.wait_until(lambda: wanted <= search.hits.keys(), timeout)
         else:
             await asyncio.sleep(timeout)  # the search window: answers arrive through the callback meanwhile
-    hits = sorted(search.hits.values(), key=lambda h: h.udn)
+    hits = [hit for udn in sorted(search.candidates) for hit in search.candidates[udn]]
     results = await asyncio.gather(*(_describe_or_refuse(hit, describe_timeout) for hit in hits))
-    return Discovery(
-        tuple(r for r in results if isinstance(r, FoundDevice)),
-        tuple(r for r in results if isinstance(r, Refusal)),
-    )
+    devices: dict[str, FoundDevice] = {}
+    refused: list[Refusal] = []
+    for result in results:  # per UDN, in the order its candidates answered: the first that reads is the device
+        if isinstance(result, Refusal):
+            refused.append(result)
+        elif result.udn in devices:
+            first = devices[result.udn]
+            refused.append(Refusal(result.udn, result.location, result.source_host,
+                                   f"device {result.udn} already answers at {first.location}; this is another "
+                                   f"place announcing the same UDN"))
+        else:
+            devices[result.udn] = result
+    return Discovery(tuple(devices.values()), tuple(refused))
 
 
 class AdvertisementListener:
@@ -238,15 +262,17 @@ class AdvertisementListener:
 
     A device sends several announcements (one per device and service type); only
     the first that changes what is known of the device is reported: a device is
-    reported alive once, and gone once. Reports go to a queue (:meth:`next`) and
-    to :attr:`seen`, which :meth:`wait_for` looks at.
+    reported alive once per place it is announced at (description URL and source
+    host: another place for the same UDN may be the real device where the first
+    was an impostor), and gone once. Reports go to a queue (:meth:`next`) and to
+    :attr:`seen`, which :meth:`wait_for` looks at.
     """
 
     def __init__(self, network: SsdpNetwork = LOOPBACK) -> None:
         self.network = network
         self.seen: list[Advertisement] = []
         """Every report so far, oldest first."""
-        self._alive: dict[str, bool] = {}
+        self._places: dict[str, list[tuple[str | None, str]]] = {}  # UDN → places announced alive; [] once gone
         self._queue: asyncio.Queue[Advertisement] = asyncio.Queue()
         self._changed = ChangeSignal()
         self._listener: SsdpAdvertisementListener | None = None
@@ -290,9 +316,17 @@ class AdvertisementListener:
 
     def _report(self, headers: CaseInsensitiveDict, alive: bool) -> None:
         found = _headers_udn(headers)
-        if found is None or self._alive.get(found[0]) is alive:
+        if found is None:
             return
-        self._alive[found[0]] = alive
+        places = self._places.get(found[0])
+        if alive:
+            if places is not None and (found[1], found[2]) in places:
+                return
+            self._places[found[0]] = [*(places or [])[-(MAX_CANDIDATES - 1):], (found[1], found[2])]
+        else:
+            if places == []:
+                return
+            self._places[found[0]] = []
         advertisement = Advertisement(found[0], alive, found[1], found[2])
         self.seen.append(advertisement)
         self._queue.put_nowait(advertisement)
