@@ -20,6 +20,7 @@ import logging
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
+from aiohttp.http_exceptions import BadHttpMessage
 from async_upnp_client.advertisement import SsdpAdvertisementListener
 from async_upnp_client.exceptions import UpnpError
 from async_upnp_client.search import SsdpSearchListener
@@ -92,6 +93,28 @@ class Discovery:
     refused: tuple[Refusal, ...]
 
 
+def _drop_malformed_datagrams(listener: SsdpSearchListener | SsdpAdvertisementListener) -> None:
+    """Have ``listener``'s socket drop every datagram async-upnp-client cannot parse.
+
+    The library ignores a datagram with an invalid header line but lets other malformed ones
+    (a duplicate header: aiohttp's ``BadHttpMessage``) out of its protocol, where asyncio logs a
+    traceback for each: any peer could flood the log so.
+    """
+    transport = getattr(listener, "_transport", None)
+    if transport is None:
+        return
+    protocol = transport.get_protocol()
+    received = protocol.datagram_received
+
+    def guarded(data: bytes, addr: tuple[str, int]) -> None:
+        try:
+            received(data, addr)
+        except BadHttpMessage:
+            _LOGGER.debug("ignoring a malformed SSDP datagram from %s", addr[0])
+
+    protocol.datagram_received = guarded
+
+
 def _headers_udn(headers: CaseInsensitiveDict) -> tuple[str, str | None, str] | None:
     udn, location, host = headers.get_lower("_udn"), headers.get_lower("location"), headers.get_lower("_host")
     if not udn or not host:
@@ -143,6 +166,7 @@ class DeviceSearch:
                 f"SSDP search on {self.network.interface} for {self.network.group}:{self.network.port}: "
                 f"cannot open the socket ({reason(exc)}); multicast must be possible on that interface"
             ) from exc
+        _drop_malformed_datagrams(listener)
         self._listener = listener
         self.search_again()
 
@@ -300,6 +324,7 @@ class AdvertisementListener:
                 f"SSDP listener on {self.network.interface} for {self.network.group}:{self.network.port}: "
                 f"cannot open the socket ({reason(exc)}); multicast must be possible on that interface"
             ) from exc
+        _drop_malformed_datagrams(listener)
         self._listener = listener
 
     async def stop(self) -> None:
