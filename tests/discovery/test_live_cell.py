@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import socket
+import threading
 from collections.abc import Mapping
 from typing import Any
 
@@ -13,10 +14,12 @@ import pytest
 from plugnproduce.discovery import LiveCell
 from plugnproduce.discovery.live import CONFIRM_TIMEOUT
 from plugnproduce.protocols.upnp import (
+    SERVICE_TYPE,
     DeviceFiles,
     SsdpNetwork,
     UpnpDeviceServer,
     device_type_for,
+    discover,
     service_spec_from_chart_events,
     udn_for,
 )
@@ -198,3 +201,51 @@ async def test_a_datagram_with_a_duplicate_header_is_dropped_without_a_traceback
         async with sensor_server(network):
             assert await changes_until(live, "plug", "sensor3d") == [("plug", "sensor3d")]
     assert [r.getMessage() for r in caplog.records if r.levelno >= logging.ERROR] == []
+
+
+class SearchSquatter:
+    """Answers every M-SEARCH on ``network`` as ``udn``, pointing at a description nobody serves."""
+
+    def __init__(self, network: SsdpNetwork, udn: str) -> None:
+        self.udn = udn
+        self.location = f"http://127.0.0.1:{free_udp_port()}/description.xml"
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        self.sock.bind(("", network.port))
+        self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                             socket.inet_aton(network.group) + socket.inet_aton(network.interface))
+        self.sock.settimeout(0.2)
+        self.answered = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._serve, daemon=True)
+
+    def _serve(self) -> None:
+        while not self._stop.is_set():
+            try:
+                data, addr = self.sock.recvfrom(4096)
+            except TimeoutError:
+                continue
+            if data.startswith(b"M-SEARCH"):
+                self.sock.sendto((f"HTTP/1.1 200 OK\r\nCACHE-CONTROL: max-age=1800\r\nEXT:\r\n"
+                                  f"LOCATION: {self.location}\r\nSERVER: squatter/1 UPnP/1.0 x/1\r\n"
+                                  f"ST: {SERVICE_TYPE}\r\nUSN: {self.udn}::{SERVICE_TYPE}\r\n\r\n").encode(), addr)
+                self.answered += 1
+
+    def __enter__(self) -> SearchSquatter:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self._stop.set()
+        self._thread.join(5)
+        self.sock.close()
+
+
+async def test_discover_takes_the_place_of_a_udn_whose_description_reads_not_the_first_answer(network) -> None:
+    async with sensor_server(network) as honest:
+        with SearchSquatter(network, udn_for("sensor3d")) as squatter:  # answers at once; the device after a delay
+            found = await discover(2.0, network=network)
+    assert squatter.answered >= 1
+    assert [(d.udn, d.location) for d in found.devices] == [(udn_for("sensor3d"), honest.location)]
+    assert [(r.udn, r.location) for r in found.refused] == [(udn_for("sensor3d"), squatter.location)]
