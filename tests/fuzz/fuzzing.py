@@ -1,7 +1,8 @@
 """The fuzz campaign's targets and mutators, shared by the Hypothesis tests and ``scripts/fuzz.py``.
 
 A *target* reads one input through the project's real entry point (the loaders, the
-validator, the XIRP decoder, the live cell's reading of what a device served) and
+validator, the XIRP decoder, the live cell's reading of what a device served, a device's
+UPnP root description and SCPD, an SSDP datagram as discovery receives it) and
 returns ``"accepted"`` or ``"refused"``. A refusal must be the documented one (a
 :class:`~plugnproduce.errors.DescriptionError`, a :class:`~plugnproduce.errors.ProtocolError`
 such as XIRP's ``MessageError``, or a problem in a validation report) with a message
