@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 
-from plugnproduce.errors import DescriptionError, ProtocolError
+from plugnproduce.errors import DescriptionError, ProtocolError, excerpt
 from plugnproduce.resources import descriptions_path
 
 MAX_MESSAGE = 1000
@@ -504,7 +504,7 @@ def run_ssdp(data: bytes) -> str:
             raise Crash(f"SSDP report without a UDN or source: {udn!r} from {host!r}")
         if location is not None:
             try:
-                check_trusted(location, host, f"description of {udn}")
+                check_trusted(location, host, f"device {excerpt(udn)} at {excerpt(location)}")  # as describe() does
             except ProtocolError as exc:
                 return _refused(exc, data)
     return "accepted" if reported else "refused"

@@ -10,7 +10,7 @@ import logging
 from pathlib import Path
 
 import pytest
-from fuzzing import Crash, InProcessHmi, Workspace, check_message, run_hmi, run_reference, run_served, seeds
+from fuzzing import Crash, InProcessHmi, Workspace, check_message, run_hmi, run_reference, run_served, run_ssdp, seeds
 
 from plugnproduce import service
 from plugnproduce.description.loader import load_cell, load_device, load_task
@@ -253,3 +253,20 @@ def test_issue_15_a_backslash_in_a_task_value_is_quoted_as_written(workspace: Wo
     path = workspace.write("tasks/bin-picking.yaml", text.encode())
     problems = [str(p) for p in service.validate([path]).sorted()]
     assert any(p.endswith(f"parameter 'grip_force' takes a number; found {value}") for p in problems), problems
+
+
+LONG_UDN = "uuid:2fac1" + "0" * 3000
+
+
+def test_issue_15_an_ssdp_alive_with_a_long_udn_off_its_host_is_refused_short() -> None:
+    alive = (f"NOTIFY * HTTP/1.1\r\nHOST: 239.255.255.250:1900\r\nUSN: {LONG_UDN}::upnp:rootdevice\r\n"
+             "LOCATION: http://10.0.0.1/d.xml\r\nNT: upnp:rootdevice\r\nNTS: ssdp:alive\r\n\r\n").encode()
+    assert run_ssdp(alive) == "refused"
+
+
+async def test_issue_15_describe_names_a_long_udn_short() -> None:
+    from plugnproduce.protocols.upnp import Advertisement, UntrustedUrlError, describe
+
+    with pytest.raises(UntrustedUrlError) as info:
+        await describe(Advertisement(LONG_UDN, True, "http://10.0.0.1/" + "d" * 3000, "127.0.0.1"))
+    _one_line(info.value, LONG_UDN + "http://10.0.0.1/" + "d" * 3000)

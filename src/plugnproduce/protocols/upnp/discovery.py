@@ -26,7 +26,7 @@ from async_upnp_client.exceptions import UpnpError
 from async_upnp_client.search import SsdpSearchListener
 from async_upnp_client.utils import CaseInsensitiveDict
 
-from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
+from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError, excerpt
 from plugnproduce.protocols.upnp.boundary import (
     LOOPBACK,
     ChangeSignal,
@@ -223,11 +223,12 @@ async def describe(found: SearchHit | Advertisement, *, timeout: float = 5.0) ->
     """
     if found.location is None:
         raise RemoteError(f"device {found.udn} from {found.source_host} gave no description URL")
-    what = f"device {found.udn} at {found.location}"
+    what = f"device {excerpt(found.udn)} at {excerpt(found.location)}"  # both as the peer sent them
     requester = TrustedRequester(NoRedirectRequester(timeout, MAX_BYTES), found.source_host, what)
     device = await load_device(found.location, requester, what, timeout)
     if device.udn.lower() != found.udn.lower():
-        raise RemoteError(f"{what}: its description names UDN {device.udn}; it was discovered as {found.udn}")
+        raise RemoteError(f"{what}: its description names UDN {excerpt(device.udn)}; it was discovered as "
+                          f"{excerpt(found.udn)}")
     return FoundDevice(found.udn, found.location, device.device_type, device.friendly_name, found.source_host)
 
 
