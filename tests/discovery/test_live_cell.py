@@ -159,11 +159,11 @@ async def test_a_device_is_read_from_the_files_it_serves_without_writing_them(ne
 # --- an impostor announcing a device's UDN does not keep the device out ------------------
 
 
-def squatter_alive(network: SsdpNetwork, udn: str, location: str, extra: str = "") -> None:
+def squatter_alive(network: SsdpNetwork, udn: str, location: str, extra: str = "", encoding: str = "utf-8") -> None:
     """One SSDP alive for ``udn`` pointing at ``location``, sent from a plain UDP socket."""
     message = (f"NOTIFY * HTTP/1.1\r\nHOST: {network.group}:{network.port}\r\nCACHE-CONTROL: max-age=1800\r\n"
                f"LOCATION: {location}\r\nNT: upnp:rootdevice\r\nNTS: ssdp:alive\r\nSERVER: squatter/1 UPnP/1.0 x/1\r\n"
-               f"USN: {udn}::upnp:rootdevice\r\n{extra}\r\n").encode()
+               f"USN: {udn}::upnp:rootdevice\r\n{extra}\r\n").encode(encoding)
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
         sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton("127.0.0.1"))
         sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
@@ -193,11 +193,13 @@ async def test_an_impostor_serving_a_bad_description_under_the_udn_is_refused_an
 
 
 
-async def test_a_datagram_with_a_duplicate_header_is_dropped_without_a_traceback(network, taxonomy, caplog) -> None:
+async def test_a_datagram_with_a_duplicate_or_undecodable_header_is_dropped_without_a_traceback(network, taxonomy, caplog) -> None:
     # async-upnp-client let aiohttp's BadHttpMessage out of its protocol: asyncio logged a traceback per datagram
     async with LiveCell(taxonomy, network=network) as live:
         for _ in range(3):
             squatter_alive(network, "uuid:dup", "http://127.0.0.1:1/d.xml", extra=f"HOST: {network.group}\r\n")
+            squatter_alive(network, "uuid:latin", "http://127.0.0.1:1/d.xml", extra="SERVER: Gr\xfc\xdfe\r\n",
+                           encoding="latin-1")  # a header that is not UTF-8
         async with sensor_server(network):
             assert await changes_until(live, "plug", "sensor3d") == [("plug", "sensor3d")]
     assert [r.getMessage() for r in caplog.records if r.levelno >= logging.ERROR] == []

@@ -486,7 +486,7 @@ def run_ssdp(data: bytes) -> str:
         return "refused"
     try:
         request_line, headers = decode_ssdp_packet(data, ("127.0.0.1", 1900), ("127.0.0.1", 50000))
-    except BadHttpMessage:  # ignored: async-upnp-client's receiver drops an InvalidHeader, discovery the rest
+    except (BadHttpMessage, ValueError):  # dropped: async-upnp-client's receiver drops an InvalidHeader, discovery the rest
         return "refused"
 
     async def deliver() -> list[tuple[str, str | None, str]]:

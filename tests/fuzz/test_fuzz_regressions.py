@@ -10,7 +10,19 @@ import logging
 from pathlib import Path
 
 import pytest
-from fuzzing import Crash, InProcessHmi, Workspace, check_message, run_hmi, run_reference, run_served, run_ssdp, seeds
+from fuzzing import (
+    Crash,
+    InProcessHmi,
+    Workspace,
+    check_message,
+    run_hmi,
+    run_reference,
+    run_served,
+    run_ssdp,
+    run_upnp_description,
+    seeds,
+    upnp_seeds,
+)
 
 from plugnproduce import service
 from plugnproduce.description.loader import load_cell, load_device, load_task
@@ -270,3 +282,13 @@ async def test_issue_15_describe_names_a_long_udn_short() -> None:
     with pytest.raises(UntrustedUrlError) as info:
         await describe(Advertisement(LONG_UDN, True, "http://10.0.0.1/" + "d" * 3000, "127.0.0.1"))
     _one_line(info.value, LONG_UDN + "http://10.0.0.1/" + "d" * 3000)
+
+
+@pytest.mark.parametrize("edit", [
+    (b"<relatedStateVariable>A_ARG_TYPE_Capture_Exposure<", b"<relatedStateVariable>A_ARG " + b"{a: " * 300 + b"<"),
+    (b"<relatedStateVariable>A_ARG_TYPE_Capture_Exposure<", b"<relatedStateVariable>%YAML 1.1\nA_ARG<"),
+])
+def test_issue_15_a_malformed_scpd_is_refused_in_one_short_line(edit: tuple[bytes, bytes]) -> None:
+    root, scpd = upnp_seeds()
+    assert edit[0] in scpd
+    assert run_upnp_description(root, scpd.replace(*edit)) == "refused"

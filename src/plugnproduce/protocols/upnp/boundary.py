@@ -195,6 +195,10 @@ class TrustedRequester(UpnpRequester):
         return await self._inner.async_http_request(http_request)
 
 
+MAX_REASON = 120
+"""Most characters of a library's reason a message carries (it may quote what a device sent)."""
+
+
 def reason(exc: BaseException) -> str:
     """A readable reason from a library exception (whose ``args`` may hold ``None`` padding).
 
@@ -202,7 +206,7 @@ def reason(exc: BaseException) -> str:
     what a device sent.
     """
     parts = [str(a) for a in exc.args if a is not None and str(a)]
-    return tidy(shorten_words("; ".join(parts))) or type(exc).__name__
+    return tidy(shorten_words("; ".join(parts)), MAX_REASON) or type(exc).__name__
 
 
 @contextmanager

@@ -97,8 +97,9 @@ def _drop_malformed_datagrams(listener: SsdpSearchListener | SsdpAdvertisementLi
     """Have ``listener``'s socket drop every datagram async-upnp-client cannot parse.
 
     The library ignores a datagram with an invalid header line but lets other malformed ones
-    (a duplicate header: aiohttp's ``BadHttpMessage``) out of its protocol, where asyncio logs a
-    traceback for each: any peer could flood the log so.
+    (a duplicate header: aiohttp's ``BadHttpMessage``; a header that is not UTF-8: a
+    ``UnicodeDecodeError``) out of its protocol, where asyncio logs a traceback for each: any peer
+    could flood the log so.
     """
     transport = getattr(listener, "_transport", None)
     if transport is None:
@@ -109,7 +110,7 @@ def _drop_malformed_datagrams(listener: SsdpSearchListener | SsdpAdvertisementLi
     def guarded(data: bytes, addr: tuple[str, int]) -> None:
         try:
             received(data, addr)
-        except BadHttpMessage:
+        except (BadHttpMessage, ValueError):
             _LOGGER.debug("ignoring a malformed SSDP datagram from %s", addr[0])
 
     protocol.datagram_received = guarded
