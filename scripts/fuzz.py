@@ -30,7 +30,8 @@ sys.path.insert(0, str(ROOT / "tests" / "fuzz"))
 
 import fuzzing  # noqa: E402  (the shared targets live beside the tests)
 
-WEIGHTS = {"turtle": 14, "chart": 14, "task": 14, "cell": 8, "xirp": 30, "served": 8, "reference": 4, "hmi": 8}
+WEIGHTS = {"turtle": 14, "chart": 14, "task": 14, "cell": 8, "xirp": 30, "served": 8, "reference": 4, "hmi": 8,
+           "upnp": 6, "ssdp": 6}
 """Share of the cases each target gets."""
 
 
@@ -58,6 +59,8 @@ def _cases(rng: random.Random, ws: fuzzing.Workspace, hmi: fuzzing.InProcessHmi 
     devices = [(r.split("/")[1].removesuffix(".ttl"), d) for r, d in kinds["turtle"] if r.startswith("devices/")]
     charts = {r.split("/")[1].removesuffix(".scxml"): d for r, d in kinds["chart"] if r.startswith("devices/")}
     requests = fuzzing.hmi_requests()
+    root, scpd = fuzzing.upnp_seeds()
+    ssdp = fuzzing.ssdp_seeds()
     runners = {"turtle": fuzzing.run_turtle, "chart": fuzzing.run_chart, "task": fuzzing.run_task,
                "cell": fuzzing.run_cell}
 
@@ -91,8 +94,18 @@ def _cases(rng: random.Random, ws: fuzzing.Workspace, hmi: fuzzing.InProcessHmi 
         request = fuzzing.mutate_request(rng.choice(requests), rng)
         return repr(request).encode(), lambda: fuzzing.run_hmi(hmi, request)
 
+    def upnp_case(i: int) -> tuple[bytes, Callable[[], str]]:
+        which = rng.choice(("root", "scpd", "both"))
+        r = fuzzing.mutate(root, rng) if which != "scpd" else root
+        s = fuzzing.mutate(scpd, rng) if which != "root" else scpd
+        return r + b"\n----\n" + s, lambda: fuzzing.run_upnp_description(r, s)
+
+    def ssdp_case(i: int) -> tuple[bytes, Callable[[], str]]:
+        data = fuzzing.mutate(rng.choice(ssdp), rng)
+        return data, lambda: fuzzing.run_ssdp(data)
+
     out = {k: description(k) for k in runners} | {"xirp": xirp_case, "served": served_case,
-                                                  "reference": reference_case}
+                                                  "reference": reference_case, "upnp": upnp_case, "ssdp": ssdp_case}
     if hmi is not None:
         out["hmi"] = hmi_case
     return out

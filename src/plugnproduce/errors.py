@@ -18,6 +18,8 @@ MAX_MESSAGE = 600
 
 _QUOTED = re.compile(r"(?<![A-Za-z])'[^']*'|\"[^\"]*\"")  # an apostrophe inside a word (device's) opens none
 
+_LONG_WORD = re.compile(rf"\S{{{MAX_EXCERPT + 1},}}")
+
 
 def excerpt(text: str, limit: int = MAX_EXCERPT) -> str:
     """``text`` on one line and at most about ``limit`` characters: its start and end around an ellipsis."""
@@ -38,6 +40,14 @@ def tidy(message: str, limit: int = 300) -> str:
     text = " ".join(str(message).split())
     text = _QUOTED.sub(lambda m: m.group()[0] + excerpt(m.group()[1:-1]) + m.group()[-1], text)
     return excerpt(text, limit)
+
+
+def shorten_words(text: str, limit: int = MAX_EXCERPT) -> str:
+    """``text`` with every run of more than ``limit`` non-blank characters cut to an :func:`excerpt`.
+
+    For messages of parsers that name what they read without quoting it (lxml's tag names).
+    """
+    return _LONG_WORD.sub(lambda m: excerpt(m.group(), limit), str(text))
 
 
 class PlugNProduceError(Exception):

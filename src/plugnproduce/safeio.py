@@ -22,7 +22,7 @@ import yaml
 from lxml import etree
 from rdflib.plugins.parsers.notation3 import BadSyntax
 
-from plugnproduce.errors import HostileInputError, UnreadableError, excerpt, tidy
+from plugnproduce.errors import HostileInputError, UnreadableError, excerpt, shorten_words, tidy
 
 logging.getLogger("rdflib.term").setLevel(logging.ERROR)
 # rdflib logs a warning for every odd IRI or literal it builds, unasked, on stderr; what matters of
@@ -111,7 +111,7 @@ def parse_xml_bytes(data: bytes, source: str | Path) -> etree._ElementTree:
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if exc.lineno else None
         msg = exc.msg.split(f", line {line}")[0] if exc.msg else "malformed XML"
-        raise UnreadableError(f"malformed XML: {tidy(msg)}", source, line) from exc
+        raise UnreadableError(f"malformed XML: {tidy(shorten_words(msg))}", source, line) from exc
     tree = root.getroottree()
     if tree.docinfo.internalDTD is not None or tree.docinfo.doctype:  # an encoding the search did not know
         raise HostileInputError("DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "

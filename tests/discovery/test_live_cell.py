@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import asyncio
+import logging
 import socket
+import threading
 from collections.abc import Mapping
 from typing import Any
 
@@ -12,11 +14,14 @@ import pytest
 from plugnproduce.discovery import LiveCell
 from plugnproduce.discovery.live import CONFIRM_TIMEOUT
 from plugnproduce.protocols.upnp import (
+    SERVICE_TYPE,
     DeviceFiles,
     SsdpNetwork,
     UpnpDeviceServer,
     device_type_for,
+    discover,
     service_spec_from_chart_events,
+    udn_for,
 )
 from plugnproduce.resources import descriptions_path
 
@@ -149,3 +154,100 @@ async def test_a_device_is_read_from_the_files_it_serves_without_writing_them(ne
         device = live.cell.device("sensor3d")
         assert {s.id for s in device.states} == {"ready", "capturing", "captured"}
         assert device.chart.states() and device.initial == "ready"
+
+
+# --- an impostor announcing a device's UDN does not keep the device out ------------------
+
+
+def squatter_alive(network: SsdpNetwork, udn: str, location: str, extra: str = "", encoding: str = "utf-8") -> None:
+    """One SSDP alive for ``udn`` pointing at ``location``, sent from a plain UDP socket."""
+    message = (f"NOTIFY * HTTP/1.1\r\nHOST: {network.group}:{network.port}\r\nCACHE-CONTROL: max-age=1800\r\n"
+               f"LOCATION: {location}\r\nNT: upnp:rootdevice\r\nNTS: ssdp:alive\r\nSERVER: squatter/1 UPnP/1.0 x/1\r\n"
+               f"USN: {udn}::upnp:rootdevice\r\n{extra}\r\n").encode(encoding)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton("127.0.0.1"))
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        sock.sendto(message, (network.group, network.port))
+
+
+async def test_an_alive_squatting_a_device_s_udn_does_not_keep_the_device_out(network, taxonomy) -> None:
+    udn = udn_for("sensor3d")
+    async with LiveCell(taxonomy, network=network) as live:
+        squatter_alive(network, udn, f"http://127.0.0.1:{free_udp_port()}/description.xml")  # nobody answers there
+        refused = await live.next_change(WAIT)
+        assert (refused.kind, refused.device) == ("refused", udn)
+        async with sensor_server(network):
+            assert ("plug", "sensor3d") in await changes_until(live, "plug", "sensor3d")
+            assert [d.id for d in live.cell.devices] == ["sensor3d"]
+
+
+async def test_an_impostor_serving_a_bad_description_under_the_udn_is_refused_and_the_device_plugged(
+        network, taxonomy) -> None:
+    impostor = bad_sensor(network, ("pnp:protocol pnp:UPnP", "pnp:protocol pnp:UPnP ; ; ; ."), device_id="sensor3d")
+    async with LiveCell(taxonomy, network=network) as live:
+        async with impostor:  # announced first
+            assert await changes_until(live, "refused", udn_for("sensor3d")) == [("refused", udn_for("sensor3d"))]
+            async with sensor_server(network):
+                assert ("plug", "sensor3d") in await changes_until(live, "plug", "sensor3d")
+                assert [d.id for d in live.cell.devices] == ["sensor3d"]
+
+
+
+async def test_a_datagram_with_a_duplicate_or_undecodable_header_is_dropped_without_a_traceback(network, taxonomy, caplog) -> None:
+    # async-upnp-client let aiohttp's BadHttpMessage out of its protocol: asyncio logged a traceback per datagram
+    async with LiveCell(taxonomy, network=network) as live:
+        for _ in range(3):
+            squatter_alive(network, "uuid:dup", "http://127.0.0.1:1/d.xml", extra=f"HOST: {network.group}\r\n")
+            squatter_alive(network, "uuid:latin", "http://127.0.0.1:1/d.xml", extra="SERVER: Gr\xfc\xdfe\r\n",
+                           encoding="latin-1")  # a header that is not UTF-8
+        async with sensor_server(network):
+            assert await changes_until(live, "plug", "sensor3d") == [("plug", "sensor3d")]
+    assert [r.getMessage() for r in caplog.records if r.levelno >= logging.ERROR] == []
+
+
+class SearchSquatter:
+    """Answers every M-SEARCH on ``network`` as ``udn``, pointing at a description nobody serves."""
+
+    def __init__(self, network: SsdpNetwork, udn: str) -> None:
+        self.udn = udn
+        self.location = f"http://127.0.0.1:{free_udp_port()}/description.xml"
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        self.sock.bind(("", network.port))
+        self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                             socket.inet_aton(network.group) + socket.inet_aton(network.interface))
+        self.sock.settimeout(0.2)
+        self.answered = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._serve, daemon=True)
+
+    def _serve(self) -> None:
+        while not self._stop.is_set():
+            try:
+                data, addr = self.sock.recvfrom(4096)
+            except TimeoutError:
+                continue
+            if data.startswith(b"M-SEARCH"):
+                self.sock.sendto((f"HTTP/1.1 200 OK\r\nCACHE-CONTROL: max-age=1800\r\nEXT:\r\n"
+                                  f"LOCATION: {self.location}\r\nSERVER: squatter/1 UPnP/1.0 x/1\r\n"
+                                  f"ST: {SERVICE_TYPE}\r\nUSN: {self.udn}::{SERVICE_TYPE}\r\n\r\n").encode(), addr)
+                self.answered += 1
+
+    def __enter__(self) -> SearchSquatter:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self._stop.set()
+        self._thread.join(5)
+        self.sock.close()
+
+
+async def test_discover_takes_the_place_of_a_udn_whose_description_reads_not_the_first_answer(network) -> None:
+    async with sensor_server(network) as honest:
+        with SearchSquatter(network, udn_for("sensor3d")) as squatter:  # answers at once; the device after a delay
+            found = await discover(2.0, network=network)
+    assert squatter.answered >= 1
+    assert [(d.udn, d.location) for d in found.devices] == [(udn_for("sensor3d"), honest.location)]
+    assert [(r.udn, r.location) for r in found.refused] == [(udn_for("sensor3d"), squatter.location)]

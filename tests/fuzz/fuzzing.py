@@ -1,7 +1,8 @@
 """The fuzz campaign's targets and mutators, shared by the Hypothesis tests and ``scripts/fuzz.py``.
 
 A *target* reads one input through the project's real entry point (the loaders, the
-validator, the XIRP decoder, the live cell's reading of what a device served) and
+validator, the XIRP decoder, the live cell's reading of what a device served, a device's
+UPnP root description and SCPD, an SSDP datagram as discovery receives it) and
 returns ``"accepted"`` or ``"refused"``. A refusal must be the documented one (a
 :class:`~plugnproduce.errors.DescriptionError`, a :class:`~plugnproduce.errors.ProtocolError`
 such as XIRP's ``MessageError``, or a problem in a validation report) with a message
@@ -15,6 +16,7 @@ and prefixes, deep nesting.
 
 from __future__ import annotations
 
+import functools
 import random
 import shutil
 import tempfile
@@ -23,7 +25,7 @@ from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 
-from plugnproduce.errors import DescriptionError, ProtocolError
+from plugnproduce.errors import DescriptionError, ProtocolError, excerpt
 from plugnproduce.resources import descriptions_path
 
 MAX_MESSAGE = 1000
@@ -359,6 +361,153 @@ REFERENCES = ["gripper.scxml", "/gripper.scxml", "http://127.0.0.1:8000/x.scxml"
               "/etc/passwd", "http://10.0.0.1/x", "//evil.example/x", "http://127.0.0.1@evil/x", "http://[::1]/x",
               "http://127.0.0.1:99999/x", "http://[zz/x", "javascript:alert(1)", "\\\\host\\share", "..\\..\\x",
               "http://127.0.0.1/%00", "http://127.0.0.1\u3002evil/x", "ftp://127.0.0.1/x", "data:text/plain,x", ""]
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# UPnP root descriptions and SSDP messages, in process
+
+LOCATION = "http://127.0.0.1:8000/dev/description.xml"
+"""Where the fuzzed device says its description is (and the host it is trusted for)."""
+
+
+def _free_udp_port() -> int:
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+@functools.cache
+def upnp_seeds() -> tuple[bytes, bytes]:
+    """The root description and the service description (SCPD) of a real device server, fetched over loopback."""
+    import asyncio
+    import urllib.request
+    from collections.abc import Mapping
+    from typing import Any
+    from urllib.parse import urljoin
+
+    from lxml import etree
+
+    from plugnproduce.protocols.upnp import (
+        DeviceFiles,
+        SsdpNetwork,
+        UpnpDeviceServer,
+        device_type_for,
+        service_spec_from_chart_events,
+    )
+
+    async def answer(action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
+        return {"Result": "accepted"}
+
+    def get(url: str) -> bytes:
+        with urllib.request.urlopen(url, timeout=10) as response:  # noqa: S310 - a loopback URL of our own server
+            return bytes(response.read())
+
+    async def fetch() -> tuple[bytes, bytes]:
+        folder = DESCRIPTIONS / "devices"
+        files = DeviceFiles("sensor3d.ttl", (folder / "sensor3d.ttl").read_text(), "sensor3d.scxml",
+                            (folder / "sensor3d.scxml").read_text())
+        spec = service_spec_from_chart_events({"Capture": ["Exposure"]}, ["CaptureDone"])
+        server = UpnpDeviceServer("sensor3d", "3D sensor", device_type_for("StereoCamera"), spec, answer,
+                                  files=files, network=SsdpNetwork(port=_free_udp_port()))
+        async with server:
+            assert server.location is not None
+            root = await asyncio.to_thread(get, server.location)
+            scpd_url = etree.fromstring(root).findtext(".//{urn:schemas-upnp-org:device-1-0}SCPDURL") or ""
+            scpd = await asyncio.to_thread(get, urljoin(server.location, scpd_url))
+        return root, scpd
+
+    return asyncio.run(fetch())
+
+
+def run_upnp_description(root: bytes, scpd: bytes) -> str:
+    """A device's root description and SCPD as the controller reads them when it connects (trust rule included)."""
+    import asyncio
+
+    from async_upnp_client.client import UpnpRequester
+    from async_upnp_client.const import HttpRequest, HttpResponse
+    from async_upnp_client.utils import CaseInsensitiveDict
+
+    from plugnproduce.protocols.upnp import UpnpDeviceClient
+    from plugnproduce.protocols.upnp.boundary import TrustedRequester
+    from plugnproduce.protocols.upnp.client import load_device
+
+    class Served(UpnpRequester):
+        """Answers the description URL with ``root`` and every other URL with ``scpd``."""
+
+        async def async_http_request(self, http_request: HttpRequest) -> HttpResponse:
+            body = root if http_request.url == LOCATION else scpd
+            return HttpResponse(200, CaseInsensitiveDict(), body.decode("utf-8", "replace"))
+
+    async def connect() -> None:
+        requester = TrustedRequester(Served(), "127.0.0.1", "device uuid:fuzz")
+        UpnpDeviceClient(await load_device(LOCATION, requester, "device uuid:fuzz", 5.0), requester, 5.0)
+
+    try:
+        asyncio.run(connect())
+    except ProtocolError as exc:
+        return _refused(exc, root + b"\n" + scpd)
+    return "accepted"
+
+
+def ssdp_seeds() -> list[bytes]:
+    """An alive, a byebye and a search answer of a device, as async-upnp-client's device server sends them."""
+    usn = "uuid:2fac1234-31f8-11b4-a222-08002b34c003::urn:schemas-plugnproduce-org:service:DeviceControl:1"
+    common = f"HOST: 239.255.255.250:1900\r\nUSN: {usn}\r\n"
+    alive = (f"NOTIFY * HTTP/1.1\r\n{common}CACHE-CONTROL: max-age=1800\r\nLOCATION: {LOCATION}\r\n"
+             "NT: urn:schemas-plugnproduce-org:service:DeviceControl:1\r\nNTS: ssdp:alive\r\n"
+             "SERVER: Linux/6 UPnP/2.0 plugnproduce/1\r\n\r\n")
+    byebye = (f"NOTIFY * HTTP/1.1\r\n{common}NT: urn:schemas-plugnproduce-org:service:DeviceControl:1\r\n"
+              "NTS: ssdp:byebye\r\n\r\n")
+    answer = (f"HTTP/1.1 200 OK\r\nCACHE-CONTROL: max-age=1800\r\nEXT:\r\nLOCATION: {LOCATION}\r\n"
+              f"SERVER: Linux/6 UPnP/2.0 plugnproduce/1\r\nST: urn:schemas-plugnproduce-org:service:DeviceControl:1\r\n"
+              f"USN: {usn}\r\n\r\n")
+    return [alive.encode(), byebye.encode(), answer.encode()]
+
+
+def run_ssdp(data: bytes) -> str:
+    """One SSDP datagram from 127.0.0.1 through async-upnp-client's parsing to the listener and the search.
+
+    What either reports must carry a UDN and a source, and a description URL naming another host
+    than the sender, or no HTTP URL at all, is refused by the trust rule with one line.
+    """
+    import asyncio
+
+    from aiohttp.http_exceptions import BadHttpMessage
+    from async_upnp_client.advertisement import SsdpAdvertisementListener
+    from async_upnp_client.search import SsdpSearchListener
+    from async_upnp_client.ssdp import decode_ssdp_packet, is_valid_ssdp_packet
+
+    from plugnproduce.protocols.upnp import AdvertisementListener, DeviceSearch
+    from plugnproduce.protocols.upnp.boundary import check_trusted
+
+    if not is_valid_ssdp_packet(data):
+        return "refused"
+    try:
+        request_line, headers = decode_ssdp_packet(data, ("127.0.0.1", 1900), ("127.0.0.1", 50000))
+    except (BadHttpMessage, ValueError):  # dropped: async-upnp-client's receiver drops an InvalidHeader, discovery the rest
+        return "refused"
+
+    async def deliver() -> list[tuple[str, str | None, str]]:
+        listener, search = AdvertisementListener(), DeviceSearch()
+        ads = SsdpAdvertisementListener(on_alive=listener._on_alive, on_byebye=listener._on_byebye)
+        ads._on_data(request_line, headers.copy())  # noqa: SLF001 - the library's own entry for a datagram
+        answers = SsdpSearchListener(callback=search._on_response)
+        answers._on_data(request_line, headers.copy())  # noqa: SLF001
+        return [(a.udn, a.location, a.source_host) for a in listener.seen] + \
+            [(h.udn, h.location, h.source_host) for h in search.hits.values()]
+
+    reported = asyncio.run(deliver())
+    for udn, location, host in reported:
+        if not (isinstance(udn, str) and udn and isinstance(host, str) and host):
+            raise Crash(f"SSDP report without a UDN or source: {udn!r} from {host!r}")
+        if location is not None:
+            try:
+                check_trusted(location, host, f"device {excerpt(udn)} at {excerpt(location)}")  # as describe() does
+            except ProtocolError as exc:
+                return _refused(exc, data)
+    return "accepted" if reported else "refused"
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -10,11 +10,23 @@ import logging
 from pathlib import Path
 
 import pytest
-from fuzzing import Crash, InProcessHmi, Workspace, check_message, run_hmi, run_reference, run_served, seeds
+from fuzzing import (
+    Crash,
+    InProcessHmi,
+    Workspace,
+    check_message,
+    run_hmi,
+    run_reference,
+    run_served,
+    run_ssdp,
+    run_upnp_description,
+    seeds,
+    upnp_seeds,
+)
 
 from plugnproduce import service
 from plugnproduce.description.loader import load_cell, load_device, load_task
-from plugnproduce.errors import DescriptionError, UnreadableError
+from plugnproduce.errors import MAX_EXCERPT, DescriptionError, UnreadableError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.protocols.xirp import MessageError, decode
 from plugnproduce.safeio import excerpt, parse_turtle, parse_yaml_node, tidy
@@ -231,3 +243,52 @@ def test_issue_15_a_served_chart_named_with_a_null_character_is_refused(workspac
     description = GRIPPER.replace("<gripper.scxml>", "<gripper\\u0000.scxml>").encode()
     assert run_served(workspace, "gripper", description, GRIPPER_CHART.encode(),
                       "http://127.0.0.1:8000/dev/description.xml") == "refused"
+
+
+@pytest.mark.parametrize("frame", [
+    b"<r><" + b"abcdefghij" * 20 + b"></" + b"klmnopqrst" * 20 + b"></r>",  # lxml names both tags, unquoted
+    b"<" + b"abcdefghij" * 30 + b' x="1">',
+    b"<a:" + b"qrstuvwxyz" * 20 + b"/>",
+])
+def test_issue_15_a_malformed_xirp_message_names_the_peer_s_tags_short(frame: bytes) -> None:
+    with pytest.raises(MessageError) as info:
+        decode(frame, "message from 127.0.0.1:9")
+    message = _one_line(info.value, frame)
+    assert message.startswith("message from 127.0.0.1:9: malformed XML:")
+    assert max(len(word) for word in message.split()) <= MAX_EXCERPT  # each name cut to an excerpt
+
+
+@pytest.mark.parametrize("value", ["a\\u1", "\\1", "\\g<0>", "x\\ny"])
+def test_issue_15_a_backslash_in_a_task_value_is_quoted_as_written(workspace: Workspace, value: str) -> None:
+    # pySHACL fills a shape's message in with re.sub: the value was read as a pattern's escapes
+    text = dict(seeds("task"))["tasks/bin-picking.yaml"].decode().replace("grip_force: 45", f"grip_force: '{value}'")
+    path = workspace.write("tasks/bin-picking.yaml", text.encode())
+    problems = [str(p) for p in service.validate([path]).sorted()]
+    assert any(p.endswith(f"parameter 'grip_force' takes a number; found {value}") for p in problems), problems
+
+
+LONG_UDN = "uuid:2fac1" + "0" * 3000
+
+
+def test_issue_15_an_ssdp_alive_with_a_long_udn_off_its_host_is_refused_short() -> None:
+    alive = (f"NOTIFY * HTTP/1.1\r\nHOST: 239.255.255.250:1900\r\nUSN: {LONG_UDN}::upnp:rootdevice\r\n"
+             "LOCATION: http://10.0.0.1/d.xml\r\nNT: upnp:rootdevice\r\nNTS: ssdp:alive\r\n\r\n").encode()
+    assert run_ssdp(alive) == "refused"
+
+
+async def test_issue_15_describe_names_a_long_udn_short() -> None:
+    from plugnproduce.protocols.upnp import Advertisement, UntrustedUrlError, describe
+
+    with pytest.raises(UntrustedUrlError) as info:
+        await describe(Advertisement(LONG_UDN, True, "http://10.0.0.1/" + "d" * 3000, "127.0.0.1"))
+    _one_line(info.value, LONG_UDN + "http://10.0.0.1/" + "d" * 3000)
+
+
+@pytest.mark.parametrize("edit", [
+    (b"<relatedStateVariable>A_ARG_TYPE_Capture_Exposure<", b"<relatedStateVariable>A_ARG " + b"{a: " * 300 + b"<"),
+    (b"<relatedStateVariable>A_ARG_TYPE_Capture_Exposure<", b"<relatedStateVariable>%YAML 1.1\nA_ARG<"),
+])
+def test_issue_15_a_malformed_scpd_is_refused_in_one_short_line(edit: tuple[bytes, bytes]) -> None:
+    root, scpd = upnp_seeds()
+    assert edit[0] in scpd
+    assert run_upnp_description(root, scpd.replace(*edit)) == "refused"

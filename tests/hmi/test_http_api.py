@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from plugnproduce import service
-from tests.hmi.conftest import AUTH, Hmi
+from tests.hmi.conftest import AUTH, Hmi, Served
 
 BIN_PICK = {"command": "bin-pick", "params": {"grip_force": 45, "exposure": 25}}
 PLACE = {"command": "place", "params": {"place_pose": [0.6, -0.2, 0.1, 0, 180, 0], "speed": 80}}
@@ -345,3 +345,30 @@ async def test_the_editor_task_is_validated_imported_and_drawn_without_temporary
     chart = next(c for c in (await client.post("/api/task/generate", json=TASK)).json()["charts"] if c["kind"] == "task")
     svg = await client.get(chart["svg"])
     assert svg.status_code == 200 and svg.content.lstrip().startswith((b"<?xml", b"<svg"))
+
+
+def test_a_large_task_is_validated_in_one_pass_and_one_too_long_is_refused_before_any_work(
+        served: Served, monkeypatch: pytest.MonkeyPatch) -> None:
+    # issue 15: validating a fuzzed 100-step task in the editor took ~20 s (one SHACL query per value)
+    from plugnproduce.validation import validate as validation
+
+    passes: list[int] = []
+    real = validation.shape_problems
+
+    def counted(kg: object) -> object:
+        passes.append(1)
+        return real(kg)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(validation, "shape_problems", counted)
+    step = {"command": "place", "params": {"place_pose": [0.6, -0.2, 0.1, 0, 180, 0], "speed": 9999}}
+    with httpx.Client(base_url=served.url, timeout=600) as client:
+        too_long = client.post("/api/task/validate", json={"name": "t", "steps": [step] * 1001})
+        assert too_long.status_code == 422 and passes == []
+        assert too_long.json()["detail"].startswith("steps: ") and "1000" in too_long.json()["detail"]
+        largest = client.post("/api/task/validate", json={"name": "t", "steps": [step] * 1000})
+        assert largest.status_code == 200 and passes == [1]
+        problems = largest.json()["problems"]
+        assert [p["row"] for p in problems] == list(range(1000))
+        assert problems[999]["text"] == ("steps[999].params.speed: step 1000: parameter 'speed' is 9999 %; "
+                                         "expected a value from 1 to 100 %")
+        assert client.get("/api/cell").status_code == 200

@@ -77,3 +77,37 @@ def test_violating_example(tmp_path: Path, case: tuple) -> None:
 
 def test_task_value_shapes_conform_for_builtin_tasks() -> None:
     assert validate_paths([DESCRIPTIONS / "tasks"]).problems == []
+
+
+def _task_text(rounds: int) -> str:
+    step = ("  - command: place\n    params:\n      place_pose: [0.6, -0.2, 0.1, 0, 180, 0]\n      speed: 9999\n"
+            "  - command: pick\n    params:\n      grip_force: strong\n")
+    return "task: t\nsteps:\n" + step * rounds
+
+
+def test_a_task_s_values_cost_the_same_queries_whatever_its_length(monkeypatch: pytest.MonkeyPatch) -> None:
+    # pySHACL parses a constraint's query anew for each focus node: one per value took ~20 s for a
+    # 100-step task in the editor (issue 15); the task's values are now checked by one query per task
+    import rdflib
+
+    from plugnproduce import service
+
+    queries: list[str] = []
+    real = rdflib.Graph.query
+
+    def counted(self: rdflib.Graph, query: object, *args: object, **kwargs: object) -> object:
+        queries.append(str(query))
+        return real(self, query, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(rdflib.Graph, "query", counted)
+    counts, findings = [], []
+    for rounds in (1, 50):
+        queries.clear()
+        task = service.task_from_text(_task_text(rounds), "t.yaml")
+        findings.append(service.validate_tasks([task]).sorted())
+        counts.append(len(queries))
+    assert counts[0] == counts[1]
+    assert len(findings[1]) == 2 * 50  # each bad value still found, at its own line
+    assert [p.line for p in findings[1][:2]] == [6, 9]
+    assert findings[1][0].message == "step 1: parameter 'speed' is 9999 %; expected a value from 1 to 100 %"
+    assert findings[1][1].message == "step 2: parameter 'grip_force' takes a number; found strong"

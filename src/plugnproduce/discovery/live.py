@@ -7,6 +7,10 @@ at start, then follows ``alive`` and ``byebye`` announcements; each change yield
 :class:`CellChange` with the new cell, so the offered process commands can be
 re-inferred at once. Entering the cell waits for the search window, or only until the
 ``expected`` devices have answered; answers later in the window still plug in.
+
+Anyone can announce a device's (predictable) UDN: each place a UDN is announced at is
+tried in turn, one at a time per UDN, until one's description reads; an impostor that
+announced first is refused and does not keep the real device out.
 """
 
 from __future__ import annotations
@@ -87,7 +91,7 @@ class LiveCell:
         """Device ids whose answers end the wait at start (none: the whole search window is waited)."""
         self._devices: dict[str, DeviceDescription] = {}
         self._found: dict[str, FoundDevice] = {}
-        self._claimed: set[str] = set()  # UDNs being described, so a search answer and an alive plug once
+        self._turns: dict[str, tuple[asyncio.Lock, int]] = {}  # UDN → its lock and how many wait for it
         self._plugged = asyncio.Event()
         self._search: asyncio.Task[None] | None = None
         self._changes: asyncio.Queue[CellChange] = asyncio.Queue()
@@ -154,8 +158,7 @@ class LiveCell:
                     hit = await search.next_hit(left)
                 except ProtocolTimeout:
                     break
-                if hit.udn not in self._claimed:
-                    await self._plug_advertised(hit)
+                await self._plug_advertised(hit)
         finally:
             search.stop()
 
@@ -163,7 +166,7 @@ class LiveCell:
         while True:
             ad = await self._listener.next(None)
             try:
-                if ad.alive and ad.udn not in self._devices and ad.udn not in self._claimed:
+                if ad.alive and ad.udn not in self._devices:
                     await self._plug_advertised(ad)
                 elif not ad.alive and ad.udn in self._devices:
                     await self._unplug_confirmed(ad.udn)
@@ -183,19 +186,33 @@ class LiveCell:
             return
         _LOGGER.warning("byebye for %s ignored: the device still answers at %s", udn, found.location)
 
-    async def _plug_advertised(self, ad: Advertisement | SearchHit) -> None:
-        self._claimed.add(ad.udn)
+    @contextlib.asynccontextmanager
+    async def _turn(self, udn: str) -> AsyncIterator[None]:
+        """One place at a time per UDN (a search answer and an alive, or a device and an impostor)."""
+        lock, waiting = self._turns.get(udn, (asyncio.Lock(), 0))
+        self._turns[udn] = (lock, waiting + 1)
         try:
-            found = await describe(ad)
-        except ProtocolError as exc:
-            self._publish(CellChange("refused", ad.udn, self.cell, str(exc)))
-            return
+            async with lock:
+                yield
         finally:
-            self._claimed.discard(ad.udn)
-        await self._plug(found)
+            lock, waiting = self._turns[udn]
+            if waiting == 1:
+                del self._turns[udn]
+            else:
+                self._turns[udn] = (lock, waiting - 1)
+
+    async def _plug_advertised(self, ad: Advertisement | SearchHit) -> None:
+        async with self._turn(ad.udn):
+            if ad.udn in self._devices:  # a place announcing this UDN was plugged meanwhile
+                return
+            try:
+                found = await describe(ad)
+            except ProtocolError as exc:
+                self._publish(CellChange("refused", ad.udn, self.cell, str(exc)))
+                return
+            await self._plug(found)
 
     async def _plug(self, found: FoundDevice) -> None:
-        self._claimed.add(found.udn)
         try:
             device = await self._fetch(found)
         except (ProtocolError, DescriptionError) as exc:
@@ -205,8 +222,6 @@ class LiveCell:
             reason = f"its description cannot be read ({type(exc).__name__}: {exc})"
             self._publish(CellChange("refused", found.udn, self.cell, reason))
             return
-        finally:
-            self._claimed.discard(found.udn)
         self._devices[found.udn] = device
         self._found[found.udn] = found
         self._publish(CellChange("plug", device.id, self.cell))

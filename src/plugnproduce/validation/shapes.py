@@ -8,6 +8,7 @@ from pathlib import Path
 import rdflib
 from pyshacl import validate as shacl_validate
 from rdflib.namespace import SH
+from rdflib.plugins.sparql.operators import register_custom_function
 
 from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.errors import tidy
@@ -15,6 +16,22 @@ from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import parse_turtle
 from plugnproduce.validation.findings import Problem
+
+VERBATIM = rdflib.URIRef("http://plugnproduce.org/shapes#verbatim")
+"""The SPARQL function the shapes bind every value a message names with (see :func:`verbatim`)."""
+
+
+def verbatim(term: rdflib.term.Node) -> rdflib.Literal:
+    """``term``'s text, made to come out of pySHACL's message filling as it is.
+
+    pySHACL puts a value into a message's ``{?x}`` as the replacement of ``re.sub``, which reads
+    backslashes as escapes: ``a\\u1`` from a task raised ``re.error``, ``\\1`` or ``\\n`` came out
+    changed. Doubled, each backslash comes out as one.
+    """
+    return rdflib.Literal(str(term).replace("\\", "\\\\"))
+
+
+register_custom_function(VERBATIM, verbatim, override=True)  # type: ignore[arg-type]  # the hint is for raw=True
 
 
 @lru_cache(maxsize=4)
@@ -40,7 +57,7 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
             continue  # the detail of a result reported in its own words
         focus = results.value(result, SH.focusNode)
         message = tidy(str(results.value(result, SH.resultMessage) or "does not conform"))  # values quoted short
-        where = kg.places.get(str(focus))
+        where = kg.places.get(str(results.value(result, SH.value))) or kg.places.get(str(focus))  # the value's line
         if not message.startswith("step ") and local_name(str(focus)) not in message:
             message = f"{local_name(str(focus))}: {message}"
         problems.append(

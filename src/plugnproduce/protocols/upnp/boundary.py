@@ -35,7 +35,15 @@ from async_upnp_client.exceptions import (
 )
 from async_upnp_client.ssdp import SSDP_IP_V4, SSDP_PORT
 
-from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError, excerpt
+from plugnproduce.errors import (
+    ProtocolConnectionError,
+    ProtocolError,
+    ProtocolTimeout,
+    RemoteError,
+    excerpt,
+    shorten_words,
+    tidy,
+)
 
 T = TypeVar("T")
 
@@ -187,10 +195,18 @@ class TrustedRequester(UpnpRequester):
         return await self._inner.async_http_request(http_request)
 
 
+MAX_REASON = 120
+"""Most characters of a library's reason a message carries (it may quote what a device sent)."""
+
+
 def reason(exc: BaseException) -> str:
-    """A readable reason from a library exception (whose ``args`` may hold ``None`` padding)."""
+    """A readable reason from a library exception (whose ``args`` may hold ``None`` padding).
+
+    One line, quoting short (:func:`~plugnproduce.errors.tidy`): a library's exception may carry
+    what a device sent.
+    """
     parts = [str(a) for a in exc.args if a is not None and str(a)]
-    return "; ".join(parts) or type(exc).__name__
+    return tidy(shorten_words("; ".join(parts)), MAX_REASON) or type(exc).__name__
 
 
 @contextmanager

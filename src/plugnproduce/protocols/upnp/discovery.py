@@ -5,6 +5,11 @@ awaited); those put what arrived into asyncio queues and wake waiters.
 Everything found carries ``source_host``, the address the SSDP message came
 from: the only host the device is trusted for (see
 :mod:`plugnproduce.protocols.upnp.boundary`).
+
+A UDN is predictable, so anyone may answer or announce with a device's UDN. The first
+message is not trusted blindly: every distinct place (description URL and source host)
+a UDN is announced at is a *candidate*, and the first candidate whose description reads
+is the device; the others are refused with their reasons.
 """
 
 from __future__ import annotations
@@ -15,12 +20,13 @@ import logging
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
+from aiohttp.http_exceptions import BadHttpMessage
 from async_upnp_client.advertisement import SsdpAdvertisementListener
 from async_upnp_client.exceptions import UpnpError
 from async_upnp_client.search import SsdpSearchListener
 from async_upnp_client.utils import CaseInsensitiveDict
 
-from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
+from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError, excerpt
 from plugnproduce.protocols.upnp.boundary import (
     LOOPBACK,
     ChangeSignal,
@@ -34,6 +40,9 @@ from plugnproduce.protocols.upnp.spec import SERVICE_TYPE
 from plugnproduce.safeio import MAX_BYTES
 
 _LOGGER = logging.getLogger(__name__)
+
+MAX_CANDIDATES = 8
+"""Most places kept per UDN (an announcer cycling through description URLs costs no more)."""
 
 
 @dataclass(frozen=True)
@@ -84,6 +93,29 @@ class Discovery:
     refused: tuple[Refusal, ...]
 
 
+def _drop_malformed_datagrams(listener: SsdpSearchListener | SsdpAdvertisementListener) -> None:
+    """Have ``listener``'s socket drop every datagram async-upnp-client cannot parse.
+
+    The library ignores a datagram with an invalid header line but lets other malformed ones
+    (a duplicate header: aiohttp's ``BadHttpMessage``; a header that is not UTF-8: a
+    ``UnicodeDecodeError``) out of its protocol, where asyncio logs a traceback for each: any peer
+    could flood the log so.
+    """
+    transport = getattr(listener, "_transport", None)
+    if transport is None:
+        return
+    protocol = transport.get_protocol()
+    received = protocol.datagram_received
+
+    def guarded(data: bytes, addr: tuple[str, int]) -> None:
+        try:
+            received(data, addr)
+        except (BadHttpMessage, ValueError):
+            _LOGGER.debug("ignoring a malformed SSDP datagram from %s", addr[0])
+
+    protocol.datagram_received = guarded
+
+
 def _headers_udn(headers: CaseInsensitiveDict) -> tuple[str, str | None, str] | None:
     udn, location, host = headers.get_lower("_udn"), headers.get_lower("location"), headers.get_lower("_host")
     if not udn or not host:
@@ -105,6 +137,8 @@ class DeviceSearch:
         self.mx = mx
         self.hits: dict[str, SearchHit] = {}
         """The first answer of each device, by UDN."""
+        self.candidates: dict[str, list[SearchHit]] = {}
+        """Every distinct answer (description URL, source host) per UDN, in the order they came."""
         self._queue: asyncio.Queue[SearchHit] = asyncio.Queue()
         self._changed = ChangeSignal()
         self._listener: SsdpSearchListener | None = None
@@ -133,6 +167,7 @@ class DeviceSearch:
                 f"SSDP search on {self.network.interface} for {self.network.group}:{self.network.port}: "
                 f"cannot open the socket ({reason(exc)}); multicast must be possible on that interface"
             ) from exc
+        _drop_malformed_datagrams(listener)
         self._listener = listener
         self.search_again()
 
@@ -150,15 +185,20 @@ class DeviceSearch:
 
     def _on_response(self, headers: CaseInsensitiveDict) -> None:
         found = _headers_udn(headers)
-        if found is None or found[1] is None or found[0] in self.hits:
+        if found is None or found[1] is None:
             return
         hit = SearchHit(found[0], found[1], found[2])
-        self.hits[hit.udn] = hit
+        known = self.candidates.setdefault(hit.udn, [])
+        if hit in known or len(known) >= MAX_CANDIDATES:
+            return
+        known.append(hit)
+        self.hits.setdefault(hit.udn, hit)
         self._queue.put_nowait(hit)
         self._changed.notify()
 
     async def next_hit(self, timeout: float) -> SearchHit:
-        """The next device that answers; :class:`~plugnproduce.errors.ProtocolTimeout` if none does in time."""
+        """The next candidate (a device, or another place answering for a UDN already seen);
+        :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time."""
         try:
             async with asyncio.timeout(timeout):
                 return await self._queue.get()
@@ -184,11 +224,12 @@ async def describe(found: SearchHit | Advertisement, *, timeout: float = 5.0) ->
     """
     if found.location is None:
         raise RemoteError(f"device {found.udn} from {found.source_host} gave no description URL")
-    what = f"device {found.udn} at {found.location}"
+    what = f"device {excerpt(found.udn)} at {excerpt(found.location)}"  # both as the peer sent them
     requester = TrustedRequester(NoRedirectRequester(timeout, MAX_BYTES), found.source_host, what)
     device = await load_device(found.location, requester, what, timeout)
     if device.udn.lower() != found.udn.lower():
-        raise RemoteError(f"{what}: its description names UDN {device.udn}; it was discovered as {found.udn}")
+        raise RemoteError(f"{what}: its description names UDN {excerpt(device.udn)}; it was discovered as "
+                          f"{excerpt(found.udn)}")
     return FoundDevice(found.udn, found.location, device.device_type, device.friendly_name, found.source_host)
 
 
@@ -225,12 +266,21 @@ async def discover(
                 await search.wait_until(lambda: wanted <= search.hits.keys(), timeout)
         else:
             await asyncio.sleep(timeout)  # the search window: answers arrive through the callback meanwhile
-    hits = sorted(search.hits.values(), key=lambda h: h.udn)
+    hits = [hit for udn in sorted(search.candidates) for hit in search.candidates[udn]]
     results = await asyncio.gather(*(_describe_or_refuse(hit, describe_timeout) for hit in hits))
-    return Discovery(
-        tuple(r for r in results if isinstance(r, FoundDevice)),
-        tuple(r for r in results if isinstance(r, Refusal)),
-    )
+    devices: dict[str, FoundDevice] = {}
+    refused: list[Refusal] = []
+    for result in results:  # per UDN, in the order its candidates answered: the first that reads is the device
+        if isinstance(result, Refusal):
+            refused.append(result)
+        elif result.udn in devices:
+            first = devices[result.udn]
+            refused.append(Refusal(result.udn, result.location, result.source_host,
+                                   f"device {result.udn} already answers at {first.location}; this is another "
+                                   f"place announcing the same UDN"))
+        else:
+            devices[result.udn] = result
+    return Discovery(tuple(devices.values()), tuple(refused))
 
 
 class AdvertisementListener:
@@ -238,15 +288,17 @@ class AdvertisementListener:
 
     A device sends several announcements (one per device and service type); only
     the first that changes what is known of the device is reported: a device is
-    reported alive once, and gone once. Reports go to a queue (:meth:`next`) and
-    to :attr:`seen`, which :meth:`wait_for` looks at.
+    reported alive once per place it is announced at (description URL and source
+    host: another place for the same UDN may be the real device where the first
+    was an impostor), and gone once. Reports go to a queue (:meth:`next`) and to
+    :attr:`seen`, which :meth:`wait_for` looks at.
     """
 
     def __init__(self, network: SsdpNetwork = LOOPBACK) -> None:
         self.network = network
         self.seen: list[Advertisement] = []
         """Every report so far, oldest first."""
-        self._alive: dict[str, bool] = {}
+        self._places: dict[str, list[tuple[str | None, str]]] = {}  # UDN → places announced alive; [] once gone
         self._queue: asyncio.Queue[Advertisement] = asyncio.Queue()
         self._changed = ChangeSignal()
         self._listener: SsdpAdvertisementListener | None = None
@@ -274,6 +326,7 @@ class AdvertisementListener:
                 f"SSDP listener on {self.network.interface} for {self.network.group}:{self.network.port}: "
                 f"cannot open the socket ({reason(exc)}); multicast must be possible on that interface"
             ) from exc
+        _drop_malformed_datagrams(listener)
         self._listener = listener
 
     async def stop(self) -> None:
@@ -290,9 +343,17 @@ class AdvertisementListener:
 
     def _report(self, headers: CaseInsensitiveDict, alive: bool) -> None:
         found = _headers_udn(headers)
-        if found is None or self._alive.get(found[0]) is alive:
+        if found is None:
             return
-        self._alive[found[0]] = alive
+        places = self._places.get(found[0])
+        if alive:
+            if places is not None and (found[1], found[2]) in places:
+                return
+            self._places[found[0]] = [*(places or [])[-(MAX_CANDIDATES - 1):], (found[1], found[2])]
+        else:
+            if places == []:
+                return
+            self._places[found[0]] = []
         advertisement = Advertisement(found[0], alive, found[1], found[2])
         self.seen.append(advertisement)
         self._queue.put_nowait(advertisement)
