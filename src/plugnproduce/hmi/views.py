@@ -140,7 +140,8 @@ def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
 
 
 def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[str, Any]:
-    """What a run's journal says so far: status, current step, every device's state, the fault if any."""
+    """What a run's journal says so far: status, current step (and every step position entered, from which
+    a loop's iterations are counted), every device's state, the values that flowed, the fault if any."""
     start = next((r for r in records if r["kind"] == "start"), {})
     end = next((r for r in records if r["kind"] == "end"), None)
     steps = [r for r in records if r["kind"] == "step"]
@@ -159,6 +160,8 @@ def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[s
         "status": status,
         "steps": start.get("steps"),
         "step": steps[-1] if steps else None,
+        "visited": [{"step": r.get("step"), "seq": r.get("seq")} for r in steps],
+        "values": [r for r in records if r["kind"] == "value"],
         "states": states,
         "faults": [r for r in records if r["kind"] == "fault"],
         "end": end,
