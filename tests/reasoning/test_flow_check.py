@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 from plugnproduce import service
+from plugnproduce.description.loader import load_device
+from tests.conftest import edit
 
 TASKS = service.builtin("tasks")
 CELL = service.builtin("cells", "bin-picking.yaml")
@@ -75,3 +78,15 @@ def test_a_step_after_the_loop_that_cannot_start_where_the_loop_ends_is_refused(
                                                     "loop ended on BinEmpty at step 4 (loop iteration 2 and later)"}
     assert all(p.where.line == line_of(path, "- command: open-gripper") for p in exits)
     assert all("is in state 'open'" in p.text for p in exits)
+
+
+def test_a_link_to_an_output_the_bound_device_never_reports_is_refused(tmp_path: Path) -> None:
+    for f in ("binpicking-pc.ttl", "binpicking-pc.scxml"):
+        shutil.copy(service.builtin("devices", f), tmp_path)
+    edit(tmp_path / "binpicking-pc.scxml", '<param name="part_pose" expr="part_pose"/>', "")
+    silent = load_device(tmp_path / "binpicking-pc.ttl", service.knowledge().taxonomy)
+    cell = service.cell(CELL).with_device(silent)
+    result = service.check(TASKS / "bin-picking-until-empty.yaml", cell)
+    [problem] = [p for p in result.problems if p.kind == "bad_link"]
+    assert not result.plausible and problem.device == "binpicking-pc" and problem.parameter == "pick_pose"
+    assert "reports no part_pose: no event of its chart carries a value of that name" in problem.text

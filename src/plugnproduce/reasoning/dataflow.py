@@ -5,17 +5,29 @@ A step's parameter may take the output of an earlier, named step
 the value: a source step that does not exist or does not come earlier, an output the
 source step's process does not give back, and an output whose datatype, unit or
 quantity does not fit the parameter (the output's quantity must be the parameter's or a
-more specific one).
+more specific one). In a cell, the device bound to the output's role must report it: some
+event of its chart carries a value of the output's name.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 
-from plugnproduce.description.model import Link, Output, Parameter, ProcessDescription, Step, Task
+from plugnproduce.description.model import (
+    Cell,
+    Command,
+    DeviceDescription,
+    Link,
+    Output,
+    Parameter,
+    ProcessDescription,
+    Step,
+    Task,
+)
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
-from plugnproduce.reasoning.results import Problem, Reason
+from plugnproduce.reasoning.results import Problem, Reason, StepCheck
+from plugnproduce.statechart.model import Send, walk
 
 
 def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[Problem]:
@@ -77,3 +89,40 @@ def _fit(head: str, output: Output, parameter: Parameter, taxonomy: Taxonomy) ->
         return (f"{head}, a {taxonomy.label(output.quantity)}; the parameter takes a "
                 f"{taxonomy.label(parameter.quantity)}", (output.quantity, parameter.quantity))
     return "", ()
+
+
+def reports(device: DeviceDescription, value: str) -> bool:
+    """Whether some protocol event of the device's chart carries a value called ``value``."""
+    for node in walk(device.chart):
+        if isinstance(node, Send) and any(p.name == value for p in node.params):
+            command = Command.parse(node.event or "")
+            if command is not None and command.kind == "event":
+                return True
+    return False
+
+
+def unreported(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
+               processes: dict[str, ProcessDescription]) -> Iterator[Problem]:
+    """One problem per link whose source step's device never reports the output."""
+    one_round = task.steps[: len(task.steps) // max(task.repeat, 1)]
+    later = {i for lp in task.loops for i in range(lp.first, lp.last + 1)}
+    devices = {d.id: d for d in cell.devices}
+    for step in one_round:
+        if step.index in later or step.command not in processes:
+            continue
+        for name, link in sorted(step.links().items()):
+            source = _named_before(one_round, step).get(link.step)
+            process = processes.get(source.command) if source is not None else None
+            if source is None or process is None or source.index > len(steps) or \
+                    link.output not in {o.name for o in process.outputs}:
+                continue  # a link problem of its own
+            role = process.output(link.output).role
+            device = devices.get(steps[source.index - 1].bindings.get(role, ""))
+            if device is None or reports(device, link.output):
+                continue
+            text = (f"step {step.index} ({step.command}): parameter {name} takes {link.output} from {link.step}, "
+                    f"but device '{device.id}' (role '{role}') reports no {link.output}: no event of its chart "
+                    "carries a value of that name")
+            where = task.where(step, name)
+            yield Problem(step.index, step.command, "bad_link", Reason("bad_link", text, (), (where, device.where)),
+                          where, role=role, device=device.id, parameter=name)

@@ -12,7 +12,7 @@ from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
 from plugnproduce.reasoning.controlflow import loop_problems, on_path
-from plugnproduce.reasoning.dataflow import link_problems
+from plugnproduce.reasoning.dataflow import link_problems, unreported
 from plugnproduce.reasoning.facts import fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program, context
 from plugnproduce.reasoning.results import CheckResult, Problem, StepCheck, StepExplanation
@@ -71,6 +71,7 @@ def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proces
     parameters = {p.id: {x.name: x for x in p.parameters} for p in processes}
     lost = list(not_accepted(task, cell, steps, parameters, taxonomy))
     lost += link_problems(task, {p.id: p for p in processes}, taxonomy)
+    lost += unreported(task, cell, steps, {p.id: p for p in processes})
     problems = [on_path(p, task) for p in _problems(model, ctx) + lost]
     plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not problems
     result = CheckResult(task.name, cell.name, plausible, (), steps, final)
