@@ -17,6 +17,7 @@ from fastapi import FastAPI
 
 from plugnproduce import service
 from plugnproduce.hmi import ExecutorRunner, SimulatedCellSource, create_app
+from plugnproduce.sim.bin import SimulatedBin
 
 TOKEN = "test-token-0123456789abcdef"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
@@ -34,10 +35,11 @@ class Hmi:
     runner: ExecutorRunner
 
 
-def make_hmi(tmp_path: Path, cell: str = "bin-picking", faults: str = "") -> Hmi:
-    """The HMI over a built-in cell, simulated (with ``faults``) once the app starts; runs journalled under ``tmp_path``."""
+def make_hmi(tmp_path: Path, cell: str = "bin-picking", faults: str = "", bin: SimulatedBin | None = None) -> Hmi:  # noqa: A002
+    """The HMI over a built-in cell, simulated (with ``faults``, working on ``bin``) once the app starts;
+    runs journalled under ``tmp_path``."""
     source = SimulatedCellSource(service.cell(service.builtin("cells", f"{cell}.yaml")), service.catalogue(),
-                                 faults=faults)
+                                 faults=faults, bin=bin)
     runner = ExecutorRunner(source, tmp_path / "runs")
     return Hmi(create_app(source, runner, TOKEN), source, runner)
 
@@ -68,9 +70,11 @@ class Served:
 def served(tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[Served]:
     """The HMI served by uvicorn on a free loopback port (listening before the thread starts: no waiting).
 
-    Parametrize it indirectly with a ``--faults`` spec to inject faults into the simulated devices.
+    Parametrize it indirectly with a ``--faults`` spec to inject faults into the simulated devices,
+    or with a :class:`SimulatedBin` for the simulated devices to work on.
     """
-    hmi = make_hmi(tmp_path, faults=getattr(request, "param", ""))
+    param = getattr(request, "param", "")
+    hmi = make_hmi(tmp_path, faults=param, bin=None) if isinstance(param, str) else make_hmi(tmp_path, bin=param)
     sock = socket.create_server(("127.0.0.1", 0))
     port = sock.getsockname()[1]
     config = uvicorn.Config(hmi.app, log_level="warning", lifespan="on", ws="none", timeout_graceful_shutdown=1)

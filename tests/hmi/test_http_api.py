@@ -91,7 +91,7 @@ async def test_reads_from_another_host_need_the_token(hmi: Hmi) -> None:
     ({"name": "t", "repeat": 0, "steps": [{"command": "pick"}]}, 422, "repeat: input should be greater than or equal to 1"),
     ({"name": "t", "steps": [{"command": "pick", "speed": 3}]}, 422, "steps[0].speed: extra inputs are not permitted"),
     ({"name": "t", "steps": [{"command": "pick", "params": {"grip_force": {"n": 1}}}]}, 422,
-     "steps[0].params.grip_force: a parameter value is a number, text, true or false, or a pose"),
+     "steps[0].params.grip_force: a parameter value is a number, text, true or false, a pose"),
     ({"name": "t", "steps": [{"command": "pick", "bind": {"robot": 3}}]}, 422,
      "steps[0].bind.robot: input should be a valid string"),
 ])

@@ -16,11 +16,13 @@ from fastapi.responses import JSONResponse
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError, excerpt, tidy
 from plugnproduce.hmi.interfaces import CellChangeRefused, RunRefused
+from plugnproduce.hmi.schemas import LOOP_TAG, STEP_TAG
 
 
 def field_name(loc: Sequence[int | str]) -> str:
     """``("body", "steps", 0, "params", "speed")`` → ``steps[0].params.speed``."""
     parts = list(loc[1:] if loc and loc[0] in ("body", "query", "path") else loc)
+    parts = [p for p in parts if p not in (STEP_TAG, LOOP_TAG)]
     out = ""
     for p in parts:
         out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))

@@ -1,18 +1,36 @@
 """The request bodies of the HTTP API, and the task as JSON.
 
-A task travels as ``{"name", "description", "repeat", "steps": [{"command", "bind", "params"}]}``,
-the YAML task description's fields in JSON (``task`` is accepted for ``name``). It becomes
-the model's :class:`~plugnproduce.description.model.Task` with :meth:`TaskIn.to_task`.
+A task travels as ``{"name", "description", "repeat", "steps": [...]}``, the YAML task
+description's fields in JSON (``task`` is accepted for ``name``): each item of ``steps`` is a
+step ``{"name", "command", "bind", "params"}`` (a parameter may be a data link
+``{"from": STEP, "output": NAME}``) or a loop ``{"loop": {"until", "max", "steps"}}``. It becomes
+the model's :class:`~plugnproduce.description.model.Task` with :meth:`TaskIn.to_task`, read by the
+task file's reader, so that a task from the editor means what the same task file means.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import json
 import math
 from typing import Annotated, Any
 
-from pydantic import AfterValidator, AliasChoices, BaseModel, ConfigDict, Field, WithJsonSchema, model_validator
+from pydantic import (
+    AfterValidator,
+    AliasChoices,
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    PrivateAttr,
+    Tag,
+    WithJsonSchema,
+    model_validator,
+)
 
-from plugnproduce.description.model import Step, Task
+from plugnproduce import service
+from plugnproduce.description.model import Task
+from plugnproduce.errors import DescriptionError
 from plugnproduce.safeio import MAX_DIGITS
 
 TASK_SOURCE = "task"
@@ -29,20 +47,32 @@ def _number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
+LINK_HELP = "an earlier step's output {from: STEP, output: NAME}"
+NAME_SCHEMA = {"type": "string", "maxLength": 200}
+
+
+def _link(value: dict[Any, Any]) -> bool:
+    return set(value) == {"from", "output"} and all(isinstance(v, str) and 0 < len(v) <= 200 for v in value.values())
+
+
 def _param_value(value: Any) -> Any:
     if isinstance(value, str | bool) or _number(value):
         return value
     if isinstance(value, list) and len(value) <= 16 and all(_number(v) for v in value):
         return value
-    kind = "a mapping" if isinstance(value, dict) else ("null" if value is None else "a list of non-numbers")
-    raise ValueError(f"a parameter value is a number, text, true or false, or {POSE_HELP}; found {kind}")
+    if isinstance(value, dict) and _link(value):
+        return value
+    kind = "another mapping" if isinstance(value, dict) else ("null" if value is None else "a list of non-numbers")
+    raise ValueError(f"a parameter value is a number, text, true or false, {POSE_HELP} or {LINK_HELP}; found {kind}")
 
 
 ParamValue = Annotated[
     Any,
     AfterValidator(_param_value),
     WithJsonSchema({"anyOf": [{"type": "number"}, {"type": "string"}, {"type": "boolean"},
-                              {"type": "array", "items": {"type": "number"}, "maxItems": 16}]}),
+                              {"type": "array", "items": {"type": "number"}, "maxItems": 16},
+                              {"type": "object", "properties": {"from": NAME_SCHEMA, "output": NAME_SCHEMA},
+                               "required": ["from", "output"], "additionalProperties": False}]}),
 ]
 
 
@@ -51,11 +81,43 @@ class StepIn(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
+    name: str | None = Field(None, min_length=1, max_length=200,
+                             description="The step's name, by which later steps take its outputs.")
     command: str = Field(min_length=1, max_length=200, description="A process command, e.g. 'pick'.")
     bind: dict[str, Annotated[str, Field(min_length=1, max_length=200)]] = Field(
         default_factory=dict, description="Role name → device id (optional where only one device fits).")
     params: dict[str, ParamValue] = Field(
         default_factory=dict, description="Parameter name → value; a parameter left out takes its default.")
+
+
+class LoopBodyIn(BaseModel):
+    """A loop: its steps run again and again until one of them ends with ``until``, at most ``max`` times."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    until: str | None = Field(None, min_length=1, max_length=200, description="An outcome, e.g. 'BinEmpty'.")
+    max: int | None = Field(None, ge=1, le=1_000_000, description="The most iterations.")
+    steps: list[StepIn] = Field(min_length=1, max_length=1000)
+
+
+class LoopIn(BaseModel):
+    """A ``loop`` item of a task's steps."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    loop: LoopBodyIn
+
+
+STEP_TAG, LOOP_TAG = "step item", "loop item"
+"""How validation errors would name a step or a loop item of ``steps``: left out of field names."""
+
+
+def _item_kind(item: Any) -> str:
+    return LOOP_TAG if isinstance(item, dict | LoopIn) and (not isinstance(item, dict) or "loop" in item) else STEP_TAG
+
+
+TaskItem = Annotated[Annotated[StepIn, Tag(STEP_TAG)] | Annotated[LoopIn, Tag(LOOP_TAG)], Discriminator(_item_kind)]
+"""An item of a task's steps: a step, or a loop (an item with ``loop``)."""
 
 
 class TaskIn(BaseModel):
@@ -72,7 +134,8 @@ class TaskIn(BaseModel):
     name: str = Field(min_length=1, max_length=200, validation_alias=AliasChoices("name", "task"))
     description: str = Field("", max_length=2000)
     repeat: int = Field(1, ge=1, le=1000, description="The steps run this many times in a row.")
-    steps: list[StepIn] = Field(min_length=1, max_length=1000)
+    steps: list[TaskItem] = Field(min_length=1, max_length=1000)
+    _task: Task | None = PrivateAttr(None)
 
     @model_validator(mode="after")
     def _not_too_long(self) -> TaskIn:
@@ -81,10 +144,27 @@ class TaskIn(BaseModel):
                              f"{len(self.steps) * self.repeat}; at most {Task.MAX_STEPS} are accepted")
         return self
 
+    @model_validator(mode="after")
+    def _readable(self) -> TaskIn:
+        """Read the task as the task file reader reads it: a duplicate step name or a loop in a
+        repeated task is refused here, with the reader's message."""
+        doc = {"task": self.name, "description": self.description, "repeat": self.repeat,
+               "steps": [s.model_dump(exclude_none=True) for s in self.steps]}
+        try:
+            task = service.task_from_text(json.dumps(doc), TASK_SOURCE)
+        except DescriptionError as exc:
+            raise ValueError(exc.message) from exc
+        # the JSON's lines are no file's lines: problems name the steps instead
+        steps = tuple(dataclasses.replace(s, line=None, param_lines={}) for s in task.steps)
+        loops = tuple(dataclasses.replace(lp, line=None) for lp in task.loops)
+        self._task = dataclasses.replace(task, steps=steps, loops=loops)
+        return self
+
     def to_task(self) -> Task:
-        """The model's task: steps numbered from 1 in the expanded (repeated) order."""
-        one_round = [Step(i + 1, s.command, dict(s.bind), dict(s.params)) for i, s in enumerate(self.steps)]
-        return Task.repeated(self.name, one_round, TASK_SOURCE, self.description, self.repeat)
+        """The model's task: steps numbered from 1 in the expanded (repeated, looped) order."""
+        if self._task is None:
+            raise TypeError("a TaskIn is read when it is validated")
+        return self._task
 
 
 class PlugIn(BaseModel):

@@ -18,6 +18,7 @@ from plugnproduce.hmi.interfaces import CellChangeRefused
 from plugnproduce.hmi.livecell import LiveCellSource
 from plugnproduce.knowledge import Knowledge
 from plugnproduce.protocols.upnp import private_network
+from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
 SEARCH_SECONDS = 0.2
@@ -29,16 +30,18 @@ def _has(device_id: str) -> Callable[[Cell], bool]:
 
 
 class SimulatedCellSource(LiveCellSource):
-    """The devices of ``cell`` simulated, and what discovery sees of them; ``faults`` as ``pnp run --faults``."""
+    """The devices of ``cell`` simulated, and what discovery sees of them; ``faults`` as ``pnp run --faults``,
+    ``bin`` the simulated bin they work on as ``pnp run --bin-parts`` (none: their charts' fixed values)."""
 
     def __init__(self, cell: Cell, catalogue: list[DeviceDescription], faults: str = "",
-                 wait: float = 10.0, knowledge: Knowledge | None = None) -> None:
+                 wait: float = 10.0, knowledge: Knowledge | None = None,
+                 bin: SimulatedBin | None = None) -> None:  # noqa: A002
         """``wait``: seconds a plug, unplug or the start may take until discovery has seen it."""
         super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS, knowledge=knowledge)
         self._wanted = [d.id for d in cell.devices]
         self._wait = wait
         self.sim = SimulatedCell(Cell(cell.name, ()), catalogue=[*catalogue, *cell.devices], network=self.network,
-                                 faults=parse_faults(faults, cell.devices))
+                                 faults=parse_faults(faults, cell.devices), bin=bin)
 
     def catalogue(self) -> list[DeviceDescription]:
         """The devices that can be plugged in: the catalogue and the cell file's own devices."""

@@ -17,6 +17,7 @@ from typing import Any
 from plugnproduce import service
 from plugnproduce.description.model import Task
 from plugnproduce.hmi.schemas import TaskIn
+from plugnproduce.hmi.views import editor_rows
 from plugnproduce.knowledge import Knowledge
 
 _validating = threading.Lock()
@@ -27,9 +28,16 @@ EDITOR_FILE = "task.yaml"
 
 
 def _fields(loaded: Task) -> dict[int, tuple[int, str]]:
-    """Line in the written file → (editor row, field name)."""
+    """Line in the written file → (editor row, field name); a loop's line is its first step's row."""
     out: dict[int, tuple[int, str]] = {}
-    for row, step in enumerate(loaded.one_round()):
+    rows = editor_rows(loaded)
+    for lp in loaded.loops:
+        if lp.line is not None:
+            out[lp.line] = (rows[lp.entry][0], f"steps[{rows[lp.entry][0]}].loop")
+    for step in loaded.one_round():
+        row, first = rows[step.index]
+        if first != 1:
+            continue
         if step.line is not None:
             out[step.line] = (row, f"steps[{row}]")
         for name, line in step.param_lines.items():

@@ -5,10 +5,19 @@ from __future__ import annotations
 from typing import Any
 
 from plugnproduce import service
-from plugnproduce.description.model import Cell, DeviceDescription, Parameter, ProcessDescription, Task, plain_value
+from plugnproduce.description.model import (
+    Cell,
+    DeviceDescription,
+    Output,
+    Parameter,
+    ProcessDescription,
+    Step,
+    Task,
+    plain_value,
+)
 from plugnproduce.executor.journal import describe
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_value, local_name
 
 DATATYPES = {"decimal": "decimal", "integer": "integer", "boolean": "boolean", "string": "string", "Pose": "pose"}
 """Local name of a parameter's ``pnp:datatype`` → the kind of field the parameter dialog shows."""
@@ -64,8 +73,16 @@ def parameter_json(p: Parameter, taxonomy: Taxonomy) -> dict[str, Any]:
     }
 
 
+def output_json(o: Output, taxonomy: Taxonomy) -> dict[str, Any]:
+    """An output: what a later step's parameter must be to take it (datatype, unit, quantity)."""
+    return {"name": o.name, "label": o.name.replace("_", " "), "role": o.role,
+            "datatype": DATATYPES.get(local_name(o.datatype), local_name(o.datatype)), "unit": o.unit,
+            "quantity": taxonomy.label(o.quantity)}
+
+
 def process_json(p: ProcessDescription, taxonomy: Taxonomy) -> dict[str, Any]:
-    """A process: its command, label, roles (required skill, start and end states) and parameters."""
+    """A process: its command, label, roles (required skill, start and end states), parameters, the outputs
+    later steps may take and the outcomes it may end with (as a loop's ``until`` names them)."""
     return {
         "command": p.id,
         "label": p.label,
@@ -74,23 +91,57 @@ def process_json(p: ProcessDescription, taxonomy: Taxonomy) -> dict[str, Any]:
                    "start": taxonomy.label(r.start_concept), "end": taxonomy.label(r.end_concept)}
                   for r in p.roles],
         "parameters": [parameter_json(x, taxonomy) for x in p.parameters],
+        "outputs": [output_json(o, taxonomy) for o in p.outputs],
+        "outcomes": [concept_value(o) for o in dict.fromkeys(p.outcomes)],
         "chart": f"/api/charts/process/{p.id}.svg",
     }
 
 
+def _step_json(s: Step) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": s.name} if s.name else {}
+    return {**out, "command": s.command, "bind": dict(s.bind),
+            "params": {n: plain_value(v) for n, v in s.params.items()}}
+
+
 def task_json(task: Task) -> dict[str, Any]:
-    """A task as the editor holds it: one round of its steps, and how often they repeat."""
-    return {
-        "name": task.name,
-        "description": task.description,
-        "repeat": task.repeat,
-        "steps": [{"command": s.command, "bind": dict(s.bind),
-                   "params": {n: plain_value(v) for n, v in s.params.items()}} for s in task.one_round()],
-    }
+    """A task as the task file writes it: one round of its steps (a loop as one item holding its body),
+    and how often they repeat."""
+    steps: list[dict[str, Any]] = []
+    for s in task.one_round():
+        loop = task.loop_at(s.index)
+        if loop is None:
+            steps.append(_step_json(s))
+        elif s.index == loop.entry:
+            body = task.steps[loop.entry - 1: loop.first - 1]
+            item: dict[str, Any] = {"until": concept_value(loop.until)} if loop.until else {}
+            if loop.max is not None:
+                item["max"] = loop.max
+            steps.append({"loop": {**item, "steps": [_step_json(b) for b in body]}})
+    return {"name": task.name, "description": task.description, "repeat": task.repeat, "steps": steps}
+
+
+def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
+    """Step position → (editor row, round): the editor shows each step once (a loop's body once), so a
+    repeated step's round counts the repeats, and a loop's later iterations are its round 2."""
+    rows: dict[int, tuple[int, int]] = {}
+    one_round = len(task.one_round())
+    row = 0
+    for s in task.steps:
+        loop = task.loop_at(s.index)
+        if loop is not None and s.index >= loop.first:
+            rows[s.index] = (rows[s.index - (loop.first - loop.entry)][0], 2)
+            continue
+        if s.index > one_round:
+            rows[s.index] = (rows[s.index - one_round][0], (s.index - 1) // one_round + 1)
+            continue
+        rows[s.index] = (row, 1)
+        row += 1
+    return rows
 
 
 def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[str, Any]:
-    """What a run's journal says so far: status, current step, every device's state, the fault if any."""
+    """What a run's journal says so far: status, current step (and every step position entered, from which
+    a loop's iterations are counted), every device's state, the values that flowed, the fault if any."""
     start = next((r for r in records if r["kind"] == "start"), {})
     end = next((r for r in records if r["kind"] == "end"), None)
     steps = [r for r in records if r["kind"] == "step"]
@@ -109,6 +160,8 @@ def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[s
         "status": status,
         "steps": start.get("steps"),
         "step": steps[-1] if steps else None,
+        "visited": [{"step": r.get("step"), "seq": r.get("seq")} for r in steps],
+        "values": [r for r in records if r["kind"] == "value"],
         "states": states,
         "faults": [r for r in records if r["kind"] == "fault"],
         "end": end,

@@ -18,18 +18,19 @@ from plugnproduce.hmi.pictures import GeneratedCharts
 from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.security import allow_read
-from plugnproduce.hmi.views import task_json
+from plugnproduce.hmi.views import editor_rows, task_json
 
 router = APIRouter(prefix="/api/task", tags=["task"], dependencies=[Depends(allow_read)])
 
 
 def _rows(problems: list[dict[str, Any]], task: TaskIn) -> list[dict[str, Any]]:
-    """Add to each problem the editor row of its step (steps repeat: step 5 of 2 rows is row 0, round 3)."""
-    n = len(task.steps)
+    """Add to each problem the editor row of its step (steps repeat: step 5 of 2 rows is row 0, round 3;
+    a loop's later iterations are its round 2)."""
+    rows = editor_rows(task.to_task())
     for p in problems:
         step = p.get("step")
-        if isinstance(step, int) and step >= 1:
-            p["row"], p["round"] = (step - 1) % n, (step - 1) // n + 1
+        if isinstance(step, int) and step in rows:
+            p["row"], p["round"] = rows[step]
     return problems
 
 

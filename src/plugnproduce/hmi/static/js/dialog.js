@@ -1,5 +1,7 @@
 // The parameter dialog of a process command, generated from its process description: a field per
 // parameter (type, unit, range, default) and a device choice per role where several devices fit.
+// A parameter may take an earlier named step's output instead of a value (the outputs whose datatype
+// and unit fit, as the server describes them); a step whose process gives outputs may be named.
 // Values are refused with the messages of the task shapes: the dialog validates the task through
 // the API (as `pnp validate` would) before it lets the step in.
 
@@ -30,7 +32,62 @@ function numberInput(id, p, value, label) {
   });
 }
 
-function paramField(p, value) {
+/** The outputs of earlier named steps a parameter may take: [{from, output, text}]. */
+function sources(p, row) {
+  const out = [];
+  state.task.steps.slice(0, row).forEach((s, r) => {
+    const process = state.processes.get(s.command);
+    if (!s.name || !process) return;
+    for (const o of process.outputs || []) {
+      if (o.datatype === p.datatype && (o.unit || "") === (p.unit || "")) {
+        out.push({ from: s.name, output: o.name, text: `${o.label} of step ${r + 1} (${s.name})` });
+      }
+    }
+  });
+  return out;
+}
+
+const ENTERED = "";
+
+function sourceField(p, value, found) {
+  const link = value && value.from ? `${value.from}.${value.output}` : ENTERED;
+  const options = found.map((f) => [`${f.from}.${f.output}`, `from ${f.text}`]);
+  if (link !== ENTERED && !options.some(([v]) => v === link)) options.push([link, `from ${value.output} of ${value.from}`]);
+  const select = h("select", { id: `param-${p.name}-source`, class: "source", "aria-label": `${p.label}: value from` },
+    h("option", { value: ENTERED, selected: link === ENTERED }, "entered here"),
+    options.map(([v, text]) => h("option", { value: v, selected: v === link }, text)));
+  return h("label", { class: "source-choice" }, "Value ", select);
+}
+
+function showSource(box) {
+  const select = box.querySelector("select.source");
+  const linked = Boolean(select && select.value !== ENTERED);
+  box.classList.toggle("linked", linked);
+  box.querySelectorAll("input").forEach((i) => { i.disabled = linked; });
+}
+
+function paramField(p, value, row) {
+  const found = sources(p, row);
+  const box = valueField(p, value && value.from ? undefined : value);
+  if (found.length || (value && value.from)) {
+    box.append(sourceField(p, value, found));
+    box.querySelector("select.source").addEventListener("change", () => showSource(box));
+    showSource(box);
+  }
+  return box;
+}
+
+function nameField(process, previous) {
+  if (!(process.outputs || []).length) return null;
+  return h("div", { class: "field step-name" },
+    h("label", { for: "step-name" }, "Step name"),
+    h("input", { id: "step-name", name: "step-name", type: "text", maxlength: 200, autocomplete: "off",
+      pattern: "[A-Za-z_][A-Za-z0-9_]*", value: (previous && previous.name) || "", "aria-describedby": "step-name-hint" }),
+    h("span", { id: "step-name-hint", class: "hint" },
+      `later steps take its ${process.outputs.map((o) => o.label).join(", ")} by this name`));
+}
+
+function valueField(p, value) {
   const id = `param-${p.name}`;
   const hint = h("span", { id: `${id}-hint`, class: "hint" }, [p.datatype, rangeText(p)].filter(Boolean).join(" · "));
   const error = h("span", { id: `${id}-error`, class: "error field-error" });
@@ -84,6 +141,11 @@ function same(a, b) {
 
 function readParam(p, root) {
   const box = root.querySelector(`[data-param="${CSS.escape(p.name)}"]`);
+  const source = box.querySelector("select.source");
+  if (source && source.value !== ENTERED) {
+    const [from, output] = source.value.split(".");
+    return { value: { from, output } };
+  }
   if (p.datatype === "pose") {
     const inputs = [...box.querySelectorAll("input")];
     if (inputs.every((i) => i.value === "" && !i.validity.badInput)) return { value: undefined };
@@ -134,7 +196,9 @@ function readStep(process, previous, root) {
   }
   const bind = {};
   root.querySelectorAll(".field.role select").forEach((s) => { if (s.value) bind[s.name] = s.value; });
-  return ok ? { command: process.command, bind, params } : null;
+  const named = root.querySelector("#step-name");
+  const name = named ? named.value.trim() : (previous && previous.name) || "";
+  return ok ? { ...(name ? { name } : {}), command: process.command, bind, params } : null;
 }
 
 /** Ask the API to validate the task with this step in its place; show each problem at its field. */
@@ -168,8 +232,9 @@ export function editStep(command, row, previous) {
   $("#dialog-title").textContent = `${previous ? "Edit" : "Add"} step ${row + 1}: ${process.label}`;
   $("#dialog-comment").textContent = process.comment || "";
   $("#dialog-ok").textContent = previous ? "Save step" : "Add step";
-  fill($("#dialog-roles"), h("legend", {}, "Devices"), process.roles.map((r) => roleField(process, r, previous)));
-  const params = process.parameters.map((p) => paramField(p, previous && previous.params ? previous.params[p.name] : undefined));
+  fill($("#dialog-roles"), h("legend", {}, "Devices"), nameField(process, previous),
+    process.roles.map((r) => roleField(process, r, previous)));
+  const params = process.parameters.map((p) => paramField(p, previous && previous.params ? previous.params[p.name] : undefined, row));
   fill($("#dialog-params"), h("legend", {}, "Parameters"), params.length ? params : h("p", { class: "hint" }, "This process has no parameters."));
   clearErrors(root);
   return new Promise((resolve) => {

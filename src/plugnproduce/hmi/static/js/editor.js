@@ -1,11 +1,12 @@
-// The task editor: add, edit, remove and reorder steps; check with problems at their steps;
-// ranked repairs applied with one click; why a step is (not) plausible; YAML in and out.
+// The task editor: add, edit, remove and reorder steps; loops around steps; check with problems at
+// their steps; ranked repairs applied with one click; why a step is (not) plausible; YAML in and out.
 
 import { api, post } from "./api.js";
 import { explanationView } from "./derivation.js";
 import { editStep } from "./dialog.js";
 import { $, announce, fill, h, showValue } from "./dom.js";
-import { changed, offer, saveTask, state, taskBody } from "./state.js";
+import { editLoop, loopText } from "./loops.js";
+import { changed, editorTask, loopOf, offer, saveTask, state, taskBody } from "./state.js";
 
 let checkTimer = null;
 let checkSeq = 0;
@@ -18,7 +19,9 @@ function label(command) {
 function paramSummary(step) {
   const process = state.processes.get(step.command);
   const units = new Map(process ? process.parameters.map((p) => [p.name, p.unit]) : []);
-  const parts = Object.entries(step.params || {}).map(([k, v]) => `${k.replace(/_/g, " ")} ${showValue(v, units.get(k))}`);
+  const parts = Object.entries(step.params || {}).map(([k, v]) => (v && v.from
+    ? `${k.replace(/_/g, " ")} ← ${v.output.replace(/_/g, " ")} of ${v.from}`
+    : `${k.replace(/_/g, " ")} ${showValue(v, units.get(k))}`));
   const binds = Object.entries(step.bind || {}).map(([role, dev]) => `${role} → ${dev}`);
   return [...binds, ...parts].join(" · ") || "defaults";
 }
@@ -34,8 +37,8 @@ export function setTask(task, message) {
   if (message) announce(message);
 }
 
-function setSteps(steps, message, focusRow, focusSelector) {
-  setTask({ ...state.task, steps }, message);
+function setSteps(steps, message, focusRow, focusSelector, loops = state.task.loops || []) {
+  setTask({ ...state.task, steps, loops }, message);
   if (focusRow !== undefined) {
     const li = $(`#steps li[data-row="${focusRow}"]`);
     const target = li && (li.querySelector(focusSelector) || li.querySelector("button:not([disabled])"));
@@ -70,18 +73,52 @@ function move(row, delta) {
 
 function remove(row) {
   const steps = state.task.steps.filter((_, i) => i !== row);
-  setSteps(steps, `Step ${row + 1} (${label(state.task.steps[row].command)}) removed.`, Math.min(row, steps.length - 1), ".edit");
+  const loops = (state.task.loops || [])
+    .map((l) => ({ ...l, first: l.first > row ? l.first - 1 : l.first, last: l.last >= row ? l.last - 1 : l.last }))
+    .filter((l) => l.first <= l.last);
+  setSteps(steps, `Step ${row + 1} (${label(state.task.steps[row].command)}) removed.`, Math.min(row, steps.length - 1),
+    ".edit", loops);
+}
+
+/** Open the loop dialog: a new loop around steps, or the loop at `index` to change. */
+async function loopDialog(index) {
+  const loops = [...(state.task.loops || [])];
+  const old = index === undefined ? null : loops[index];
+  const loop = await editLoop(old);
+  if (!loop) return;
+  if (old) loops[index] = loop;
+  else loops.push(loop);
+  loops.sort((a, b) => a.first - b.first);
+  setSteps(state.task.steps, `${loopText(loop)} ${old ? "saved" : "added"}.`, undefined, undefined, loops);
+}
+
+function removeLoop(loop) {
+  setSteps(state.task.steps, `${loopText(loop)} removed; its steps run once.`, loop.first, ".edit",
+    state.task.loops.filter((l) => l !== loop));
+}
+
+function loopHead(loop) {
+  const index = state.task.loops.indexOf(loop);
+  const text = loopText(loop);
+  return h("li", { class: "loop-head", dataset: { first: loop.first, last: loop.last } },
+    h("span", { class: "loop-text" }, text),
+    h("span", { class: "step-actions" },
+      h("button", { type: "button", class: "edit-loop quiet", "aria-label": `Edit ${text}`, onclick: () => loopDialog(index) },
+        "Edit loop"),
+      h("button", { type: "button", class: "remove-loop quiet danger", "aria-label": `Remove ${text}`,
+        onclick: () => removeLoop(loop) }, "Remove loop")));
 }
 
 function stepItem(step, row, count) {
   const n = row + 1;
   const name = `step ${n} (${label(step.command)})`;
   const offered = !state.commands || offer(step.command);
-  const li = h("li", { class: "step", dataset: { row, command: step.command } },
+  const li = h("li", { class: loopOf(row) ? "step in-loop" : "step", dataset: { row, command: step.command } },
     h("div", { class: "step-head" },
       h("span", { class: "step-no", "aria-hidden": "true" }, String(n)),
       h("div", { class: "step-main" },
         h("span", { class: "step-cmd" }, label(step.command), " ", h("code", {}, step.command),
+          step.name ? h("span", { class: "badge step-name" }, step.name) : null,
           offered ? null : h("span", { class: "badge warn" }, "not offered")),
         h("span", { class: "step-detail" }, paramSummary(step))),
       h("span", { class: "step-actions" },
@@ -108,7 +145,11 @@ export function renderTask() {
   if (document.activeElement !== $("#task-name")) $("#task-name").value = t.name;
   if (document.activeElement !== $("#task-repeat")) $("#task-repeat").value = t.repeat;
   if (document.activeElement !== $("#task-description")) $("#task-description").value = t.description || "";
-  fill($("#steps"), t.steps.map((s, i) => stepItem(s, i, t.steps.length)));
+  fill($("#steps"), t.steps.flatMap((s, i) => {
+    const loop = (t.loops || []).find((l) => l.first === i);
+    return [loop ? loopHead(loop) : null, stepItem(s, i, t.steps.length)];
+  }));
+  $("#add-loop").disabled = t.steps.length === 0;
   $("#steps-empty").hidden = t.steps.length > 0;
   renderCheck();
 }
@@ -136,8 +177,7 @@ function problemItem(p, i) {
 }
 
 function applyRepair(repair) {
-  const t = repair.task;
-  setTask({ ...state.task, name: t.name, description: t.description, repeat: t.repeat, steps: t.steps },
+  setTask({ ...state.task, ...editorTask(repair.task) },
     `Repair ${repair.rank} applied: ${repair.edits.map((e) => e.text).join("; ")}.`);
   $("#check").focus();
 }
@@ -232,7 +272,8 @@ async function importYaml(file) {
     const text = await file.text();
     const task = await api("POST", `/api/task/import?filename=${encodeURIComponent(file.name)}`, text,
       { raw: true, contentType: "application/yaml" });
-    setTask(task, `Task ${task.name} imported with ${task.steps.length} steps.`);
+    const loaded = editorTask(task);
+    setTask(loaded, `Task ${task.name} imported with ${loaded.steps.length} steps.`);
   } catch (err) {
     state.check = { error: err.message };
     renderCheck();
@@ -253,5 +294,7 @@ export function initEditor() {
     if (e.target.files[0]) importYaml(e.target.files[0]);
     e.target.value = "";
   });
-  $("#clear").addEventListener("click", () => setTask({ name: "task", description: "", repeat: 1, steps: [] }, "Task cleared."));
+  $("#add-loop").addEventListener("click", () => loopDialog());
+  $("#clear").addEventListener("click", () => setTask({ name: "task", description: "", repeat: 1, steps: [], loops: [] },
+    "Task cleared."));
 }

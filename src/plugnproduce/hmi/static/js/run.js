@@ -1,9 +1,57 @@
-// Runs: start and stop, each device's state and the current step live, the journal, the fault report.
+// Runs: start and stop, each device's state and the current step live, a loop's iteration, each value
+// as it flows from the step that produced it to the step that used it, the journal, the fault report.
 
 import { get, post } from "./api.js";
 import { renderDeviceState } from "./cell.js";
-import { $, announce, fill, h } from "./dom.js";
-import { state, taskBody } from "./state.js";
+import { $, announce, fill, h, showValue } from "./dom.js";
+import { loopText } from "./loops.js";
+import { state, stepPositions, taskBody } from "./state.js";
+
+/** Where step position `n` of the run lies in the editor's task: {row, loop, iteration}. */
+function where(n) {
+  const positions = stepPositions();
+  const count = positions.length - 1;
+  return count > 0 && n >= 1 ? positions[((n - 1) % count) + 1] : null;
+}
+
+/** Each loop's iteration as of journal record `seq`: a new one starts whenever its first step is entered. */
+function iterations(run, seq = Infinity) {
+  const counts = new Map();
+  for (const v of run.visited || []) {
+    const at = where(v.step);
+    if (v.seq < seq && at && at.loop && at.row === at.loop.first) counts.set(at.loop, (counts.get(at.loop) || 0) + 1);
+  }
+  return counts;
+}
+
+function stepName(n) {
+  const at = where(n);
+  const s = at ? state.task.steps[at.row] : null;
+  return s ? `step ${at.row + 1} (${s.name || s.command})` : `step ${n}`;
+}
+
+function valueItem(record, iteration) {
+  const produced = "produced" in record;
+  const value = showValue(produced ? record.produced : record.used);
+  const text = produced
+    ? `${record.value} = ${value}, produced by ${stepName(record.step)} on ${record.device}`
+    : `${record.value} = ${value}, used by ${stepName(record.step)} as ${record.parameter} on ${record.device}`;
+  return h("li", { class: produced ? "produced" : "used", dataset: { value: record.value, iteration: iteration || "" } },
+    iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
+}
+
+function renderFlow(run) {
+  const counts = iterations(run);
+  fill($("#run-loops"), [...counts].map(([loop, n]) => h("li", { dataset: { first: loop.first, iteration: n } },
+    `${loopText(loop)}: iteration ${n}`)));
+  $("#run-loops").hidden = counts.size === 0;
+  const items = (run.values || []).map((record) => {
+    const at = where(record.step);
+    return valueItem(record, at && at.loop ? iterations(run, record.seq).get(at.loop) : null);
+  });
+  fill($("#run-values"), items);
+  $("#run-values-box").hidden = items.length === 0;
+}
 
 function statusText(run) {
   const step = run.step ? `step ${run.step.step} of ${run.steps}: ${run.step.command}` : "starting";
@@ -16,13 +64,13 @@ function statusText(run) {
 }
 
 function markCurrentStep(run) {
-  const n = state.task.steps.length;
   document.querySelectorAll("#steps .step").forEach((li) => {
     li.classList.remove("running");
     li.removeAttribute("aria-current");
   });
-  if (!run || run.status !== "running" || !run.step || n === 0) return;
-  const li = $(`#steps li[data-row="${(run.step.step - 1) % n}"]`);
+  const at = run && run.status === "running" && run.step ? where(run.step.step) : null;
+  if (!at) return;
+  const li = $(`#steps li[data-row="${at.row}"]`);
   if (li) {
     li.classList.add("running");
     li.setAttribute("aria-current", "step");
@@ -82,6 +130,7 @@ export function renderRun() {
   fill(table.querySelector("tbody"), Object.entries(run.states).map(([d, s]) =>
     h("tr", { class: used.has(d) && running ? "busy" : "", dataset: { device: d } },
       h("th", { scope: "row" }, d), h("td", {}, h("span", { class: "badge" }, s)))));
+  renderFlow(run);
   fill($("#journal"), run.lines.map((line) => h("li", {}, line)));
   const link = $("#journal-link");
   link.href = `/api/runs/${encodeURIComponent(run.run)}/journal?format=jsonl`;
@@ -97,7 +146,7 @@ export function renderRun() {
 export function takeRecord({ run: id, record, text }) {
   if (!state.run || state.run.run !== id) {
     state.run = { run: id, task: null, status: "running", steps: null, step: null, states: {}, faults: [], end: null,
-      lines: [], seq: 0 };
+      lines: [], seq: 0, visited: [], values: [] };
   }
   const run = state.run;
   if (record.seq <= run.seq) return; // already in the run's view
@@ -107,7 +156,11 @@ export function takeRecord({ run: id, record, text }) {
     case "start":
       Object.assign(run, { task: record.task, steps: record.steps, states: { ...(record.states || {}) } });
       break;
-    case "step": run.step = record; break;
+    case "step":
+      run.step = record;
+      run.visited.push({ step: record.step, seq: record.seq });
+      break;
+    case "value": run.values.push(record); break;
     case "state":
       run.states[record.device] = record.state;
       break;
