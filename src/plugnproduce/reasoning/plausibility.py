@@ -24,13 +24,14 @@ def _problems(model: Model, ctx: render.Context) -> list[Problem]:
     out = [render.wrong_state(ctx, a, left.get((a.i, a.d))) for a in model[s.WrongState]]
     out += [render.stuck(ctx, a) for a in model[s.Stuck]]
     out += [render.unknown_command(ctx, a) for a in model[s.UnknownCommand]]
-    out += [render.binding_problem(ctx, "no_device", a.i, a.r, []) for a in model[s.NoDevice]]
+    missing = tuple(sorted(model[s.MissingArg], key=lambda m: (m.d, m.req, m.q)))
+    out += [render.binding_problem(ctx, "no_device", a.i, a.r, [], missing) for a in model[s.NoDevice]]
     ambiguous: dict[tuple[int, str], list[str]] = defaultdict(list)
     for b in model[s.Ambiguous]:
         ambiguous[(b.i, b.r)].append(b.d)
     out += [render.binding_problem(ctx, "ambiguous", i, r, ds) for (i, r), ds in ambiguous.items()]
     out += [render.binding_problem(ctx, "absent", a.i, a.r, [a.d]) for a in model[s.Absent]]
-    out += [render.binding_problem(ctx, "cannot_play", a.i, a.r, [a.d]) for a in model[s.CannotPlay]]
+    out += [render.binding_problem(ctx, "cannot_play", a.i, a.r, [a.d], missing) for a in model[s.CannotPlay]]
     out += [render.binding_problem(ctx, "unknown_role", a.i, a.r, []) for a in model[s.UnknownRole]]
     values: list[s.BadType | s.TooLow | s.TooHigh | s.UnknownParam] = [
         *model[s.BadType], *model[s.TooLow], *model[s.TooHigh], *model[s.UnknownParam]]
