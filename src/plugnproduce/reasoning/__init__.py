@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
 from plugnproduce.reasoning.batches import BatchRow, Configuration, batch, generate, read_configurations
+from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.offers import capabilities, explain_process
 from plugnproduce.reasoning.plausibility import check, explain_step
 from plugnproduce.reasoning.repairs import repair
@@ -29,6 +30,7 @@ from plugnproduce.reasoning.results import (
 )
 
 __all__ = [
+    "normalised",
     "BATCH_CSV_HEADER",
     "BatchRow",
     "Capabilities",

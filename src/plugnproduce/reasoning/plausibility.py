@@ -10,6 +10,7 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
+from plugnproduce.reasoning.contracts import beyond_limits, normalised
 from plugnproduce.reasoning.facts import fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program, context
 from plugnproduce.reasoning.results import CheckResult, Problem, StepCheck, StepExplanation
@@ -60,11 +61,17 @@ def run_check(task: Task, cell: Cell, taxonomy: Taxonomy,
 
 
 def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> CheckResult:
-    """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems."""
+    """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems.
+
+    Quantities written with a unit are read in their parameters' units first; every value a device
+    is sent must keep that device's contract (:mod:`plugnproduce.reasoning.contracts`).
+    """
+    task, unreadable = normalised(task, processes)
     model, ctx = run_check(task, cell, taxonomy, processes)
     steps, final = _steps(model, task)
     parameters = {p.id: {x.name: x for x in p.parameters} for p in processes}
     lost = list(not_accepted(task, cell, steps, parameters, taxonomy))
+    lost += unreadable + list(beyond_limits(task, cell, steps, processes))
     plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not lost
     problems = sorted(_problems(model, ctx) + lost, key=lambda p: (p.step, p.kind, p.parameter or ""))
     return CheckResult(task.name, cell.name, plausible, tuple(problems), steps, final)
@@ -75,6 +82,7 @@ def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,
     """Why step ``n`` (1-based) is (not) plausible: each device it uses, its state and what the step needs."""
     if not 1 <= n <= len(task.steps):
         raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+    task, _ = normalised(task, processes)
     model, ctx = run_check(task, cell, taxonomy, processes)
     left = {(a.i, a.d): a.j for a in model[s.LeftBy]}
     at = {(a.i, a.d): a.x for a in model[s.At]}
