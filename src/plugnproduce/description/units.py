@@ -38,7 +38,7 @@ class Amount:
 
 
 @cache
-def registry() -> pint.UnitRegistry:
+def registry() -> pint.UnitRegistry[float]:
     """The one unit registry (built once, on first use)."""
     import pint
 

@@ -17,7 +17,7 @@ import math
 from collections.abc import Iterator, Sequence
 
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Parameter, ProcessDescription, Task
-from plugnproduce.description.units import UnitError, convert, read_amount
+from plugnproduce.description.units import Amount, UnitError, convert, read_amount
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.facts import DATATYPES
 from plugnproduce.reasoning.results import Problem, Reason, StepCheck
@@ -42,9 +42,10 @@ def normalised(task: Task, processes: Sequence[ProcessDescription]) -> tuple[Tas
         params = dict(step.params)
         for name, value in step.params.items():
             par = declared.get(step.command, {}).get(name)
-            if par is None or not _numeric(par) or not isinstance(value, str):
-                continue
-            number, why = _read(value, par)
+            amount = read_amount(value) if isinstance(value, str) else None
+            if par is None or amount is None or not _numeric(par):
+                continue  # not a quantity written as text: the type check tells of anything wrong with it
+            number, why = _read(amount, par)
             if why is None:
                 params[name] = int(number) if par.datatype.endswith("integer") and number.is_integer() else number
                 continue
@@ -57,12 +58,8 @@ def normalised(task: Task, processes: Sequence[ProcessDescription]) -> tuple[Tas
     return dataclasses.replace(task, steps=tuple(steps)), problems
 
 
-def _read(value: str, par: Parameter) -> tuple[float, str | None]:
-    """``value`` in the parameter's unit, or why it cannot be read so."""
-    unit = par.unit or "no unit"
-    amount = read_amount(value)
-    if amount is None:
-        return math.nan, f"expected a number, or a number and a unit such as '{_example(par)}'"
+def _read(amount: Amount, par: Parameter) -> tuple[float, str | None]:
+    """An amount in the parameter's unit, or why it cannot be read so."""
     if not math.isfinite(amount.number):
         return math.nan, "expected a finite number"
     if amount.unit and not par.unit:
@@ -70,11 +67,7 @@ def _read(value: str, par: Parameter) -> tuple[float, str | None]:
     try:
         return convert(amount.number, amount.unit, par.unit), None
     except UnitError as exc:
-        return math.nan, f"expected a quantity in {unit} or a unit convertible to it ({exc})"
-
-
-def _example(par: Parameter) -> str:
-    return f"{par.default} {par.unit}".strip() if par.default is not None else f"1 {par.unit}".strip()
+        return math.nan, f"expected a quantity in {par.unit} or a unit convertible to it ({exc})"
 
 
 # ------------------------------------------------------------------ the devices' limits
@@ -96,8 +89,8 @@ def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
         for par in proc.parameters if proc else ():
             device = devices.get(check.bindings.get(par.role, ""))
             value = step.params.get(par.name, par.default)
-            if device is None or value is None:
-                continue
+            if device is None or value is None or _beyond_own_range(value, par):
+                continue  # the type and range check tells of a value outside the process's own range
             for contract in contracts_for(device, par.quantity):
                 why = _beyond(value, par, contract)
                 if why is None:
@@ -109,6 +102,13 @@ def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
                 reason = Reason("device_limit", text, (par.quantity, device.iri), rests)
                 yield Problem(step.index, step.command, "device_limit", reason, task.where(step, par.name),
                               role=par.role, device=device.id, parameter=par.name)
+
+
+def _beyond_own_range(value: object, par: Parameter) -> bool:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    return ((par.minimum is not None and value < par.minimum)
+            or (par.maximum is not None and value > par.maximum))
 
 
 def _beyond(value: object, par: Parameter, contract: Argument) -> str | None:

@@ -165,8 +165,8 @@ def binding_problem(ctx: Context, kind: str, i: int, r: str, devices: list[str],
     else:
         roles = ", ".join(x.name for x in proc.roles) if proc else "-"
         text = f"{head} is bound, but {p} has no such role (its roles: {roles})"
-    rests = (role.where,) if role else ()
-    iris = (role.required_skill,) if role else ()
+    rests: tuple[Where, ...] = (role.where,) if role else ()
+    iris: tuple[str, ...] = (role.required_skill,) if role else ()
     lacks = [m for m in missing if m.p == p and m.r == r and (kind == "no_device" or m.d == named)]
     if kind in ("no_device", "cannot_play") and lacks:
         why = [missing_argument(ctx, m.p, m.r, m.d, m.req, m.q) for m in lacks]

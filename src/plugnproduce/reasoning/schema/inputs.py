@@ -87,7 +87,7 @@ class Recovers(Atom):
 
 @predicate("missing_arg")
 class MissingArg(Atom):
-    """Playing role ``r`` of ``p``, ``d`` waits for request ``req`` needing argument ``q`` that ``p`` does not supply."""
+    """Playing role ``r`` of ``p``, ``d`` waits for request ``req`` needing argument ``q`` ``p`` lacks."""
 
     p: str
     r: str

@@ -72,7 +72,7 @@ class Unreachable(Atom):
 
 @predicate("no_argument")
 class NoArgument(Atom):
-    """Why not: ``d`` could play ``r`` of ``p`` but its request ``req`` needs argument ``q``, which ``p`` does not supply."""
+    """Why not: ``d`` could play ``r`` of ``p`` but its request ``req`` needs argument ``q``, which ``p`` lacks."""
 
     c: str
     p: str
