@@ -49,6 +49,10 @@ from plugnproduce.statechart.io.reader import parse_chart, read_chart
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 
 
+class ContractError(DescriptionError):
+    """A device's argument contract that does not fit its chart, or names a unit there is not."""
+
+
 @dataclass(frozen=True)
 class Loaded:
     """A parsed Turtle description: its graph, text and path."""
@@ -185,11 +189,11 @@ def _check_arguments(arguments: tuple[Argument, ...], transitions: tuple[ChartTr
     for a in arguments:
         line = a.where.line if a.where else None
         if (a.request, a.quantity) not in accepted:
-            raise DescriptionError(f"argument {local_name(a.quantity)} of request {a.request}: no transition of the "
+            raise ContractError(f"argument {local_name(a.quantity)} of request {a.request}: no transition of the "
                                    f"chart waits for request {a.request} with pnp:accepts=\"{local_name(a.quantity)}\"",
                                    path, line)
         if not unit_known(a.unit):
-            raise DescriptionError(f"argument {local_name(a.quantity)} of request {a.request}: unknown unit "
+            raise ContractError(f"argument {local_name(a.quantity)} of request {a.request}: unknown unit "
                                    f"{excerpt(a.unit)!r}; expected a unit such as \"N\", \"mm/s\" or \"kPa\"",
                                    path, line)
 

@@ -20,8 +20,8 @@ if TYPE_CHECKING:  # pint is imported on first use: a command that reads no unit
 MAX_TEXT = 64
 """Longest quantity text read; a longer string is no quantity."""
 
-_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d{1,3})?|[-+]?(?:nan|inf|infinity))\s*(\S.*)?$",
-                       re.IGNORECASE)
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d{1,3})?|[-+]?(?:nan|inf|infinity))\s*"
+                       r"([A-Za-z%°µΩ].*)?$", re.IGNORECASE)
 _UNIT = re.compile(r"^[A-Za-z%°µΩ][A-Za-z0-9%°µΩ_/*^ .·-]*$")
 
 
