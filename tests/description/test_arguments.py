@@ -69,3 +69,9 @@ def test_units_convert_within_a_dimension_only() -> None:
     with pytest.raises(UnitError, match="kg cannot be converted to N"):
         convert(12, "kg", "N")
     assert unit_known("N m") and unit_known("%") and not unit_known("__import__('os')")
+
+
+@pytest.mark.parametrize("unit", ["N**9**9**9", "kg/0", "degC*m", "__import__('os')", "N" * 70])
+def test_a_hostile_or_meaningless_unit_is_refused_quickly(unit: str) -> None:
+    with pytest.raises(UnitError):
+        convert(5, unit, "N")

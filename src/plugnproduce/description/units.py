@@ -22,7 +22,9 @@ MAX_TEXT = 64
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d{1,3})?|[-+]?(?:nan|inf|infinity))\s*"
                        r"([A-Za-z%°µΩ].*)?$", re.IGNORECASE)
-_UNIT = re.compile(r"^[A-Za-z%°µΩ][A-Za-z0-9%°µΩ_/*^ .·-]*$")
+_FACTOR = r"[A-Za-z%°µΩ_]+(?:(?:\*\*|\^)-?\d{1,2})?"
+_UNIT = re.compile(rf"^{_FACTOR}(?:\s*[*/· ]\s*{_FACTOR})*$")
+"""Units as factors with small whole exponents (``N m``, ``mm/s``, ``m/s^2``): nothing pint would compute long on."""
 
 
 class UnitError(ValueError):
@@ -69,7 +71,7 @@ def unit_known(unit: str) -> bool:
 
     try:
         registry().Unit(_spelling(unit))
-    except (pint.PintError, AttributeError, ValueError, TypeError, SyntaxError):  # what pint raises on bad text
+    except (pint.PintError, AttributeError, ValueError, TypeError, SyntaxError, ArithmeticError):  # pint on bad text
         return False
     return True
 
@@ -89,7 +91,7 @@ def convert(number: float, unit: str, to: str) -> float:
     ureg = registry()
     try:
         return float(ureg.Quantity(number, _spelling(unit)).to(_spelling(to)).magnitude)
-    except pint.DimensionalityError as exc:
+    except (pint.PintError, AttributeError, ValueError, TypeError, ArithmeticError) as exc:  # pint's own and offsets
         raise UnitError(f"{unit} cannot be converted to {to}") from exc
 
 
