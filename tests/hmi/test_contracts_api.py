@@ -8,7 +8,6 @@ import pytest
 from tests.hmi.conftest import AUTH
 
 
-
 def _task(value: object) -> dict[str, object]:
     return {"name": "t", "steps": [{"command": "pick", "params": {"grip_force": value}}]}
 

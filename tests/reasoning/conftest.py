@@ -9,8 +9,8 @@ import clingo
 import pytest
 
 from plugnproduce import service
-from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.description.loader import load_device
+from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.resources import rules_path
 from tests.conftest import edit
 
