@@ -75,3 +75,15 @@ def test_units_convert_within_a_dimension_only() -> None:
 def test_a_hostile_or_meaningless_unit_is_refused_quickly(unit: str) -> None:
     with pytest.raises(UnitError):
         convert(5, unit, "N")
+
+
+@pytest.mark.parametrize("value, code, needle", [
+    ("0.12 kN", 0, "1 files valid"),
+    ("1.2 kN", 1, "parameter 'grip_force' is 1200.0 N; expected a value from 10 to 140 N"),
+    ("12 kg", 1, "parameter 'grip_force' takes a number; found 12 kg"),
+])
+def test_validate_reads_a_quantity_in_its_parameters_unit(tmp_path, value: str, code: int, needle: str) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text(f"task: t\nsteps:\n  - command: pick\n    params: {{grip_force: {value}}}\n")
+    result = CliRunner().invoke(app, ["validate", str(task)])
+    assert result.exit_code == code and needle in result.output

@@ -95,6 +95,18 @@ def convert(number: float, unit: str, to: str) -> float:
         raise UnitError(f"{unit} cannot be converted to {to}") from exc
 
 
+def number_in(value: str, unit: str) -> float | None:
+    """A quantity written as text (``"0.12 kN"``) as a number in ``unit``; None if it is none, is not
+    finite, or cannot be converted (the check says which)."""
+    amount = read_amount(value)
+    if amount is None or not math.isfinite(amount.number) or (amount.unit and not unit):
+        return None
+    try:
+        return convert(amount.number, amount.unit, unit)
+    except UnitError:
+        return None
+
+
 def _spelling(unit: str) -> str:
     """How pint reads a unit written in a description (``%`` is ``percent``)."""
     return unit.replace("%", "percent")
