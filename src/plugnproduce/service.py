@@ -360,7 +360,8 @@ class Generation:
 def _generate_task(the_task: Task, the_cell: Cell, result: reasoning.CheckResult, k: Knowledge) -> GeneratedTask:
     from plugnproduce.codegen import generate_task
 
-    return generate_task(the_task, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
+    in_units, _ = reasoning.normalised(the_task, k.processes)  # the values in their parameters' units
+    return generate_task(in_units, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
 
 
 def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,

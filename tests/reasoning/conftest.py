@@ -9,8 +9,10 @@ import clingo
 import pytest
 
 from plugnproduce import service
+from plugnproduce.description.loader import load_device
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.resources import rules_path
+from tests.conftest import edit
 
 DESCRIPTIONS = service.builtin()
 BIN_PICKING = DESCRIPTIONS / "cells" / "bin-picking.yaml"
@@ -33,6 +35,14 @@ def device(devices: list[DeviceDescription]):
         return next(d for d in devices if d.id == name)
 
     return get
+
+
+@pytest.fixture()
+def vacuum_with_default(device_copy, taxonomy) -> DeviceDescription:
+    """The vacuum gripper, made to declare a default vacuum: it needs no process to supply one."""
+    ttl, _ = device_copy("vacuum-gripper")
+    edit(ttl, "pnp:minValue 20 ; pnp:maxValue 85 .", "pnp:minValue 20 ; pnp:maxValue 85 ; pnp:defaultValue 60 .")
+    return load_device(ttl, taxonomy)
 
 
 def task(name: str) -> Task:

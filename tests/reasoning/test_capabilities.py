@@ -21,8 +21,8 @@ def test_every_valid_binding_is_listed(cell: Cell) -> None:
                                   "sensor": "sensor3d"},)
 
 
-def test_a_second_gripper_doubles_the_bindings_of_pick(cell: Cell, device) -> None:
-    caps = service.capabilities(cell.with_device(device("vacuum-gripper")), all_bindings=True)
+def test_a_second_gripper_doubles_the_bindings_of_pick(cell: Cell, vacuum_with_default: DeviceDescription) -> None:
+    caps = service.capabilities(cell.with_device(vacuum_with_default), all_bindings=True)
     pick = next(o for o in caps.offered if o.command == "pick")
     assert sorted(b["gripper"] for b in pick.bindings) == ["gripper", "vacuum-gripper"]
     assert pick.binding_count == 2
@@ -68,9 +68,21 @@ def test_the_reason_is_the_missing_can_grip(cell: Cell) -> None:
     assert reason.where[0].file.endswith("pick.ttl") and reason.where[0].line is not None
 
 
-def test_a_vacuum_gripper_brings_back_what_its_gripping_role_can_do(cell: Cell, device) -> None:
-    swapped = cell.without("gripper").with_device(device("vacuum-gripper"))
+def test_a_vacuum_gripper_brings_back_what_its_gripping_role_can_do(cell: Cell,
+                                                                   vacuum_with_default: DeviceDescription) -> None:
+    swapped = cell.without("gripper").with_device(vacuum_with_default)
     assert GRIPPING <= set(service.capabilities(swapped).commands())
+
+
+def test_a_vacuum_gripper_needing_a_vacuum_no_process_supplies_grips_nothing(cell: Cell, device) -> None:
+    swapped = cell.without("gripper").with_device(device("vacuum-gripper"))
+    caps = service.capabilities(swapped)
+    assert set(caps.commands()) & GRIPPING == {"open-gripper", "place"}  # these never send SuctionOn
+    pick = next(n for n in caps.not_offered if n.command == "pick")
+    (reason,) = pick.reasons
+    assert reason.code == "no_argument"
+    assert "'vacuum-gripper'" in reason.text and "request SuctionOn" in reason.text and "pnp:Vacuum" in reason.text
+    assert reason.where[0].file.endswith("vacuum-gripper.ttl") and reason.where[1].file.endswith(".scxml")
 
 
 def test_a_device_lacking_a_state_is_explained_with_its_chart(cell: Cell, device) -> None:

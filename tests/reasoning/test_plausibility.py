@@ -50,6 +50,15 @@ def test_parameter_values_must_fit_type_and_range(cell: Cell) -> None:
     assert kinds == {("too_high", "grip_force"), ("bad_type", "exposure"), ("unknown_param", "colour")}
 
 
+def test_a_value_in_the_process_range_beyond_the_device_limit_is_a_finding_at_its_line(cell: Cell) -> None:
+    t = task("bin-picking-invalid")
+    bad = replace(t, steps=(replace(t.steps[0], params={"grip_force": 130}),))  # the process allows up to 140 N
+    (p,) = [p for p in service.check(bad, cell).problems if p.parameter == "grip_force"]
+    assert (p.kind, p.device, p.where) == ("device_limit", "gripper", t.where(t.steps[0], "grip_force"))
+    assert "takes at most 100 N; the value is 130 N" in p.text
+    assert p.reason.where[0].file.endswith("gripper.ttl")
+
+
 def test_a_pose_is_six_numbers(cell: Cell) -> None:
     t = task("pick-and-place")
     short = replace(t, steps=(replace(t.steps[0], params={"pick_pose": [1, 2, 3]}),))

@@ -45,6 +45,14 @@ CASES = [
      "default 400 of parameter 'grip_force' lies outside its range [10, 140]"),
     ("ParameterShape/quantity", "processes", "pick", "pnp:quantity pnp:GripForce", "pnp:quantity pnp:Open", 41,
      "pnp:quantity"),
+    ("RequestArgumentShape/range", "devices", "gripper", "pnp:minValue 20 ; pnp:maxValue 100",
+     "pnp:minValue 200 ; pnp:maxValue 100", 20, "argument's pnp:minValue must not exceed"),
+    ("RequestArgumentShape/required", "devices", "gripper", 'pnp:request "Close" ;',
+     'pnp:request "Close" ; pnp:required "yes" ;', 20, "pnp:required is one boolean"),
+    ("RequestArgumentShape/reach", "devices", "robot", "pnp:maxReach 1.45", "pnp:maxReach 0", 19,
+     "pnp:maxReach is one positive"),
+    ("RequestArgumentShape/datatype", "devices", "cobot", "pnp:datatype xsd:decimal", "pnp:datatype xsd:float", 26,
+     "argument's pnp:datatype"),
 ]
 
 

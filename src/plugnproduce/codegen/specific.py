@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.description.paths import find_path
+from plugnproduce.description.units import convert
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
@@ -164,12 +165,27 @@ def _request(
     process: ProcessDescription,
 ) -> Send:
     send = Send(type=command.protocol, target=device.id, event=command.event)
+    given: set[str] = set()
     for name, value in sorted(values.items()):
-        quantity = process.parameter(name).quantity
-        if quantity in accepts:
-            expr = value.expr if isinstance(value, Varying | Flow) else literal(value)
-            send.params.append(Param(name=local_name(quantity), expr=expr))
+        par = process.parameter(name)
+        if par.quantity in accepts:
+            contract = device.argument(command.name, par.quantity)
+            expr = (value.expr if isinstance(value, Varying | Flow)
+                    else literal(_in_unit(value, par.unit, contract.unit)))
+            send.params.append(Param(name=local_name(par.quantity), expr=expr))
+            given.add(par.quantity)
+    for quantity in accepts:  # an argument the process does not supply takes the device's own default
+        contract = device.argument(command.name, quantity)
+        if quantity not in given and contract.default is not None:
+            send.params.append(Param(name=local_name(quantity), expr=literal(contract.default)))
     return send
+
+
+def _in_unit(value: object, unit: str, to: str) -> object:
+    """A plain number in the parameter's unit converted to the unit the device's contract declares."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not unit or not to or unit == to:
+        return value
+    return convert(float(value), unit, to)
 
 
 def literal(value: object) -> str:

@@ -15,8 +15,12 @@ from rdflib.namespace import RDF, RDFS, XSD
 
 from plugnproduce.description.loader import Loaded
 from plugnproduce.description.model import ChartState, DeviceDescription, ProcessDescription, Task, Where
+from plugnproduce.description.units import number_in
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP
+
+NUMBERS = frozenset(str(t) for t in (XSD.decimal, XSD.double, XSD.float, XSD.integer, XSD.int, XSD.long))
+"""Parameter datatypes whose values may be written as quantities with a unit."""
 
 
 @dataclass
@@ -91,6 +95,9 @@ class KnowledgeGraph:
                 self.places[str(pv)] = task.where(step, name)
                 self.graph.add((node, PNP.hasValue, pv))
                 self.graph.add((pv, PNP.parameter, rdflib.URIRef(params[name].iri)))
+                if isinstance(value, str) and params[name].datatype in NUMBERS:  # "0.12 kN": in the parameter's unit
+                    number = number_in(value, params[name].unit)
+                    value = value if number is None else number
                 self.graph.add((pv, PNP.value, value_literal(value)))
 
 

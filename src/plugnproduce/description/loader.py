@@ -22,7 +22,9 @@ from rdflib.namespace import RDF, RDFS, XSD
 
 from plugnproduce.description.charts import device_chart, process_regions
 from plugnproduce.description.model import (
+    Argument,
     Cell,
+    ChartTransition,
     DeviceDescription,
     Link,
     Loop,
@@ -36,6 +38,7 @@ from plugnproduce.description.model import (
     plain_value,
 )
 from plugnproduce.description.rdf import term_line
+from plugnproduce.description.units import unit_known
 from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
 from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -56,6 +59,10 @@ SAFE_STOP = str(PNP.SafeStop)
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")
 _OUTPUT_NAME = re.compile(r"[a-z][a-z0-9_]{0,63}")
+
+
+class ContractError(DescriptionError):
+    """A device's argument contract that does not fit its chart, or names a unit there is not."""
 
 
 @dataclass(frozen=True)
@@ -166,6 +173,9 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
     timeout = _opt(loaded, s, PNP.commandTimeout)
     cost = _opt(loaded, s, PNP.cost)
     label = _opt(loaded, s, RDFS.label)
+    arguments = tuple(sorted((_argument(loaded, a) for a in loaded.graph.objects(s, PNP.hasArgument)),
+                             key=lambda a: (a.request, a.quantity)))
+    _check_arguments(arguments, transitions, loaded.path)
     return DeviceDescription(
         id=local_name(str(s)),
         iri=str(s),
@@ -184,6 +194,40 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         skills=tuple(sorted(taxonomy.device_skills(classes, declared))),
         chart=chart,
         stops=stops,
+        arguments=arguments,
+    )
+
+
+def _check_arguments(arguments: tuple[Argument, ...], transitions: tuple[ChartTransition, ...], path: Path) -> None:
+    """Each argument belongs to a request of the chart that accepts its quantity, in a unit there is."""
+    accepted = {(t.request.name, q) for t in transitions if t.request for q in t.accepts}
+    for a in arguments:
+        line = a.where.line if a.where else None
+        if (a.request, a.quantity) not in accepted:
+            raise ContractError(f"argument {local_name(a.quantity)} of request {a.request}: no transition of the "
+                                   f"chart waits for request {a.request} with pnp:accepts=\"{local_name(a.quantity)}\"",
+                                   path, line)
+        if not unit_known(a.unit):
+            raise ContractError(f"argument {local_name(a.quantity)} of request {a.request}: unknown unit "
+                                   f"{excerpt(a.unit)!r}; expected a unit such as \"N\", \"mm/s\" or \"kPa\"",
+                                   path, line)
+
+
+def _argument(loaded: Loaded, a: rdflib.term.Node) -> Argument:
+    """One ``pnp:RequestArgument`` of a device (the shapes check its terms; the limits must be finite)."""
+    required = _opt(loaded, a, PNP.required)
+    datatype = _opt(loaded, a, PNP.datatype)
+    return Argument(
+        request=str(_one(loaded, a, PNP.request, "request")),
+        quantity=str(_one(loaded, a, PNP.quantity, "quantity")),
+        required=not (isinstance(required, rdflib.Literal) and required.toPython() is False),
+        datatype=str(datatype) if datatype is not None else "",
+        unit=str(_opt(loaded, a, PNP.unit) or ""),
+        minimum=_finite(loaded, a, _opt(loaded, a, PNP.minValue), "minimum"),
+        maximum=_finite(loaded, a, _opt(loaded, a, PNP.maxValue), "maximum"),
+        reach=_finite(loaded, a, _opt(loaded, a, PNP.maxReach), "maximum reach"),
+        default=_default(_opt(loaded, a, PNP.defaultValue)),
+        where=loaded.where(str(a)),
     )
 
 

@@ -84,6 +84,33 @@ class ChartTransition:
 
 
 @dataclass(frozen=True)
+class Argument:
+    """The contract of one argument of a device request (``pnp:RequestArgument``): the device's own terms.
+
+    A quantity a request ``pnp:accepts`` with no declared argument is required, of any type, unit
+    and value (what ``pnp:accepts`` alone always meant).
+    """
+
+    request: str
+    """The request's name (``Close`` for ``xirp.request.Close``)."""
+    quantity: str
+    required: bool = True
+    datatype: str = ""
+    unit: str = ""
+    minimum: float | None = None
+    maximum: float | None = None
+    reach: float | None = None
+    """For a pose: the largest distance of its position from the device's base, in metres."""
+    default: object = None
+    where: Where | None = None
+
+    @property
+    def needed(self) -> bool:
+        """Whether a process must supply it: required and without a default of the device's own."""
+        return self.required and self.default is None
+
+
+@dataclass(frozen=True)
 class DeviceDescription:
     """A device: its metadata and its Device State Chart."""
 
@@ -120,6 +147,15 @@ class DeviceDescription:
         wherever a plan starts from it)."""
         self.state(state_id)
         return dataclasses.replace(self, initial=state_id, reported_state=True)
+    arguments: tuple[Argument, ...] = ()
+    """Declared contracts of its requests' arguments (``pnp:hasArgument``)."""
+
+    def argument(self, request: str, quantity: str) -> Argument:
+        """The contract of a request's argument: the declared one, else required with no limits."""
+        for a in self.arguments:
+            if a.request == request and a.quantity == quantity:
+                return a
+        return Argument(request, quantity)
 
     def state(self, state_id: str) -> ChartState:
         """The chart state called ``state_id``."""

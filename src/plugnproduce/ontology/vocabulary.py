@@ -59,6 +59,12 @@ class PNP(DefinedNamespace):
     concept: URIRef
     sourceLine: URIRef
     mandatoryState: URIRef
+    # a device's contracts for its requests' arguments
+    RequestArgument: URIRef
+    hasArgument: URIRef
+    request: URIRef
+    required: URIRef
+    maxReach: URIRef
     # task description lifted to RDF (for the task shapes)
     hasStep: URIRef
     stepIndex: URIRef

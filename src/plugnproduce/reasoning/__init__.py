@@ -23,6 +23,7 @@ from plugnproduce.reasoning.batches import (
 )
 from plugnproduce.reasoning.cluster import check_address as check_cluster_address
 from plugnproduce.reasoning.cluster import cluster_mapper
+from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.counterfactuals import Counterfactual
 from plugnproduce.reasoning.counterfactuals import from_repairs as counterfactuals_from_repairs
 from plugnproduce.reasoning.derivation import Node
@@ -57,6 +58,7 @@ __all__ = [
     "counterfactuals_from_repairs",
     "explain_offered",
     "explain_plausible",
+    "normalised",
     "ontology_of",
     "BATCH_CSV_HEADER",
     "BatchRow",

@@ -68,35 +68,53 @@ def _pose(items: Sequence[object]) -> bool:
 # ------------------------------------------------------------------ devices
 
 
+def region_walk(device: DeviceDescription, process: ProcessDescription, role: Role, start: str,
+                taxonomy: Taxonomy) -> tuple[str, frozenset[tuple[str, str]]] | None:
+    """Where playing ``role`` from ``start`` leaves ``device`` (code generation's walk), and the arguments
+    (request, quantity) its requests on the way need that the process does not hand them; None if stuck."""
+    current, missing = start, set()
+    for general in role.region[1:]:
+        try:
+            given = frozenset(process.parameter(p).quantity for p in general.params)
+            path = find_path(device, current, general.concept, taxonomy, given)
+        except (NoPath, KeyError):
+            return None
+        current = path.target
+        missing |= {(t.request.name, q) for t in path.steps if t.request for q in t.accepts
+                    if q not in given and device.argument(t.request.name, q).needed}
+    return current, frozenset(missing)
+
+
 def region_end(device: DeviceDescription, process: ProcessDescription, role: Role, start: str,
                taxonomy: Taxonomy) -> str | None:
     """The state playing ``role`` from ``start`` leaves ``device`` in, as code generation walks it; None if stuck."""
-    current = start
-    for general in role.region[1:]:
-        try:
-            wanted = frozenset(process.parameter(p).quantity for p in general.params)
-            current = find_path(device, current, general.concept, taxonomy, wanted).target
-        except (NoPath, KeyError):
-            return None
-    return current
+    walked = region_walk(device, process, role, start, taxonomy)
+    return walked[0] if walked is not None else None
 
 
 def effects(device: DeviceDescription, process: ProcessDescription, taxonomy: Taxonomy) -> list[Atom]:
-    """``leaves/5`` and ``recovers/4`` for each role of ``process`` the device has the skill for."""
+    """``leaves/5``, ``recovers/4`` and ``missing_arg/5`` for each role of ``process`` the device has the skill for.
+
+    A request on the way that needs an argument the process does not supply (``missing_arg``) keeps
+    the device from the role: the request would be refused at run time.
+    """
     out: list[Atom] = []
     for role in process.roles:
         if role.required_skill not in device.skills:
             continue
         first: str | None = None
+        missing: set[tuple[str, str]] = set()
         for state in device.states:
             if state.concept is None or not taxonomy.is_a(state.concept, role.start_concept):
                 continue
-            end = region_end(device, process, role, state.id, taxonomy)
-            if end is not None:
-                out.append(s.Leaves(process.id, role.name, device.id, state.id, end))
-                first = first or end
+            walked = region_walk(device, process, role, state.id, taxonomy)
+            if walked is not None:
+                out.append(s.Leaves(process.id, role.name, device.id, state.id, walked[0]))
+                first = first or walked[0]
+                missing |= walked[1]
         if first is not None:
             out.append(s.Recovers(process.id, role.name, device.id, first))
+        out += [s.MissingArg(process.id, role.name, device.id, r, q) for r, q in sorted(missing)]
     return out
 
 

@@ -68,6 +68,8 @@ def _reasons(model: Model, ctx: render.Context) -> dict[str, list[Reason]]:
         out[b.p].append(render.lacks_state(ctx, b))
     for c in sorted(model[s.Unreachable], key=lambda a: (a.p, a.r, a.d, a.i, a.x)):
         out[c.p].append(render.unreachable(ctx, c))
+    for n in sorted(model[s.NoArgument], key=lambda a: (a.p, a.r, a.d, a.req, a.q)):
+        out[n.p].append(render.no_argument(ctx, n))
     return out
 
 

@@ -11,6 +11,7 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
+from plugnproduce.reasoning.contracts import beyond_limits, normalised
 from plugnproduce.reasoning.controlflow import loop_problems, on_path
 from plugnproduce.reasoning.dataflow import link_problems, unreported
 from plugnproduce.reasoning.facts import fact_book, task_facts
@@ -27,13 +28,14 @@ def _problems(model: Model, ctx: render.Context) -> list[Problem]:
     out = [render.wrong_state(ctx, a, left.get((a.i, a.d))) for a in model[s.WrongState]]
     out += [render.stuck(ctx, a) for a in model[s.Stuck]]
     out += [render.unknown_command(ctx, a) for a in model[s.UnknownCommand]]
-    out += [render.binding_problem(ctx, "no_device", a.i, a.r, []) for a in model[s.NoDevice]]
+    missing = tuple(sorted(model[s.MissingArg], key=lambda m: (m.d, m.req, m.q)))
+    out += [render.binding_problem(ctx, "no_device", a.i, a.r, [], missing) for a in model[s.NoDevice]]
     ambiguous: dict[tuple[int, str], list[str]] = defaultdict(list)
     for b in model[s.Ambiguous]:
         ambiguous[(b.i, b.r)].append(b.d)
     out += [render.binding_problem(ctx, "ambiguous", i, r, ds) for (i, r), ds in ambiguous.items()]
     out += [render.binding_problem(ctx, "absent", a.i, a.r, [a.d]) for a in model[s.Absent]]
-    out += [render.binding_problem(ctx, "cannot_play", a.i, a.r, [a.d]) for a in model[s.CannotPlay]]
+    out += [render.binding_problem(ctx, "cannot_play", a.i, a.r, [a.d], missing) for a in model[s.CannotPlay]]
     out += [render.binding_problem(ctx, "unknown_role", a.i, a.r, []) for a in model[s.UnknownRole]]
     values: list[s.BadType | s.TooLow | s.TooHigh | s.UnknownParam] = [
         *model[s.BadType], *model[s.TooLow], *model[s.TooHigh], *model[s.UnknownParam]]
@@ -65,13 +67,17 @@ def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proces
     """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems.
 
     A task with loops is checked on every path: see :mod:`plugnproduce.reasoning.controlflow`.
+    Quantities written with a unit are read in their parameters' units first; every value a device
+    is sent must keep that device's contract (:mod:`plugnproduce.reasoning.contracts`).
     """
+    task, unreadable = normalised(task, processes)
     model, ctx = run_check(task, cell, taxonomy, processes)
     steps, final = _steps(model, task)
     parameters = {p.id: {x.name: x for x in p.parameters} for p in processes}
     lost = list(not_accepted(task, cell, steps, parameters, taxonomy))
     lost += link_problems(task, {p.id: p for p in processes}, taxonomy)
     lost += unreported(task, cell, steps, {p.id: p for p in processes})
+    lost += unreadable + list(beyond_limits(task, cell, steps, processes))
     problems = [on_path(p, task) for p in _problems(model, ctx) + lost]
     plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not problems
     result = CheckResult(task.name, cell.name, plausible, (), steps, final)
@@ -87,6 +93,7 @@ def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,
     """Why step ``n`` (1-based) is (not) plausible: each device it uses, its state and what the step needs."""
     if not 1 <= n <= len(task.steps):
         raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+    task, _ = normalised(task, processes)
     model, ctx = run_check(task, cell, taxonomy, processes)
     left = {(a.i, a.d): a.j for a in model[s.LeftBy]}
     at = {(a.i, a.d): a.x for a in model[s.At]}

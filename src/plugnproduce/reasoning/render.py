@@ -93,6 +93,24 @@ def unreachable(ctx: Context, a: s.Unreachable) -> Reason:
     return Reason("unreachable", text, (a.con, prev, dev.iri), where)
 
 
+def no_argument(ctx: Context, a: s.NoArgument) -> Reason:
+    """A device could play a role, but a request on its way needs an argument the process does not supply."""
+    return missing_argument(ctx, a.p, a.r, a.d, a.req, a.q)
+
+
+def missing_argument(ctx: Context, p: str, r: str, d: str, request: str, quantity: str) -> Reason:
+    """Device ``d``'s request needs an argument (``quantity``) no parameter of process ``p`` hands it."""
+    dev = ctx.devices[d]
+    contract = dev.argument(request, quantity)
+    text = (f"device '{d}' cannot play role '{r}' of {p}: its request {request} needs the argument "
+            f"{ctx.term(quantity)}, and no parameter of {p} for role '{r}' supplies it (the device "
+            f"declares no default)")
+    line = next((t.line for t in dev.transitions if t.request and t.request.name == request
+                 and quantity in t.accepts), None)
+    where = (contract.where or dev.where, Where(dev.chart_file, line), ctx.role_where(p, r))
+    return Reason("no_argument", text, (quantity, dev.iri), where)
+
+
 # ------------------------------------------------------------------ why a step is not plausible
 
 
@@ -127,8 +145,12 @@ def stuck(ctx: Context, a: s.Stuck) -> Problem:
     return Problem(a.i, p, "stuck", reason, ctx.step_where(a.i), a.r, a.d, a.x, ctx.state_concept(a.d, a.x))
 
 
-def binding_problem(ctx: Context, kind: str, i: int, r: str, devices: list[str]) -> Problem:
-    """A role of a step that cannot be bound: none fits, several fit, or the named device cannot play it."""
+def binding_problem(ctx: Context, kind: str, i: int, r: str, devices: list[str],
+                    missing: tuple[s.MissingArg, ...] = ()) -> Problem:
+    """A role of a step that cannot be bound: none fits, several fit, or the named device cannot play it.
+
+    ``missing`` are the arguments devices that would otherwise play the role lack: named in the text.
+    """
     p = ctx.step_command(i)
     proc = ctx.processes.get(p)
     role = next((x for x in proc.roles if x.name == r), None) if proc else None
@@ -146,8 +168,14 @@ def binding_problem(ctx: Context, kind: str, i: int, r: str, devices: list[str])
     else:
         roles = ", ".join(x.name for x in proc.roles) if proc else "-"
         text = f"{head} is bound, but {p} has no such role (its roles: {roles})"
-    rests = (role.where,) if role else ()
-    iris = (role.required_skill,) if role else ()
+    rests: tuple[Where, ...] = (role.where,) if role else ()
+    iris: tuple[str, ...] = (role.required_skill,) if role else ()
+    lacks = [m for m in missing if m.p == p and m.r == r and (kind == "no_device" or m.d == named)]
+    if kind in ("no_device", "cannot_play") and lacks:
+        why = [missing_argument(ctx, m.p, m.r, m.d, m.req, m.q) for m in lacks]
+        text += "; " + "; ".join(w.text for w in why)
+        rests += tuple(x for w in why for x in w.where)
+        iris += tuple(x for w in why for x in w.iris)
     reason = Reason(kind, text, iris, rests)
     device = devices[0] if len(devices) == 1 else None
     return Problem(i, p, kind, reason, ctx.step_where(i), r, device)

@@ -11,6 +11,7 @@ from rdflib.namespace import OWL, RDF
 from plugnproduce.description.charts import device_chart
 from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.description.loader import (
+    ContractError,
     Loaded,
     cell_device_files,
     cell_libraries,
@@ -185,6 +186,9 @@ def _turtle(
         kg.add_device_facts(str(subject), skills, str(file_of(chart)) if chart is not None else "", states)
         try:
             device = device_from(loaded, taxonomy)
+        except ContractError as exc:  # no shape can see a chart: a finding of its own
+            report.add(Problem(str(exc.file), exc.line or 0, exc.message))
+            return
         except DescriptionError as exc:
             if isinstance(exc, UnreadableError):
                 raise

@@ -85,6 +85,17 @@ class Recovers(Atom):
     y: str
 
 
+@predicate("missing_arg")
+class MissingArg(Atom):
+    """Playing role ``r`` of ``p``, ``d`` waits for request ``req`` needing argument ``q`` ``p`` lacks."""
+
+    p: str
+    r: str
+    d: str
+    req: str
+    q: str
+
+
 # ------------------------------------------------------------------ input: processes
 
 

@@ -70,6 +70,18 @@ class Unreachable(Atom):
     con: str
 
 
+@predicate("no_argument")
+class NoArgument(Atom):
+    """Why not: ``d`` could play ``r`` of ``p`` but its request ``req`` needs argument ``q``, which ``p`` lacks."""
+
+    c: str
+    p: str
+    r: str
+    d: str
+    req: str
+    q: str
+
+
 # ------------------------------------------------------------------ output: plausibility
 
 

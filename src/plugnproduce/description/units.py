@@ -1,0 +1,112 @@
+"""Quantities with real units (pint): how a value a task writes is read and converted.
+
+A task writes a quantity as a number (in the parameter's declared unit) or as a string of a
+number and a unit, ``"120 N"`` or ``"0.12 kN"``; both name the same force. A device's contract
+may declare another unit than the process parameter (``mm/s`` against ``m/s``): values are
+converted, and a value in a unit of another dimension (``12 kg`` for a force) is refused.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from functools import cache
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # pint is imported on first use: a command that reads no unit never pays for it
+    import pint
+
+MAX_TEXT = 64
+"""Longest quantity text read; a longer string is no quantity."""
+
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d{1,3})?|[-+]?(?:nan|inf|infinity))\s*"
+                       r"([A-Za-z%°µΩ].*)?$", re.IGNORECASE)
+_FACTOR = r"[A-Za-z%°µΩ_]+(?:(?:\*\*|\^)-?\d{1,2})?"
+_UNIT = re.compile(rf"^{_FACTOR}(?:\s*[*/· ]\s*{_FACTOR})*$")
+"""Units as factors with small whole exponents (``N m``, ``mm/s``, ``m/s^2``): nothing pint would compute long on."""
+
+
+class UnitError(ValueError):
+    """A unit the registry does not know, or a conversion between different dimensions."""
+
+
+@dataclass(frozen=True)
+class Amount:
+    """A number and the unit it is in (``""``: the parameter's own unit)."""
+
+    number: float
+    unit: str
+
+
+@cache
+def registry() -> pint.UnitRegistry[float]:
+    """The one unit registry (built once, on first use)."""
+    import pint
+
+    return pint.UnitRegistry()
+
+
+def read_amount(value: object) -> Amount | None:
+    """A value as a number with an optional unit; None if it is neither (a pose, a word, a boolean)."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int | float):
+        return Amount(float(value), "")
+    if not isinstance(value, str) or len(value) > MAX_TEXT:
+        return None
+    m = _QUANTITY.match(value)
+    if m is None:
+        return None
+    return Amount(float(m.group(1)), (m.group(2) or "").strip())
+
+
+def unit_known(unit: str) -> bool:
+    """Whether ``unit`` is a unit the registry can read (``""`` is: it means none)."""
+    if not unit:
+        return True
+    if len(unit) > MAX_TEXT or not _UNIT.match(unit):
+        return False
+    import pint
+
+    try:
+        registry().Unit(_spelling(unit))
+    except (pint.PintError, AttributeError, ValueError, TypeError, SyntaxError, ArithmeticError):  # pint on bad text
+        return False
+    return True
+
+
+def convert(number: float, unit: str, to: str) -> float:
+    """``number`` in ``unit`` expressed in ``to``; the same number when either is ``""``.
+
+    Raises :class:`UnitError` for an unknown unit or units of different dimensions.
+    """
+    if not unit or not to or unit == to or not math.isfinite(number):
+        return number
+    import pint
+
+    for u in (unit, to):
+        if not unit_known(u):
+            raise UnitError(f"unknown unit {u!r}")
+    ureg = registry()
+    try:
+        return float(ureg.Quantity(number, _spelling(unit)).to(_spelling(to)).magnitude)
+    except (pint.PintError, AttributeError, ValueError, TypeError, ArithmeticError) as exc:  # pint's own and offsets
+        raise UnitError(f"{unit} cannot be converted to {to}") from exc
+
+
+def number_in(value: str, unit: str) -> float | None:
+    """A quantity written as text (``"0.12 kN"``) as a number in ``unit``; None if it is none, is not
+    finite, or cannot be converted (the check says which)."""
+    amount = read_amount(value)
+    if amount is None or not math.isfinite(amount.number) or (amount.unit and not unit):
+        return None
+    try:
+        return convert(amount.number, amount.unit, unit)
+    except UnitError:
+        return None
+
+
+def _spelling(unit: str) -> str:
+    """How pint reads a unit written in a description (``%`` is ``percent``)."""
+    return unit.replace("%", "percent")

@@ -1,0 +1,146 @@
+"""A task's values against the units of its processes and the limits of the devices bound to them.
+
+Two steps of the plausibility check:
+
+- :func:`normalised` reads each quantity a task writes with a unit (``"0.12 kN"``) in the unit
+  its process parameter declares (``120`` N); a unit of another dimension, an unknown unit or a
+  number that is not finite is a problem at the value's line;
+- :func:`beyond_limits` holds each value a device is sent (given, or the process's default) to
+  that device's contract for the request that carries it (``pnp:RequestArgument``): its minimum
+  and maximum, in the device's unit, and for a pose the device's reach.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterator, Sequence
+
+from plugnproduce.description.model import Argument, Cell, DeviceDescription, Parameter, ProcessDescription, Task
+from plugnproduce.description.units import Amount, UnitError, convert, read_amount
+from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.reasoning.facts import DATATYPES
+from plugnproduce.reasoning.results import Problem, Reason, StepCheck
+
+NUMERIC = ("decimal", "integer")
+
+
+def _numeric(par: Parameter) -> bool:
+    return DATATYPES.get(par.datatype, par.datatype) in NUMERIC
+
+
+def normalised(task: Task, processes: Sequence[ProcessDescription]) -> tuple[Task, list[Problem]]:
+    """The task with every quantity written with a unit in its parameter's unit, and the values that cannot be.
+
+    A value that cannot be read is left out of the task returned (its parameter takes the default
+    there), so that one problem, not two, is told of it.
+    """
+    declared = {p.id: {x.name: x for x in p.parameters} for p in processes}
+    one_round = len(task.one_round())
+    steps, problems = [], []
+    for step in task.steps:
+        params = dict(step.params)
+        for name, value in step.params.items():
+            par = declared.get(step.command, {}).get(name)
+            amount = read_amount(value) if isinstance(value, str) else None
+            if par is None or amount is None or not _numeric(par):
+                continue  # not a quantity written as text: the type check tells of anything wrong with it
+            number, why = _read(amount, par)
+            if why is None:
+                params[name] = int(number) if par.datatype.endswith("integer") and number.is_integer() else number
+                continue
+            del params[name]
+            if step.index <= one_round:
+                text = f"step {step.index} ({step.command}): parameter {name} is {value!r}; {why}"
+                problems.append(Problem(step.index, step.command, "bad_unit", Reason("bad_unit", text, (par.quantity,),
+                                        (par.where,)), task.where(step, name), role=par.role, parameter=name))
+        steps.append(dataclasses.replace(step, params=params))
+    return dataclasses.replace(task, steps=tuple(steps)), problems
+
+
+def _read(amount: Amount, par: Parameter) -> tuple[float, str | None]:
+    """An amount in the parameter's unit, or why it cannot be read so."""
+    if not math.isfinite(amount.number):
+        return math.nan, "expected a finite number"
+    if amount.unit and not par.unit:
+        return math.nan, f"parameter {par.name} takes a plain number (no unit)"
+    try:
+        return convert(amount.number, amount.unit, par.unit), None
+    except UnitError as exc:
+        return math.nan, f"expected a quantity in {par.unit} or a unit convertible to it ({exc})"
+
+
+# ------------------------------------------------------------------ the devices' limits
+
+
+def contracts_for(device: DeviceDescription, quantity: str) -> list[Argument]:
+    """The contracts of the device's requests that carry ``quantity`` (one per request)."""
+    requests = sorted({t.request.name for t in device.transitions if t.request and quantity in t.accepts})
+    return [device.argument(r, quantity) for r in requests]
+
+
+def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
+                  processes: Sequence[ProcessDescription]) -> Iterator[Problem]:
+    """One problem per value (given or default) outside the limits of the device it goes to."""
+    devices = {d.id: d for d in cell.devices}
+    procs = {p.id: p for p in processes}
+    for check, step in zip(steps, task.one_round(), strict=False):
+        proc = procs.get(step.command)
+        for par in proc.parameters if proc else ():
+            device = devices.get(check.bindings.get(par.role, ""))
+            value = step.params.get(par.name, par.default)
+            if device is None or value is None or _beyond_own_range(value, par):
+                continue  # the type and range check tells of a value outside the process's own range
+            for contract in contracts_for(device, par.quantity):
+                why = _beyond(value, par, contract)
+                if why is None:
+                    continue
+                given = "" if par.name in step.params else " (its default)"
+                text = (f"step {step.index} ({step.command}): parameter {par.name}{given} goes to device "
+                        f"'{device.id}' with request {contract.request}, which {why}")
+                rests = tuple(w for w in (contract.where, par.where) if w is not None) or (device.where,)
+                reason = Reason("device_limit", text, (par.quantity, device.iri), rests)
+                yield Problem(step.index, step.command, "device_limit", reason, task.where(step, par.name),
+                              role=par.role, device=device.id, parameter=par.name)
+
+
+def _beyond_own_range(value: object, par: Parameter) -> bool:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    return ((par.minimum is not None and value < par.minimum)
+            or (par.maximum is not None and value > par.maximum))
+
+
+def _beyond(value: object, par: Parameter, contract: Argument) -> str | None:
+    """Why ``value`` (in the parameter's unit) breaks the device's contract, or None if it keeps it."""
+    if contract.reach is not None:
+        position = _position(value)
+        if position is not None and math.dist(position, (0.0, 0.0, 0.0)) > contract.reach:
+            distance = math.dist(position, (0.0, 0.0, 0.0))
+            return f"reaches at most {contract.reach:g} m from its base; the pose is {distance:.3g} m away"
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    try:
+        number = convert(float(value), par.unit, contract.unit)
+    except UnitError as exc:
+        return (f"takes {local_name(contract.quantity)} in {contract.unit}; the process gives it in "
+                f"{par.unit or 'no unit'} ({exc})")
+    unit = f" {contract.unit}" if contract.unit else ""
+    shown = f"{value:g} {par.unit}".strip() if par.unit != contract.unit else f"{number:g}{unit}"
+    if contract.minimum is not None and number < contract.minimum:
+        return f"takes at least {contract.minimum:g}{unit}; the value is {shown}"
+    if contract.maximum is not None and number > contract.maximum:
+        return f"takes at most {contract.maximum:g}{unit}; the value is {shown}"
+    return None
+
+
+def _position(value: object) -> tuple[float, float, float] | None:
+    """The x, y, z of a pose written as a list or as six numbers in a string."""
+    items = value.split() if isinstance(value, str) else value
+    if not isinstance(items, list | tuple) or len(items) != 6:
+        return None
+    try:
+        x, y, z = (float(v) for v in items[:3])
+    except (TypeError, ValueError):
+        return None
+    return (x, y, z) if all(math.isfinite(v) for v in (x, y, z)) else None

@@ -1,0 +1,41 @@
+"""The HTTP API tells of a value beyond a device's limits, or in a wrong unit, as a finding: never a 500."""
+
+from __future__ import annotations
+
+import httpx
+import pytest
+
+from tests.hmi.conftest import AUTH
+
+
+def _task(value: object) -> dict[str, object]:
+    return {"name": "t", "steps": [{"command": "pick", "params": {"grip_force": value}}]}
+
+
+@pytest.mark.parametrize("path", ["/api/task/check", "/api/task/repair", "/api/task/generate"])
+@pytest.mark.parametrize("value, kind, needle", [
+    ("0.12 kN", "device_limit", "takes at most 100 N; the value is 120 N"),
+    (130, "device_limit", "takes at most 100 N; the value is 130 N"),
+    ("12 kg", "bad_unit", "kg cannot be converted to N"),
+    ("nan N", "bad_unit", "expected a finite number"),
+    ("5 N**9**9**9", "bad_unit", "unknown unit"),
+])
+async def test_a_value_the_gripper_cannot_take_is_a_finding_at_its_row(
+        client: httpx.AsyncClient, path: str, value: object, kind: str, needle: str) -> None:
+    res = await client.post(path, json=_task(value))
+    assert res.status_code == 200
+    body = res.json()
+    assert body["plausible"] is False
+    (problem,) = [p for p in body["problems"] if p["kind"] == kind]
+    assert needle in problem["text"] and problem["parameter"] == "grip_force" and problem["row"] == 0
+
+
+async def test_a_force_with_a_unit_in_the_limits_generates(client: httpx.AsyncClient) -> None:
+    res = await client.post("/api/task/generate", json=_task("0.05 kN"))
+    assert res.status_code == 200 and res.json()["plausible"] is True and res.json()["charts"]
+
+
+async def test_a_run_beyond_a_device_limit_is_refused_with_the_finding(client: httpx.AsyncClient) -> None:
+    res = await client.post("/api/runs", json={"task": _task("0.12 kN")}, headers=AUTH)
+    assert res.status_code == 409
+    assert "takes at most 100 N" in res.json()["detail"]
