@@ -49,13 +49,26 @@ def test_two_missing_devices_are_bought_together() -> None:
     assert row.purchase.options[0] == (("gripper", "robot"), cost("gripper", "robot"))
 
 
-def test_alternatives_come_cheapest_first() -> None:
-    (row,) = service.batch([Configuration("gripper-only", ("gripper",))], None, [task("pick-and-place")],
-                           workers=1, top=3)
+def test_alternatives_come_cheapest_first(tmp_path: Path) -> None:
+    within_every_robot = tmp_path / "pick-and-place.yaml"  # within the scara's reach and the cobot's speed
+    within_every_robot.write_text(
+        "task: pick-and-place\nsteps:\n  - command: pick-and-place\n    params:\n"
+        "      pick_pose: [0.35, 0.15, 0.04, 0, 180, 0]\n      place_pose: [0.45, -0.25, 0.08, 0, 180, 0]\n"
+        "      retract_pose: [0.30, 0.00, 0.30, 0, 180, 0]\n      grip_force: 30\n"
+        "  - command: move-to\n    params: {target_pose: [0.30, 0.00, 0.50, 0, 180, 0], speed: 50}\n")
+    (row,) = service.batch([Configuration("gripper-only", ("gripper",))], None,
+                           [service.task(within_every_robot)], workers=1, top=3)
     assert row.purchase is not None
     assert row.purchase.options == ((("scara",), cost("scara")), (("cobot",), cost("cobot")),
                                     (("robot",), cost("robot")))
     assert cost("scara") < cost("cobot") < cost("robot")
+
+
+def test_a_robot_whose_own_limits_refuse_the_tasks_values_is_not_bought() -> None:
+    (row,) = service.batch([Configuration("gripper-only", ("gripper",))], None, [task("pick-and-place")],
+                           workers=1, top=3)
+    assert row.purchase is not None  # the scara cannot reach the place pose, the cobot goes at most 60 %
+    assert row.purchase.options == ((("robot",), cost("robot")),)
 
 
 def test_no_purchase_when_the_catalogue_lacks_a_skill_and_the_reason_names_it() -> None:

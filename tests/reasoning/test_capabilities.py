@@ -34,11 +34,11 @@ def _offer(caps, command: str):
 
 def test_by_default_one_binding_is_shown_with_the_number_of_bindings_and_who_can_play_each_role(
         cell: Cell, device) -> None:
-    two = cell.with_device(device("vacuum-gripper")).with_device(device("scara"))
+    two = cell.with_device(device("magnetic-gripper")).with_device(device("scara"))
     pick = _offer(service.capabilities(two), "pick")
     assert pick.bindings == ({"gripper": "gripper", "robot": "robot"},)
     assert pick.binding_count == 4
-    assert pick.role_devices == {"gripper": ("gripper", "vacuum-gripper"), "robot": ("robot", "scara")}
+    assert pick.role_devices == {"gripper": ("gripper", "magnetic-gripper"), "robot": ("robot", "scara")}
 
 
 def test_the_count_and_the_one_binding_agree_with_listing_them_all(cell: Cell, devices) -> None:

@@ -44,17 +44,17 @@ def test_capabilities_json() -> None:
 
 
 def test_capabilities_shows_one_binding_and_their_number_unless_all_are_asked_for(tmp_path: Path) -> None:
-    cell = cell_file(tmp_path, "robot", "scara", "gripper", "vacuum-gripper")
+    cell = cell_file(tmp_path, "robot", "scara", "gripper", "magnetic-gripper")
     few = pnp("capabilities", "--cell", cell)
     assert "pick             gripper=gripper robot=robot  (1 of 4 bindings)" in few.stdout
     every = pnp("capabilities", "--cell", cell, "--all-bindings")
     assert ("pick             gripper=gripper robot=robot | gripper=gripper robot=scara | "
-            "gripper=vacuum-gripper robot=robot | gripper=vacuum-gripper robot=scara\n") in every.stdout
+            "gripper=magnetic-gripper robot=robot | gripper=magnetic-gripper robot=scara\n") in every.stdout
     doc = json.loads(pnp("capabilities", "--cell", cell, "--json").stdout)
     pick = next(o for o in doc["offered"] if o["command"] == "pick")
     assert pick["bindings"] == [{"gripper": "gripper", "robot": "robot"}]
     assert pick["binding_count"] == 4
-    assert pick["role_devices"] == {"gripper": ["gripper", "vacuum-gripper"], "robot": ["robot", "scara"]}
+    assert pick["role_devices"] == {"gripper": ["gripper", "magnetic-gripper"], "robot": ["robot", "scara"]}
     listed = json.loads(pnp("capabilities", "--cell", cell, "--json", "--all-bindings").stdout)
     assert len(next(o for o in listed["offered"] if o["command"] == "pick")["bindings"]) == 4
 

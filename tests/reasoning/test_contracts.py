@@ -66,7 +66,7 @@ def test_a_pose_beyond_the_robots_reach_is_a_finding(tmp_path: Path) -> None:
 
 def test_issue_12_the_assembly_cells_pick_and_place_is_refused_naming_the_missing_vacuum() -> None:
     result = CliRunner().invoke(app, ["check", str(DESCRIPTIONS / "tasks" / "pick-and-place.yaml"),
-                                      "--cell", str(ASSEMBLY)])
+                                      "--cell", str(ASSEMBLY), "--verbose"])
     assert result.exit_code == 1
     assert ("device 'vacuum-gripper' cannot play role 'gripper' of pick-and-place: its request SuctionOn needs "
             "the argument vacuum (pnp:Vacuum)") in result.stdout
@@ -105,7 +105,7 @@ def _bin_picking(tmp_path: Path, grip_force: object) -> Path:
 
 def test_a_library_devices_own_limit_in_its_own_unit_refuses_a_value(library: Path, tmp_path: Path) -> None:
     cell = library / "cells" / "bin-picking-adaptive.yaml"
-    result = CliRunner().invoke(app, ["check", str(_bin_picking(tmp_path, "70")), "--cell", str(cell)])
+    result = CliRunner().invoke(app, ["check", str(_bin_picking(tmp_path, "70")), "--cell", str(cell), "--verbose"])
     assert result.exit_code == 1
     assert "device 'adaptive-gripper' with request Close, which takes at most 0.06 kN; the value is 70 N" \
         in result.stdout

@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 from plugnproduce import service
 from plugnproduce.cli import app
 from plugnproduce.resources import descriptions_path
+from plugnproduce.verification.arguments import argument_problems
 
 runner = CliRunner()
 D = descriptions_path()
@@ -101,12 +102,26 @@ def test_a_device_that_never_answers_is_a_deadlock_at_the_step_that_waits(tmp_pa
     assert str(result.trace[-1]).startswith(f"{TASK}:6: deadlock")
 
 
-def test_a_request_missing_an_argument_the_device_takes_is_refuted(tmp_path: Path) -> None:
+def test_a_request_missing_an_argument_the_device_takes_is_refused_before_any_program_is_made(tmp_path: Path) -> None:
     chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8").replace(
         'pnp:accepts="GripForce"', 'pnp:accepts="GripForce OpeningAngle"')
-    result = service.verify(TASK, seeded_cell(tmp_path, chart))
-    assert result.verdict == "refuted"
-    assert "xirp.request.Close lacks the argument OpeningAngle" in result.problem
+    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(seeded_cell(tmp_path, chart))])
+    assert result.exit_code == 1, result.output
+    assert "its request Close needs the argument opening angle" in result.stderr
+
+
+def test_the_arguments_a_program_sends_are_held_to_the_devices_terms() -> None:
+    gripper = service.knowledge().device("gripper")
+    close = next(t for t in gripper.transitions if t.request and t.request.name == "Close")
+    force = close.accepts[0]
+    limit = gripper.argument("Close", force).maximum
+    assert limit is not None
+    assert argument_problems(gripper, close, {}) == ["lacks the argument GripForce that its transition accepts"]
+    assert argument_problems(gripper, close, {"GripForce": limit}) == []
+    (too_much,) = argument_problems(gripper, close, {"GripForce": limit + 1})
+    assert "outside the device's limits" in too_much
+    assert argument_problems(gripper, close, {"GripForce": float("nan")}) == [
+        "argument GripForce is nan, not a finite value"]
 
 
 def test_a_budget_too_small_is_inconclusive_not_a_hang() -> None:

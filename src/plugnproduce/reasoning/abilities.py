@@ -20,6 +20,7 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning import solver
 from plugnproduce.reasoning.accepts import accepts
+from plugnproduce.reasoning.contracts import normalised, refuses
 from plugnproduce.reasoning.facts import device_facts, process_facts, task_facts
 from plugnproduce.reasoning.terms import Atom, program
 
@@ -41,6 +42,9 @@ class StepSpec:
     bad_value: bool
     refusals: tuple[tuple[str, int], ...] = ()
     """Per parameter value given: the role it goes to, and the devices (bit mask) that accept no such quantity."""
+    beyond: tuple[tuple[str, int], ...] = ()
+    """Per parameter value sent (given or default): the role it goes to, and the devices (bit mask) whose own
+    limits refuse it (:mod:`plugnproduce.reasoning.contracts`)."""
 
 
 @dataclass(frozen=True)
@@ -106,8 +110,8 @@ def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str,
         concepts=_concepts(dev_atoms, index),
         leaves=_leaves(dev_atoms, index),
         recovers=_recovers(dev_atoms, index),
-        tasks=tuple(_task(name, t, processes, bad, _refusing(devices, processes, taxonomy))
-                    for name, t in tasks),
+        tasks=tuple(_task(name, normalised(t, processes)[0], processes, bad, _refusing(devices, processes, taxonomy),
+                          devices) for name, t in tasks),
         bits={d.id: 1 << n for n, d in enumerate(devices)},
     )
 
@@ -156,7 +160,7 @@ def _refusing(devices: Sequence[DeviceDescription], processes: Sequence[ProcessD
 
 
 def _task(name: str, task: Task, processes: Sequence[ProcessDescription], bad: set[tuple[str, int]],
-          refusing: dict[tuple[str, str], int]) -> TaskSpec:
+          refusing: dict[tuple[str, str], int], devices: Sequence[DeviceDescription]) -> TaskSpec:
     by_id = {p.id: p for p in processes}
     steps = []
     for step in task.steps:
@@ -167,6 +171,9 @@ def _task(name: str, task: Task, processes: Sequence[ProcessDescription], bad: s
         declared = {par.name: par for par in p.parameters} if p is not None else {}
         refusals = tuple((declared[n].role, refusing[(step.command, n)]) for n in sorted(step.params)
                          if n in declared)
+        sent = {n: step.params.get(n, par.default) for n, par in declared.items()}
+        beyond = tuple((declared[n].role, sum(1 << k for k, d in enumerate(devices) if refuses(d, v, declared[n])))
+                       for n, v in sorted(sent.items()) if v is not None)
         steps.append(StepSpec(step.index, p.id if p is not None else None, roles, unknown,
-                              (name, step.index) in bad, refusals))
+                              (name, step.index) in bad, refusals, tuple(b for b in beyond if b[1])))
     return TaskSpec(name, tuple(steps))

@@ -91,7 +91,7 @@ def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
             value = step.params.get(par.name, par.default)
             if device is None or value is None or _beyond_own_range(value, par):
                 continue  # the type and range check tells of a value outside the process's own range
-            for contract in contracts_for(device, par.quantity):
+            for contract in contracts_for(device, par.quantity):  # as refuses(), telling why
                 why = _beyond(value, par, contract)
                 if why is None:
                     continue
@@ -102,6 +102,12 @@ def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
                 reason = Reason("device_limit", text, (par.quantity, device.iri), rests)
                 yield Problem(step.index, step.command, "device_limit", reason, task.where(step, par.name),
                               role=par.role, device=device.id, parameter=par.name)
+
+
+def refuses(device: DeviceDescription, value: object, par: Parameter) -> bool:
+    """Whether ``device`` refuses ``value`` of ``par`` by its own limits (what :func:`beyond_limits` tells of)."""
+    return not _beyond_own_range(value, par) and any(
+        _beyond(value, par, contract) is not None for contract in contracts_for(device, par.quantity))
 
 
 def _beyond_own_range(value: object, par: Parameter) -> bool:

@@ -12,7 +12,8 @@ those of ``offered.lp``, ``resolve.lp`` and ``chain.lp``, applied to the per-dev
   (``wrong_state``) from which the role can be played (``stuck``), and leaves it where the role
   ends; a device filling several roles of a step plays them in role order;
 - a parameter value given to a bound device none of whose commands accepts its quantity is
-  ``not_accepted`` (accepts.py).
+  ``not_accepted`` (accepts.py); a value sent to a bound device (given or the default) beyond
+  that device's own limits is ``device_limit`` (contracts.py).
 
 A task's answer depends only on, for each role it leaves to the configuration, whether none, one
 (which) or several of the devices that can play it are present, and on whether each device it
@@ -116,6 +117,8 @@ def _findings(ab: Abilities, task: TaskSpec, mask: int) -> tuple[Finding, ...]:
         unbound |= bool(problems)
         played = dict(bound)
         out += [("not_accepted", step.index, role, ab.devices[played[role]]) for role, refusing in step.refusals
+                if role in played and refusing >> played[role] & 1]
+        out += [("device_limit", step.index, role, ab.devices[played[role]]) for role, refusing in step.beyond
                 if role in played and refusing >> played[role] & 1]
         bindings.append(bound)
     if not unbound:

@@ -31,6 +31,7 @@ KINDS = {
     "wrong_state": "device {device} is not in the state role {role} starts from",
     "stuck": "device {device} cannot play role {role} from the state it is in",
     "not_accepted": "device {device} (role {role}) accepts no command for a parameter value given",
+    "device_limit": "device {device} (role {role}) refuses a value sent to it by its own limits",
 }
 
 

@@ -1,9 +1,11 @@
 """The arguments of a request against what the device's transition takes (``pnp:accepts``).
 
-The one place a request's arguments are judged during verification: every quantity the
-transition accepts must come with the request, as a value a device can take (a finite
-number where a number is given). Device limits and units, once descriptions declare them,
-are checked here too.
+The one place a request's arguments are judged during verification, by the device's own terms
+(its ``pnp:RequestArgument`` contracts): every argument the device needs (required, with no
+default of its own) must come with the request, and each value sent must be one a device can
+take: finite, and a number within the device's limits (the generated program sends values in
+the device's unit). The plausibility check holds the task to the same terms before a program
+is generated; this is the proof that the program really sends what it promised.
 """
 
 from __future__ import annotations
@@ -20,12 +22,20 @@ def argument_problems(device: DeviceDescription, transition: ChartTransition, ar
     """What is wrong with ``arguments`` for ``transition`` of ``device``'s chart: one phrase each (none: fine)."""
     given: Mapping[str, Any] = arguments if isinstance(arguments, Mapping) else {}
     problems = []
+    request = transition.request.name if transition.request else ""
     for quantity in transition.accepts:
-        name = local_name(quantity)
+        name, contract = local_name(quantity), device.argument(request, quantity)
+        value = given.get(name)
         if name not in given:
-            problems.append(f"lacks the argument {name} that its transition accepts")
-        elif not _finite(given[name]):
-            problems.append(f"argument {name} is {given[name]!r}, not a finite value")
+            if contract.needed:
+                problems.append(f"lacks the argument {name} that its transition accepts")
+        elif not _finite(value):
+            problems.append(f"argument {name} is {value!r}, not a finite value")
+        elif isinstance(value, int | float) and not isinstance(value, bool) and (
+                (contract.minimum is not None and value < contract.minimum)
+                or (contract.maximum is not None and value > contract.maximum)):
+            problems.append(f"argument {name} is {value!r}, outside the device's limits "
+                            f"[{contract.minimum}, {contract.maximum}] {contract.unit}".rstrip())
     return problems
 
 
