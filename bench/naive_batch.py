@@ -1,11 +1,12 @@
 """The naive reference for the batch benchmark: the reasoner's rules applied by plain brute force.
 
 It reads the same facts the encodings read (``facts.py``: devices, processes, tasks) and applies
-``roles.lp``, ``offered.lp``, ``resolve.lp``, ``chain.lp``, ``params.lp`` and the acceptance check
-literally, per configuration, with Python sets; nothing is shared between configurations. The
-cheapest purchase tries every set of up to ``MAX_BUY`` catalogue devices, keeps those that make
-every task plausible and of which no smaller such set is a part, and sorts them by cost, then
-size, then the devices' order by (cost, id).
+``roles.lp``, ``offered.lp``, ``resolve.lp``, ``chain.lp``, ``params.lp``, the acceptance check
+and the devices' own limits (``contracts.refuses``) literally, per configuration, with Python
+sets; nothing is shared between configurations. The cheapest purchase tries every set of up to
+``MAX_BUY`` catalogue devices, keeps those that make every task plausible and of which no
+smaller such set is a part, and sorts them by cost, then size, then the devices' order by
+(cost, id).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import accepts
+from plugnproduce.reasoning.contracts import normalised, refuses
 from plugnproduce.reasoning.facts import device_facts, process_facts, task_facts
 
 MAX_BUY = 4
@@ -29,6 +31,7 @@ class Naive:
 
     def __init__(self, catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]],
                  taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> None:
+        tasks = [(name, normalised(t, processes)[0]) for name, t in tasks]
         atoms = [a for p in processes for a in process_facts(p)]
         atoms += [a for d in catalogue for a in device_facts(d, taxonomy, processes)]
         atoms += [a for name, t in tasks for a in task_facts(t, name)]
@@ -40,6 +43,7 @@ class Naive:
         self.params = {(p.id, par.name): par for p in processes for par in p.parameters}
         self.tasks = [name for name, _ in tasks]
         self.given = {(name, st.index): dict(st.params) for name, t in tasks for st in t.steps}
+        self.declared = {p.id: p.parameters for p in processes}
         self.can_play = self._can_play()
         self.bad_value = self._bad_values()
 
@@ -55,6 +59,7 @@ class Naive:
         region = defaultdict(dict)
         for a in self.by[s.RegionState]:
             region[(a.p, a.r)][a.i] = a.c
+        lacking = {(a.p, a.r, a.d) for a in self.by[s.MissingArg]}
         out = set()
         for q in self.by[s.Requires]:
             for d in [x.d for x in self.by[s.Device]]:
@@ -64,7 +69,7 @@ class Naive:
                 here = {x for x in states[d] if (d, x, concepts[0]) in is_}
                 for c in concepts[1:]:
                     here = {y for x in here for y in _reach(edges, d, x) if (d, y, c) in is_}
-                if here:
+                if here and (q.p, q.r, d) not in lacking:
                     out.add((q.p, q.r, d))
         return out
 
@@ -131,6 +136,11 @@ class Naive:
                 par = self.params.get((p, name))
                 player = dict(here).get(par.role) if par else None
                 if player is not None and not accepts(self.catalogue[player], par.quantity, self.taxonomy):
+                    return False
+            for par in self.declared[p]:
+                value = self.given.get((t, i), {}).get(par.name, par.default)
+                player = dict(here).get(par.role)
+                if player is not None and value is not None and refuses(self.catalogue[player], value, par):
                     return False
             bound.append(here)
         return self._chain(steps, bound, members)
