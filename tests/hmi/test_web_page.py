@@ -128,10 +128,10 @@ def test_a_device_plugged_in_elsewhere_shows_up_live(page: Page, served: Served)
 def test_a_second_gripper_gives_pick_two_bindings_and_its_dialog_both_grippers(page: Page, served: Served) -> None:
     import httpx
 
-    httpx.post(f"{served.url}/api/cell/devices", json={"device": "vacuum-gripper"}, headers=AUTH).raise_for_status()
+    httpx.post(f"{served.url}/api/cell/devices", json={"device": "magnetic-gripper"}, headers=AUTH).raise_for_status()
     expect(page.locator("#offered li[data-command='pick'] .cmd-binding")).to_have_text("2 ways to bind its roles")
     page.get_by_role("button", name=f"Add {_label('pick')} to the task", exact=True).click()
-    expect(page.locator("#step-dialog #role-gripper option")).to_have_text(["gripper", "vacuum-gripper"])
+    expect(page.locator("#step-dialog #role-gripper option")).to_have_text(["gripper", "magnetic-gripper"])
 
 
 def test_steps_are_reordered_and_removed_from_the_keyboard(page: Page) -> None:
