@@ -8,14 +8,17 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import httpx
 import pytest
 from typer.testing import CliRunner
 
+from plugnproduce import service
 from plugnproduce.cli import app
 from plugnproduce.protocols.upnp import private_network
+from plugnproduce.sim.bin import SimulatedBin
 from tests.hmi.conftest import TOKEN
 from tests.lines import Lines
 
@@ -89,6 +92,41 @@ def test_without_sim_the_cell_is_what_discovery_finds() -> None:
         assert (cell["name"], cell["devices"], cell["pluggable"]) == ("live", [], False)
     finally:
         _stop(proc, out)
+
+
+def _finished(url: str, run_id: str) -> dict[str, object]:
+    """The run's view once it has ended (waits as long as the run takes, up to the test's own timeout)."""
+    with httpx.Client(timeout=120) as client:
+        while (view := client.get(f"{url}api/runs/{run_id}").json())["status"] == "running":
+            time.sleep(0.1)  # polling, not synchronisation: the loop ends on what the server says
+    return view
+
+
+def test_serve_sim_works_on_a_simulated_bin_of_the_given_parts() -> None:
+    proc, out, lines = _start("--sim", "--bin-parts", "2", "--bin-seed", "3")
+    try:
+        lines += [out.next().strip(), out.next().strip()]
+        url, token = lines[0].rsplit(" ", 1)[1], lines[2].removeprefix("token: ")
+        yaml = (service.builtin("tasks") / "bin-picking-until-empty.yaml").read_bytes()
+        task = httpx.post(url + "api/task/import", content=yaml, headers={"Content-Type": "application/yaml"}).json()
+        res = httpx.post(url + "api/runs", json={"task": task}, headers={"Authorization": f"Bearer {token}"},
+                         timeout=120)
+        assert res.status_code == 202, res.text
+        run_id = res.json()["run"]
+        assert _finished(url, run_id)["status"] == "succeeded"
+        journal = httpx.get(f"{url}api/runs/{run_id}/journal").json()
+        found = [r["params"] for r in journal if r["kind"] == "event" and r["event"] == "PartLocalized"]
+        placed = sorted(p.pose for p in SimulatedBin(2, 3).parts)
+        assert [f["outcome"] for f in found] == ["PartFound", "PartFound", "BinEmpty"]
+        assert sorted(f["part_pose"] for f in found[:2]) == placed  # the two parts of that bin, each once
+    finally:
+        _stop(proc, out)
+
+
+def test_bin_parts_need_sim() -> None:
+    result = CliRunner().invoke(app, ["serve", "--bin-parts", "3"])
+    assert result.exit_code == 2
+    assert result.output.strip() == "--bin-parts works on simulated devices: add --sim"
 
 
 def test_faults_need_sim() -> None:

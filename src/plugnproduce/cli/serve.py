@@ -28,12 +28,14 @@ else:
 LOOPBACK_NAMES = ("127.0.0.1", "localhost")
 
 
-def cell_source(cell: Path | None, sim: bool, faults: str = "") -> CellSource:
+def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int | None = None,
+                bin_seed: int = 0) -> CellSource:
     """The cell the HMI shows, as discovery sees it.
 
     With ``sim`` the devices of ``cell`` (default: the built-in bin-picking cell) are simulated
-    on a private loopback SSDP network and can be plugged and unplugged from the page; without,
-    the devices are the ones on the network (``PNP_SSDP_PORT``) and plug in themselves.
+    on a private loopback SSDP network and can be plugged and unplugged from the page, working on
+    a simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given; without, the devices are
+    the ones on the network (``PNP_SSDP_PORT``) and plug in themselves.
     """
     if not sim:
         from plugnproduce.hmi.livecell import LiveCellSource
@@ -42,10 +44,13 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "") -> CellSource:
         return LiveCellSource(network_from_env(), name=service.cell(cell, knowledge()).name if cell else "live",
                               knowledge=knowledge(cell))
     from plugnproduce.hmi.simcell import SimulatedCellSource
+    from plugnproduce.sim.bin import SimulatedBin
 
     cell = cell or service.builtin("cells", "bin-picking.yaml")
     k = knowledge(cell)
-    return SimulatedCellSource(service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k)
+    parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
+    return SimulatedCellSource(service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k,
+                               bin=parts)
 
 
 def runner_for(source: CellSource, cell: Path | None = None) -> Runner:
@@ -72,6 +77,9 @@ def serve(
     sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices on a private loopback SSDP network; "
                              "they can be plugged and unplugged from the page."),
     faults: str = typer.Option("", "--faults", metavar="SPEC", help="With --sim: faults to inject, as for pnp run."),
+    bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
+                                         help="With --sim: a simulated bin of N parts at random poses (as pnp run)."),
+    bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
     host: str = typer.Option("127.0.0.1", "--host", metavar="ADDRESS", help="Address to listen on."),
     port: int = typer.Option(0, "--port", min=0, max=65535, metavar="PORT",
                              help="Port to listen on (0: any free port)."),
@@ -90,7 +98,9 @@ def serve(
     token = read_token(token_file) if token_file else new_token()
     if faults and not sim:
         fail("--faults needs --sim: faults are injected into simulated devices")
-    source = cell_source(cell, sim, faults)
+    if bin_parts is not None and not sim:
+        fail("--bin-parts works on simulated devices: add --sim")
+    source = cell_source(cell, sim, faults, bin_parts, bin_seed)
     the_cell = cell or (service.builtin("cells", "bin-picking.yaml") if sim else None)
     allowed = list(LOOPBACK_NAMES) if host in LOOPBACK_NAMES else None
     application = create_app(source, runner_for(source, the_cell), token, allowed_hosts=allowed,

@@ -22,6 +22,7 @@ import logging
 import socket
 import xml.etree.ElementTree as ET
 from collections.abc import Awaitable, Callable, Mapping
+from contextvars import ContextVar
 from functools import partial
 from typing import Any, cast
 
@@ -78,9 +79,8 @@ class ActionFailed(Exception):
 
     Use 501 (Action Failed) for a failure, a code from 700 to 799 for an
     action-specific refusal, e.g. :data:`NOT_ACCEPTED_NOW` when the device's state
-    chart does not wait for this request in its current state. async-upnp-client
-    sends only the code (its description is always "Action Failed"), so the message
-    is logged on the device's side.
+    chart does not wait for this request in its current state. The message goes to the
+    caller as the error's description (at most :data:`DESCRIPTION_CHARS` characters).
     """
 
     def __init__(self, message: str, code: int = UpnpActionErrorCode.ACTION_FAILED.value) -> None:
@@ -90,6 +90,29 @@ class ActionFailed(Exception):
 
 NOT_ACCEPTED_NOW = 701
 """UPnP error code: the request is not accepted in the device's current state."""
+DESCRIPTION_CHARS = 200
+"""Most characters of a refusal's message sent as its UPnP error description."""
+
+_REFUSAL: ContextVar[str | None] = ContextVar("refusal", default=None)
+"""The message of the refusal the action being answered ended with (set by the handler, read by the control route)."""
+
+
+async def _control(service: UpnpServerService, request: web.Request) -> web.StreamResponse:
+    """The library's control route, with a refusal's own message as the error description.
+
+    async-upnp-client always describes an action error as "Action Failed"; the caller would
+    never learn why the device refused.
+    """
+    _REFUSAL.set(None)
+    response = await action_handler(service, request)
+    message = _REFUSAL.get()
+    if message is None or not isinstance(response, web.Response) or response.body is None:
+        return response
+    root = ET.fromstring(cast(bytes, response.body))  # the library's own answer, not a peer's
+    for element in root.iter("{urn:schemas-upnp-org:control-1-0}errorDescription"):
+        element.text = message[:DESCRIPTION_CHARS]
+    return web.Response(status=response.status, content_type="text/xml", charset="utf-8",
+                        body=ET.tostring(root, encoding="utf-8", xml_declaration=True))
 
 
 def _arg_var_name(action: ActionSpec, argument: ArgumentSpec) -> str:
@@ -281,7 +304,7 @@ class UpnpDeviceServer:
         app = web.Application()
         app.router.add_get(DESCRIPTION_PATH, self._description)
         app.router.add_get(SCPD_PATH, partial(to_xml, service))
-        app.router.add_post(CONTROL_PATH, partial(action_handler, service))
+        app.router.add_post(CONTROL_PATH, partial(_control, service))
         app.router.add_route("SUBSCRIBE", EVENT_PATH, partial(self._subscribe, service))
         app.router.add_route("UNSUBSCRIBE", EVENT_PATH, partial(unsubscribe_handler, service))
         if self.files is not None:
@@ -326,6 +349,7 @@ class UpnpDeviceServer:
             result = dict(await self._handler(action, dict(arguments)))
         except ActionFailed as exc:
             _LOGGER.info("device %s: action %s failed (%s): %s", self.device_id, action, exc.code, exc)
+            _REFUSAL.set(str(exc))
             raise UpnpActionError(error_code=exc.code, error_desc=str(exc)) from exc
         except Exception as exc:  # a handler bug must not become a bare HTTP 500
             _LOGGER.exception("device %s: handler of action %s raised", self.device_id, action)
