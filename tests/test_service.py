@@ -36,6 +36,18 @@ def test_generation_of_a_plausible_task_has_the_charts_generate_writes() -> None
     assert [c.name for c in result.charts] == [c.name for c in service.generate(TASK, CELL).charts]
 
 
+def test_generation_of_a_program_verification_refutes_is_a_result_without_charts(tmp_path: Path) -> None:
+    from plugnproduce.verification import Budget
+    from tests.verification.test_verify import napping_gripper, seeded_cell
+
+    result = service.generation(TASK, seeded_cell(tmp_path, napping_gripper()), verify=Budget())
+    assert result.check.plausible and result.charts == []
+    assert result.verification is not None and result.verification.verdict == "refuted"
+    assert "device gripper in state standby refuses xirp.request.Close" in result.verification.problem
+    with pytest.raises(service.Unverified):
+        service.generate(TASK, seeded_cell(tmp_path / "again", napping_gripper()), verify=Budget())
+
+
 def test_a_run_is_planned_without_the_closed_world_chart_or_device_programs(
         monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     def refuse(*_: object, **__: object) -> None:

@@ -346,14 +346,16 @@ class Generated:
 
 @dataclass(frozen=True)
 class Generation:
-    """The plausibility check of a task and, when it is plausible, its generated program (else None)."""
+    """The plausibility check of a task and, when it is plausible (and proved, when verified), its generated
+    program (else None), with the verification's answer when it was verified."""
 
     check: reasoning.CheckResult
     generated: Generated | None
+    verification: Verification | None = None
 
     @property
     def charts(self) -> list[GeneratedChart]:
-        """The charts written for the task (none for an implausible task)."""
+        """The charts written for the task (none for an implausible or unproved task)."""
         return self.generated.charts if self.generated is not None else []
 
 
@@ -365,10 +367,13 @@ def _generate_task(the_task: Task, the_cell: Cell, result: reasoning.CheckResult
 
 
 def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,
-               knowledge: Knowledge | None = None) -> Generation:
-    """Check a task and, when it is plausible, generate its charts (as :func:`generate`).
+               knowledge: Knowledge | None = None, verify: Budget | None = None) -> Generation:
+    """Check a task and, when it is plausible, generate its specific process charts, task chart,
+    closed-world chart and, with ``per_device``, each device's program.
 
-    An implausible task is a result here (``generated`` is None), not an error.
+    With a ``verify`` budget every interleaving of the program is explored first (:func:`verify`)
+    and charts are made only for a proved program. An implausible or unproved task is a result
+    here (``generated`` is None), not an error.
     """
     the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
     result = check(the_task, the_cell, k)
@@ -377,30 +382,22 @@ def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = 
     from plugnproduce.codegen.outputs import all_charts
 
     generated = _generate_task(the_task, the_cell, result, k)
-    return Generation(result, Generated(generated, all_charts(generated, the_cell, per_device)))
+    proof = _verify(generated, the_cell, verify) if verify is not None else None
+    if proof is not None and not proof.proved:
+        return Generation(result, None, proof)
+    return Generation(result, Generated(generated, all_charts(generated, the_cell, per_device), proof), proof)
 
 
 def generate(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,
              knowledge: Knowledge | None = None, verify: Budget | None = None) -> Generated:
-    """Check a task, then generate its specific process charts, task chart, closed-world chart and,
-    with ``per_device``, each device's program. Raises :class:`ImplausibleTask` for an implausible task.
-
-    With a ``verify`` budget every interleaving of the program is explored first (:func:`verify`):
-    a program not proved raises :class:`Unverified`, and no charts are made.
-    """
-    if verify is None:
-        result = generation(task_or_path, cell_or_path, per_device, knowledge)
-        if result.generated is None:
-            raise ImplausibleTask(result.check)
+    """:func:`generation` for a task that must be plausible (else :class:`ImplausibleTask`) and, with a
+    ``verify`` budget, proved (else :class:`Unverified`, and no charts are made)."""
+    result = generation(task_or_path, cell_or_path, per_device, knowledge, verify)
+    if result.generated is not None:
         return result.generated
-    from plugnproduce.codegen.outputs import all_charts
-
-    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
-    generated = plan_run(the_task, the_cell, k)
-    proof = _verify(generated, the_cell, verify)
-    if not proof.proved:
-        raise Unverified(proof)
-    return Generated(generated, all_charts(generated, the_cell, per_device), proof)
+    if result.verification is not None:
+        raise Unverified(result.verification)
+    raise ImplausibleTask(result.check)
 
 
 class Unverified(PlugNProduceError):

@@ -19,6 +19,7 @@ from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.security import allow_read
 from plugnproduce.hmi.views import editor_rows, task_json
+from plugnproduce.verification import Budget
 
 router = APIRouter(prefix="/api/task", tags=["task"], dependencies=[Depends(allow_read)])
 
@@ -75,15 +76,18 @@ def explain(task: TaskIn, step: int = Query(..., ge=1, description="The step, fr
     return {**service.explain_step(model, hub.planning_cell, step, hub.knowledge).to_json(), **why.to_json()}
 
 
-@router.post("/generate", summary="Generate the SCXML charts of a plausible task")
+@router.post("/generate", summary="Generate the SCXML charts of a plausible task, once its program is proved")
 def generate(task: TaskIn, request: Request, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """Specific process charts, the Task State Chart and the closed-world chart, each as SCXML and SVG.
 
-    ``service.generation``: an implausible task is a result (its problems, no charts), not an error.
+    ``service.generation``: an implausible task is a result (its problems, no charts), not an error; so is a
+    program verification does not prove (``verification``: refuted with its shortest trace, or inconclusive),
+    for which no charts are made, as ``pnp generate`` writes none.
     """
-    result = service.generation(task.to_task(), hub.planning_cell, knowledge=hub.knowledge)
+    result = service.generation(task.to_task(), hub.planning_cell, knowledge=hub.knowledge, verify=Budget())
     out: dict[str, Any] = {"plausible": result.check.plausible,
                            "problems": _rows([p.to_json() for p in result.check.problems], task),
+                           "verification": result.verification.to_json() if result.verification else None,
                            "generation": None, "charts": []}
     if result.charts:
         store: GeneratedCharts = request.app.state.generated

@@ -134,6 +134,10 @@ export async function generate() {
       caption.textContent = `No code generated: ${result.problems.length ? result.problems[0].text : "the task is not plausible"}`;
       return;
     }
+    if (!result.charts.length) {
+      caption.textContent = `No code generated: ${unproved(result.verification)}`;
+      return;
+    }
     state.generated = result.charts;
     renderChartChoices();
     renderLinks();
@@ -143,6 +147,12 @@ export async function generate() {
   } catch (err) {
     caption.textContent = err.message;
   }
+}
+
+function unproved(verification) {
+  if (!verification) return "the program was not generated";
+  const last = verification.trace.length ? ` (${verification.trace[verification.trace.length - 1].where})` : "";
+  return `verification ${verification.verdict} the program: ${verification.problem}${last}`;
 }
 
 export function initCharts() {
