@@ -47,6 +47,8 @@ sys.path.insert(0, str(ROOT / "tests" / "fuzz"))
 
 import fuzzing  # noqa: E402  (the shared targets live beside the tests)
 
+from plugnproduce.cli.app import quiet_library_chatter  # noqa: E402
+
 WEIGHTS = {"turtle": 14, "chart": 14, "task": 14, "cell": 8, "xirp": 30, "served": 8, "reference": 4, "hmi": 8,
            "upnp": 6, "ssdp": 6}
 """Share of the cases each target gets."""
@@ -265,6 +267,7 @@ def main() -> int:
     rng = random.Random(args.seed)
     ws = fuzzing.Workspace()
     hmi = fuzzing.InProcessHmi(ws.root / "runs") if "hmi" in targets else None
+    quiet_library_chatter()  # logging configured as the command line and the HMI it serves do
     chatter = _Chatter()
     logging.getLogger().addHandler(chatter)
     makers = _cases(rng, ws, hmi, max(args.deep_every, 1))

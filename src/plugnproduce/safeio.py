@@ -10,7 +10,6 @@ the file and line.
 from __future__ import annotations
 
 import codecs
-import logging
 import re
 import stat
 import warnings
@@ -23,10 +22,6 @@ from lxml import etree
 from rdflib.plugins.parsers.notation3 import BadSyntax
 
 from plugnproduce.errors import HostileInputError, UnreadableError, excerpt, shorten_words, tidy
-
-logging.getLogger("rdflib.term").setLevel(logging.ERROR)
-# rdflib logs a warning for every odd IRI or literal it builds, unasked, on stderr; what matters of
-# them is reported as a finding with its file and line, so its own chatter is silenced.
 
 MAX_BYTES = 4 * 1024 * 1024
 """Largest description file accepted (descriptions are a few kB; 4 MiB is generous)."""
