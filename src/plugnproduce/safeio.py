@@ -227,6 +227,9 @@ def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
                 document = node
             elif isinstance(stack[-1], yaml.MappingNode):
                 if keys[-1] is None:
+                    if not isinstance(node, yaml.ScalarNode):  # "? [a]: 1": no plain value could be built of it
+                        raise yaml.MarkedYAMLError(None, None, "a key is a list or a mapping; expected a plain name",
+                                                   node.start_mark)
                     keys[-1] = node
                 else:
                     stack[-1].value.append((keys[-1], node))

@@ -312,3 +312,15 @@ def test_issue_15_a_long_request_name_of_an_argument_is_quoted_short(workspace: 
     with pytest.raises(DescriptionError) as info:
         load_device(path, taxonomy)
     assert "of request Close of {a: b}" in _one_line(info.value, text)
+
+
+@pytest.mark.parametrize("key", ["? speed: 80", "? [speed, 80]\n      : 1", "{speed: 80}: 1"])
+def test_issue_15_a_yaml_key_that_is_a_mapping_or_list_is_refused_at_its_line(workspace: Workspace,
+                                                                              key: str) -> None:
+    # seed 12: "? speed: 80" made a mapping a key; building the step's values raised "found unhashable key"
+    text = dict(seeds("task"))["tasks/bin-picking.yaml"].decode().replace("speed: 80", key)
+    path = workspace.write("tasks/bin-picking.yaml", text.encode())
+    with pytest.raises(UnreadableError) as info:
+        load_task(path)
+    assert info.value.line == 15
+    assert _one_line(info.value, text).endswith("a key is a list or a mapping; expected a plain name")
