@@ -191,7 +191,7 @@ def _outcome(target: str, run: Callable[[], str], chatter: _Chatter, tally: Tall
                 raise fuzzing.Crash(f"log line from {record.name}: {record.getMessage()[:200]}")
         except Exception as exc:  # noqa: BLE001 - the point: every unexpected exception is counted
             where = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
-            signature = f"{target}: {type(exc).__name__}: {str(exc)[:160]}"
+            signature = f"{target}: {type(exc).__name__}: {' '.join(str(exc).split())[:160]}"  # one line each
             if where is not None and not isinstance(exc, fuzzing.Crash):
                 signature += f" (at {Path(where.filename).name}:{where.lineno})"
             tally.signatures[signature] += 1
