@@ -227,9 +227,6 @@ def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
                 document = node
             elif isinstance(stack[-1], yaml.MappingNode):
                 if keys[-1] is None:
-                    if not isinstance(node, yaml.ScalarNode):  # "? [a]: 1": no plain value could be built of it
-                        raise yaml.MarkedYAMLError(None, None, "a key is a list or a mapping; expected a plain name",
-                                                   node.start_mark)
                     keys[-1] = node
                 else:
                     stack[-1].value.append((keys[-1], node))
@@ -298,7 +295,8 @@ def _check_yaml_values(root: yaml.Node, path: str | Path) -> None:
     """Refuse what a description never needs and what would crash or blow up its reading:
     tags other than plain data (``!!timestamp``, ``!!omap``, ``!!binary``, ...), NaN and
     infinities, integers of more than :data:`MAX_DIGITS` digits, nesting deeper than
-    :data:`MAX_YAML_DEPTH`."""
+    :data:`MAX_YAML_DEPTH`, a key that is a list or a mapping (``? [a]: 1``: no plain value
+    can be built of it)."""
     stack: list[tuple[yaml.Node, int]] = [(root, 1)]
     while stack:
         node, depth = stack.pop()
@@ -315,6 +313,10 @@ def _check_yaml_values(root: yaml.Node, path: str | Path) -> None:
         elif isinstance(node, yaml.SequenceNode):
             stack.extend((child, depth + 1) for child in node.value)
         else:
+            for key, _ in node.value:
+                if not isinstance(key, yaml.ScalarNode):
+                    raise UnreadableError("malformed YAML: a key is a list or a mapping; expected a plain name", path,
+                                          key.start_mark.line + 1)
             stack.extend((part, depth + 1) for pair in node.value for part in pair)
 
 
