@@ -10,7 +10,6 @@ the file and line.
 from __future__ import annotations
 
 import codecs
-import logging
 import re
 import stat
 import warnings
@@ -23,10 +22,6 @@ from lxml import etree
 from rdflib.plugins.parsers.notation3 import BadSyntax
 
 from plugnproduce.errors import HostileInputError, UnreadableError, excerpt, shorten_words, tidy
-
-logging.getLogger("rdflib.term").setLevel(logging.ERROR)
-# rdflib logs a warning for every odd IRI or literal it builds, unasked, on stderr; what matters of
-# them is reported as a finding with its file and line, so its own chatter is silenced.
 
 MAX_BYTES = 4 * 1024 * 1024
 """Largest description file accepted (descriptions are a few kB; 4 MiB is generous)."""
@@ -300,7 +295,8 @@ def _check_yaml_values(root: yaml.Node, path: str | Path) -> None:
     """Refuse what a description never needs and what would crash or blow up its reading:
     tags other than plain data (``!!timestamp``, ``!!omap``, ``!!binary``, ...), NaN and
     infinities, integers of more than :data:`MAX_DIGITS` digits, nesting deeper than
-    :data:`MAX_YAML_DEPTH`."""
+    :data:`MAX_YAML_DEPTH`, a key that is a list or a mapping (``? [a]: 1``: no plain value
+    can be built of it)."""
     stack: list[tuple[yaml.Node, int]] = [(root, 1)]
     while stack:
         node, depth = stack.pop()
@@ -317,6 +313,10 @@ def _check_yaml_values(root: yaml.Node, path: str | Path) -> None:
         elif isinstance(node, yaml.SequenceNode):
             stack.extend((child, depth + 1) for child in node.value)
         else:
+            for key, _ in node.value:
+                if not isinstance(key, yaml.ScalarNode):
+                    raise UnreadableError("malformed YAML: a key is a list or a mapping; expected a plain name", path,
+                                          key.start_mark.line + 1)
             stack.extend((part, depth + 1) for pair in node.value for part in pair)
 
 

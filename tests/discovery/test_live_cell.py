@@ -251,3 +251,15 @@ async def test_discover_takes_the_place_of_a_udn_whose_description_reads_not_the
     assert squatter.answered >= 1
     assert [(d.udn, d.location) for d in found.devices] == [(udn_for("sensor3d"), honest.location)]
     assert [(r.udn, r.location) for r in found.refused] == [(udn_for("sensor3d"), squatter.location)]
+
+
+async def test_issue_15_discover_waits_for_an_expected_device_whose_description_reads_not_its_squatter(
+        network) -> None:
+    # the search ended once each expected UDN had answered once: a squatter answering first ended it,
+    # and the real device, answering a moment later, was never read
+    async with sensor_server(network) as honest:
+        with SearchSquatter(network, udn_for("sensor3d")) as squatter:  # answers at once; the device within MX s
+            found = await discover(30.0, network=network, expected=[udn_for("sensor3d")])
+    assert squatter.answered >= 1
+    assert [(d.udn, d.location) for d in found.devices] == [(udn_for("sensor3d"), honest.location)]
+    assert (udn_for("sensor3d"), squatter.location) in [(r.udn, r.location) for r in found.refused]

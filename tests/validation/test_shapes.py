@@ -119,3 +119,26 @@ def test_a_task_s_values_cost_the_same_queries_whatever_its_length(monkeypatch: 
     assert [p.line for p in findings[1][:2]] == [6, 9]
     assert findings[1][0].message == "step 1: parameter 'speed' is 9999 %; expected a value from 1 to 100 %"
     assert findings[1][1].message == "step 2: parameter 'grip_force' takes a number; found strong"
+
+
+def test_issue_15_a_shape_pyshacl_cannot_run_is_one_line_not_an_attribute_error() -> None:
+    # pySHACL returns (not raises) a ValidationFailure when it refuses a SPARQL constraint, here
+    # for a nested select it reads in the query's comment; shape_problems took it for a report
+    import rdflib
+
+    from plugnproduce.description.knowledge import KnowledgeGraph
+    from plugnproduce.errors import OntologyError
+    from plugnproduce.validation.shapes import shape_problems
+
+    shapes = rdflib.Graph().parse(format="turtle", data='''
+        @prefix sh: <http://www.w3.org/ns/shacl#> .
+        @prefix ex: <urn:ex:> .
+        ex:S a sh:NodeShape ; sh:targetNode ex:a ;
+            sh:sparql [ sh:select """SELECT $this WHERE { # not { SELECT ?o } here
+                $this ?p ?o . }""" ] .''')
+    kg = KnowledgeGraph()
+    kg.graph.add((rdflib.URIRef("urn:ex:a"), rdflib.URIRef("urn:ex:p"), rdflib.Literal(1)))
+    with pytest.raises(OntologyError) as info:
+        shape_problems(kg, shapes)
+    assert str(info.value).startswith("the SHACL shapes could not be run: All potentially pre-bound variables")
+    assert "\n" not in str(info.value)

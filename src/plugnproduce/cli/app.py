@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import os
 import sys
 from collections.abc import Callable
@@ -42,6 +43,21 @@ def knowledge(cell: str | Path | None = None) -> Knowledge:
 JSON_OPTION = typer.Option(False, "--json", help="Machine-readable output.")
 
 
+QUIET_LOGGERS = ("rdflib.term",)
+"""Libraries' loggers the command line (and the HMI it serves) hears only from at ERROR."""
+
+
+def quiet_library_chatter() -> None:
+    """Silence the warnings rdflib logs, unasked, for every odd IRI or literal it builds.
+
+    What matters of them is reported as a finding with its file and line; the warnings would
+    reach the user's terminal as lines of their own. Configuring logging is the application's
+    part, so this is done here, at the command line's start, not where the library reads Turtle.
+    """
+    for name in QUIET_LOGGERS:
+        logging.getLogger(name).setLevel(logging.ERROR)
+
+
 def _print_version(wanted: bool) -> None:
     if wanted:
         from plugnproduce import __version__
@@ -60,6 +76,7 @@ def _options(
     no_builtin: bool = typer.Option(False, "--no-builtin", help="Leave the built-in library out."),
 ) -> None:
     """Plug'n'Produce cell controller: from device and process descriptions to executable SCXML."""
+    quiet_library_chatter()
     LIBRARIES["folders"] = [*library, *[p for p in os.environ.get("PNP_LIBRARY", "").split(":") if p.strip()]]
     LIBRARIES["builtin"] = not no_builtin
 

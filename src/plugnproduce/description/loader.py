@@ -203,12 +203,13 @@ def _check_arguments(arguments: tuple[Argument, ...], transitions: tuple[ChartTr
     accepted = {(t.request.name, q) for t in transitions if t.request for q in t.accepts}
     for a in arguments:
         line = a.where.line if a.where else None
+        quantity, request = excerpt(local_name(a.quantity)), excerpt(a.request)  # as the file spells them: short
         if (a.request, a.quantity) not in accepted:
-            raise ContractError(f"argument {local_name(a.quantity)} of request {a.request}: no transition of the "
-                                   f"chart waits for request {a.request} with pnp:accepts=\"{local_name(a.quantity)}\"",
+            raise ContractError(f"argument {quantity} of request {request}: no transition of the "
+                                   f"chart waits for request {request} with pnp:accepts=\"{quantity}\"",
                                    path, line)
         if not unit_known(a.unit):
-            raise ContractError(f"argument {local_name(a.quantity)} of request {a.request}: unknown unit "
+            raise ContractError(f"argument {quantity} of request {request}: unknown unit "
                                    f"{excerpt(a.unit)!r}; expected a unit such as \"N\", \"mm/s\" or \"kPa\"",
                                    path, line)
 

@@ -7,11 +7,12 @@ from pathlib import Path
 
 import rdflib
 from pyshacl import validate as shacl_validate
+from pyshacl.errors import ValidationFailure
 from rdflib.namespace import SH
 from rdflib.plugins.sparql.operators import register_custom_function
 
 from plugnproduce.description.knowledge import KnowledgeGraph
-from plugnproduce.errors import tidy
+from plugnproduce.errors import OntologyError, tidy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import parse_turtle
@@ -41,7 +42,11 @@ def shapes_graph(path: Path | None = None) -> rdflib.Graph:
 
 
 def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> list[Problem]:
-    """Run the shapes over the knowledge graph; one problem per violation, at its node's place."""
+    """Run the shapes over the knowledge graph; one problem per violation, at its node's place.
+
+    A shape pySHACL cannot run (a SPARQL constraint it refuses, say ``{ SELECT ?x }`` in a
+    query's comment, read as a nested select) raises :class:`OntologyError` in one line.
+    """
     conforms, results, _ = shacl_validate(
         kg.graph,
         shacl_graph=shapes if shapes is not None else shapes_graph(),
@@ -49,6 +54,8 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
         advanced=True,
         allow_warnings=True,
     )
+    if isinstance(results, ValidationFailure):  # pySHACL returns, not raises, a shape it could not run
+        raise OntologyError(f"the SHACL shapes could not be run: {tidy(results.message)}")
     if conforms:
         return []
     problems = []

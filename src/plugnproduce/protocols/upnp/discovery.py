@@ -252,8 +252,10 @@ async def discover(
     """Search for devices for ``timeout`` seconds, then read each one's description.
 
     SSDP gives no end to the answers, so the whole ``timeout`` is waited, unless the
-    UDNs of the ``expected`` devices are given: then the search ends as soon as they
-    have all answered. Devices answer within ``MX`` seconds, here ``timeout`` rounded
+    UDNs of the ``expected`` devices are given: then each answer's description is read
+    as it comes, and the search ends as soon as each expected UDN has one that reads (an
+    early answer under its UDN that does not read, a squatter's, does not end the wait).
+    Devices answer within ``MX`` seconds, here ``timeout`` rounded
     down and clamped to 1..5, so ``timeout`` should be at least 1 s. By default only
     Plug'n'Produce devices (those with
     :data:`~plugnproduce.protocols.upnp.spec.SERVICE_TYPE`) answer.
@@ -262,25 +264,62 @@ async def discover(
     wanted = frozenset(expected)
     async with DeviceSearch(network, search_target, mx) as search:
         if wanted:
-            with contextlib.suppress(ProtocolTimeout):  # then those that answered are all there is
-                await search.wait_until(lambda: wanted <= search.hits.keys(), timeout)
+            results = await _read_until_expected(search, wanted, timeout, describe_timeout)
         else:
             await asyncio.sleep(timeout)  # the search window: answers arrive through the callback meanwhile
-    hits = [hit for udn in sorted(search.candidates) for hit in search.candidates[udn]]
-    results = await asyncio.gather(*(_describe_or_refuse(hit, describe_timeout) for hit in hits))
+    if not wanted:
+        hits = [hit for udn in sorted(search.candidates) for hit in search.candidates[udn]]
+        results = await asyncio.gather(*(_describe_or_refuse(hit, describe_timeout) for hit in hits))
     devices: dict[str, FoundDevice] = {}
     refused: list[Refusal] = []
-    for result in results:  # per UDN, in the order its candidates answered: the first that reads is the device
-        if isinstance(result, Refusal):
+    for result in sorted(results, key=lambda r: r.udn):  # per UDN in the order its candidates answered:
+        if isinstance(result, Refusal):                   # the first that reads is the device
             refused.append(result)
         elif result.udn in devices:
-            first = devices[result.udn]
             refused.append(Refusal(result.udn, result.location, result.source_host,
-                                   f"device {result.udn} already answers at {first.location}; this is another "
-                                   f"place announcing the same UDN"))
+                                   f"device {result.udn} already answers at {devices[result.udn].location}; this "
+                                   f"is another place announcing the same UDN"))
         else:
             devices[result.udn] = result
     return Discovery(tuple(devices.values()), tuple(refused))
+
+
+async def _read_until_expected(search: DeviceSearch, wanted: frozenset[str], timeout: float,
+                               describe_timeout: float) -> list[FoundDevice | Refusal]:
+    """Each candidate's description read as it answers, until every ``wanted`` UDN has one that reads or
+    ``timeout`` passes; readings under way then end (each within ``describe_timeout``)."""
+    readings: dict[SearchHit, asyncio.Task[FoundDevice | Refusal]] = {}
+    read: set[str] = set()
+    settled = asyncio.Event()
+
+    def note(task: asyncio.Task[FoundDevice | Refusal]) -> None:
+        result = None if task.cancelled() or task.exception() else task.result()
+        if isinstance(result, FoundDevice):
+            read.add(result.udn)
+            if wanted <= read:
+                settled.set()
+
+    def start_reading(hit: SearchHit) -> None:
+        if hit not in readings:
+            readings[hit] = asyncio.ensure_future(_describe_or_refuse(hit, describe_timeout))
+            readings[hit].add_done_callback(note)
+
+    async def follow() -> None:
+        with contextlib.suppress(ProtocolTimeout):
+            while True:
+                start_reading(await search.next_hit(timeout))
+
+    follower = asyncio.ensure_future(follow())
+    try:
+        with contextlib.suppress(TimeoutError):
+            await asyncio.wait_for(settled.wait(), timeout)
+        follower.cancel()
+        for hit in [hit for hits in search.candidates.values() for hit in hits]:  # any not yet taken from the queue
+            start_reading(hit)
+        return list(await asyncio.gather(*readings.values()))
+    finally:  # cancelled: nothing is left reading
+        for task in (follower, *readings.values()):
+            task.cancel()
 
 
 class AdvertisementListener:
