@@ -142,3 +142,13 @@ def test_other_clients_are_answered_while_a_long_request_is_worked_on(tmp_path: 
         check = client.post("/api/task/check", json=SMALL)
         assert check.status_code == 200 and check.json()["plausible"] is True
         assert _unanswered(long)  # the long validation is still being worked on
+
+
+def test_a_request_over_its_memory_budget_ends_with_413(tmp_path: Path, server_log: ServerLog) -> None:
+    with serving(tmp_path, WorkLimits(workers=1, waiting=0, memory=16 * 1024**2)) as (url, _), \
+            httpx.Client(base_url=url, timeout=WAIT) as client:
+        res = client.post("/api/task/validate", content=LONG, headers={"content-type": "application/json"})
+        assert res.status_code == 413
+        assert res.json() == {"detail": "the validation needed more than the 16 MiB of memory a request may use; "
+                                        "try a shorter task"}
+        assert "over its memory budget" in server_log.wait_for("POST /api/task/validate: the validation stopped")

@@ -8,10 +8,13 @@ half-done in the server. A worker holds the server's knowledge and catalogue, gi
 
 from __future__ import annotations
 
+import os
 import resource
 import signal
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from pathlib import Path
+from typing import Any, TypeVar
 
 from plugnproduce import service
 from plugnproduce.codegen.outputs import GeneratedChart
@@ -20,6 +23,8 @@ from plugnproduce.hmi import taskfiles
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.views import editor_rows, task_json
 from plugnproduce.knowledge import Knowledge
+
+T = TypeVar("T")
 
 
 @dataclass
@@ -33,12 +38,37 @@ _worker = _Context()
 
 
 def start_worker(knowledge: Knowledge, catalogue: list[DeviceDescription], memory: int | None) -> None:
-    """Initialise a worker process: keep the server's knowledge and catalogue; bound its memory to ``memory``
-    bytes of address space (a job over it fails with MemoryError); leave Ctrl-C to the server, which stops it."""
+    """Initialise a worker process: keep the server's knowledge and catalogue; let a job use at most ``memory``
+    bytes of address space more than the worker has now (a job over it fails with MemoryError); leave Ctrl-C
+    to the server, which stops its workers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _worker.knowledge, _worker.catalogue = knowledge, catalogue
     if memory is not None:
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        limit = _address_space() + memory
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+
+
+def _address_space() -> int:
+    """The bytes of address space this process uses (0 where the system does not say)."""
+    try:
+        pages = int(Path("/proc/self/statm").read_text(encoding="ascii").split()[0])
+    except (OSError, ValueError, IndexError):
+        return 0
+    return pages * os.sysconf("SC_PAGE_SIZE")
+
+
+class OverMemory(Exception):
+    """A job needed more memory than its budget (raised once the job's memory is free again)."""
+
+
+def call(function: Callable[..., T], *args: Any) -> T:
+    """``function(*args)``; a MemoryError is reported as :class:`OverMemory` once the job's frames and data are
+    gone, so that the worker has the memory to report it and goes on."""
+    try:
+        return function(*args)
+    except MemoryError:
+        pass  # leaving this block drops the traceback, and with it everything the job held
+    raise OverMemory
 
 
 def ready() -> None:

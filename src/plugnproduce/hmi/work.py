@@ -7,7 +7,7 @@ each such request runs as a job (:mod:`plugnproduce.hmi.jobs`) in a pool of work
 
 - a job that runs longer than its budget is stopped (its worker is killed and replaced) and the
   request ends with 504 and ``"the check took longer than 60 s; try a shorter task"``;
-- a job that needs more memory than a worker may have ends with 413;
+- a job that needs more memory than its budget ends with 413;
 - when the client closes the connection, its job is stopped at once;
 - at most ``workers`` jobs run at a time and ``waiting`` more wait for a worker; a request beyond
   that is refused with 503 and ``Retry-After`` instead of joining an endless queue;
@@ -51,7 +51,8 @@ WAITING = 4
 """Expensive requests that may wait for a worker; one more is refused (503) until one ends."""
 
 WORK_MEMORY = 2 * 1024**3
-"""The address space a worker process may use, in bytes (a job over it ends with 413)."""
+"""The address space one request's job may use, in bytes, beyond what its worker process uses when it starts
+(about 110 MiB); a job over it ends with 413. Validating the largest task the editor accepts uses about 45 MiB."""
 
 PRELOAD = ["plugnproduce.hmi.jobs", "plugnproduce.validation", "networkx", "pyshacl"]
 """Modules every worker starts with (imported once, before any worker is forked), so that no request
@@ -150,7 +151,7 @@ class Work:
             raise _stopping(what) from None
         finally:
             self._waiting.discard(waiting)
-        job: concurrent.futures.Future[T] = pool.schedule(function, args, timeout=self.limits.seconds)
+        job: concurrent.futures.Future[T] = pool.schedule(jobs.call, (function, *args), timeout=self.limits.seconds)
         self._jobs.add(job)
         where = f"{request.method} {request.url.path}"
         log.debug("%s: %s scheduled", where, what)
@@ -187,7 +188,7 @@ class Work:
             log.warning("%s: %s stopped: over its budget of %g s", where, what, self.limits.seconds)
             raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT,
                                 f"{what} took longer than {self.limits.seconds:g} s; try a shorter task") from None
-        except MemoryError:
+        except (jobs.OverMemory, MemoryError):
             log.warning("%s: %s stopped: over its memory budget", where, what)
             raise HTTPException(status.HTTP_413_CONTENT_TOO_LARGE,
                                 f"{what} needed more than the {_mib(self.limits.memory)} MiB of memory "
