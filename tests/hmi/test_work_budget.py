@@ -152,3 +152,13 @@ def test_a_request_over_its_memory_budget_ends_with_413(tmp_path: Path, server_l
         assert res.json() == {"detail": "the validation needed more than the 16 MiB of memory a request may use; "
                                         "try a shorter task"}
         assert "over its memory budget" in server_log.wait_for("POST /api/task/validate: the validation stopped")
+
+
+def test_the_readme_gives_the_budgets_the_hmi_keeps() -> None:
+    from plugnproduce.hmi.work import WAITING, WORK_MEMORY, WORK_SECONDS, WORKERS
+
+    readme = " ".join((Path(__file__).parents[2] / "README.md").read_text(encoding="utf-8").split())
+    words = {2: "two", 4: "four"}
+    assert f"a budget of {WORK_SECONDS:g} s (then 504" in readme
+    assert f"{WORK_MEMORY // 1024**2} MiB of memory (413)" in readme
+    assert f"{words[WORKERS]} run at a time, {words[WAITING]} more may wait" in readme

@@ -20,17 +20,24 @@ from plugnproduce.hmi.interfaces import CellSource, Runner
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
 from plugnproduce.hmi.routes import cell, charts, runs, sources, task
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders
-from plugnproduce.hmi.work import Work, WorkLimits
+from plugnproduce.hmi.work import WAITING, WORK_MEMORY, WORK_SECONDS, WORKERS, Work, WorkLimits
 from plugnproduce.knowledge import Knowledge
 from plugnproduce.safeio import MAX_BYTES
 
-DESCRIPTION = """\
+DESCRIPTION = f"""\
 The Generic HMI of a Plug'n'Produce cell: the live cell, the process commands it offers,
 tasks checked, repaired, explained and turned into SCXML, and runs watched live.
 
 Requests that change the cell or a run need `Authorization: Bearer TOKEN` (the token
 `pnp serve` prints); the others are open to clients on this machine. Errors are
-`{"detail": "one line"}` with the messages the `pnp` command line gives.
+`{{"detail": "one line"}}` with the messages the `pnp` command line gives.
+
+Checking, validating, repairing, explaining and generating a task, importing a task file and
+explaining a process command run in worker processes, each under a budget: {WORK_SECONDS:g} s (504,
+`"the check took longer than {WORK_SECONDS:g} s; try a shorter task"`) and {WORK_MEMORY // 1024**2} MiB of
+memory (413). A request whose client disconnects is stopped at once. {WORKERS} run at a time and
+{WAITING} more may wait; a request beyond that is refused with 503 and `Retry-After`. The cell, the commands,
+the processes and the event stream are answered meanwhile.
 """
 
 
