@@ -6,7 +6,7 @@ each such request runs as a job (:mod:`plugnproduce.hmi.jobs`) in a pool of work
 (``pebble.ProcessPool``) and the server's event loop only waits for it:
 
 - a job that runs longer than its budget is stopped (its worker is killed and replaced) and the
-  request ends with 504 and ``"the check took longer than 60 s; try a shorter task"``;
+  request ends with 504 and ``"the check took longer than 120 s; try a shorter task"``;
 - a job that needs more memory than its budget ends with 413;
 - when the client closes the connection, its job is stopped at once;
 - at most ``workers`` jobs run at a time and ``waiting`` more wait for a worker; a request beyond
@@ -30,7 +30,6 @@ from typing import Any, TypeVar
 
 from fastapi import HTTPException, Request, status
 from pebble import ProcessExpired, ProcessPool
-from pebble.common.types import RemoteTraceback
 
 from plugnproduce.description.model import DeviceDescription
 from plugnproduce.hmi import jobs
@@ -93,11 +92,12 @@ class Work:
         """Expensive requests running or waiting for a worker."""
         return self._active
 
-    def start(self) -> None:
+    def start(self) -> asyncio.Future[ProcessPool]:
         """Start the worker processes in the background (each is given the knowledge and the catalogue once);
         the first expensive request waits for them. Call on the server's event loop."""
         if self._starting is None:
             self._starting = asyncio.ensure_future(asyncio.to_thread(self._new_pool))
+        return self._starting
 
     def _new_pool(self) -> ProcessPool:
         context = multiprocessing.get_context("forkserver")  # workers forked from a clean, single-threaded server
@@ -108,9 +108,7 @@ class Work:
         return pool
 
     async def _pool(self) -> ProcessPool:
-        self.start()
-        assert self._starting is not None  # set by start()
-        return await asyncio.shield(self._starting)
+        return await asyncio.shield(self.start())
 
     async def stop(self) -> None:
         """Stop every job and the worker processes."""
@@ -178,12 +176,16 @@ class Work:
             job.cancel()
             log.info("%s: %s stopped: the client closed the connection", where, what)
             raise _stopping(what)
+        return self._answer(result, what, where)
+
+    def _answer(self, result: asyncio.Future[T], what: str, where: str) -> T:
+        """The job's result, or its error as the HTTP error a client is told."""
         try:
             return result.result()
         except (asyncio.CancelledError, concurrent.futures.CancelledError):
             raise _stopping(what) from None
         except TimeoutError as exc:
-            if isinstance(exc.__cause__, RemoteTraceback):  # raised by the job itself, not the budget
+            if exc.__cause__ is not None:  # raised by the job itself (with its remote traceback), not the budget
                 raise
             log.warning("%s: %s stopped: over its budget of %g s", where, what, self.limits.seconds)
             raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT,
