@@ -332,14 +332,21 @@ async def test_discover_json_shows_each_device_with_the_keys_and_values_of_the_h
 
 
 async def test_the_editor_task_is_validated_imported_and_drawn_without_temporary_files(
-        client: httpx.AsyncClient, monkeypatch: pytest.MonkeyPatch) -> None:
+        client: httpx.AsyncClient, hmi: Hmi, monkeypatch: pytest.MonkeyPatch) -> None:
     import tempfile
+
+    from plugnproduce.hmi import jobs
+    from plugnproduce.hmi.schemas import TaskIn
 
     def refuse(*_: object, **__: object) -> str:
         raise AssertionError("a temporary file was made")
 
     monkeypatch.setattr(tempfile, "mkdtemp", refuse)
     monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    task, cell = TaskIn.model_validate(TASK), hmi.app.state.hub.planning_cell  # the requests' jobs, in this process
+    assert jobs.validate(task)["valid"] is True
+    assert jobs.import_yaml(service.task_text(task.to_task()).encode(), "t.yaml")["repeat"] == 3
+    assert [c.kind for c in jobs.generate(task, cell)[1]].count("task") == 1
     assert (await client.post("/api/task/validate", json=TASK)).json()["valid"] is True
     text = (await client.post("/api/task/export", json=TASK)).text
     assert (await client.post("/api/task/import", content=text.encode(), headers=YAML)).json()["repeat"] == 3
@@ -351,6 +358,8 @@ async def test_the_editor_task_is_validated_imported_and_drawn_without_temporary
 def test_a_large_task_is_validated_in_one_pass_and_one_too_long_is_refused_before_any_work(
         served: Served, monkeypatch: pytest.MonkeyPatch) -> None:
     # issue 15: validating a fuzzed 100-step task in the editor took ~20 s (one SHACL query per value)
+    from plugnproduce.hmi import jobs
+    from plugnproduce.hmi.schemas import TaskIn
     from plugnproduce.validation import validate as validation
 
     passes: list[int] = []
@@ -360,16 +369,18 @@ def test_a_large_task_is_validated_in_one_pass_and_one_too_long_is_refused_befor
         passes.append(1)
         return real(kg)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(validation, "shape_problems", counted)
     step = {"command": "place", "params": {"place_pose": [0.6, -0.2, 0.1, 0, 180, 0], "speed": 9999}}
     with httpx.Client(base_url=served.url, timeout=600) as client:
         too_long = client.post("/api/task/validate", json={"name": "t", "steps": [step] * 1001})
-        assert too_long.status_code == 422 and passes == []
+        assert too_long.status_code == 422
         assert too_long.json()["detail"].startswith("steps: ") and "1000" in too_long.json()["detail"]
         largest = client.post("/api/task/validate", json={"name": "t", "steps": [step] * 1000})
-        assert largest.status_code == 200 and passes == [1]
+        assert largest.status_code == 200
         problems = largest.json()["problems"]
         assert [p["row"] for p in problems] == list(range(1000))
         assert problems[999]["text"] == ("steps[999].params.speed: step 1000: parameter 'speed' is 9999 %; "
                                          "expected a value from 1 to 100 %")
         assert client.get("/api/cell").status_code == 200
+    monkeypatch.setattr(validation, "shape_problems", counted)  # the request's job, here in this process
+    assert jobs.validate(TaskIn.model_validate({"name": "t", "steps": [step] * 100}))["problems"] == problems[:100]
+    assert passes == [1]

@@ -19,6 +19,7 @@ from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
     import uvicorn
+    from fastapi import FastAPI
 
     from plugnproduce import service
     from plugnproduce.hmi import CellSource, Runner
@@ -118,13 +119,28 @@ def serve(
     config = uvicorn.Config(application, log_level="warning", timeout_graceful_shutdown=2, lifespan="on", ws="none")
     previous = signal.signal(signal.SIGTERM, _interrupt)  # uvicorn re-raises the signal it stopped on: as Ctrl-C
     try:
-        _serve(uvicorn.Server(config), sock)  # SIGINT/SIGTERM: a graceful shutdown, then KeyboardInterrupt
+        _serve(_server(config, application), sock)  # SIGINT/SIGTERM: a graceful shutdown, then KeyboardInterrupt
     except KeyboardInterrupt:
         pass
     finally:
         signal.signal(signal.SIGTERM, previous)
     typer.echo("stopped")
     _leave_busy_workers()
+
+
+def _server(config: uvicorn.Config, application: FastAPI) -> uvicorn.Server:
+    """A uvicorn server that, when it stops, first stops the requests still being worked on (each ends at
+    once with 503), so that shutdown neither waits for them nor cancels them with a traceback."""
+    import uvicorn
+
+    from plugnproduce.hmi.app import stop_requests
+
+    class Server(uvicorn.Server):
+        async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
+            stop_requests(application)
+            await super().shutdown(sockets)
+
+    return Server(config)
 
 
 def _interrupt(signum: int, frame: FrameType | None) -> None:

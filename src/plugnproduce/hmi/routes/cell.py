@@ -4,15 +4,16 @@ from __future__ import annotations
 
 from typing import Any
 
-from fastapi import APIRouter, Depends, HTTPException, status
+from fastapi import APIRouter, Depends, HTTPException, Request, status
 
-from plugnproduce import service
+from plugnproduce.hmi import jobs
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.interfaces import PluggableCellSource
 from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.schemas import PlugIn
 from plugnproduce.hmi.security import allow_read, require_token
 from plugnproduce.hmi.views import device_json, process_json
+from plugnproduce.hmi.work import Work, work_of
 
 router = APIRouter(prefix="/api", tags=["cell"])
 read = [Depends(allow_read)]
@@ -66,12 +67,13 @@ def get_commands(hub: Hub = Depends(hub_of)) -> dict[str, Any]:
 
 @router.get("/commands/{command}/explanation", dependencies=read,
             summary="Why a process command is (not) offered")
-def explain_command(command: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+async def explain_command(command: str, request: Request, hub: Hub = Depends(hub_of),
+                          work: Work = Depends(work_of)) -> dict[str, Any]:
     """``service.explain_process`` and ``service.explain_offered``: the bindings or the reasons, the derivation
     tree (rules, ontology axioms, chart states, each with its line) and the counterfactuals the reasoner
-    confirms (catalogue devices to plug in or swap in; for an offered command, the devices it rests on)."""
-    why = service.explain_offered(hub.cell, command, hub.knowledge, hub.catalogue)
-    return {**service.explain_process(hub.cell, command, hub.knowledge).to_json(), **why.to_json()}
+    confirms (catalogue devices to plug in or swap in; for an offered command, the devices it rests on).
+    Runs in a worker under the time budget, like a check."""
+    return await work.run(request, "the explanation", jobs.explain_command, hub.cell, command)
 
 
 @router.get("/processes", dependencies=read, summary="Every known process with its roles and parameters")

@@ -1,7 +1,8 @@
 """A task from the editor: validate, check, repair, explain a step, generate its code; YAML in and out.
 
 None of these change anything, so they are open on loopback like every other read.
-Implausible is a result (``"plausible": false``), never an error status.
+Implausible is a result (``"plausible": false``), never an error status. All but export run in a
+worker process under a time budget and stop when their client goes away (:mod:`plugnproduce.hmi.work`).
 """
 
 from __future__ import annotations
@@ -11,91 +12,65 @@ from typing import Any
 from fastapi import APIRouter, Depends, HTTPException, Query, Request, status
 from fastapi.responses import PlainTextResponse
 
-from plugnproduce import service
-from plugnproduce.hmi import taskfiles
+from plugnproduce.hmi import jobs, taskfiles
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.pictures import GeneratedCharts
 from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.security import allow_read
-from plugnproduce.hmi.views import editor_rows, task_json
-from plugnproduce.verification import Budget
+from plugnproduce.hmi.work import Work, work_of
 
 router = APIRouter(prefix="/api/task", tags=["task"], dependencies=[Depends(allow_read)])
 
 
-def _rows(problems: list[dict[str, Any]], task: TaskIn) -> list[dict[str, Any]]:
-    """Add to each problem the editor row of its step (steps repeat: step 5 of 2 rows is row 0, round 3;
-    a loop's later iterations are its round 2)."""
-    rows = editor_rows(task.to_task())
-    for p in problems:
-        step = p.get("step")
-        if isinstance(step, int) and step in rows:
-            p["row"], p["round"] = rows[step]
-    return problems
-
-
 @router.post("/validate", summary="Validate the task like a task file: types, ranges, known commands")
-def validate(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+async def validate(task: TaskIn, request: Request, work: Work = Depends(work_of)) -> dict[str, Any]:
     """Schema, SHACL shapes and structure, as ``pnp validate`` does; each problem names its editor field."""
-    return taskfiles.validate_task(task, hub.knowledge)
+    return await work.run(request, "the validation", jobs.validate, task)
 
 
 @router.post("/check", summary="Is the task plausible in the cell as it is now?")
-def check(task: TaskIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+async def check(task: TaskIn, request: Request, hub: Hub = Depends(hub_of),
+                work: Work = Depends(work_of)) -> dict[str, Any]:
     """``service.check``: per step its bindings and device states, and every problem at its step."""
-    result = service.check(task.to_task(), hub.planning_cell, hub.knowledge).to_json()
-    problems = result["problems"]
-    if not isinstance(problems, list):
-        raise TypeError(f"a check result's problems are a list; found {type(problems).__name__}")
-    result["problems"] = _rows(problems, task)
-    return result
+    return await work.run(request, "the check", jobs.check, task, hub.planning_cell)
 
 
 @router.post("/repair", summary="Ranked minimal repairs of an implausible task")
-def repair(task: TaskIn, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+async def repair(task: TaskIn, request: Request, top: int = Query(3, ge=1, le=20), hub: Hub = Depends(hub_of),
+                 work: Work = Depends(work_of)) -> dict[str, Any]:
     """``service.assessed_repairs`` with the catalogue: each repair's edits, cost, side effects (ranked by them)
     and resulting task (ready to apply)."""
-    model, cell = task.to_task(), hub.planning_cell
-    result = service.check(model, cell, hub.knowledge)
-    repairs = [] if result.plausible else service.assessed_repairs(model, cell, hub.catalogue, top, hub.knowledge)
-    return {
-        "plausible": result.plausible,
-        "problems": _rows([p.to_json() for p in result.problems], task),
-        "repairs": [{**r.to_json(), "task": task_json(r.repair.task)} for r in repairs],
-    }
+    return await work.run(request, "the repair", jobs.repair, task, hub.planning_cell, top)
 
 
 @router.post("/explain", summary="Why a step is (not) plausible")
-def explain(task: TaskIn, step: int = Query(..., ge=1, description="The step, from 1 in the repeated order"),
-            hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+async def explain(task: TaskIn, request: Request,
+                  step: int = Query(..., ge=1, description="The step, from 1 in the repeated order"),
+                  hub: Hub = Depends(hub_of), work: Work = Depends(work_of)) -> dict[str, Any]:
     """``service.explain_step`` and ``service.explain_plausible``: each device's state before the step, where it
     came from, what the step needs, the derivation tree and the states that would make the step plausible."""
-    model = task.to_task()
-    why = service.explain_plausible(model, hub.planning_cell, step, hub.knowledge)
-    return {**service.explain_step(model, hub.planning_cell, step, hub.knowledge).to_json(), **why.to_json()}
+    return await work.run(request, "the explanation", jobs.explain, task, hub.planning_cell, step)
 
 
 @router.post("/generate", summary="Generate the SCXML charts of a plausible task, once its program is proved")
-def generate(task: TaskIn, request: Request, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+async def generate(task: TaskIn, request: Request, hub: Hub = Depends(hub_of),
+                   work: Work = Depends(work_of)) -> dict[str, Any]:
     """Specific process charts, the Task State Chart and the closed-world chart, each as SCXML and SVG.
 
     ``service.generation``: an implausible task is a result (its problems, no charts), not an error; so is a
     program verification does not prove (``verification``: refuted with its shortest trace, or inconclusive),
     for which no charts are made, as ``pnp generate`` writes none.
     """
-    result = service.generation(task.to_task(), hub.planning_cell, knowledge=hub.knowledge, verify=Budget())
-    out: dict[str, Any] = {"plausible": result.check.plausible,
-                           "problems": _rows([p.to_json() for p in result.check.problems], task),
-                           "verification": result.verification.to_json() if result.verification else None,
-                           "generation": None, "charts": []}
-    if result.charts:
+    out, charts = await work.run(request, "the code generation", jobs.generate, task, hub.planning_cell)
+    out = {**out, "generation": None, "charts": []}
+    if charts:
         store: GeneratedCharts = request.app.state.generated
-        gen = store.add(result.charts)
+        gen = store.add(charts)
         base = f"/api/charts/generated/{gen}"
         out["generation"] = gen
         out["charts"] = [{"name": c.name, "kind": c.kind, "scxml": f"{base}/{c.name}", "svg": f"{base}/{c.name}.svg"}
-                         for c in result.charts]
+                         for c in charts]
     return out
 
 
@@ -118,6 +93,7 @@ YAML_BODY = {"requestBody": {"required": True, "description": "A YAML task descr
 async def import_(
     request: Request,
     filename: str = Query("task.yaml", max_length=200, description="The file's name, for error messages"),
+    work: Work = Depends(work_of),
 ) -> dict[str, Any]:
     """Parse YAML with the task file's hardened reader; errors are ``FILE:LINE: message``.
 
@@ -129,4 +105,4 @@ async def import_(
         raise HTTPException(status.HTTP_415_UNSUPPORTED_MEDIA_TYPE,
                             f"{filename}: send the task as application/yaml; found {kind or 'no content type'}")
     data = await request.body()
-    return task_json(taskfiles.import_yaml(data, filename))
+    return await work.run(request, "reading the task file", jobs.import_yaml, data, filename)
