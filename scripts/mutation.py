@@ -3,6 +3,7 @@
     python scripts/mutation.py                    # every guard module
     python scripts/mutation.py evaluator tokens   # some of them (names below, or --list)
     python scripts/mutation.py --jobs 2 --work build/mutation
+    python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
 
 For each guard module, mutmut (3.x, the ``test`` extra) makes small changes to its guard
 functions, one at a time (``<`` for ``<=``, ``and`` for ``or``, a string or number changed,
@@ -81,6 +82,11 @@ GUARDS = (
            "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail", "xǁTaskRunǁ_outcome")),
 )
 
+PRELOADED = ("lxml.etree", "yaml", "rdflib", "pyshacl", "clingo", "networkx", "xmlschema", "aiohttp",
+             "async_upnp_client.client", "fastapi", "starlette.applications", "httpx", "uvicorn", "hypothesis",
+             "pytest_asyncio", "plugnproduce.errors", "plugnproduce.safeio", "plugnproduce.statechart")
+"""Imported once by the server the mutants' processes fork from (the libraries take seconds to import)."""
+
 COPIED = ("src", "tests", "ontology", "rules", "descriptions", "pyproject.toml")
 _KILLED = {1: "killed", 3: "killed"}
 _TIMEOUT = {36, -24, 24, 152, 255, -9, -11}
@@ -130,8 +136,14 @@ def _prepare(guard: Guard, work: Path) -> None:
         "also_copy": ["ontology", "rules", "descriptions"],
         "pytest_add_cli_args_test_selection": list(guard.tests),
         "pytest_add_cli_args": ["-p", "no:cacheprovider"],
-        # a fresh process per mutant: no cache filled by another mutant's run (compiled expressions, names)
+        # Each mutant runs in a process forked from a server that imported the libraries and the package
+        # but no test module and ran no test: no cache filled by an earlier run (compiled expressions,
+        # checked names) and no object a test module built at import, before the mutant was switched on.
         "process_isolation": "forkserver",
+        "forkserver_warmup": "import",
+        "preload_modules_file": str(work / "preload.txt"),
+        "timeout_multiplier": 3.0,
+        "timeout_constant": 5.0,
         # the wording of an error is not a guard (the condition that raises it is): raise lines are not mutated
         "do_not_mutate_patterns": [r"^\s*raise\s"],
         "use_git_change_detection": False,
@@ -141,11 +153,20 @@ def _prepare(guard: Guard, work: Path) -> None:
     text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
     (work / "pyproject.toml").write_text(text + "\n[tool.mutmut]\n" + "\n".join(lines) + "\n", encoding="utf-8")
     (work / "mutants" / "src").mkdir(parents=True)  # on sys.path of the tests' child processes from the start
+    modules = [*PRELOADED, *(Path(f).with_suffix("").as_posix().removeprefix("src/").replace("/", ".")
+                             for f in guard.files)]
+    (work / "preload.txt").write_text("\n".join(modules) + "\n", encoding="utf-8")
 
 
-def _run_mutmut(guard: Guard, work: Path, jobs: int) -> None:
+def _refresh_tests(work: Path) -> None:
+    """The checkout's tests, copied again into a prepared work folder (to test the survivors again)."""
+    for where in (work / "tests", work / "mutants" / "tests"):
+        shutil.copytree(ROOT / "tests", where, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__"))
+
+
+def _run_mutmut(guard: Guard, work: Path, jobs: int, names: list[str] | None = None) -> None:
     env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
-    patterns = [f"*.{f}__mutmut_*" for f in guard.functions]
+    patterns = names or [f"*.{f}__mutmut_*" for f in guard.functions]
     command = [sys.executable, "-m", "mutmut", "run", "--max-children", str(jobs), *patterns]
     done = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True)
     log = work / "mutmut.log"
@@ -206,11 +227,18 @@ def _survivor(key: str, file: str, work: Path) -> Survivor:
     return Survivor(key, f"{file}:{line}", " ".join(before), " ".join(after))
 
 
-def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, str], str]) -> dict[str, int]:
-    """Mutate one guard module, print its figures and survivors; the figures."""
+def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, str], str],
+              again: bool = False) -> dict[str, int]:
+    """Mutate one guard module (``again``: test only the last run's survivors), print its figures and survivors."""
     started = time.monotonic()
-    _prepare(guard, work)
-    _run_mutmut(guard, work, jobs)
+    if again and (work / "mutants").is_dir():
+        _refresh_tests(work)
+        survivors = [k for k, code in _results(guard, work).items() if code not in _KILLED and code not in _TIMEOUT]
+        if survivors:
+            _run_mutmut(guard, work, jobs, survivors)
+    else:
+        _prepare(guard, work)
+        _run_mutmut(guard, work, jobs)
     codes = _results(guard, work)
     counts: Counter[str] = Counter()
     lines: list[str] = []
@@ -245,13 +273,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("modules", nargs="*", help="guard modules to run (default: all; see --list)")
     parser.add_argument("--list", action="store_true", help="list the guard modules with their files and tests")
     parser.add_argument("--jobs", type=int, default=2, help="mutants tested at once (default 2)")
+    parser.add_argument("--again", action="store_true",
+                        help="test only the survivors of the last run again, with the tests as they are now")
     parser.add_argument("--work", type=Path, default=ROOT / "build" / "mutation",
                         help="folder for the per-module copies (default build/mutation)")
     args = parser.parse_args(argv)
     by_name = {g.name: g for g in GUARDS}
     if args.list:
         for g in GUARDS:
-            print(f"{g.name}: {', '.join(g.files)}\n  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
+            print(f"{g.name}: {', '.join(g.files)}")
+            print(f"  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
         return 0
     unknown = [m for m in args.modules if m not in by_name]
     if unknown:
@@ -262,7 +293,7 @@ def main(argv: list[str] | None = None) -> int:
     total: Counter[str] = Counter()
     try:
         for name in args.modules or list(by_name):
-            total.update(run_guard(by_name[name], args.work / name, args.jobs, known))
+            total.update(run_guard(by_name[name], args.work.resolve() / name, args.jobs, known, args.again))
     except RuntimeError as exc:
         print(f"scripts/mutation.py: {exc}", file=sys.stderr)
         return 2

@@ -15,12 +15,12 @@ from types import SimpleNamespace
 import pytest
 
 from plugnproduce.statechart import SCXML_NS, parse_chart
-from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator
+from plugnproduce.statechart.runtime.evaluator import MAX_ITEMS, EvaluationError, Evaluator
 from plugnproduce.statechart.runtime.events import ERROR, MetaEvent
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 
-UNTRUSTED = Evaluator()
-TRUSTED = Evaluator(trusted=True)
+TRUSTED = True
+"""Evaluate as for a chart the user trusts (plain Python)."""
 
 # Reaches ``__import__`` from nothing but an empty tuple: it reads the file in a plain eval sandbox.
 ESCAPE = ("[c for c in ().__class__.__base__.__subclasses__() if c.__name__ == 'catch_warnings'][0]()"
@@ -34,7 +34,9 @@ def secret(tmp_path: Path) -> Path:
     return path
 
 
-def evaluate(source: str, evaluator: Evaluator = UNTRUSTED, **data: object) -> object:
+def evaluate(source: str, trusted: bool = False, **data: object) -> object:
+    """The value of ``source`` in a fresh namespace: restricted as for a device's chart unless ``trusted``."""
+    evaluator = Evaluator(trusted=True) if trusted else Evaluator()
     return evaluator.expr(source).evaluate({"__builtins__": evaluator.builtins(), **data})
 
 
@@ -178,3 +180,65 @@ def test_assigning_to_a_missing_key_of_a_list_is_an_execution_error() -> None:
     <state id="s"><onentry><assign location="items[5]" expr="1"/></onentry></state>""")
     assert "cannot assign to 'items[5]'" in errors[0].data["event"].data["message"]
     assert interpreter.datamodel["items"] == [0]
+
+
+def test_a_location_assigns_to_an_attribute_of_an_object_and_to_a_computed_key() -> None:
+    box, table = SimpleNamespace(size=1), {"k": 0}
+    namespace = {"box": box, "table": table, "key": "k"}
+    Evaluator().location("box.size").assign(namespace, 3)
+    Evaluator().location("table[key]").assign(namespace, 4)
+    assert (box.size, table) == (3, {"k": 4})
+
+
+# --- the budgets of join and replace, at their limits ------------------------------------
+
+
+def test_join_may_build_up_to_the_limit_and_not_beyond() -> None:
+    half = "a" * (MAX_ITEMS // 2)
+    assert len(evaluate("''.join([s, s])", s=half)) == MAX_ITEMS  # type: ignore[arg-type]
+    with pytest.raises(EvaluationError, match="exceed"):
+        evaluate("''.join([s, s, 'a'])", s=half)
+
+
+def test_a_long_separator_counts_once_per_part() -> None:
+    with pytest.raises(EvaluationError, match="exceed"):
+        evaluate("sep.join(['a', 'b', 'c'])", sep="-" * (MAX_ITEMS // 3))
+    assert evaluate("sep.join([])", sep="-" * (MAX_ITEMS // 3)) == ""
+    assert evaluate("'-'.join([x for x in 'abc'])") == "a-b-c"
+
+
+def test_join_and_replace_take_the_arguments_python_takes() -> None:
+    with pytest.raises(EvaluationError, match="TypeError"):
+        evaluate("'-'.join(['a'], 'b')")
+    try:
+        value = evaluate("'aaa'.replace('a', 'b', count=1)")
+    except EvaluationError:
+        value = None  # Python before 3.13 takes no keywords here
+    assert value in ("baa", None)
+
+
+def test_replace_may_build_up_to_the_limit_and_not_beyond() -> None:
+    assert len(evaluate("''.replace('', new)", new="x" * MAX_ITEMS)) == MAX_ITEMS  # type: ignore[arg-type]
+    with pytest.raises(EvaluationError, match="exceed"):
+        evaluate("'ab'.replace('', new)", new="x" * (MAX_ITEMS // 2))
+
+
+def test_other_methods_with_a_string_argument_are_not_budgeted_as_replace() -> None:
+    items = [0] * (MAX_ITEMS * 3 // 4)
+    assert evaluate("items.insert(0, 'x') or len(items)", items=items) == len(items)
+
+
+# --- <script>, for trusted charts only ----------------------------------------------------
+
+
+def test_a_trusted_script_runs_whatever_its_indentation_and_first_name() -> None:
+    run = Evaluator(trusted=True).script("\n    X = 7\n    y = X * 6\n", "chart")
+    namespace: dict[str, object] = {}
+    run(namespace)
+    assert (namespace["X"], namespace["y"]) == (7, 42)
+
+
+def test_a_trusted_script_with_a_syntax_error_fails_when_run_naming_it() -> None:
+    run = Evaluator(trusted=True).script("x = (", "chart")
+    with pytest.raises(EvaluationError, match=r"syntax error in <script> \('\(' was never closed\)"):
+        run({})
