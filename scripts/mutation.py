@@ -82,10 +82,23 @@ GUARDS = (
            "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail", "xǁTaskRunǁ_outcome")),
 )
 
-PRELOADED = ("lxml.etree", "yaml", "rdflib", "pyshacl", "clingo", "networkx", "xmlschema", "aiohttp",
-             "async_upnp_client.client", "fastapi", "starlette.applications", "httpx", "uvicorn", "hypothesis",
-             "pytest_asyncio", "plugnproduce.errors", "plugnproduce.safeio", "plugnproduce.statechart")
-"""Imported once by the server the mutants' processes fork from (the libraries take seconds to import)."""
+PLUGIN = "mutation_fresh_caches"
+PLUGIN_TEXT = '''"""Empties the caches of the guard modules before each test (mutation runs only)."""
+
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def _fresh_caches():
+    from plugnproduce.protocols.xirp import codec
+    from plugnproduce.statechart.runtime import evaluator
+
+    evaluator._compile_expression.cache_clear()
+    codec._NAMES.clear()
+    yield
+'''
+"""A pytest plugin of the work folder: a cache filled while the tests were collected (by the unmutated
+code) would otherwise answer for the mutated function."""
 
 COPIED = ("src", "tests", "ontology", "rules", "descriptions", "pyproject.toml")
 _KILLED = {1: "killed", 3: "killed"}
@@ -135,13 +148,11 @@ def _prepare(guard: Guard, work: Path) -> None:
         "only_mutate": list(guard.files),
         "also_copy": ["ontology", "rules", "descriptions"],
         "pytest_add_cli_args_test_selection": list(guard.tests),
-        "pytest_add_cli_args": ["-p", "no:cacheprovider"],
-        # Each mutant runs in a process forked from a server that imported the libraries and the package
-        # but no test module and ran no test: no cache filled by an earlier run (compiled expressions,
-        # checked names) and no object a test module built at import, before the mutant was switched on.
+        "pytest_add_cli_args": ["-p", "no:cacheprovider", "-p", PLUGIN],
+        # Each mutant runs in a process forked from a server that collected the tests but ran none, and
+        # the plugin below empties the package's caches before each test, so that no value computed by
+        # the unmutated code (a compiled expression, a checked name) hides the mutant.
         "process_isolation": "forkserver",
-        "forkserver_warmup": "import",
-        "preload_modules_file": str(work / "preload.txt"),
         "timeout_multiplier": 3.0,
         "timeout_constant": 5.0,
         # the wording of an error is not a guard (the condition that raises it is): raise lines are not mutated
@@ -153,9 +164,7 @@ def _prepare(guard: Guard, work: Path) -> None:
     text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
     (work / "pyproject.toml").write_text(text + "\n[tool.mutmut]\n" + "\n".join(lines) + "\n", encoding="utf-8")
     (work / "mutants" / "src").mkdir(parents=True)  # on sys.path of the tests' child processes from the start
-    modules = [*PRELOADED, *(Path(f).with_suffix("").as_posix().removeprefix("src/").replace("/", ".")
-                             for f in guard.files)]
-    (work / "preload.txt").write_text("\n".join(modules) + "\n", encoding="utf-8")
+    (work / "src" / f"{PLUGIN}.py").write_text(PLUGIN_TEXT, encoding="utf-8")
 
 
 def _refresh_tests(work: Path) -> None:

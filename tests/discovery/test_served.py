@@ -63,7 +63,7 @@ def test_a_device_naming_any_chart_but_the_one_it_serves_is_refused(chart: str) 
 
 def test_issue_15_a_percent_encoded_nul_in_the_chart_name_is_a_refusal_not_a_crash() -> None:
     """``<gripper%00.scxml>`` decodes to a path with a NUL, which ``Path.resolve`` cannot take (ValueError)."""
-    with pytest.raises(DescriptionError, match="names its chart <gripper%00.scxml>"):
+    with pytest.raises(DescriptionError, match=r"names its chart <file:///gripper%00.scxml>; expected the chart it serves"):
         read("gripper", turtle=("<gripper.scxml>", "<gripper%00.scxml>"))
 
 
