@@ -10,11 +10,10 @@ import pytest
 
 from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator
 
-UNTRUSTED = Evaluator()
-
 
 def evaluate(source: str, **data: object) -> object:
-    return UNTRUSTED.expr(source).evaluate({"__builtins__": UNTRUSTED.builtins(), **data})
+    untrusted = Evaluator()  # built per call: what a device's chart gets
+    return untrusted.expr(source).evaluate({"__builtins__": untrusted.builtins(), **data})
 
 
 @pytest.mark.parametrize(("source", "needle"), [

@@ -25,6 +25,8 @@ from pathlib import Path
 from typing import Literal
 from urllib.parse import urlparse
 
+from rdflib.term import Node
+
 from plugnproduce.description.loader import device_from, file_of, parse_description
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout, excerpt
@@ -234,6 +236,12 @@ class LiveCell:
         return read_served(files, found, self.taxonomy)
 
 
+def _is_served_chart(named: Node, chart: Path) -> bool:
+    """Whether a chart a description names is the chart the device served (a NUL, even %00, names no file)."""
+    path = file_of(named)
+    return "\0" not in str(path) and path.resolve() == chart.resolve()
+
+
 def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> DeviceDescription:
     """Read the description and chart a device served (fetched already) as any description, from memory.
 
@@ -247,7 +255,7 @@ def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> D
     try:
         loaded = parse_description(files.description.encode("utf-8"), ttl)
         for named in loaded.graph.objects(None, PNP.stateChart):
-            if "\0" in str(named) or file_of(named).resolve() != chart.resolve():  # elsewhere, or no path at all
+            if not _is_served_chart(named, chart):
                 raise DescriptionError(f"device {found.udn} names its chart <{excerpt(str(named))}>; expected "
                                        f"the chart it serves ({chart.name})", ttl)
         device = device_from(loaded, taxonomy, charts={chart: files.chart.encode("utf-8")})

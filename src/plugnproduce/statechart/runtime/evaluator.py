@@ -195,8 +195,7 @@ class Location:
             raise EvaluationError(f"cannot assign to {self.source!r}: {exc}") from exc
 
 
-@functools.lru_cache(maxsize=EXPRESSIONS_REMEMBERED)
-def _compile_expression(source: str, trusted: bool) -> Expr:
+def _compile(source: str, trusted: bool) -> Expr:
     try:
         if not trusted and len(source) > MAX_SOURCE:
             raise _Refused(f"the expression is {len(source)} characters long; at most {MAX_SOURCE} are allowed")
@@ -213,6 +212,10 @@ def _compile_expression(source: str, trusted: bool) -> Expr:
         return Expr(source, None, f"not allowed by the restricted evaluator: {exc}")
     except (RecursionError, MemoryError):
         return Expr(source, None, "the expression is nested too deeply")
+
+
+_compile_expression = functools.lru_cache(maxsize=EXPRESSIONS_REMEMBERED)(_compile)
+# (wrapped rather than decorated, so that mutation testing reaches the checks in ``_compile``)
 
 
 class _Refused(Exception):

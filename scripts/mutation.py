@@ -1,0 +1,316 @@
+"""Mutation testing of the guard modules: does a test fail when a guard is broken?
+
+    python scripts/mutation.py                    # every guard module
+    python scripts/mutation.py evaluator tokens   # some of them (names below, or --list)
+    python scripts/mutation.py --jobs 2 --work build/mutation
+    python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
+
+For each guard module, mutmut (3.x, the ``test`` extra) makes small changes to its guard
+functions, one at a time (``<`` for ``<=``, ``and`` for ``or``, a string or number changed,
+an argument dropped, a ``return`` emptied, ...) and runs only the tests named for that module
+below; of those, only the tests that reach the changed function. A mutant is *killed* when
+a test fails, *survived* when every test passes. Printed per module: mutants, killed,
+survived, timeouts, equivalent, and each survivor at its ``file:line`` with the change.
+
+A survivor that cannot change any behaviour (an equivalent mutant) is listed with the
+reason in ``scripts/mutation_equivalent.txt``; it is printed as such and does not count as
+a survivor. Exit 0 when no mutant survives, 1 otherwise, 2 when the run itself fails.
+
+Each module runs in its own work folder (``--work``, default ``build/mutation/NAME``) that
+holds a copy of the checkout, so the checkout is never changed. mutmut only changes code
+inside functions: a guard must live in a function to be tested here (module-level tables
+such as allow-lists are exercised by the tests of the functions that read them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+EQUIVALENT_FILE = ROOT / "scripts" / "mutation_equivalent.txt"
+
+
+@dataclass(frozen=True)
+class Guard:
+    """One guard module: the files mutated, which of their functions, and the tests that cover them."""
+
+    name: str
+    files: tuple[str, ...]
+    tests: tuple[str, ...]
+    functions: tuple[str, ...] = ("*",)
+    """Patterns of mutmut's function keys (``x_name`` for a function, ``xǁClassǁmethod`` for a method)."""
+
+
+GUARDS = (
+    Guard("evaluator", ("src/plugnproduce/statechart/runtime/evaluator.py",),
+          ("tests/statechart/test_evaluator_guards.py", "tests/statechart/test_evaluator_budgets.py",
+           "tests/statechart/test_interpreter.py")),
+    Guard("safeio", ("src/plugnproduce/safeio.py",),
+          ("tests/test_safeio.py", "tests/test_safeio_yaml.py")),
+    Guard("upnp-trust", ("src/plugnproduce/protocols/upnp/boundary.py", "src/plugnproduce/protocols/upnp/client.py",
+                         "src/plugnproduce/protocols/upnp/discovery.py"),
+          ("tests/protocols/test_upnp_trust.py", "tests/protocols/test_upnp_loopback.py",
+           "tests/protocols/test_upnp_http_reading.py"),
+          ("x__host_key", "x_check_trusted", "x_resolve_trusted", "xǁTrustedRequesterǁ*", "xǁNoRedirectRequesterǁ*",
+           "x_load_device", "xǁUpnpDeviceClientǁfetch_files", "xǁUpnpDeviceClientǁfrom_found", "x_describe")),
+    Guard("discovery-trust", ("src/plugnproduce/discovery/live.py",),
+          ("tests/discovery/test_served.py", "tests/discovery/test_live_cell.py"),
+          ("x_read_served", "x__safe_name")),
+    Guard("tokens", ("src/plugnproduce/hmi/security.py",),
+          ("tests/hmi/test_security.py", "tests/hmi/test_route_tokens.py", "tests/hmi/test_http_api.py")),
+    Guard("xirp-codec", ("src/plugnproduce/protocols/xirp/codec.py", "src/plugnproduce/protocols/xirp/decoding.py"),
+          ("tests/protocols/test_xirp_guards.py", "tests/protocols/test_xirp_messages.py",
+           "tests/protocols/test_xirp_robustness.py"),
+          ("x__escaped", "x__attr", "x__checked", "x__name", "x__decimal", "x__write_pose", "x__value", "x__positive",
+           "x_encode", "x_decode", "x__decode_document", "x__number", "x__integer", "x__pose", "x__decode_event")),
+    Guard("executor-faults", ("src/plugnproduce/executor/run.py",),
+          ("tests/executor/test_run.py", "tests/executor/test_faults.py"),
+          ("xǁTaskRunǁrun", "xǁTaskRunǁstop", "xǁTaskRunǁdevice_lost", "xǁTaskRunǁ_connect", "xǁTaskRunǁsend",
+           "xǁTaskRunǁ_request", "xǁTaskRunǁ_answers", "xǁTaskRunǁ_safe_stop", "xǁTaskRunǁ_stop_device",
+           "xǁTaskRunǁ_on_event", "xǁTaskRunǁ_on_lost", "xǁTaskRunǁ_on_anomaly", "xǁTaskRunǁ_on_step",
+           "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail", "xǁTaskRunǁ_outcome")),
+)
+
+PLUGIN = "mutation_fresh_caches"
+PLUGIN_TEXT = '''"""Empties the caches of the guard modules before each test (mutation runs only)."""
+
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def _fresh_caches():
+    from plugnproduce.protocols.xirp import codec
+    from plugnproduce.statechart.runtime import evaluator
+
+    evaluator._compile_expression.cache_clear()
+    codec._NAMES.clear()
+    yield
+'''
+"""A pytest plugin of the work folder: a cache filled while the tests were collected (by the unmutated
+code) would otherwise answer for the mutated function."""
+
+COPIED = ("src", "tests", "ontology", "rules", "descriptions", "pyproject.toml")
+_KILLED = {1: "killed", 3: "killed"}
+_TIMEOUT = {36, -24, 24, 152, 255, -9, -11}
+_SURVIVED = {0: "survived", 33: "no tests", 5: "no tests"}
+
+
+@dataclass(frozen=True)
+class Survivor:
+    """A mutant no test killed: where, and what was changed."""
+
+    key: str
+    where: str
+    before: str
+    after: str
+
+    @property
+    def function(self) -> str:
+        """The mutated function's key (``x_name`` or ``xǁClassǁmethod``)."""
+        return self.key.rsplit(".", 1)[-1].split("__mutmut_")[0]
+
+
+def equivalents(path: Path = EQUIVALENT_FILE) -> dict[tuple[str, str, str], str]:
+    """The listed equivalent mutants: (function, line before, line after) → why no behaviour can differ."""
+    found: dict[tuple[str, str, str], str] = {}
+    if not path.exists():
+        return found
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+        if not line.strip() or line.startswith("#"):
+            continue
+        parts = [p.strip() for p in line.split(" | ")]
+        if len(parts) != 4:
+            raise SystemExit(f"{path.relative_to(ROOT)}:{number}: expected 'function | before | after | why'")
+        found[(parts[0], parts[1], parts[2])] = parts[3]
+    return found
+
+
+def _prepare(guard: Guard, work: Path) -> None:
+    """A fresh copy of the checkout in ``work``, with the mutmut settings of ``guard``."""
+    if work.exists():
+        shutil.rmtree(work)
+    work.mkdir(parents=True)
+    for name in COPIED[:-1]:
+        shutil.copytree(ROOT / name, work / name, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    settings = {
+        "source_paths": ["src"],
+        "only_mutate": list(guard.files),
+        "also_copy": ["ontology", "rules", "descriptions"],
+        "pytest_add_cli_args_test_selection": list(guard.tests),
+        "pytest_add_cli_args": ["-p", "no:cacheprovider", "-p", PLUGIN],
+        # Each mutant runs in a process forked from a server that collected the tests but ran none, and
+        # the plugin below empties the package's caches before each test, so that no value computed by
+        # the unmutated code (a compiled expression, a checked name) hides the mutant.
+        "process_isolation": "forkserver",
+        "timeout_multiplier": 3.0,
+        "timeout_constant": 5.0,
+        # the wording of an error is not a guard (the condition that raises it is): raise lines are not mutated
+        "do_not_mutate_patterns": [r"^\s*raise\s"],
+        "use_git_change_detection": False,
+        "track_dependencies": False,
+    }
+    lines = [f"{key} = {json.dumps(value)}" for key, value in settings.items()]
+    text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
+    (work / "pyproject.toml").write_text(text + "\n[tool.mutmut]\n" + "\n".join(lines) + "\n", encoding="utf-8")
+    (work / "mutants" / "src").mkdir(parents=True)  # on sys.path of the tests' child processes from the start
+    (work / "src" / f"{PLUGIN}.py").write_text(PLUGIN_TEXT, encoding="utf-8")
+
+
+def _refresh_tests(work: Path) -> None:
+    """The checkout's tests, copied again into a prepared work folder (to test the survivors again)."""
+    for where in (work / "tests", work / "mutants" / "tests"):
+        shutil.copytree(ROOT / "tests", where, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__"))
+
+
+def _run_mutmut(guard: Guard, work: Path, jobs: int, names: list[str] | None = None) -> None:
+    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
+    patterns = names or [f"*.{f}__mutmut_*" for f in guard.functions]
+    command = [sys.executable, "-m", "mutmut", "run", "--max-children", str(jobs), *patterns]
+    done = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True)
+    log = work / "mutmut.log"
+    log.write_text(done.stdout + done.stderr, encoding="utf-8")
+    if done.returncode != 0:
+        tail = (done.stdout + done.stderr).strip().splitlines()[-5:]
+        raise RuntimeError(f"mutmut failed for {guard.name} (exit {done.returncode}, see {log}): " + " / ".join(tail))
+
+
+def _results(guard: Guard, work: Path) -> dict[str, int]:
+    """Exit code per mutant of the guard's functions (mutmut's own records)."""
+    codes: dict[str, int] = {}
+    wanted = [re.compile(r".*\." + re.escape(f).replace(r"\*", ".*") + r"__mutmut_\d+$") for f in guard.functions]
+    for file in guard.files:
+        meta = json.loads((work / "mutants" / (file + ".meta")).read_text(encoding="utf-8"))
+        for key, code in meta["exit_code_by_key"].items():
+            if any(w.match(key) for w in wanted):
+                codes[key] = -1000 if code is None else int(code)
+    return codes
+
+
+def _function_start(source: str, function: str) -> int:
+    """The line of a function's ``def`` (or first decorator), found from mutmut's key for it."""
+    parts = function.split("ǁ")[1:] if "ǁ" in function else [function[2:]]
+    tree = ast.parse(source)
+    scope: list[ast.stmt] = tree.body
+    for part in parts:
+        for node in scope:
+            if isinstance(node, ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef) and node.name == part:
+                if not isinstance(node, ast.ClassDef):
+                    return min([node.lineno, *(d.lineno for d in node.decorator_list)])
+                scope = node.body
+                break
+    return 1
+
+
+def _survivor(key: str, file: str, work: Path) -> Survivor:
+    """Where a surviving mutant is, and the lines it changed (from ``mutmut show``)."""
+    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src")}
+    shown = subprocess.run([sys.executable, "-m", "mutmut", "show", key], cwd=work, env=env,
+                           capture_output=True, text=True).stdout
+    start = _function_start((work / file).read_text(encoding="utf-8"), key.rsplit(".", 1)[-1].split("__mutmut_")[0])
+    line, before, after, offset = start, [], [], None
+    for text in shown.splitlines():
+        hunk = re.match(r"@@ -(\d+)", text)
+        if hunk:
+            offset = int(hunk.group(1)) - 1
+        elif offset is None or text.startswith(("---", "+++")):
+            continue
+        elif text.startswith("-"):
+            if not before:
+                line = start + offset
+            before.append(text[1:].strip())
+        elif text.startswith("+"):
+            after.append(text[1:].strip())
+        elif not before:
+            offset += 1
+    return Survivor(key, f"{file}:{line}", " ".join(before), " ".join(after))
+
+
+def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, str], str],
+              again: bool = False) -> dict[str, int]:
+    """Mutate one guard module (``again``: test only the last run's survivors), print its figures and survivors."""
+    started = time.monotonic()
+    if again and (work / "mutants").is_dir():
+        _refresh_tests(work)
+        survivors = [k for k, code in _results(guard, work).items() if code not in _KILLED and code not in _TIMEOUT]
+        if survivors:
+            _run_mutmut(guard, work, jobs, survivors)
+    else:
+        _prepare(guard, work)
+        _run_mutmut(guard, work, jobs)
+    codes = _results(guard, work)
+    counts: Counter[str] = Counter()
+    lines: list[str] = []
+    for key, code in sorted(codes.items(), key=lambda kv: kv[0]):
+        counts["mutants"] += 1
+        if code in _KILLED:
+            counts["killed"] += 1
+            continue
+        if code in _TIMEOUT:
+            counts["timeouts"] += 1
+            continue
+        file = next(f for f in guard.files if key.startswith(Path(f).with_suffix("").as_posix()
+                                                            .removeprefix("src/").replace("/", ".") + "."))
+        s = _survivor(key, file, work)
+        why = known.get((s.function, s.before, s.after))
+        status = "equivalent" if why is not None else _SURVIVED.get(code, f"exit {code}")
+        counts["equivalent" if why is not None else "survived"] += 1
+        lines.append(f"  {status}: {s.where}: {s.before}  ->  {s.after}" + (f"  ({why})" if why else ""))
+    seconds = time.monotonic() - started
+    print(f"{guard.name}: {counts['mutants']} mutants, {counts['killed']} killed, {counts['survived']} survived, "
+          f"{counts['timeouts']} timeouts, {counts['equivalent']} equivalent ({seconds:.0f} s; "
+          f"{', '.join(guard.files)})", flush=True)
+    for line in lines:
+        print(line, flush=True)
+    counts["seconds"] = round(seconds)
+    return dict(counts)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the guard modules named (all by default) and print the figures; exit 1 if a mutant survived."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0] if __doc__ else None)
+    parser.add_argument("modules", nargs="*", help="guard modules to run (default: all; see --list)")
+    parser.add_argument("--list", action="store_true", help="list the guard modules with their files and tests")
+    parser.add_argument("--jobs", type=int, default=2, help="mutants tested at once (default 2)")
+    parser.add_argument("--again", action="store_true",
+                        help="test only the survivors of the last run again, with the tests as they are now")
+    parser.add_argument("--work", type=Path, default=ROOT / "build" / "mutation",
+                        help="folder for the per-module copies (default build/mutation)")
+    args = parser.parse_args(argv)
+    by_name = {g.name: g for g in GUARDS}
+    if args.list:
+        for g in GUARDS:
+            print(f"{g.name}: {', '.join(g.files)}")
+            print(f"  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
+        return 0
+    unknown = [m for m in args.modules if m not in by_name]
+    if unknown:
+        print(f"scripts/mutation.py: unknown guard module {unknown[0]!r}; expected one of {', '.join(by_name)}",
+              file=sys.stderr)
+        return 2
+    known = equivalents()
+    total: Counter[str] = Counter()
+    try:
+        for name in args.modules or list(by_name):
+            total.update(run_guard(by_name[name], args.work.resolve() / name, args.jobs, known, args.again))
+    except RuntimeError as exc:
+        print(f"scripts/mutation.py: {exc}", file=sys.stderr)
+        return 2
+    print(f"total: {len(args.modules or by_name)} modules, {total['mutants']} mutants, {total['killed']} killed, "
+          f"{total['survived']} survived, {total['timeouts']} timeouts, {total['equivalent']} equivalent "
+          f"({total['seconds']} s)")
+    return 1 if total["survived"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,190 @@
+"""The UPnP trust rule: a device is trusted only for the address it was discovered at.
+
+Every URL a device names (its description, its services, the files it serves, a follow-up
+request) must be plain ``http`` on that host; anything else is refused before a connection
+is made. Redirects are not followed (they could lead elsewhere) and answers are bounded.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import AsyncIterator
+
+import pytest
+from aiohttp import web
+from async_upnp_client.client import UpnpRequester
+from async_upnp_client.const import HttpRequest, HttpResponse
+from async_upnp_client.exceptions import (
+    UpnpCommunicationError,
+    UpnpConnectionError,
+    UpnpConnectionTimeoutError,
+)
+
+from plugnproduce.errors import RemoteError
+from plugnproduce.protocols.upnp.boundary import (
+    NoRedirectRequester,
+    TrustedRequester,
+    UntrustedUrlError,
+    check_trusted,
+    resolve_trusted,
+)
+from plugnproduce.protocols.upnp.client import UpnpDeviceClient
+from plugnproduce.protocols.upnp.discovery import FoundDevice, SearchHit, describe
+
+
+@pytest.mark.parametrize(("url", "host"), [
+    ("http://127.0.0.1:8080/description.xml", "127.0.0.1"),
+    ("http://127.0.0.1/", "127.0.0.1"),
+    ("http://[::1]:80/d.xml", "::1"),
+    ("http://[0:0:0:0:0:0:0:1]/d.xml", "::1"),
+    ("http://LocalHost:8080/d.xml", "localhost"),
+    ("http://device.local/d.xml", "DEVICE.local"),
+    ("http://user@127.0.0.1/d.xml", "127.0.0.1"),
+])
+def test_an_http_url_on_the_discovery_host_is_trusted(url: str, host: str) -> None:
+    assert check_trusted(url, host, "device x") == url
+
+
+@pytest.mark.parametrize(("url", "needle"), [
+    ("http://127.0.0.2/d.xml", "points at host 127.0.0.2, but the device was discovered at 127.0.0.1"),
+    ("http://127.0.0.1@evil.example/d.xml", "points at host evil.example"),
+    ("http://[::ffff:7f00:1]/d.xml", "points at host ::ffff:7f00:1"),
+    ("http://localhost/d.xml", "points at host localhost"),
+    ("https://127.0.0.1/d.xml", "expected an http URL on host 127.0.0.1"),
+    ("file:///etc/passwd", "expected an http URL"),
+    ("ftp://127.0.0.1/d.xml", "expected an http URL"),
+    ("/etc/passwd", "expected an http URL"),
+    ("http:///d.xml", "expected an http URL"),
+    ("http://[::1/d.xml", "expected an http URL"),
+    ("", "expected an http URL"),
+])
+def test_any_other_url_is_refused_naming_why(url: str, needle: str) -> None:
+    with pytest.raises(UntrustedUrlError, match="^device x: ") as caught:
+        check_trusted(url, "127.0.0.1", "device x")
+    assert needle in str(caught.value)
+
+
+@pytest.mark.parametrize(("reference", "resolved"), [
+    ("chart.scxml", "http://127.0.0.1:9000/files/chart.scxml"),
+    ("  /other/chart.scxml\n", "http://127.0.0.1:9000/other/chart.scxml"),
+    ("http://127.0.0.1:9001/chart.scxml", "http://127.0.0.1:9001/chart.scxml"),
+])
+def test_a_reference_is_resolved_against_the_description_and_checked(reference: str, resolved: str) -> None:
+    assert resolve_trusted("http://127.0.0.1:9000/files/d.xml", reference, "127.0.0.1", "chart") == resolved
+
+
+@pytest.mark.parametrize(("reference", "needle"), [
+    ("//evil.example/chart.scxml", "points at host evil.example"),
+    ("http://evil.example/chart.scxml", "points at host evil.example"),
+    ("file:///etc/passwd", "expected an http URL"),
+    ("http://[::1", "is not a URL"),
+])
+def test_a_reference_to_another_host_or_scheme_is_refused(reference: str, needle: str) -> None:
+    with pytest.raises(UntrustedUrlError, match="^chart: ") as caught:
+        resolve_trusted("http://127.0.0.1:9000/files/d.xml", reference, "127.0.0.1", "chart")
+    assert needle in str(caught.value)
+
+
+class Recording(UpnpRequester):
+    """A requester that answers every request with 200 and remembers the URLs it was asked for."""
+
+    def __init__(self) -> None:
+        self.urls: list[str] = []
+
+    async def async_http_request(self, http_request: HttpRequest) -> HttpResponse:
+        self.urls.append(http_request.url)
+        return HttpResponse(200, {}, "answer")
+
+
+async def test_a_follow_up_request_to_another_host_never_leaves_the_controller() -> None:
+    inner = Recording()
+    requester = TrustedRequester(inner, "127.0.0.1", "device gripper")
+    with pytest.raises(UntrustedUrlError, match="^SUBSCRIBE for device gripper: .*points at host 10.0.0.9"):
+        await requester.async_http_request(HttpRequest("SUBSCRIBE", "http://10.0.0.9/events", {}, None))
+    assert inner.urls == []
+    answer = await requester.async_http_request(HttpRequest("GET", "http://127.0.0.1:81/x", {}, None))
+    assert (answer.status_code, answer.body, inner.urls) == (200, "answer", ["http://127.0.0.1:81/x"])
+
+
+async def test_describe_refuses_a_description_on_another_host_before_connecting() -> None:
+    hit = SearchHit("uuid:gripper", "http://10.0.0.9:1/d.xml", "127.0.0.1")
+    with pytest.raises(UntrustedUrlError, match="discovered at 127.0.0.1"):
+        await describe(hit, timeout=30.0)
+
+
+async def test_connect_refuses_a_location_on_another_host() -> None:
+    found = FoundDevice("uuid:gripper", "http://10.0.0.9:1/d.xml", "type", "name", "127.0.0.1")
+    with pytest.raises(UntrustedUrlError, match="discovered at 127.0.0.1"):
+        await UpnpDeviceClient.from_found(found, timeout=30.0)
+
+
+async def test_describe_without_a_location_is_a_remote_error() -> None:
+    with pytest.raises(RemoteError, match="gave no description URL"):
+        await describe(SearchHit("uuid:gripper", None, "127.0.0.1"))  # type: ignore[arg-type]
+
+
+# --- the HTTP reader: no redirects, bounded answers ------------------------------------------
+
+
+async def redirect(request: web.Request) -> web.Response:
+    raise web.HTTPFound("http://10.0.0.9/elsewhere.xml")
+
+
+async def sized(request: web.Request) -> web.Response:
+    return web.Response(body=b"z" * int(request.query["size"]))
+
+
+async def latin(request: web.Request) -> web.Response:
+    return web.Response(body="caf\u00e9".encode("latin-1"), content_type="text/xml", charset="utf-8")
+
+
+@pytest.fixture
+async def server() -> AsyncIterator[str]:
+    app = web.Application()
+    app.router.add_get("/redirect", redirect)
+    app.router.add_get("/sized", sized)
+    app.router.add_get("/latin", latin)
+    runner = web.AppRunner(app)
+    await runner.setup()
+    site = web.TCPSite(runner, "127.0.0.1", 0)
+    await site.start()
+    yield f"http://127.0.0.1:{runner.addresses[0][1]}"
+    await runner.cleanup()
+
+
+async def get(requester: UpnpRequester, url: str) -> HttpResponse:
+    return await requester.async_http_request(HttpRequest("GET", url, {}, None))
+
+
+async def test_a_redirect_is_not_followed(server: str) -> None:
+    answer = await get(NoRedirectRequester(5.0, 100), f"{server}/redirect")
+    assert answer.status_code == 302 and answer.headers["Location"] == "http://10.0.0.9/elsewhere.xml"
+
+
+async def test_an_answer_up_to_the_limit_is_read_and_one_byte_more_is_refused(server: str) -> None:
+    assert (await get(NoRedirectRequester(5.0, 100), f"{server}/sized?size=100")).body == "z" * 100
+    with pytest.raises(UpnpCommunicationError, match="larger than the 100 bytes accepted"):
+        await get(NoRedirectRequester(5.0, 100), f"{server}/sized?size=101")
+
+
+async def test_an_answer_that_is_not_its_declared_encoding_is_a_communication_error(server: str) -> None:
+    with pytest.raises(UpnpCommunicationError, match="UnicodeDecodeError"):
+        await get(NoRedirectRequester(5.0, 100), f"{server}/latin")
+
+
+async def test_an_unreachable_device_is_a_connection_error(server: str) -> None:
+    with pytest.raises(UpnpConnectionError):
+        await get(NoRedirectRequester(5.0, 100), "http://127.0.0.1:1/d.xml")
+
+
+async def test_a_device_that_does_not_answer_in_time_is_a_timeout() -> None:
+    async def silent(reader: object, writer: object) -> None:
+        await asyncio.sleep(30)
+
+    listening = await asyncio.start_server(silent, "127.0.0.1", 0)  # type: ignore[arg-type]
+    port = listening.sockets[0].getsockname()[1]
+    try:
+        with pytest.raises(UpnpConnectionTimeoutError):
+            await get(NoRedirectRequester(0.2, 100), f"http://127.0.0.1:{port}/d.xml")
+    finally:
+        listening.close()
