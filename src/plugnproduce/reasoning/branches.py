@@ -194,13 +194,32 @@ def check_paths(task: Task, paths: list[Path], check: Check) -> PathChecks:
 _STEP = re.compile(r"\bstep (\d+)\b")
 
 
-def renumbered(problem: Problem, positions: tuple[int, ...]) -> Problem:
-    """A straight path's problem with its step numbers (in its text too) the task's positions."""
+def renumbered_text(text: str, positions: tuple[int, ...]) -> str:
+    """A straight path's sentence with its step numbers the task's positions."""
     def position(m: re.Match[str]) -> str:
         n = int(m.group(1))
         return f"step {positions[n - 1]}" if 1 <= n <= len(positions) else m.group(0)
 
-    reason = dataclasses.replace(problem.reason, text=_STEP.sub(position, problem.reason.text))
+    return _STEP.sub(position, text)
+
+
+def on_a_path(task: Task, index: int, processes: dict[str, ProcessDescription], taxonomy: Taxonomy,
+              check: Check | None = None) -> tuple[Task, tuple[int, ...]]:
+    """A path through the task's branches that runs position ``index``, as a straight task, and its positions:
+    the first on which ``check`` finds a problem at the step (the first that runs it, without ``check``)."""
+    paths = [p for p in task_paths(task, processes, taxonomy) if index in p.positions]
+    for path in paths if check is not None else ():
+        straight = _straight(task, path.positions)
+        assert check is not None
+        if any(p.step == path.positions.index(index) + 1 for p in check(straight).problems):
+            return straight, path.positions
+    path = paths[0] if paths else Path(None, tuple(range(1, len(task.steps) + 1)))
+    return _straight(task, path.positions), path.positions
+
+
+def renumbered(problem: Problem, positions: tuple[int, ...]) -> Problem:
+    """A straight path's problem with its step numbers (in its text too) the task's positions."""
+    reason = dataclasses.replace(problem.reason, text=renumbered_text(problem.reason.text, positions))
     step = positions[problem.step - 1] if 1 <= problem.step <= len(positions) else positions[-1]
     return dataclasses.replace(problem, step=step, reason=reason)
 
