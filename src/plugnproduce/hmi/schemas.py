@@ -2,8 +2,9 @@
 
 A task travels as ``{"name", "description", "repeat", "steps": [...]}``, the YAML task
 description's fields in JSON (``task`` is accepted for ``name``): each item of ``steps`` is a
-step ``{"name", "command", "bind", "params"}`` (a parameter may be a data link
-``{"from": STEP, "output": NAME}``) or a loop ``{"loop": {"until", "max", "steps"}}``. It becomes
+step ``{"name", "command", "bind", "params", "on"}`` (a parameter may be a data link
+``{"from": STEP, "output": NAME}``; ``on`` maps an outcome to the steps of its branch) or a loop
+``{"loop": {"until", "max", "steps"}}``. It becomes
 the model's :class:`~plugnproduce.description.model.Task` with :meth:`TaskIn.to_task`, read by the
 task file's reader, so that a task from the editor means what the same task file means.
 """
@@ -88,6 +89,9 @@ class StepIn(BaseModel):
         default_factory=dict, description="Role name → device id (optional where only one device fits).")
     params: dict[str, ParamValue] = Field(
         default_factory=dict, description="Parameter name → value; a parameter left out takes its default.")
+    on: dict[Annotated[str, Field(min_length=1, max_length=200)],
+             Annotated[list[StepIn], Field(min_length=1, max_length=1000)]] | None = Field(
+        None, description="Branches: outcome → the steps that run only when this step ends with that outcome.")
 
 
 class LoopBodyIn(BaseModel):

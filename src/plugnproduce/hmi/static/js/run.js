@@ -1,10 +1,11 @@
-// Runs: start and stop, each device's state and the current step live, a loop's iteration, each value
-// as it flows from the step that produced it to the step that used it, the journal, the fault report.
+// Runs: start and stop, each device's state and the current step live, a loop's iteration, each branch
+// taken, each value as it flows from the step that produced it to the step that used it, the journal, the fault report.
 
 import { get, post } from "./api.js";
 import { renderDeviceState } from "./cell.js";
 import { $, announce, fill, h, showValue } from "./dom.js";
 import { loopText } from "./loops.js";
+import { numberOf, placeKey, stepAt } from "./places.js";
 import { state, stepPositions, taskBody } from "./state.js";
 
 /** Where step position `n` of the run lies in the editor's task: {row, loop, iteration}. */
@@ -19,15 +20,14 @@ function iterations(run, seq = Infinity) {
   const counts = new Map();
   for (const v of run.visited || []) {
     const at = where(v.step);
-    if (v.seq < seq && at && at.loop && at.row === at.loop.first) counts.set(at.loop, (counts.get(at.loop) || 0) + 1);
+    if (v.seq < seq && at && at.loop && at.top === at.loop.first && !at.branch) counts.set(at.loop, (counts.get(at.loop) || 0) + 1);
   }
   return counts;
 }
 
 function stepName(n) {
   const at = where(n);
-  const s = at ? state.task.steps[at.row] : null;
-  return s ? `step ${at.row + 1} (${s.name || s.command})` : `step ${n}`;
+  return at ? `step ${at.number} (${at.step.name || at.step.command})` : `step ${n}`;
 }
 
 function valueItem(record, iteration) {
@@ -38,6 +38,22 @@ function valueItem(record, iteration) {
     : `${record.value} = ${value}, used by ${stepName(record.step)} as ${record.parameter} on ${record.device}`;
   return h("li", { class: produced ? "produced" : "used", dataset: { value: record.value, iteration: iteration || "" } },
     iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
+}
+
+/** The branches the run took, in order: a branch is taken when its first step is entered. */
+function branchesTaken(run) {
+  return (run.visited || []).map((v) => ({ v, at: where(v.step) }))
+    .filter(({ at }) => at && at.branch && at.place[at.place.length - 1] === 0);
+}
+
+function branchItem({ v, at }, run) {
+  const iteration = at.loop ? iterations(run, v.seq).get(at.loop) : null;
+  const steps = state.task.steps;
+  const owner = stepAt(steps, at.branch.place);
+  const text = `step ${numberOf(steps, at.branch.place)} (${owner.name || owner.command}) ended with ${at.branch.outcome}: `
+    + `branch taken, step ${at.number} (${at.step.name || at.step.command}) next`;
+  return h("li", { class: "branch-taken", dataset: { outcome: at.branch.outcome, place: placeKey(at.branch.place),
+    iteration: iteration || "" } }, iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
 }
 
 function renderFlow(run) {
@@ -51,6 +67,9 @@ function renderFlow(run) {
   });
   fill($("#run-values"), items);
   $("#run-values-box").hidden = items.length === 0;
+  const taken = branchesTaken(run).map((b) => branchItem(b, run));
+  fill($("#run-branches"), taken);
+  $("#run-branches-box").hidden = taken.length === 0;
 }
 
 function statusText(run) {

@@ -1,5 +1,7 @@
 // What the page knows: the cell, the offered commands, the processes, the task being edited, the run.
 
+import { numberOf, placeKey, rowsOf } from "./places.js";
+
 const TASK_KEY = "pnp-task";
 
 export const state = {
@@ -8,7 +10,9 @@ export const state = {
   pluggable: false,
   catalogue: [],
   processes: new Map(), // command -> process (roles, parameters)
-  task: { name: "task", description: "", repeat: 1, steps: [], loops: [] }, // loops: [{first, last, until, max}] (rows)
+  // steps: the task's steps, each with its branches (`on: {OUTCOME: [steps]}`); loops: [{first, last, until, max}]
+  // (indices of the task's steps, not of its branches' steps)
+  task: { name: "task", description: "", repeat: 1, steps: [], loops: [] },
   check: null, // the last check (with repairs) of the task as it is
   run: null, // {run, status, step, states, faults, lines}
   generated: [], // charts of the last generation
@@ -46,8 +50,11 @@ export function loadTask() {
   }
 }
 
+/** A step as the API takes it; a branch on an outcome holds its steps (`on: {NoPartFound: [...]}`). */
 function stepBody(s) {
-  return { ...(s.name ? { name: s.name } : {}), command: s.command, bind: s.bind || {}, params: s.params || {} };
+  const on = Object.entries(s.on || {}).filter(([, steps]) => steps.length);
+  return { ...(s.name ? { name: s.name } : {}), command: s.command, bind: s.bind || {}, params: s.params || {},
+    ...(on.length ? { on: Object.fromEntries(on.map(([outcome, steps]) => [outcome, steps.map(stepBody)])) } : {}) };
 }
 
 /** The loop whose body holds editor row `row`, if any. */
@@ -86,17 +93,27 @@ export function editorTask(body) {
 }
 
 /**
- * Where each step position of a run lies in the editor: {row, loop, iteration} (iteration 1, or 2 for
- * "2 and later"). A loop's body counts twice in the positions, as the task's step numbers do.
+ * Where each step position of a run lies in the editor: {row, top, place, number, step, loop, iteration,
+ * branch}. Positions number the steps as the server does: a step, then its branches' steps; a loop's body
+ * twice (iteration 1, then 2 for "2 and later"). `top` is the index of the task's step the position is, or
+ * lies in a branch of; `branch` is the innermost branch holding it ({place of its step, outcome}) or null.
  */
 export function stepPositions(task = state.task) {
+  const rows = new Map(rowsOf(task.steps).map((r) => [placeKey(r.place), r.row]));
   const out = [null];
-  task.steps.forEach((_, row) => {
-    const loop = loopOf(row, task);
-    if (!loop) out.push({ row, loop: null, iteration: 1 });
-    else if (row === loop.last) {
+  const walk = (step, place, at) => {
+    out.push({ ...at, row: rows.get(placeKey(place)), place, number: numberOf(task.steps, place), step });
+    for (const [outcome, inner] of Object.entries(step.on || {})) {
+      inner.forEach((s, j) => walk(s, [...place, outcome, j], { ...at, branch: { place, outcome } }));
+    }
+  };
+  const add = (top, loop, iteration) => walk(task.steps[top], [top], { top, loop, iteration, branch: null });
+  task.steps.forEach((_, top) => {
+    const loop = loopOf(top, task);
+    if (!loop) add(top, null, 1);
+    else if (top === loop.last) {
       for (const iteration of [1, 2]) {
-        for (let r = loop.first; r <= loop.last; r++) out.push({ row: r, loop, iteration });
+        for (let r = loop.first; r <= loop.last; r++) add(r, loop, iteration);
       }
     }
   });
