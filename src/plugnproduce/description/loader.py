@@ -6,7 +6,6 @@ kept (:class:`Loaded`) so the SHACL shapes can check the same data.
 
 from __future__ import annotations
 
-import dataclasses
 import keyword
 import math
 import re
@@ -26,30 +25,26 @@ from plugnproduce.description.model import (
     Cell,
     ChartTransition,
     DeviceDescription,
-    Link,
-    Loop,
     Output,
     Parameter,
     ProcessDescription,
     Role,
-    Step,
-    Task,
     Where,
-    plain_value,
 )
 from plugnproduce.description.rdf import term_line
+from plugnproduce.description.taskfile import _mapping, _plain, _unknown_keys
+from plugnproduce.description.taskfile import load_task as load_task
+from plugnproduce.description.taskfile import parse_task as parse_task
+from plugnproduce.description.taskfile import task_to_yaml as task_to_yaml
 from plugnproduce.description.units import unit_known
 from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
 from plugnproduce.ontology.names import unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP, concept_iri, concept_value, local_name
+from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.safeio import (
-    PlainDumper,
     parse_turtle,
     parse_turtle_bytes,
-    parse_yaml_bytes,
     parse_yaml_node,
-    read_bytes,
 )
 from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
@@ -353,200 +348,7 @@ def load_process(path: str | Path) -> ProcessDescription:
     return process_from(read_description(path))
 
 
-# ------------------------------------------------------------------ YAML: tasks and cells
-
-
-def _mapping(node: yaml.Node, path: Path, what: str) -> dict[str, yaml.Node]:
-    if not isinstance(node, yaml.MappingNode):
-        raise DescriptionError(f"{what} must be a mapping", path, node.start_mark.line + 1)
-    out: dict[str, yaml.Node] = {}
-    for k, v in node.value:
-        if not isinstance(k, yaml.ScalarNode):
-            raise DescriptionError(f"{what}: keys must be plain names", path, k.start_mark.line + 1)
-        if k.value in out:
-            raise DescriptionError(f"{what}: key {excerpt(k.value)!r} appears twice", path, k.start_mark.line + 1)
-        out[k.value] = v
-    return out
-
-
-def _plain(node: yaml.Node) -> object:
-    return yaml.SafeLoader("").construct_document(node)
-
-
-def _unknown_keys(m: dict[str, yaml.Node], allowed: set[str], path: Path, what: str) -> None:
-    for k, v in m.items():
-        if k not in allowed:
-            raise DescriptionError(
-                f"{what}: unknown key {excerpt(k)!r}; expected one of {', '.join(sorted(allowed))}", path,
-                v.start_mark.line + 1,
-            )
-
-
-def _str_map(node: yaml.Node | None, path: Path, what: str) -> dict[str, object]:
-    if node is None:
-        return {}
-    value = _plain(node)
-    if not isinstance(value, dict):
-        raise DescriptionError(f"{what} must be a mapping", path, node.start_mark.line + 1)
-    return {str(k): v for k, v in value.items()}
-
-
-def load_task(path: str | Path) -> Task:
-    """Read a task description (YAML)."""
-    return parse_task(read_bytes(path), path)
-
-
-def parse_task(data: bytes, source: str | Path) -> Task:
-    """Read a task description from YAML text; ``source`` names it in messages and in ``Task.file``."""
-    p = Path(source)
-    top = _mapping(parse_yaml_bytes(data, p), p, "task")
-    _unknown_keys(top, {"task", "description", "repeat", "steps"}, p, "task")
-    if "task" not in top or "steps" not in top:
-        raise DescriptionError("a task needs 'task' (its name) and 'steps'", p, 1)
-    repeat = _plain(top["repeat"]) if "repeat" in top else 1
-    if not isinstance(repeat, int) or isinstance(repeat, bool) or not 1 <= repeat <= 1000:
-        raise DescriptionError(f"repeat must be a whole number from 1 to 1000; found {excerpt(repr(repeat))}", p,
-                               top["repeat"].start_mark.line + 1)
-    steps_node = top["steps"]
-    if not isinstance(steps_node, yaml.SequenceNode) or not steps_node.value:
-        raise DescriptionError("steps must be a non-empty list", p, steps_node.start_mark.line + 1)
-    if len(steps_node.value) * repeat > Task.MAX_STEPS:
-        raise DescriptionError(f"{len(steps_node.value)} steps repeated {repeat} times make "
-                               f"{len(steps_node.value) * repeat}; at most {Task.MAX_STEPS} are accepted",
-                               p, steps_node.start_mark.line + 1)
-    names: set[str] = set()
-    one_round: list[Step] = []
-    loops: list[Loop] = []
-    for node in steps_node.value:
-        if isinstance(node, yaml.MappingNode) and "loop" in _mapping(node, p, "step"):
-            if repeat != 1:
-                raise DescriptionError("a task with a loop cannot also repeat; put its steps in the loop", p,
-                                       node.start_mark.line + 1)
-            loops.append(_loop(_mapping(node, p, "step"), p, names, one_round))
-        else:
-            one_round.append(_step(node, p, names, len(one_round) + 1))
-    if len(one_round) * repeat > Task.MAX_STEPS:
-        raise DescriptionError(f"the task makes {len(one_round) * repeat} steps; at most {Task.MAX_STEPS} are "
-                               "accepted", p, steps_node.start_mark.line + 1)
-    description = _plain(top["description"]) if "description" in top else ""
-    task = Task.repeated(str(_plain(top["task"])), one_round, str(p), str(description or ""), repeat)
-    return dataclasses.replace(task, loops=tuple(loops)) if loops else task
-
-
-def _step(node: yaml.Node, p: Path, names: set[str], index: int) -> Step:
-    """One step of a task file."""
-    line = node.start_mark.line + 1
-    m = _mapping(node, p, "step")
-    _unknown_keys(m, {"name", "command", "bind", "params"}, p, "step")
-    if "command" not in m or not isinstance(_plain(m["command"]), str):
-        raise DescriptionError("a step needs 'command': the name of a process command (or 'loop')", p, line)
-    bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
-    params = m.get("params")
-    lines = {}
-    if isinstance(params, yaml.MappingNode):
-        lines = {str(k.value): k.start_mark.line + 1 for k, _ in params.value}
-    values = {n: _link(v, p, lines.get(n, line)) for n, v in _str_map(params, p, "params").items()}
-    name = _step_name(m.get("name"), names, p)
-    return Step(index, str(_plain(m["command"])), bind, values, line, lines, name)
-
-
-def _loop(item: dict[str, yaml.Node], p: Path, names: set[str], steps: list[Step]) -> Loop:
-    """A ``loop:`` item: its body goes into ``steps`` twice (the first iteration, then the ones after it)."""
-    _unknown_keys(item, {"loop"}, p, "step")
-    node = item["loop"]
-    line = node.start_mark.line + 1
-    m = _mapping(node, p, "loop")
-    _unknown_keys(m, {"until", "max", "steps"}, p, "loop")
-    until = _plain(m["until"]) if "until" in m else None
-    if until is not None and (not isinstance(until, str) or not _NAME.fullmatch(until)):
-        raise DescriptionError(f"until names an outcome such as BinEmpty; found {excerpt(repr(until))}", p,
-                               m["until"].start_mark.line + 1)
-    most = _plain(m["max"]) if "max" in m else None
-    if most is not None and (not isinstance(most, int) or isinstance(most, bool) or not 1 <= most <= 1_000_000):
-        raise DescriptionError(f"max must be a whole number from 1 to 1000000; found {excerpt(repr(most))}", p,
-                               m["max"].start_mark.line + 1)
-    if until is None and most is None:
-        raise DescriptionError("a loop needs a way out: 'until: OUTCOME', 'max: N' or both", p, line)
-    body_node = m.get("steps")
-    if not isinstance(body_node, yaml.SequenceNode) or not body_node.value:
-        raise DescriptionError("a loop needs 'steps', a non-empty list", p, line)
-    for b in body_node.value:
-        if isinstance(b, yaml.MappingNode) and "loop" in _mapping(b, p, "step"):
-            raise DescriptionError("a loop inside a loop is not supported; flatten the inner one", p,
-                                   b.start_mark.line + 1)
-    entry = len(steps) + 1
-    body = [_step(b, p, names, entry + i) for i, b in enumerate(body_node.value)]
-    steps += body
-    first = len(steps) + 1
-    steps += [dataclasses.replace(s, index=first + i) for i, s in enumerate(body)]
-    return Loop(entry, first, len(steps), concept_iri(until) if until else None, most, line)
-
-
-def _step_name(node: yaml.Node | None, seen: set[str], path: Path) -> str | None:
-    """A step's ``name:``: a plain name, unique in the task."""
-    if node is None:
-        return None
-    name = _plain(node)
-    line = node.start_mark.line + 1
-    if not isinstance(name, str) or not _NAME.fullmatch(name):
-        raise DescriptionError(f"a step name must be a plain name such as localize; found {excerpt(repr(name))}",
-                               path, line)
-    if name in seen:
-        raise DescriptionError(f"step name {name!r} appears twice; each step needs its own name", path, line)
-    seen.add(name)
-    return name
-
-
-def _link(value: object, path: Path, line: int) -> object:
-    """A parameter value, or the earlier step's output it takes (``{from: STEP, output: NAME}``)."""
-    if not isinstance(value, dict):
-        return value
-    if set(value) != {"from", "output"} or not all(isinstance(v, str) for v in value.values()):
-        raise DescriptionError("a parameter taken from an earlier step reads {from: STEP, output: NAME}; found "
-                               f"{excerpt(repr(value))}", path, line)
-    return Link(str(value["from"]), str(value["output"]))
-
-
-def _step_entry(s: Step) -> dict[str, object]:
-    entry: dict[str, object] = {"name": s.name} if s.name else {}
-    entry["command"] = s.command
-    if s.bind:
-        entry["bind"] = dict(s.bind)
-    if s.params:
-        entry["params"] = {n: plain_value(v) for n, v in s.params.items()}
-    return entry
-
-
-def _loop_entry(task: Task, loop: Loop) -> dict[str, object]:
-    out: dict[str, object] = {}
-    if loop.until:
-        out["until"] = concept_value(loop.until)
-    if loop.max is not None:
-        out["max"] = loop.max
-    out["steps"] = [_step_entry(s) for s in task.steps[loop.first - 1 : loop.last]]
-    return out
-
-
-def task_to_yaml(task: Task, block: bool = False) -> str:
-    """Write a task as a task file (one round of its steps when it repeats): the one task writer.
-
-    ``block`` puts every value on a line of its own, so that a finding's line names its field.
-    """
-    steps = []
-    for s in task.one_round():
-        loop = task.loop_at(s.index)
-        if loop is not None and s.index < loop.first:
-            continue  # the first iteration: written once, as the loop
-        if loop is None or s.index == loop.first:
-            steps.append(_step_entry(s) if loop is None else {"loop": _loop_entry(task, loop)})
-    doc: dict[str, object] = {"task": task.name}
-    if task.description:
-        doc["description"] = task.description
-    if task.repeat != 1:
-        doc["repeat"] = task.repeat
-    doc["steps"] = steps
-    return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=False if block else None,
-                     allow_unicode=True)
+# ------------------------------------------------------------------ YAML: cells (tasks: taskfile.py)
 
 
 def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:

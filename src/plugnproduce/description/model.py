@@ -12,6 +12,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
+from plugnproduce.description.flow import Branch as Branch
+from plugnproduce.description.flow import Loop as Loop
+from plugnproduce.description.flow import path_name
 from plugnproduce.statechart.model import Chart
 
 Protocol = Literal["xirp", "upnp"]
@@ -323,35 +326,9 @@ class Step:
 
 
 @dataclass(frozen=True)
-class Loop:
-    """A loop of a task: its body runs again and again until one of its steps ends with ``until``
-    (the rest of that iteration is skipped), at most ``max`` times.
-
-    The task's steps hold the body twice: the first iteration (steps ``entry`` to ``first - 1``) and
-    the iterations after it (``first`` to ``last``), which start from the states the first one left
-    and which the generated chart repeats without unrolling. Indices are 1-based positions in the task.
-    """
-
-    entry: int
-    first: int
-    last: int
-    until: str | None
-    """The outcome concept (IRI) that ends the loop."""
-    max: int | None
-    line: int | None = None
-
-    def path(self, index: int) -> str | None:
-        """Which iteration a step position belongs to (``loop iteration 1`` / ``loop iteration 2 and later``)."""
-        if self.entry <= index < self.first:
-            return "loop iteration 1"
-        if self.first <= index <= self.last:
-            return "loop iteration 2 and later"
-        return None
-
-
-@dataclass(frozen=True)
 class Task:
-    """A task description: an ordered list of process commands, some of them in loops."""
+    """A task description: an ordered list of process commands, some of them in loops and branches
+    (:mod:`plugnproduce.description.flow`)."""
 
     MAX_STEPS = 10_000
     """Most steps a task may have once its repeats are expanded."""
@@ -362,6 +339,7 @@ class Task:
     description: str = ""
     repeat: int = 1
     loops: tuple[Loop, ...] = ()
+    branches: tuple[Branch, ...] = ()
 
     @classmethod
     def repeated(cls, name: str, one_round: Sequence[Step], file: str, description: str = "",
@@ -382,6 +360,14 @@ class Task:
     def loop_at(self, index: int) -> Loop | None:
         """The loop whose body (either copy) holds step position ``index``, if any."""
         return next((lp for lp in self.loops if lp.entry <= index <= lp.last), None)
+
+    def branches_of(self, index: int) -> tuple[Branch, ...]:
+        """The branches on the outcome of the step at position ``index``, in the order written."""
+        return tuple(b for b in self.branches if b.step == index)
+
+    def path(self, index: int) -> str | None:
+        """The path step position ``index`` lies on (``loop iteration 1, branch NoPartFound at step 2``)."""
+        return path_name(self.loops, self.branches, index)
 
     def where(self, step: Step, parameter: str | None = None) -> Where:
         """The place of a step (or of one of its parameter values) in the task file."""
