@@ -161,7 +161,8 @@ class TaskIn(BaseModel):
         # the JSON's lines are no file's lines: problems name the steps instead
         steps = tuple(dataclasses.replace(s, line=None, param_lines={}) for s in task.steps)
         loops = tuple(dataclasses.replace(lp, line=None) for lp in task.loops)
-        self._task = dataclasses.replace(task, steps=steps, loops=loops)
+        branches = tuple(dataclasses.replace(b, line=None) for b in task.branches)
+        self._task = dataclasses.replace(task, steps=steps, loops=loops, branches=branches)
         return self
 
     def to_task(self) -> Task:

@@ -25,12 +25,14 @@ router = APIRouter(prefix="/api/task", tags=["task"], dependencies=[Depends(allo
 
 def _rows(problems: list[dict[str, Any]], task: TaskIn) -> list[dict[str, Any]]:
     """Add to each problem the editor row of its step (steps repeat: step 5 of 2 rows is row 0, round 3;
-    a loop's later iterations are its round 2)."""
-    rows = editor_rows(task.to_task())
+    a loop's later iterations are its round 2) and the path it lies on (``branch NoPartFound at step 2``)."""
+    model = task.to_task()
+    rows = editor_rows(model)
     for p in problems:
         step = p.get("step")
         if isinstance(step, int) and step in rows:
             p["row"], p["round"] = rows[step]
+            p["path"] = model.path(step)
     return problems
 
 

@@ -144,8 +144,9 @@ function problemItem(p, i) {
   const box = h("div", { id, class: "why", hidden: true });
   const button = h("button", { type: "button", class: "quiet", "aria-expanded": "false", "aria-controls": id,
     onclick: () => why(p, box, button) }, "Why?");
-  const round = p.round > 1 ? ` (round ${p.round})` : "";
-  return h("li", { class: "problem", dataset: { kind: p.kind } }, h("span", {}, (p.plain || p.text) + round), " ", button, box);
+  const round = p.round > 1 && !p.path ? ` (round ${p.round})` : "";
+  return h("li", { class: "problem", dataset: { kind: p.kind } },
+    p.path ? h("span", { class: "badge path" }, p.path) : null, " ", h("span", {}, (p.plain || p.text) + round), " ", button, box);
 }
 
 function applyRepair(repair) {

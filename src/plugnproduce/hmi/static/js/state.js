@@ -78,6 +78,10 @@ export function taskBody(task = state.task) {
 
 /** A task from the API as the editor holds it: one row per step, each loop as the rows it spans. */
 export function editorTask(body) {
+  if (rowsOf(body.steps).some((r) => r.depth > 0 && r.step.loop)) {
+    throw new Error("This task has a loop inside a branch: the editor builds loops of the task's steps only; "
+      + "edit that task file by hand.");
+  }
   const steps = [];
   const loops = [];
   for (const item of body.steps) {
