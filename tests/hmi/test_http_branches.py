@@ -76,3 +76,13 @@ async def test_a_malformed_branch_is_refused_with_one_line(client: httpx.AsyncCl
     res = await client.post("/api/task/check", json=task)
     assert res.status_code == 422
     assert detail in res.text
+
+
+async def test_a_loop_that_goes_on_while_an_outcome_comes_round_trips(client: httpx.AsyncClient) -> None:
+    text = b"task: t\nsteps:\n  - loop:\n      while: PartFound\n      max: 5\n      steps:\n        - command: localize-part\n"
+    task = (await client.post("/api/task/import", content=text, headers=YAML)).json()
+    assert {k: v for k, v in task["steps"][0]["loop"].items() if k != "steps"} == {"while": "PartFound", "max": 5}
+    result = (await client.post("/api/task/validate", json=task)).json()
+    assert result["valid"] is True, result["problems"]
+    back = (await client.post("/api/task/export", json=task)).text
+    assert (await client.post("/api/task/import", content=back.encode(), headers=YAML)).json() == task

@@ -141,3 +141,24 @@ def test_the_run_shows_each_branch_taken_and_succeeds(page: Page, served: Served
     expect(page.locator("#run-loops")).to_contain_text(f"iteration {PARTS + 1}")
     screenshot(page, "run-branch-in-loop")
     assert served.hmi.source.sim.bin is not None and served.hmi.source.sim.bin.parts == []
+
+
+def test_a_loop_goes_on_while_its_steps_report_an_outcome(page: Page) -> None:
+    page.get_by_role("button", name=f"Add {_label('place')} to the task", exact=True).click()
+    _save_step(page)
+    _localize(page)
+    page.get_by_role("button", name="Add loop").click()
+    page.locator("#loop-last").select_option("0")
+    expect(page.locator("#loop-while option")).to_have_text(["no step here ends with an outcome"])
+    page.locator("#loop-first").select_option("1")
+    page.locator("#loop-last").select_option("1")
+    expect(page.locator("#loop-while option")).to_have_text(["whatever the steps report", "PartFound", "BinEmpty"])
+    page.locator("#loop-while").select_option("PartFound")
+    page.locator("#loop-max").fill("5")
+    page.locator("#loop-dialog").get_by_role("button", name="Save loop").click()
+    expect(page.locator("#steps .loop-head .loop-text")).to_have_text("Loop over step 2 while PartFound, at most 5 times")
+    with page.expect_download() as download:
+        page.get_by_role("button", name="Export YAML").click()
+    built = yaml.safe_load(download.value.path().read_text(encoding="utf-8"))
+    assert built["steps"][1] == {"loop": {"while": "PartFound", "max": 5, "steps": [
+        {"name": "localize", "command": LOCALIZE, "params": {"exposure": 25}}]}}

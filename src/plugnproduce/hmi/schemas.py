@@ -4,7 +4,7 @@ A task travels as ``{"name", "description", "repeat", "steps": [...]}``, the YAM
 description's fields in JSON (``task`` is accepted for ``name``): each item of ``steps`` is a
 step ``{"name", "command", "bind", "params", "on"}`` (a parameter may be a data link
 ``{"from": STEP, "output": NAME}``; ``on`` maps an outcome to the steps of its branch) or a loop
-``{"loop": {"until", "max", "steps"}}``. It becomes
+``{"loop": {"until", "while", "max", "steps"}}``. It becomes
 the model's :class:`~plugnproduce.description.model.Task` with :meth:`TaskIn.to_task`, read by the
 task file's reader, so that a task from the editor means what the same task file means.
 """
@@ -95,11 +95,14 @@ class StepIn(BaseModel):
 
 
 class LoopBodyIn(BaseModel):
-    """A loop: its steps run again and again until one of them ends with ``until``, at most ``max`` times."""
+    """A loop: its steps run again and again until one of them ends with ``until`` (while the last outcome they
+    reported is ``while``), at most ``max`` times."""
 
     model_config = ConfigDict(extra="forbid")
 
     until: str | None = Field(None, min_length=1, max_length=200, description="An outcome, e.g. 'BinEmpty'.")
+    while_: str | None = Field(None, alias="while", min_length=1, max_length=200,
+                               description="An outcome the loop goes on while its steps report it, e.g. 'PartFound'.")
     max: int | None = Field(None, ge=1, le=1_000_000, description="The most iterations.")
     steps: list[StepIn] = Field(min_length=1, max_length=1000)
 
@@ -153,7 +156,7 @@ class TaskIn(BaseModel):
         """Read the task as the task file reader reads it: a duplicate step name or a loop in a
         repeated task is refused here, with the reader's message."""
         doc = {"task": self.name, "description": self.description, "repeat": self.repeat,
-               "steps": [s.model_dump(exclude_none=True) for s in self.steps]}
+               "steps": [s.model_dump(exclude_none=True, by_alias=True) for s in self.steps]}
         try:
             task = service.task_from_text(json.dumps(doc), TASK_SOURCE)
         except DescriptionError as exc:

@@ -10,7 +10,7 @@ export const state = {
   pluggable: false,
   catalogue: [],
   processes: new Map(), // command -> process (roles, parameters)
-  // steps: the task's steps, each with its branches (`on: {OUTCOME: [steps]}`); loops: [{first, last, until, max}]
+  // steps: the task's steps, each with its branches (`on: {OUTCOME: [steps]}`); loops: [{first, last, until, while, max}]
   // (indices of the task's steps, not of its branches' steps)
   task: { name: "task", description: "", repeat: 1, steps: [], loops: [] },
   check: null, // the last check (with repairs) of the task as it is
@@ -69,7 +69,8 @@ export function taskBody(task = state.task) {
     const loop = loopOf(row, task);
     if (!loop) steps.push(stepBody(s));
     else if (row === loop.first) {
-      steps.push({ loop: { ...(loop.until ? { until: loop.until } : {}), ...(loop.max ? { max: loop.max } : {}),
+      steps.push({ loop: { ...(loop.until ? { until: loop.until } : {}), ...(loop.while ? { while: loop.while } : {}),
+        ...(loop.max ? { max: loop.max } : {}),
         steps: task.steps.slice(loop.first, loop.last + 1).map(stepBody) } });
     }
   });
@@ -90,7 +91,8 @@ export function editorTask(body) {
       continue;
     }
     const { until, max, steps: inner } = item.loop;
-    loops.push({ first: steps.length, last: steps.length + inner.length - 1, until: until || null, max: max || null });
+    loops.push({ first: steps.length, last: steps.length + inner.length - 1, until: until || null,
+      while: item.loop.while || null, max: max || null });
     steps.push(...inner);
   }
   return { name: body.name, description: body.description || "", repeat: body.repeat || 1, steps, loops };
