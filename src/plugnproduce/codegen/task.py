@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from plugnproduce.codegen.flow import OUTCOME, flow_data, flow_transitions
+from plugnproduce.codegen.flow import OUTCOME, Outcomes, branch_variable, flow_data, flow_transitions, outcome_names
 from plugnproduce.codegen.specific import (
     PLAN,
     STEP,
@@ -136,13 +136,15 @@ def consumed_outputs(task: Task) -> dict[str, set[str]]:
 def _produces(task: Task, step: Step, process: ProcessDescription,
               consumed: dict[str, set[str]]) -> tuple[tuple[str, str, str], ...]:
     """(role, output, variable) of each output of this step that a later step takes, and of the
-    outcome when a loop of the task ends on it."""
+    outcome when a loop of the task ends or goes on on it, or the step has branches."""
     wanted = consumed.get(step.name or "", set())
     out = tuple((o.role, o.name, output_variable(step.name or "", o.name))
                 for o in process.outputs if o.name in wanted)
     loop, role = task.loop_at(step.index), process.outcome_role()
-    if loop is not None and role is not None and loop.until in process.outcomes:
+    if loop is not None and role is not None and (loop.until or loop.while_outcome):
         out += ((role.name, "outcome", OUTCOME),)
+    if role is not None and task.branches_of(step.index):
+        out += ((role.name, "outcome", branch_variable(step.index)),)
     return out
 
 
@@ -172,9 +174,11 @@ def generate_task(
     varying = {key: _varying(rows) for key, rows in groups.items()}
     charts: dict[_Key, StepChart] = {}
     current = {d.id: d.initial for d in cell.devices}
+    left: dict[int, dict[str, str]] = {}
     steps: list[StepChart] = []
     for i, (step, binding) in enumerate(zip(task.steps, bindings, strict=True)):
         key, process = keys[i], processes[step.command]
+        current = _branch_start(task, step.index, left, current)
         if key not in charts:
             bound = {n: Varying(n) if n in varying[key] else v for n, v in values[i].items()}
             charts[key] = _step(step, process, binding, cell, dict(current), taxonomy, bound, key[4])
@@ -182,7 +186,15 @@ def generate_task(
         row = {n: v for n, v in values[i].items() if n in varying[key]}
         steps.append(StepChart(step, process, binding, first.regions, first.element, first.body, row, first.produces))
         current.update({r.device.id: r.end_state for r in first.regions})
-    return GeneratedTask(task, steps, _task_chart(task, steps), current)
+        left[step.index] = dict(current)
+    return GeneratedTask(task, steps, _task_chart(task, steps, outcome_names(task, processes, taxonomy)), current)
+
+
+def _branch_start(task: Task, index: int, left: dict[int, dict[str, str]], current: dict[str, str]) -> dict[str, str]:
+    """The device states step position ``index`` starts from: a branch's first step starts where its step left
+    the devices (not where a branch written before it did)."""
+    branch = next((b for b in task.branches if b.first == index), None)
+    return dict(left[branch.step]) if branch is not None else current
 
 
 def _plan(
@@ -198,8 +210,10 @@ def _plan(
     keys: list[_Key] = []
     values: list[dict[str, object]] = []
     after: dict[_Key, dict[str, str]] = {}
+    left: dict[int, dict[str, str]] = {}
     for step, binding in zip(task.steps, bindings, strict=True):
         process = processes[step.command]
+        current = _branch_start(task, step.index, left, current)
         values.append(step_values(step, process))
         flows = tuple(sorted((n, v.variable if isinstance(v, Flow) else "") for n, v in values[-1].items()))
         produces = _produces(task, step, process, consumed)
@@ -210,6 +224,7 @@ def _plan(
             after[key] = dict(current)
         keys.append(key)
         current = dict(after[key])
+        left[step.index] = dict(current)
     return keys, values
 
 
@@ -224,11 +239,11 @@ def values_data(rows: list[dict[str, object]]) -> Data:
         "{" + ", ".join(f"{n!r}: {literal(v)}" for n, v in sorted(r.items())) + "}" for r in rows) + "]")
 
 
-def _task_chart(task: Task, steps: list[StepChart]) -> Chart:
+def _task_chart(task: Task, steps: list[StepChart], outcomes: Outcomes) -> Chart:
     """The task chart: each distinct step chart once, the plan of which runs when, and the values that vary."""
     bodies = [s for s in steps if s.body == s.step.index]
     plan = [s.body for s in steps] + [0]
-    pick = State(id=NEXT, transitions=flow_transitions(task, NEXT))
+    pick = State(id=NEXT, transitions=flow_transitions(task, NEXT, outcomes))
     pick.transitions += [Transition(cond=f"{PLAN}[{STEP}] == {b.body}", targets=[f"s{b.body}"]) for b in bodies]
     pick.transitions.append(Transition(cond=f"{PLAN}[{STEP}] == 0", targets=[DONE]))
     body = State(id="task", initial=[NEXT], transitions=[Transition(event="timeout error", targets=[FAILED])],

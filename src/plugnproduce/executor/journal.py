@@ -21,7 +21,7 @@ from typing import Any, TextIO
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 
-KINDS = ("start", "step", "command", "event", "value", "state", "fault", "stop", "end")
+KINDS = ("start", "step", "command", "event", "value", "state", "branch", "fault", "stop", "end")
 
 
 class JournalInUse(PlugNProduceError):
@@ -154,6 +154,9 @@ def describe(record: dict[str, Any]) -> str:
     if kind == "value":
         return (f"  value {record.get('value')} → {record.get('device')} as {record.get('parameter')}"
                 f" = {record.get('used')}")
+    if kind == "branch":
+        taken = f"takes {record.get('path')}" if record.get("branch") else "goes on without a branch"
+        return f"  step {record.get('step')} reported {record.get('outcome')}: the task {taken}"
     if kind == "fault":
         return f"FAULT {record.get('fault')}: {record.get('message')}"
     if kind == "stop":

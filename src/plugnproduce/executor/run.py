@@ -32,12 +32,14 @@ from pathlib import Path
 from typing import Any
 
 from plugnproduce.codegen import DONE, GeneratedTask
+from plugnproduce.codegen.flow import branch_variable
 from plugnproduce.codegen.task import STEP
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import values
 from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
+from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
 from plugnproduce.statechart.model import StateNode
 from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, EventData, MacroStep, MetaEvent
@@ -299,12 +301,23 @@ class TaskRun:
         if info is None:
             return
         if info.starts_step:
-            self.step, self.command = int(self.interpreter.dm[STEP]) + 1, info.command
+            done, self.step, self.command = self.step, int(self.interpreter.dm[STEP]) + 1, info.command
+            self._branch_taken(done, self.step)
             self._record("step", step=self.step, command=info.command, bindings=self._bindings.get(self.step, {}))
         if info.device is not None and info.device_state is not None:
             if self.device_states.get(info.device) != info.device_state:
                 self.device_states[info.device] = info.device_state
                 self._record("state", step=self.step, device=info.device, state=info.device_state)
+
+    def _branch_taken(self, done: int | None, starts: int) -> None:
+        """After a step with branches, journal which branch the run takes (``branch: null``: none)."""
+        branches = self.generated.task.branches_of(done) if done is not None else ()
+        if not branches:
+            return
+        taken = next((b for b in branches if b.first == starts), None)
+        self._record("branch", step=done, outcome=self.interpreter.dm.get(branch_variable(done or 0)),
+                     branch=local_name(taken.outcome) if taken else None, path=taken.path if taken else None,
+                     next=starts)
 
     def _on_step(self, step: MacroStep) -> None:
         """A macrostep done: a timer that fired, or a device event nothing waited for, is a fault."""

@@ -20,7 +20,9 @@ import dataclasses
 from collections.abc import Callable, Iterator
 
 from plugnproduce.description.model import Loop, ProcessDescription, Task, Where
+from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.reasoning.branches import Path, covering, renumbered
 from plugnproduce.reasoning.results import CheckResult, Problem, Reason
 
 Check = Callable[[Task], CheckResult]
@@ -28,9 +30,8 @@ Check = Callable[[Task], CheckResult]
 
 
 def on_path(problem: Problem, task: Task) -> Problem:
-    """The problem with the loop iteration its step belongs to named in its text."""
-    loop = task.loop_at(problem.step)
-    path = loop.path(problem.step) if loop is not None else None
+    """The problem with the path its step lies on (loop iteration, branches) named in its text."""
+    path = task.path(problem.step)
     return _named(problem, path) if path else problem
 
 
@@ -39,13 +40,17 @@ def _named(problem: Problem, path: str) -> Problem:
     return dataclasses.replace(problem, reason=reason)
 
 
-def loop_problems(task: Task, result: CheckResult, processes: dict[str, ProcessDescription],
-                  check: Check) -> Iterator[Problem]:
-    """Problems of the task's loops: an iteration that does not return the devices, an exit that strands them."""
+def loop_problems(task: Task, result: CheckResult, processes: dict[str, ProcessDescription], taxonomy: Taxonomy,
+                  check: Check, paths: list[Path] | None = None) -> Iterator[Problem]:
+    """Problems of the task's loops: an iteration that does not return the devices, an exit that strands them.
+
+    ``paths`` are the task's paths through its branches (none: the steps in order are its one path).
+    """
+    every = paths or [Path(None, tuple(range(1, len(task.steps) + 1)))]
     for loop in task.loops:
         yield from _fixpoint(task, loop, result)
         if loop.until is not None:
-            yield from _exits(task, loop, processes, check)
+            yield from _exits(task, loop, processes, taxonomy, check, every)
 
 
 def _states_before(result: CheckResult, index: int) -> dict[str, str]:
@@ -66,21 +71,23 @@ def _fixpoint(task: Task, loop: Loop, result: CheckResult) -> Iterator[Problem]:
                           where, device=device, state=after[device])
 
 
-def _exits(task: Task, loop: Loop, processes: dict[str, ProcessDescription], check: Check) -> Iterator[Problem]:
+def _exits(task: Task, loop: Loop, processes: dict[str, ProcessDescription], taxonomy: Taxonomy, check: Check,
+           paths: list[Path]) -> Iterator[Problem]:
     """Check the steps after the loop from where each step that can end the loop leaves the devices."""
-    rest = task.steps[loop.last:]
+    rest = tuple(i for i in paths[0].positions if i > loop.last)
     if not rest:
         return
     assert loop.until is not None
+    until = loop.until
     for step in task.steps[loop.entry - 1 : loop.last]:
         process = processes.get(step.command)
-        if process is None or loop.until not in process.outcomes:
+        if process is None or not any(taxonomy.is_a(o, until) for o in process.outcomes):
             continue
-        path = [*task.steps[: step.index], *rest]
-        straight = dataclasses.replace(task, steps=tuple(dataclasses.replace(s, index=i + 1)
-                                                         for i, s in enumerate(path)), loops=(), repeat=1)
-        label = f"loop ended on {local_name(loop.until)} at step {step.index} ({loop.path(step.index)})"
+        route = tuple(i for i in covering(paths, step.index).positions if i <= step.index) + rest
+        straight = dataclasses.replace(task, steps=tuple(dataclasses.replace(task.steps[p - 1], index=i + 1)
+                                                         for i, p in enumerate(route)),
+                                       loops=(), branches=(), repeat=1)
+        label = f"loop ended on {local_name(until)} at step {step.index} ({task.path(step.index)})"
         for problem in check(straight).problems:
-            if problem.step > step.index:
-                moved = dataclasses.replace(problem, step=problem.step - step.index + loop.last)
-                yield _named(moved, label)
+            if problem.step > len(route) - len(rest) and problem.kind != "bad_link":
+                yield _named(renumbered(problem, route), label)

@@ -45,6 +45,7 @@ def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy
                 continue  # an unknown parameter is a problem of its own
             named = _named_before(one_round, step)
             text, iris = _link_text(step, link, named, processes, process.parameter(name), taxonomy)
+            text = text or _on_every_path(task, step, name, link, named)
             if text:
                 where = task.where(step, name)
                 yield Problem(step.index, step.command, "bad_link", Reason("bad_link", text, iris, (where,)), where,
@@ -56,6 +57,17 @@ def _named_before(steps: tuple[Step, ...], step: Step) -> dict[str, Step]:
     named = {s.name: s for s in reversed(steps) if s.name}
     named.update({s.name: s for s in steps[: step.index - 1] if s.name})
     return named
+
+
+def _on_every_path(task: Task, step: Step, name: str, link: Link, named: dict[str, Step]) -> str:
+    """What is wrong with a link whose source step runs only in a branch the consuming step is not in."""
+    source = named.get(link.step)
+    only = [b for b in task.branches if source is not None and b.holds(source.index) and not b.holds(step.index)]
+    if source is None or not only:
+        return ""
+    return (f"step {step.index} ({step.command}): parameter {name} takes {link.output} from {link.step}, but step "
+            f"{source.index} ({link.step}) runs only on {only[-1].path}; a step may take only an output produced "
+            "on every path to it")
 
 
 def _link_text(step: Step, link: Link, named: dict[str, Step], processes: dict[str, ProcessDescription],

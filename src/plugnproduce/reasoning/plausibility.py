@@ -6,17 +6,19 @@ import dataclasses
 from collections import defaultdict
 from collections.abc import Sequence
 
-from plugnproduce.description.model import Cell, ProcessDescription, Task
+from plugnproduce.description.model import Cell, ProcessDescription, Task, Where
+from plugnproduce.description.outcomes import flow_findings
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
+from plugnproduce.reasoning.branches import MAX_PATHS, check_paths, join_problems, task_paths
 from plugnproduce.reasoning.contracts import beyond_limits, normalised
 from plugnproduce.reasoning.controlflow import loop_problems, on_path
 from plugnproduce.reasoning.dataflow import link_problems, unreported
 from plugnproduce.reasoning.facts import fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program, context
-from plugnproduce.reasoning.results import CheckResult, Problem, StepCheck, StepExplanation
+from plugnproduce.reasoning.results import CheckResult, Problem, Reason, StepCheck, StepExplanation
 from plugnproduce.reasoning.terms import Model, program
 
 TASK = "task"
@@ -70,6 +72,8 @@ def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proces
     Quantities written with a unit are read in their parameters' units first; every value a device
     is sent must keep that device's contract (:mod:`plugnproduce.reasoning.contracts`).
     """
+    if task.branches:
+        return _branched(task, cell, taxonomy, processes)
     task, unreadable = normalised(task, processes)
     model, ctx = run_check(task, cell, taxonomy, processes)
     steps, final = _steps(model, task)
@@ -77,15 +81,46 @@ def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proces
     lost = list(not_accepted(task, cell, steps, parameters, taxonomy))
     lost += link_problems(task, {p.id: p for p in processes}, taxonomy)
     lost += unreported(task, cell, steps, {p.id: p for p in processes})
-    lost += unreadable + list(beyond_limits(task, cell, steps, processes))
+    lost += unreadable + list(beyond_limits(task, cell, steps, processes)) + flow_problems(task, processes, taxonomy)
     problems = [on_path(p, task) for p in _problems(model, ctx) + lost]
     plausible = any(a.c == CELL and a.t == TASK for a in model[s.Plausible]) and not problems
     result = CheckResult(task.name, cell.name, plausible, (), steps, final)
     if task.loops:
-        problems += loop_problems(task, result, {p.id: p for p in processes},
+        problems += loop_problems(task, result, {p.id: p for p in processes}, taxonomy,
                                   lambda straight: check(straight, cell, taxonomy, processes))
     problems = sorted(problems, key=lambda p: (p.step, p.kind, p.parameter or ""))
     return dataclasses.replace(result, plausible=result.plausible and not problems, problems=tuple(problems))
+
+
+def flow_problems(task: Task, processes: Sequence[ProcessDescription], taxonomy: Taxonomy) -> list[Problem]:
+    """Branches and loops on outcomes that cannot work (:mod:`plugnproduce.description.outcomes`), at their lines."""
+    out = []
+    for f in flow_findings(task, {p.id: p for p in processes}, taxonomy):
+        where = Where(task.file, f.line)
+        out.append(Problem(f.step, f.command, "bad_flow", Reason("bad_flow", f.text, (), (where,)), where))
+    return out
+
+
+def _branched(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> CheckResult:
+    """The check of a task with branches: each of its paths (:mod:`plugnproduce.reasoning.branches`)."""
+    by_id = {p.id: p for p in processes}
+    paths = task_paths(task, by_id, taxonomy)
+    if len(paths) > MAX_PATHS:
+        where = Where(task.file, task.branches[MAX_PATHS - 1].line)
+        text = f"the task has {len(paths)} paths through its branches; at most {MAX_PATHS} are checked"
+        problem = Problem(1, task.steps[0].command, "too_many_paths", Reason("too_many_paths", text, (), (where,)),
+                          where)
+        return CheckResult(task.name, cell.name, False, (problem,), ())
+    checks = check_paths(task, paths, lambda straight: check(straight, cell, taxonomy, processes))
+    steps = tuple(checks.steps.get(i, StepCheck(i, s.command, {}, {})) for i, s in enumerate(task.steps, start=1))
+    result = CheckResult(task.name, cell.name, True, (), steps, checks.final(paths[0]))
+    problems = [*checks.problems.values(), *flow_problems(task, processes, taxonomy)]
+    problems += [on_path(p, task) for p in link_problems(task, by_id, taxonomy)]
+    problems += [on_path(p, task) for p in unreported(task, cell, steps, by_id)]
+    problems += join_problems(task, checks, by_id, taxonomy)
+    problems += loop_problems(task, result, by_id, taxonomy, lambda t: check(t, cell, taxonomy, processes), paths)
+    problems = sorted(problems, key=lambda p: (p.step, p.kind, p.parameter or ""))
+    return dataclasses.replace(result, plausible=not problems, problems=tuple(problems))
 
 
 def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,

@@ -12,6 +12,7 @@ import difflib
 from collections.abc import Iterator
 
 from plugnproduce.description.model import Command, DeviceDescription, ProcessDescription, Task
+from plugnproduce.description.outcomes import flow_findings
 from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
@@ -68,23 +69,16 @@ def process_problems(process: ProcessDescription, taxonomy: Taxonomy) -> Iterato
                               "which is not a state of another region")
 
 
-def loop_problems(task: Task, processes: dict[str, ProcessDescription]) -> Iterator[Problem]:
-    """A loop whose ``until`` no step of its body can end with: it would never end that way."""
-    for loop in task.loops:
-        if loop.until is None:
-            continue
-        body = task.steps[loop.first - 1 : loop.last]
-        outcomes = sorted({local_name(o) for s in body if s.command in processes
-                           for o in processes[s.command].outcomes})
-        if local_name(loop.until) not in outcomes:
-            known = ", ".join(outcomes) or "none"
-            yield Problem(task.file, loop.line or 0, f"loop until {local_name(loop.until)}: no step of its body can "
-                          f"end with that outcome, so the loop never ends on it; its steps' outcomes: {known}")
+def flow_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[Problem]:
+    """Branches and loops on outcomes: an unknown outcome, a branch that can never run, a loop that never
+    ends (or never goes on) on its outcome."""
+    for f in flow_findings(task, processes, taxonomy):
+        yield Problem(task.file, f.line or 0, f.text)
 
 
-def task_problems(task: Task, processes: dict[str, ProcessDescription]) -> Iterator[Problem]:
-    """Problems of a task that need no cell: unknown commands, roles, parameters and loop outcomes."""
-    yield from loop_problems(task, processes)
+def task_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[Problem]:
+    """Problems of a task that need no cell: unknown commands, roles, parameters, and outcomes of branches and loops."""
+    yield from flow_problems(task, processes, taxonomy)
     n = len(task.steps) // task.repeat
     for step in task.steps[:n]:
         line = step.line or 0

@@ -155,7 +155,7 @@ def _tasks(tasks: list[Task], knowledge: Knowledge, processes: dict[str, Process
         kg.add_description(read_description(process.where.file))
         kg.add_process(process)
     for task in tasks:
-        for p in task_problems(task, known):
+        for p in task_problems(task, known, knowledge.taxonomy):
             report.add(p)
         kg.add_task(task, known)
 

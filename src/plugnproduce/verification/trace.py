@@ -44,6 +44,7 @@ def _step(world: ClosedWorld, before: World, after: World, move: Move, taken: li
     if move.session == CONTROLLER:
         sent = _sent(world, before, after)
         what = f"takes {move.name}" if move.kind == "own" else f"receives {move.name}"
+        what += f" reporting {move.outcome}" if move.outcome else ""
         text = f"controller {what}" + (f"; sends {', '.join(sent)}" if sent else "")
         return TraceStep(text, _task_where(world, before))
     i = world.devices_index(move.session)

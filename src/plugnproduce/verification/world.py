@@ -11,6 +11,10 @@ open, as the devices' delays are unknown:
 - ``timer``: one of a device's delayed sends arrives (its own motion ending, say);
 - ``own``: a session takes an event it sent itself without delay (these come first).
 
+An event that reports the step's ``outcome`` may report any outcome the step's process declares
+(which one a device finds is not in its chart): each is a move of its own, so every branch and
+every way out of a loop is explored.
+
 The controller's own timers (a device's command timeout) never fire: the devices are taken to
 behave as their charts say, so a controller that would wait for ever is a deadlock, not a timeout.
 """
@@ -24,6 +28,7 @@ from typing import Any, Literal
 from plugnproduce.codegen.task import DONE, STEP, GeneratedTask
 from plugnproduce.description.model import Cell, ChartTransition, DeviceDescription
 from plugnproduce.errors import ExecutionError
+from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.runtime.clock import ManualClock
 from plugnproduce.statechart.runtime.events import Event, EventData, MacroStep
 from plugnproduce.statechart.runtime.interpreter import Interpreter
@@ -72,6 +77,8 @@ class Move:
     """The event that arrives."""
     timer: int = -1
     """Which delayed send arrives (``timer`` moves)."""
+    outcome: str = ""
+    """The outcome the event reports (``event`` moves of an event that reports one)."""
 
 
 @dataclass(frozen=True)
@@ -140,7 +147,18 @@ class ClosedWorld:
                 yield Move("timer", device.id, device.id, pending.event.name, n)
         for i, device in enumerate(self.devices):
             if world.events[i] and not world.controller.external:  # what a session sent itself comes first
-                yield Move("event", CONTROLLER, device.id, f"{device.id}.{world.events[i][0].name}")
+                name = f"{device.id}.{world.events[i][0].name}"
+                data = world.events[i][0].data
+                if isinstance(data, EventData) and "outcome" in data and self._outcomes(world):
+                    yield from (Move("event", CONTROLLER, device.id, name, outcome=o) for o in self._outcomes(world))
+                else:
+                    yield Move("event", CONTROLLER, device.id, name)
+
+    def _outcomes(self, world: World) -> tuple[str, ...]:
+        """The outcomes the process of the step the controller is in declares."""
+        steps = self.generated.steps
+        ended = self.steps_ended(world)
+        return tuple(local_name(o) for o in steps[ended].process.outcomes) if ended < len(steps) else ()
 
     def apply(self, world: World, move: Move) -> tuple[World, Violation | None]:
         """The world after ``move``, and what went wrong in it (None: nothing)."""
@@ -175,7 +193,8 @@ class ClosedWorld:
         try:
             if move.kind == "event":
                 message = events[self._index[move.device]].pop(0)
-                self.controller.external.append(Event(move.name, message.data))
+                data = EventData({**message.data, "outcome": move.outcome}) if move.outcome else message.data
+                self.controller.external.append(Event(move.name, data))
             step = self.controller.execute_once()
             if move.kind == "event" and step is not None and not step.transitions:
                 violation = Violation("unexpected", f"the controller does not wait for {move.name} "
