@@ -64,6 +64,14 @@ def _pick_in_branch(page: Page, number: str) -> None:
     _save_step(page)
 
 
+def _loop_until_empty(page: Page) -> None:
+    page.get_by_role("button", name="Add loop").click()
+    page.locator("#loop-until").select_option("BinEmpty")
+    page.locator("#loop-max").fill("100")
+    page.locator("#loop-dialog").get_by_role("button", name="Save loop").click()
+    expect(page.locator("#loop-dialog")).to_be_hidden()
+
+
 def _build(page: Page) -> None:
     """Loop until the bin is empty: localise; when a part was found, pick it where it was found and place it."""
     page.locator("#task-name").fill("bin-picking-branch")
@@ -77,11 +85,7 @@ def _build(page: Page) -> None:
     expect(page.locator("#branch-steps li")).to_have_count(2)
     page.locator("#branch-dialog").get_by_role("button", name="Save branch").click()
     expect(page.locator("#branch-dialog")).to_be_hidden()
-    page.get_by_role("button", name="Add loop").click()
-    page.locator("#loop-until").select_option("BinEmpty")
-    page.locator("#loop-max").fill("100")
-    page.locator("#loop-dialog").get_by_role("button", name="Save loop").click()
-    expect(page.locator("#loop-dialog")).to_be_hidden()
+    _loop_until_empty(page)
 
 
 def test_a_branch_in_a_loop_is_built_through_the_dialogs_shown_under_its_step_and_exported(page: Page) -> None:
@@ -109,21 +113,26 @@ def test_a_branch_in_a_loop_is_built_through_the_dialogs_shown_under_its_step_an
 def test_a_finding_in_a_branch_shows_at_its_row_with_its_path_and_the_branch_is_edited_and_removed(
         page: Page) -> None:
     _localize(page)
+    _loop_until_empty(page)
     _open_branch(page, "PartFound")
     _pick_in_branch(page, "1.1")
     _pick_in_branch(page, "1.2")  # the gripper holds the part: a second pick cannot start
     page.locator("#branch-dialog").get_by_role("button", name="Save branch").click()
     second = page.locator("#steps li.step[data-place='0/PartFound/1']")
-    expect(second.locator(".problem").first).to_contain_text("branch PartFound at step 1")
-    expect(page.locator("#steps li.step[data-place='0/PartFound/0'] .problem")).to_have_count(0)
+    finding = second.locator(".problem[data-kind='wrong_state']").first
+    expect(finding.locator(".path")).to_have_text("loop iteration 1, branch PartFound at step 1")
+    expect(finding).to_contain_text("device 'gripper' (role 'gripper') is in state 'closed'")
+    expect(page.locator("#steps li.step[data-place='0'] .problem")).to_have_count(0)
     screenshot(page, "task-editor-branch-finding")
     page.get_by_role("button", name="Edit the PartFound branch of step 1").click()
     page.get_by_role("button", name="Remove branch step 2 (pick)").click()
+    _branch_step(page, "place", "step 1.2 in the PartFound branch of step 1")
+    _save_step(page)
     page.locator("#branch-dialog").get_by_role("button", name="Save branch").click()
-    expect(page.locator("#steps li.step")).to_have_count(2)
+    expect(page.locator("#steps li.step")).to_have_count(3)
     expect(page.locator("#verdict .ok")).to_contain_text("Plausible")
     page.get_by_role("button", name="Remove the PartFound branch of step 1").click()
-    expect(page.locator("#steps > li")).to_have_count(1)
+    expect(page.locator("#steps li.step")).to_have_count(1)
     expect(page.locator("#steps .branch-head")).to_have_count(0)
 
 
@@ -136,8 +145,8 @@ def test_the_run_shows_each_branch_taken_and_succeeds(page: Page, served: Served
     taken = page.locator("#run-branches li.branch-taken")
     expect(taken).to_have_count(PARTS)  # a part found in each iteration but the last, which finds the bin empty
     for i in range(PARTS):
-        expect(taken.nth(i)).to_have_text(f"iteration {i + 1} step 1 (localize) ended with PartFound: branch taken, "
-                                          "step 1.1 (pick) next")
+        expect(taken.nth(i)).to_have_text(f"iteration {i + 1} step 1 (localize) ended with PartFound: the PartFound "
+                                          "branch taken, step 1.1 (pick) next")
     expect(page.locator("#run-loops")).to_contain_text(f"iteration {PARTS + 1}")
     screenshot(page, "run-branch-in-loop")
     assert served.hmi.source.sim.bin is not None and served.hmi.source.sim.bin.parts == []

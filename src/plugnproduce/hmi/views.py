@@ -162,7 +162,8 @@ def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
 
 def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[str, Any]:
     """What a run's journal says so far: status, current step (and every step position entered, from which
-    a loop's iterations are counted), every device's state, the values that flowed, the fault if any."""
+    a loop's iterations are counted), every device's state, the values that flowed, the branch taken after
+    each step with branches, the fault if any."""
     start = next((r for r in records if r["kind"] == "start"), {})
     end = next((r for r in records if r["kind"] == "end"), None)
     steps = [r for r in records if r["kind"] == "step"]
@@ -183,6 +184,7 @@ def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[s
         "step": steps[-1] if steps else None,
         "visited": [{"step": r.get("step"), "seq": r.get("seq")} for r in steps],
         "values": [r for r in records if r["kind"] == "value"],
+        "branches": [r for r in records if r["kind"] == "branch"],
         "states": states,
         "faults": [r for r in records if r["kind"] == "fault"],
         "end": end,

@@ -139,6 +139,16 @@ async function why(problem, box, button) {
   }
 }
 
+/** A finding's text without the path it starts with (shown apart): "branch X at step 1: step 2 …" → "step 2 …". */
+function withoutPath(text, path) {
+  let rest = text;
+  for (const part of (path || "").split(", ")) {
+    const sep = [": ", ", "].find((x) => part && rest.startsWith(part + x));
+    if (sep) rest = rest.slice(part.length + sep.length);
+  }
+  return rest;
+}
+
 function problemItem(p, i) {
   const id = `why-step-${p.step}-${i}`;
   const box = h("div", { id, class: "why", hidden: true });
@@ -146,7 +156,8 @@ function problemItem(p, i) {
     onclick: () => why(p, box, button) }, "Why?");
   const round = p.round > 1 && !p.path ? ` (round ${p.round})` : "";
   return h("li", { class: "problem", dataset: { kind: p.kind } },
-    p.path ? h("span", { class: "badge path" }, p.path) : null, " ", h("span", {}, (p.plain || p.text) + round), " ", button, box);
+    p.path ? h("span", { class: "badge path" }, p.path) : null, " ",
+    h("span", {}, withoutPath(p.plain || p.text, p.path) + round), " ", button, box);
 }
 
 function applyRepair(repair) {

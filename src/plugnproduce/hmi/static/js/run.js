@@ -1,11 +1,11 @@
-// Runs: start and stop, each device's state and the current step live, a loop's iteration, each branch
-// taken, each value as it flows from the step that produced it to the step that used it, the journal, the fault report.
+// Runs: start and stop, each device's state and the current step live, a loop's iteration, the branch
+// taken after each step with branches, each value as it flows from the step that produced it to the step that used it, the journal, the fault report.
 
 import { get, post } from "./api.js";
 import { renderDeviceState } from "./cell.js";
 import { $, announce, fill, h, showValue } from "./dom.js";
 import { loopText } from "./loops.js";
-import { numberOf, placeKey, stepAt } from "./places.js";
+import { placeKey } from "./places.js";
 import { state, stepPositions, taskBody } from "./state.js";
 
 /** Where step position `n` of the run lies in the editor's task: {row, loop, iteration}. */
@@ -40,20 +40,18 @@ function valueItem(record, iteration) {
     iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
 }
 
-/** The branches the run took, in order: a branch is taken when its first step is entered. */
-function branchesTaken(run) {
-  return (run.visited || []).map((v) => ({ v, at: where(v.step) }))
-    .filter(({ at }) => at && at.branch && at.place[at.place.length - 1] === 0);
-}
-
-function branchItem({ v, at }, run) {
-  const iteration = at.loop ? iterations(run, v.seq).get(at.loop) : null;
-  const steps = state.task.steps;
-  const owner = stepAt(steps, at.branch.place);
-  const text = `step ${numberOf(steps, at.branch.place)} (${owner.name || owner.command}) ended with ${at.branch.outcome}: `
-    + `branch taken, step ${at.number} (${at.step.name || at.step.command}) next`;
-  return h("li", { class: "branch-taken", dataset: { outcome: at.branch.outcome, place: placeKey(at.branch.place),
-    iteration: iteration || "" } }, iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
+/** A journal record of the branch a run took after a step with branches (or that it took none). */
+function branchItem(record, run) {
+  const at = where(record.step);
+  const next = where(record.next);
+  if (!at) return null;
+  const iteration = at.loop ? iterations(run, record.seq).get(at.loop) : null;
+  const name = (p) => `step ${p.number} (${p.step.name || p.step.command})`;
+  const taken = record.branch ? `the ${record.branch} branch taken` : "no branch taken";
+  const text = `${name(at)} ended with ${record.outcome}: ${taken}${next ? `, ${name(next)} next` : ""}`;
+  return h("li", { class: record.branch ? "branch-taken" : "no-branch",
+    dataset: { outcome: record.outcome, branch: record.branch || "", place: placeKey(at.place), iteration: iteration || "" } },
+  iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
 }
 
 function renderFlow(run) {
@@ -67,7 +65,7 @@ function renderFlow(run) {
   });
   fill($("#run-values"), items);
   $("#run-values-box").hidden = items.length === 0;
-  const taken = branchesTaken(run).map((b) => branchItem(b, run));
+  const taken = (run.branches || []).map((record) => branchItem(record, run)).filter(Boolean);
   fill($("#run-branches"), taken);
   $("#run-branches-box").hidden = taken.length === 0;
 }
@@ -165,7 +163,7 @@ export function renderRun() {
 export function takeRecord({ run: id, record, text }) {
   if (!state.run || state.run.run !== id) {
     state.run = { run: id, task: null, status: "running", steps: null, step: null, states: {}, faults: [], end: null,
-      lines: [], seq: 0, visited: [], values: [] };
+      lines: [], seq: 0, visited: [], values: [], branches: [] };
   }
   const run = state.run;
   if (record.seq <= run.seq) return; // already in the run's view
@@ -180,6 +178,7 @@ export function takeRecord({ run: id, record, text }) {
       run.visited.push({ step: record.step, seq: record.seq });
       break;
     case "value": run.values.push(record); break;
+    case "branch": run.branches.push(record); break;
     case "state":
       run.states[record.device] = record.state;
       break;
