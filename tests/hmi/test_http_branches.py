@@ -86,3 +86,14 @@ async def test_a_loop_that_goes_on_while_an_outcome_comes_round_trips(client: ht
     assert result["valid"] is True, result["problems"]
     back = (await client.post("/api/task/export", json=task)).text
     assert (await client.post("/api/task/import", content=back.encode(), headers=YAML)).json() == task
+
+
+async def test_a_branch_in_a_branch_counts_its_rows_as_written(client: httpx.AsyncClient) -> None:
+    inner = {"command": "localize-part", "on": {"BinEmpty": [{"command": "place", "params": {"speed": 900}}]}}
+    task = {"name": "t", "steps": [{"name": "localize", "command": "localize-part", "on": {
+        "PartFound": [{"command": "scan-bin"}, inner]}}, {"command": "scan-bin"}]}
+    exported = (await client.post("/api/task/export", json=task)).text
+    back = (await client.post("/api/task/import", content=exported.encode(), headers=YAML)).json()
+    assert back["steps"][0]["on"]["PartFound"][1]["on"]["BinEmpty"][0]["command"] == "place"
+    result = (await client.post("/api/task/validate", json=task)).json()
+    assert {(p["row"], p["field"]) for p in result["problems"]} == {(3, "steps[3].params.speed")}

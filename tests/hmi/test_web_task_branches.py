@@ -171,3 +171,45 @@ def test_a_loop_goes_on_while_its_steps_report_an_outcome(page: Page) -> None:
     built = yaml.safe_load(download.value.path().read_text(encoding="utf-8"))
     assert built["steps"][1] == {"loop": {"while": "PartFound", "max": 5, "steps": [
         {"name": "localize", "command": LOCALIZE, "params": {"exposure": 25}}]}}
+
+
+NESTED = b"""\
+task: nested
+steps:
+  - name: localize
+    command: localize-part
+    on:
+      PartFound:
+        - command: scan-bin
+        - command: localize-part
+          on:
+            BinEmpty:
+              - command: scan-bin
+      BinEmpty:
+        - command: scan-bin
+  - command: scan-bin
+"""
+
+
+def test_an_imported_branch_in_a_branch_is_listed_as_written_and_a_loop_in_a_branch_is_refused(page: Page) -> None:
+    page.locator("#import").set_input_files(files=[{"name": "nested.yaml", "mimeType": "application/yaml",
+                                                    "buffer": NESTED}])
+    expect(page.locator("#steps li.step")).to_have_count(6)
+    numbers = page.locator("#steps li.step .step-no")
+    expect(numbers).to_have_text(["1", "1.1", "1.2", "1.2.1", "1.3", "2"])
+    expect(page.locator("#steps li.step[data-place='0/PartFound/1/BinEmpty/0']")).to_have_class(
+        "step in-branch depth-2")
+    expect(page.locator("#steps .branch-head .branch-text")).to_have_text([
+        f"If step 1 ({_label(LOCALIZE)}) ends with PartFound:", f"If step 1.2 ({_label(LOCALIZE)}) ends with BinEmpty:",
+        f"If step 1 ({_label(LOCALIZE)}) ends with BinEmpty:"])
+    expect(page.get_by_role("button", name=f"Add a branch to step 1 ({_label(LOCALIZE)})")).to_have_count(0)
+    expect(page.locator("#verdict .ok, #verdict .bad")).to_be_visible()  # checked: no check is pending
+    screenshot(page, "task-editor-nested-branches")
+    looped = NESTED.replace(b"        - command: scan-bin\n        - command: localize-part",
+                            b"        - loop: {max: 2, steps: [{command: scan-bin}]}\n        - command: localize-part")
+    page.locator("#import").set_input_files(files=[{"name": "looped.yaml", "mimeType": "application/yaml",
+                                                    "buffer": looped}])
+    expect(page.locator("#verdict .error")).to_have_text(
+        "This task has a loop inside a branch: the editor builds loops of the task's steps only; edit that task file "
+        "by hand.")
+    expect(page.locator("#steps li.step")).to_have_count(6)
