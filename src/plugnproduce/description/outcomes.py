@@ -15,7 +15,7 @@ from plugnproduce.description.flow import Branch, Loop
 from plugnproduce.description.model import ProcessDescription, Task
 from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import concept_iri, local_name
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,7 @@ def flow_findings(task: Task, processes: dict[str, ProcessDescription], taxonomy
 
 
 def _unknown(iri: str, taxonomy: Taxonomy) -> str | None:
-    if taxonomy.is_kind(iri, "Outcome"):
+    if taxonomy.is_kind(iri, "Outcome") or iri == concept_iri("Outcome"):
         return None
     return (f"{local_name(iri)} is not an outcome of the ontology"
             + did_you_mean(iri, taxonomy.classes_of_kind("Outcome")))

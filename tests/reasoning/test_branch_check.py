@@ -1,0 +1,131 @@
+"""The check of branches on an outcome: every path, each refusal at its line and naming its path."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from plugnproduce import service
+
+TASKS = service.builtin("tasks")
+CELL = service.builtin("cells", "bin-picking.yaml")
+THEN_HOME = (TASKS / "bin-picking-then-home.yaml").read_text(encoding="utf-8")
+
+GRIPPER_CLOSED = """task: closed
+steps:
+  - name: localize
+    command: localize-part
+    on:
+      NoPartFound:
+        - command: close-gripper
+  - command: pick
+    params:
+      pick_pose: {from: localize, output: part_pose}
+  - command: place
+"""
+
+
+def checked(tmp_path: Path, text: str) -> tuple[service.reasoning.CheckResult, Path]:
+    path = tmp_path / "task.yaml"
+    path.write_text(text, encoding="utf-8")
+    return service.check(path, CELL), path
+
+
+def line_of(path: Path, text: str) -> int:
+    return next(i for i, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if text in line)
+
+
+def test_the_shipped_branching_task_is_plausible() -> None:
+    result = service.check(TASKS / "bin-picking-then-home.yaml", CELL)
+    assert result.plausible, [str(p) for p in result.problems]
+
+
+def test_a_branch_that_leaves_the_gripper_closed_before_a_pick_is_refused_after_it(tmp_path: Path) -> None:
+    result, path = checked(tmp_path, GRIPPER_CLOSED)
+    [problem] = [p for p in result.problems if p.kind == "wrong_state"]
+    assert problem.where.line == line_of(path, "command: pick") and problem.step == 3
+    assert problem.text.startswith("after branch NoPartFound at step 1: step 3 (pick): device 'gripper'")
+    assert "left there by step 2 (close-gripper)" in problem.text and not result.plausible
+
+
+def test_a_branch_must_leave_the_devices_as_going_on_without_it_does(tmp_path: Path) -> None:
+    result, path = checked(tmp_path, GRIPPER_CLOSED)
+    [problem] = [p for p in result.problems if p.kind == "branch_join"]
+    assert problem.where.line == line_of(path, "NoPartFound:") and problem.device == "gripper"
+    assert problem.text.startswith("branch NoPartFound at step 1: device gripper is left in state 'closed', but "
+                                   "going on without a branch leaves it in 'open'")
+
+
+def test_the_path_without_the_branch_is_checked_too(tmp_path: Path) -> None:
+    # a pick inside the branch taken when a part is found; the place after it must also work without it
+    text = """task: without
+steps:
+  - name: localize
+    command: localize-part
+    on:
+      PartFound:
+        - command: pick
+          params: {pick_pose: {from: localize, output: part_pose}}
+  - command: place
+"""
+    result, path = checked(tmp_path, text)
+    wrong = [p for p in result.problems if p.kind == "wrong_state"]
+    assert [(p.step, p.where.line) for p in wrong] == [(3, line_of(path, "command: place"))]
+    assert "step 3 (place): device 'gripper'" in wrong[0].text and not wrong[0].text.startswith("after")
+
+
+def test_each_branch_of_a_step_starts_from_the_states_the_step_left(tmp_path: Path) -> None:
+    # the NoPartFound branch is written after the pick and place of PartFound, but starts where localize left
+    result, _ = checked(tmp_path, THEN_HOME)
+    move_to = next(s for s in result.steps if s.command == "move-to")
+    localize = result.steps[0]
+    assert move_to.states["gripper"] == localize.states["gripper"] == "open"
+    assert move_to.states["robot"] == "home"
+
+
+def test_a_link_to_an_output_made_only_in_a_branch_is_refused_at_the_value(tmp_path: Path) -> None:
+    text = """task: only-in-a-branch
+steps:
+  - command: localize-part
+    on:
+      PartFound:
+        - name: again
+          command: localize-part
+  - command: pick
+    params:
+      pick_pose: {from: again, output: part_pose}
+  - command: place
+"""
+    result, path = checked(tmp_path, text)
+    [problem] = [p for p in result.problems if p.kind == "bad_link"]
+    assert problem.where.line == line_of(path, "pick_pose:") and problem.parameter == "pick_pose"
+    assert problem.text == ("step 3 (pick): parameter pick_pose takes part_pose from again, but step 2 (again) "
+                            "runs only on branch PartFound at step 1; a step may take only an output produced on "
+                            "every path to it")
+
+
+def test_a_link_inside_the_branch_to_its_own_step_is_fine(tmp_path: Path) -> None:
+    text = THEN_HOME.replace("            PartFound:\n              - command: pick",
+                             "            PartFound:\n              - name: again\n                command: "
+                             "localize-part\n              - command: pick").replace("from: localize", "from: again")
+    result, _ = checked(tmp_path, text)
+    assert not [p for p in result.problems if p.kind == "bad_link"], [str(p) for p in result.problems]
+
+
+def test_a_problem_in_a_branch_in_a_loop_names_both(tmp_path: Path) -> None:
+    text = THEN_HOME.replace("              - command: move-to\n",
+                             "              - command: close-gripper\n              - command: move-to\n")
+    result, path = checked(tmp_path, text)
+    joins = sorted({p.text.split(":")[0] for p in result.problems if p.kind == "branch_join"})
+    assert joins == ["branch NoPartFound at step 1", "branch NoPartFound at step 6"]
+    later = [p for p in result.problems if p.kind == "wrong_state" and p.command == "pick"]
+    assert [p.text.split(": step")[0] for p in later] == [
+        "loop iteration 2 and later, branch PartFound at step 6, after branch NoPartFound at step 1"]
+    assert all(p.where.line == line_of(path, "command: pick") for p in later)
+
+
+def test_an_unreachable_branch_is_refused_by_the_check_too(tmp_path: Path) -> None:
+    text = GRIPPER_CLOSED.replace("NoPartFound:", "NoPartFund:")
+    result, path = checked(tmp_path, text)
+    [problem] = [p for p in result.problems if p.kind == "bad_flow"]
+    assert problem.where.line == line_of(path, "NoPartFund:")
+    assert "did you mean NoPartFound or PartFound?" in problem.text
