@@ -88,12 +88,13 @@ def _catalogue() -> list[DeviceDescription]:
 
 def _rows(problems: list[dict[str, Any]], task: Task) -> list[dict[str, Any]]:
     """Add to each problem the editor row of its step (steps repeat: step 5 of 2 rows is row 0, round 3;
-    a loop's later iterations are its round 2)."""
+    a loop's later iterations are its round 2) and the path it lies on (``branch NoPartFound at step 2``)."""
     rows = editor_rows(task)
     for p in problems:
         step = p.get("step")
         if isinstance(step, int) and step in rows:
             p["row"], p["round"] = rows[step]
+            p["path"] = task.path(step)
     return problems
 
 

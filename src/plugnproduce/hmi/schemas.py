@@ -2,8 +2,9 @@
 
 A task travels as ``{"name", "description", "repeat", "steps": [...]}``, the YAML task
 description's fields in JSON (``task`` is accepted for ``name``): each item of ``steps`` is a
-step ``{"name", "command", "bind", "params"}`` (a parameter may be a data link
-``{"from": STEP, "output": NAME}``) or a loop ``{"loop": {"until", "max", "steps"}}``. It becomes
+step ``{"name", "command", "bind", "params", "on"}`` (a parameter may be a data link
+``{"from": STEP, "output": NAME}``; ``on`` maps an outcome to the steps of its branch) or a loop
+``{"loop": {"until", "while", "max", "steps"}}``. It becomes
 the model's :class:`~plugnproduce.description.model.Task` with :meth:`TaskIn.to_task`, read by the
 task file's reader, so that a task from the editor means what the same task file means.
 """
@@ -88,14 +89,20 @@ class StepIn(BaseModel):
         default_factory=dict, description="Role name → device id (optional where only one device fits).")
     params: dict[str, ParamValue] = Field(
         default_factory=dict, description="Parameter name → value; a parameter left out takes its default.")
+    on: dict[Annotated[str, Field(min_length=1, max_length=200)],
+             Annotated[list[StepIn], Field(min_length=1, max_length=1000)]] | None = Field(
+        None, description="Branches: outcome → the steps that run only when this step ends with that outcome.")
 
 
 class LoopBodyIn(BaseModel):
-    """A loop: its steps run again and again until one of them ends with ``until``, at most ``max`` times."""
+    """A loop: its steps run again and again until one of them ends with ``until`` (while the last outcome they
+    reported is ``while``), at most ``max`` times."""
 
     model_config = ConfigDict(extra="forbid")
 
     until: str | None = Field(None, min_length=1, max_length=200, description="An outcome, e.g. 'BinEmpty'.")
+    while_: str | None = Field(None, alias="while", min_length=1, max_length=200,
+                               description="An outcome the loop goes on while its steps report it, e.g. 'PartFound'.")
     max: int | None = Field(None, ge=1, le=1_000_000, description="The most iterations.")
     steps: list[StepIn] = Field(min_length=1, max_length=1000)
 
@@ -149,7 +156,7 @@ class TaskIn(BaseModel):
         """Read the task as the task file reader reads it: a duplicate step name or a loop in a
         repeated task is refused here, with the reader's message."""
         doc = {"task": self.name, "description": self.description, "repeat": self.repeat,
-               "steps": [s.model_dump(exclude_none=True) for s in self.steps]}
+               "steps": [s.model_dump(exclude_none=True, by_alias=True) for s in self.steps]}
         try:
             task = service.task_from_text(json.dumps(doc), TASK_SOURCE)
         except DescriptionError as exc:

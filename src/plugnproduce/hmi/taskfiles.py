@@ -19,6 +19,7 @@ from plugnproduce.description.model import Task
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.views import editor_rows
 from plugnproduce.knowledge import Knowledge
+from plugnproduce.ontology.vocabulary import concept_value
 
 _validating = threading.Lock()
 """One validation at a time: the shapes engine is not meant to share its graphs between threads."""
@@ -28,12 +29,16 @@ EDITOR_FILE = "task.yaml"
 
 
 def _fields(loaded: Task) -> dict[int, tuple[int, str]]:
-    """Line in the written file → (editor row, field name); a loop's line is its first step's row."""
+    """Line in the written file → (editor row, field name); a loop's line is its first step's row, a branch's
+    line its step's row (editor rows count every step as written, a branch's steps after their step)."""
     out: dict[int, tuple[int, str]] = {}
     rows = editor_rows(loaded)
     for lp in loaded.loops:
         if lp.line is not None:
             out[lp.line] = (rows[lp.entry][0], f"steps[{rows[lp.entry][0]}].loop")
+    for b in loaded.branches:
+        if b.line is not None:
+            out[b.line] = (rows[b.step][0], f"steps[{rows[b.step][0]}].on.{concept_value(b.outcome)}")
     for step in loaded.one_round():
         row, first = rows[step.index]
         if first != 1:

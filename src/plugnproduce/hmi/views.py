@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from plugnproduce import service
+from plugnproduce.description.flow import Loop
 from plugnproduce.description.model import (
     Cell,
     DeviceDescription,
@@ -103,26 +104,46 @@ def _step_json(s: Step) -> dict[str, Any]:
             "params": {n: plain_value(v) for n, v in s.params.items()}}
 
 
+def _loop_json(task: Task, loop: Loop) -> dict[str, Any]:
+    head: dict[str, Any] = {"until": concept_value(loop.until)} if loop.until else {}
+    if loop.while_outcome:
+        head["while"] = concept_value(loop.while_outcome)
+    if loop.max is not None:
+        head["max"] = loop.max
+    return {"loop": {**head, "steps": _items(task, loop.entry, loop.first - 1, loop)}}
+
+
+def _items(task: Task, first: int, last: int, inside: Loop | None = None) -> list[dict[str, Any]]:
+    """The items of step positions ``first`` to ``last`` as the task file nests them: a step with its branches
+    (``on``), a loop holding its body once."""
+    items: list[dict[str, Any]] = []
+    index = first
+    while index <= last:
+        loop = task.loop_at(index)
+        if loop is not None and loop is not inside and index == loop.entry:
+            items.append(_loop_json(task, loop))
+            index = loop.last + 1
+            continue
+        item = _step_json(task.steps[index - 1])
+        branches = task.branches_of(index)
+        if branches:
+            item["on"] = {concept_value(b.outcome): _items(task, b.first, b.last, inside) for b in branches}
+        items.append(item)
+        index = max([index] + [b.last for b in branches]) + 1
+    return items
+
+
 def task_json(task: Task) -> dict[str, Any]:
-    """A task as the task file writes it: one round of its steps (a loop as one item holding its body),
-    and how often they repeat."""
-    steps: list[dict[str, Any]] = []
-    for s in task.one_round():
-        loop = task.loop_at(s.index)
-        if loop is None:
-            steps.append(_step_json(s))
-        elif s.index == loop.entry:
-            body = task.steps[loop.entry - 1: loop.first - 1]
-            item: dict[str, Any] = {"until": concept_value(loop.until)} if loop.until else {}
-            if loop.max is not None:
-                item["max"] = loop.max
-            steps.append({"loop": {**item, "steps": [_step_json(b) for b in body]}})
+    """A task as the task file writes it: one round of its steps (a loop as one item holding its body, a step's
+    branches under its ``on``), and how often they repeat."""
+    steps = _items(task, 1, len(task.one_round()))
     return {"name": task.name, "description": task.description, "repeat": task.repeat, "steps": steps}
 
 
 def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
-    """Step position → (editor row, round): the editor shows each step once (a loop's body once), so a
-    repeated step's round counts the repeats, and a loop's later iterations are its round 2."""
+    """Step position → (editor row, round): the editor shows each step once (a loop's body once; a step's
+    branches' steps after it, as positions number them), so a repeated step's round counts the repeats, and
+    a loop's later iterations are its round 2."""
     rows: dict[int, tuple[int, int]] = {}
     one_round = len(task.one_round())
     row = 0
@@ -141,8 +162,8 @@ def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
 
 def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[str, Any]:
     """What a run's journal says so far: status, current step (and every step position entered, from which
-    a loop's iterations are counted), every device's state, the values that flowed, the branches taken, the
-    fault if any."""
+    a loop's iterations are counted), every device's state, the values that flowed, the branch taken after
+    each step with branches, the fault if any."""
     start = next((r for r in records if r["kind"] == "start"), {})
     end = next((r for r in records if r["kind"] == "end"), None)
     steps = [r for r in records if r["kind"] == "step"]

@@ -2,11 +2,13 @@
 // parameter (type, unit, range, default) and a device choice per role where several devices fit.
 // A parameter may take an earlier named step's output instead of a value (the outputs whose datatype
 // and unit fit, as the server describes them); a step whose process gives outputs may be named.
+// A step may lie in a branch: it takes the outputs of the steps before it on every path to it.
 // Values are refused with the messages of the task shapes: the dialog validates the task through
 // the API (as `pnp validate` would) before it lets the step in.
 
 import { post } from "./api.js";
 import { $, fill, h, num } from "./dom.js";
+import { earlierOnPath, numberOf, rowOf, withStep } from "./places.js";
 import { offer, state, taskBody } from "./state.js";
 
 const POSE_AXES = ["x", "y", "z", "rx", "ry", "rz"];
@@ -32,18 +34,18 @@ function numberInput(id, p, value, label) {
   });
 }
 
-/** The outputs of earlier named steps a parameter may take: [{from, output, text}]. */
-function sources(p, row) {
+/** The outputs of the named steps before `at` on every path to it a parameter may take: [{from, output, text}]. */
+function sources(p, at) {
   const out = [];
-  state.task.steps.slice(0, row).forEach((s, r) => {
+  for (const { step: s, place } of earlierOnPath(at.steps, at.place)) {
     const process = state.processes.get(s.command);
-    if (!s.name || !process) return;
+    if (!s.name || !process) continue;
     for (const o of process.outputs || []) {
       if (o.datatype === p.datatype && (o.unit || "") === (p.unit || "")) {
-        out.push({ from: s.name, output: o.name, text: `${o.label} of step ${r + 1} (${s.name})` });
+        out.push({ from: s.name, output: o.name, text: `${o.label} of step ${numberOf(at.steps, place)} (${s.name})` });
       }
     }
-  });
+  }
   return out;
 }
 
@@ -66,8 +68,8 @@ function showSource(box) {
   box.querySelectorAll("input").forEach((i) => { i.disabled = linked; });
 }
 
-function paramField(p, value, row) {
-  const found = sources(p, row);
+function paramField(p, value, at) {
+  const found = sources(p, at);
   const box = valueField(p, value && value.from ? undefined : value);
   if (found.length || (value && value.from)) {
     box.append(sourceField(p, value, found));
@@ -198,15 +200,15 @@ function readStep(process, previous, root) {
   root.querySelectorAll(".field.role select").forEach((s) => { if (s.value) bind[s.name] = s.value; });
   const named = root.querySelector("#step-name");
   const name = named ? named.value.trim() : (previous && previous.name) || "";
-  return ok ? { ...(name ? { name } : {}), command: process.command, bind, params } : null;
+  const on = previous && previous.on ? { on: previous.on } : {}; // its branches stay
+  return ok ? { ...(name ? { name } : {}), command: process.command, bind, params, ...on } : null;
 }
 
 /** Ask the API to validate the task with this step in its place; show each problem at its field. */
-async function refused(step, row, root) {
-  const steps = [...state.task.steps];
-  if (row < steps.length) steps[row] = step;
-  else steps.push(step);
+async function refused(step, at, root) {
+  const steps = withStep(at.steps, at.place, step);
   const result = await post("/api/task/validate", taskBody({ ...state.task, steps }));
+  const row = rowOf(steps, at.place);
   const mine = result.problems.filter((p) => p.row === row);
   let first = null;
   for (const p of mine) {
@@ -220,21 +222,28 @@ async function refused(step, row, root) {
   return mine.length > 0;
 }
 
+/** "step 3", or "step 3.2 in the NoPartFound branch of step 3". */
+function stepTitle(at, step) {
+  const steps = withStep(at.steps, at.place, step);
+  const owner = at.place.length > 1 ? ` in the ${at.place[at.place.length - 2]} branch of step ${numberOf(steps, at.place.slice(0, -2))}` : "";
+  return `step ${numberOf(steps, at.place)}${owner}`;
+}
+
 /**
- * Open the dialog for `command` (a new step at `row`, or the step there to edit).
- * Resolves to the step, or null when cancelled.
+ * Open the dialog for `command`: a new step at `at.place` of the steps `at.steps` (one past the end of its list),
+ * or the step there (`previous`) to edit. Resolves to the step, or null when cancelled.
  */
-export function editStep(command, row, previous) {
+export function editStep(command, at, previous) {
   const process = state.processes.get(command);
   const dialog = $("#step-dialog");
   const root = $("#step-form");
   if (!process) return Promise.resolve(null);
-  $("#dialog-title").textContent = `${previous ? "Edit" : "Add"} step ${row + 1}: ${process.label}`;
+  $("#dialog-title").textContent = `${previous ? "Edit" : "Add"} ${stepTitle(at, previous || { command })}: ${process.label}`;
   $("#dialog-comment").textContent = process.comment || "";
   $("#dialog-ok").textContent = previous ? "Save step" : "Add step";
   fill($("#dialog-roles"), h("legend", {}, "Devices"), nameField(process, previous),
     process.roles.map((r) => roleField(process, r, previous)));
-  const params = process.parameters.map((p) => paramField(p, previous && previous.params ? previous.params[p.name] : undefined, row));
+  const params = process.parameters.map((p) => paramField(p, previous && previous.params ? previous.params[p.name] : undefined, at));
   fill($("#dialog-params"), h("legend", {}, "Parameters"), params.length ? params : h("p", { class: "hint" }, "This process has no parameters."));
   clearErrors(root);
   return new Promise((resolve) => {
@@ -255,7 +264,7 @@ export function editStep(command, row, previous) {
       ok.disabled = true;
       ok.setAttribute("aria-busy", "true");
       try {
-        if (!(await refused(step, row, root))) done(step);
+        if (!(await refused(step, at, root))) done(step);
       } catch (err) {
         $("#dialog-error").textContent = err.message;
       } finally {

@@ -1,30 +1,18 @@
-// The task editor: add, edit, remove and reorder steps; loops around steps; check with problems at
-// their steps; ranked repairs applied with one click; why a step is (not) plausible; YAML in and out.
+// The task editor: add, edit, remove and reorder steps; loops around steps, branches on a step's outcome;
+// check with problems at their steps; ranked repairs applied with one click; why a step is (not) plausible; YAML in and out.
 
 import { api, post } from "./api.js";
 import { explanationView } from "./derivation.js";
 import { editStep } from "./dialog.js";
-import { $, announce, fill, h, showValue } from "./dom.js";
+import { branchText, editBranch } from "./branches.js";
+import { $, announce, fill, h } from "./dom.js";
 import { editLoop, loopText } from "./loops.js";
-import { changed, editorTask, loopOf, offer, saveTask, state, taskBody } from "./state.js";
+import { listAt, numberOf, placeKey, stepAt, withList, withStep } from "./places.js";
+import { changed, editorTask, saveTask, state, taskBody } from "./state.js";
+import { label, taskItems } from "./tasklist.js";
 
 let checkTimer = null;
 let checkSeq = 0;
-
-function label(command) {
-  const p = state.processes.get(command);
-  return p ? p.label : command;
-}
-
-function paramSummary(step) {
-  const process = state.processes.get(step.command);
-  const units = new Map(process ? process.parameters.map((p) => [p.name, p.unit]) : []);
-  const parts = Object.entries(step.params || {}).map(([k, v]) => (v && v.from
-    ? `${k.replace(/_/g, " ")} ← ${v.output.replace(/_/g, " ")} of ${v.from}`
-    : `${k.replace(/_/g, " ")} ${showValue(v, units.get(k))}`));
-  const binds = Object.entries(step.bind || {}).map(([role, dev]) => `${role} → ${dev}`);
-  return [...binds, ...parts].join(" · ") || "defaults";
-}
 
 /** Change the task, remember it, re-render and re-check. */
 export function setTask(task, message) {
@@ -37,10 +25,10 @@ export function setTask(task, message) {
   if (message) announce(message);
 }
 
-function setSteps(steps, message, focusRow, focusSelector, loops = state.task.loops || []) {
+function setSteps(steps, message, focus, focusSelector, loops = state.task.loops || []) {
   setTask({ ...state.task, steps, loops }, message);
-  if (focusRow !== undefined) {
-    const li = $(`#steps li[data-row="${focusRow}"]`);
+  if (focus !== undefined) {
+    const li = $(`#steps li.step[data-place="${placeKey(focus)}"]`);
     const target = li && (li.querySelector(focusSelector) || li.querySelector("button:not([disabled])"));
     if (target) target.focus();
   }
@@ -48,36 +36,63 @@ function setSteps(steps, message, focusRow, focusSelector, loops = state.task.lo
 
 /** Open the dialog for a new step at the end of the task. */
 export async function addStep(command) {
-  const row = state.task.steps.length;
-  const step = await editStep(command, row);
-  if (step) setSteps([...state.task.steps, step], `Step ${row + 1} (${label(command)}) added.`, row, ".edit");
+  const place = [state.task.steps.length];
+  const step = await editStep(command, { steps: state.task.steps, place });
+  if (step) setSteps([...state.task.steps, step], `Step ${place[0] + 1} (${label(command)}) added.`, place, ".edit");
 }
 
-async function edit(row) {
-  const old = state.task.steps[row];
-  const step = await editStep(old.command, row, old);
-  if (step) {
-    const steps = [...state.task.steps];
-    steps[row] = step;
-    setSteps(steps, `Step ${row + 1} saved.`, row, ".edit");
-  }
+function nameOf(place) {
+  return `Step ${numberOf(state.task.steps, place)} (${label(stepAt(state.task.steps, place).command)})`;
 }
 
-function move(row, delta) {
+async function edit(place) {
+  const old = stepAt(state.task.steps, place);
+  const step = await editStep(old.command, { steps: state.task.steps, place }, old);
+  if (step) setSteps(withStep(state.task.steps, place, step), `${nameOf(place)} saved.`, place, ".edit");
+}
+
+function move(place, delta) {
+  const prefix = place.slice(0, -1);
+  const row = place[place.length - 1];
   const to = row + delta;
-  const steps = [...state.task.steps];
-  if (to < 0 || to >= steps.length) return;
-  [steps[row], steps[to]] = [steps[to], steps[row]];
-  setSteps(steps, `Step ${row + 1} moved to position ${to + 1}.`, to, delta < 0 ? ".up" : ".down");
+  if (to < 0 || to >= listAt(state.task.steps, prefix).length) return;
+  const steps = withList(state.task.steps, prefix, (list) => {
+    const copy = [...list];
+    [copy[row], copy[to]] = [copy[to], copy[row]];
+    return copy;
+  });
+  setSteps(steps, `${nameOf(place)} moved to position ${numberOf(steps, [...prefix, to])}.`, [...prefix, to],
+    delta < 0 ? ".up" : ".down");
 }
 
-function remove(row) {
-  const steps = state.task.steps.filter((_, i) => i !== row);
-  const loops = (state.task.loops || [])
+/** The loops once the task's step `row` is gone (a loop left with no step goes too). */
+function loopsWithout(row) {
+  return (state.task.loops || [])
     .map((l) => ({ ...l, first: l.first > row ? l.first - 1 : l.first, last: l.last >= row ? l.last - 1 : l.last }))
     .filter((l) => l.first <= l.last);
-  setSteps(steps, `Step ${row + 1} (${label(state.task.steps[row].command)}) removed.`, Math.min(row, steps.length - 1),
-    ".edit", loops);
+}
+
+function remove(place) {
+  const steps = withStep(state.task.steps, place, null);
+  const loops = place.length === 1 ? loopsWithout(place[0]) : state.task.loops;
+  const left = listAt(steps, place.slice(0, -1)).length;
+  const focus = left ? [...place.slice(0, -1), Math.min(place[place.length - 1], left - 1)] : place.slice(0, -2);
+  setSteps(steps, `${nameOf(place)} removed.`, focus.length ? focus : undefined, ".edit", loops);
+}
+
+/** Open the branch dialog: a new branch of the step at `place`, or its branch on `old` to change. */
+async function branchDialog(place, old) {
+  const branch = await editBranch(place, old);
+  if (!branch) return;
+  const without = old ? withList(state.task.steps, [...place, old], () => []) : state.task.steps;
+  const steps = withList(without, [...place, branch.outcome], () => branch.steps);
+  setSteps(steps, `${branchText(steps, place, branch.outcome)}: ${branch.steps.length} step${branch.steps.length === 1 ? "" : "s"} ${old ? "saved" : "added"}.`,
+    place, ".add-branch");
+}
+
+function removeBranch(place, outcome) {
+  const text = branchText(state.task.steps, place, outcome);
+  setSteps(withList(state.task.steps, [...place, outcome], () => []), `Branch removed: ${text}.`, place, ".edit");
 }
 
 /** Open the loop dialog: a new loop around steps, or the loop at `index` to change. */
@@ -93,51 +108,11 @@ async function loopDialog(index) {
 }
 
 function removeLoop(loop) {
-  setSteps(state.task.steps, `${loopText(loop)} removed; its steps run once.`, loop.first, ".edit",
+  setSteps(state.task.steps, `${loopText(loop)} removed; its steps run once.`, [loop.first], ".edit",
     state.task.loops.filter((l) => l !== loop));
 }
 
-function loopHead(loop) {
-  const index = state.task.loops.indexOf(loop);
-  const text = loopText(loop);
-  return h("li", { class: "loop-head", dataset: { first: loop.first, last: loop.last } },
-    h("span", { class: "loop-text" }, text),
-    h("span", { class: "step-actions" },
-      h("button", { type: "button", class: "edit-loop quiet", "aria-label": `Edit ${text}`, onclick: () => loopDialog(index) },
-        "Edit loop"),
-      h("button", { type: "button", class: "remove-loop quiet danger", "aria-label": `Remove ${text}`,
-        onclick: () => removeLoop(loop) }, "Remove loop")));
-}
-
-function stepItem(step, row, count) {
-  const n = row + 1;
-  const name = `step ${n} (${label(step.command)})`;
-  const offered = !state.commands || offer(step.command);
-  const li = h("li", { class: loopOf(row) ? "step in-loop" : "step", dataset: { row, command: step.command } },
-    h("div", { class: "step-head" },
-      h("span", { class: "step-no", "aria-hidden": "true" }, String(n)),
-      h("div", { class: "step-main" },
-        h("span", { class: "step-cmd" }, label(step.command), " ", h("code", {}, step.command),
-          step.name ? h("span", { class: "badge step-name" }, step.name) : null,
-          offered ? null : h("span", { class: "badge warn" }, "not offered")),
-        h("span", { class: "step-detail" }, paramSummary(step))),
-      h("span", { class: "step-actions" },
-        h("button", { type: "button", class: "edit quiet", "aria-label": `Edit ${name}`, onclick: () => edit(row) }, "Edit"),
-        h("button", { type: "button", class: "up quiet", "aria-label": `Move ${name} up`, disabled: row === 0,
-          onclick: () => move(row, -1) }, "↑"),
-        h("button", { type: "button", class: "down quiet", "aria-label": `Move ${name} down`, disabled: row === count - 1,
-          onclick: () => move(row, 1) }, "↓"),
-        h("button", { type: "button", class: "remove quiet danger", "aria-label": `Remove ${name}`,
-          onclick: () => remove(row) }, "Remove"))),
-    h("ul", { class: "problems", "aria-label": `Problems of ${name}` }));
-  li.addEventListener("keydown", (e) => {
-    if (e.altKey && (e.key === "ArrowUp" || e.key === "ArrowDown")) {
-      e.preventDefault();
-      move(row, e.key === "ArrowUp" ? -1 : 1);
-    }
-  });
-  return li;
-}
+const ACTIONS = { edit, move, remove, branch: branchDialog, removeBranch, loop: loopDialog, removeLoop };
 
 /** Show the task as it is. */
 export function renderTask() {
@@ -145,10 +120,7 @@ export function renderTask() {
   if (document.activeElement !== $("#task-name")) $("#task-name").value = t.name;
   if (document.activeElement !== $("#task-repeat")) $("#task-repeat").value = t.repeat;
   if (document.activeElement !== $("#task-description")) $("#task-description").value = t.description || "";
-  fill($("#steps"), t.steps.flatMap((s, i) => {
-    const loop = (t.loops || []).find((l) => l.first === i);
-    return [loop ? loopHead(loop) : null, stepItem(s, i, t.steps.length)];
-  }));
+  fill($("#steps"), taskItems(t, ACTIONS));
   $("#add-loop").disabled = t.steps.length === 0;
   $("#steps-empty").hidden = t.steps.length > 0;
   renderCheck();
@@ -167,13 +139,25 @@ async function why(problem, box, button) {
   }
 }
 
+/** A finding's text without the path it starts with (shown apart): "branch X at step 1: step 2 …" → "step 2 …". */
+function withoutPath(text, path) {
+  let rest = text;
+  for (const part of (path || "").split(", ")) {
+    const sep = [": ", ", "].find((x) => part && rest.startsWith(part + x));
+    if (sep) rest = rest.slice(part.length + sep.length);
+  }
+  return rest;
+}
+
 function problemItem(p, i) {
   const id = `why-step-${p.step}-${i}`;
   const box = h("div", { id, class: "why", hidden: true });
   const button = h("button", { type: "button", class: "quiet", "aria-expanded": "false", "aria-controls": id,
     onclick: () => why(p, box, button) }, "Why?");
-  const round = p.round > 1 ? ` (round ${p.round})` : "";
-  return h("li", { class: "problem", dataset: { kind: p.kind } }, h("span", {}, (p.plain || p.text) + round), " ", button, box);
+  const round = p.round > 1 && !p.path ? ` (round ${p.round})` : "";
+  return h("li", { class: "problem", dataset: { kind: p.kind } },
+    p.path ? h("span", { class: "badge path" }, p.path) : null, " ",
+    h("span", {}, withoutPath(p.plain || p.text, p.path) + round), " ", button, box);
 }
 
 function applyRepair(repair) {

@@ -2,14 +2,16 @@
 // outcomes offered are those the chosen steps' processes may end with, as the server describes them.
 
 import { $, fill, h } from "./dom.js";
+import { rowsOf } from "./places.js";
 import { state } from "./state.js";
 
 /** A loop in words: "Loop over steps 1–3 until BinEmpty, at most 100 times". */
 export function loopText(loop) {
   const steps = loop.first === loop.last ? `step ${loop.first + 1}` : `steps ${loop.first + 1}–${loop.last + 1}`;
   const until = loop.until ? ` until ${loop.until}` : "";
-  const most = loop.max ? `${loop.until ? "," : ""} at most ${loop.max} time${loop.max === 1 ? "" : "s"}` : "";
-  return `Loop over ${steps}${until}${most}`;
+  const goesOn = loop.while ? `${loop.until ? "," : ""} while ${loop.while}` : "";
+  const most = loop.max ? `${loop.until || loop.while ? "," : ""} at most ${loop.max} time${loop.max === 1 ? "" : "s"}` : "";
+  return `Loop over ${steps}${until}${goesOn}${most}`;
 }
 
 function stepOption(row, chosen) {
@@ -18,19 +20,19 @@ function stepOption(row, chosen) {
   return h("option", { value: row, selected: row === chosen }, `${row + 1}: ${p ? p.label : s.command}${s.name ? ` (${s.name})` : ""}`);
 }
 
-/** The outcomes the processes of rows first..last may end with, each once, in order. */
+/** The outcomes the processes of steps first..last (and of their branches' steps) may end with, each once, in order. */
 function outcomesOf(first, last) {
   const out = [];
-  for (let row = first; row <= last; row++) {
-    const p = state.processes.get(state.task.steps[row].command);
+  for (const { step } of rowsOf(state.task.steps.slice(first, last + 1))) {
+    const p = state.processes.get(step.command);
     for (const o of (p && p.outcomes) || []) if (!out.includes(o)) out.push(o);
   }
   return out;
 }
 
-function fillOutcomes(select, first, last, chosen) {
+function fillOutcomes(select, first, last, chosen, none) {
   const outcomes = outcomesOf(first, last);
-  fill(select, h("option", { value: "" }, outcomes.length ? "no outcome: only the maximum" : "no step here ends with an outcome"),
+  fill(select, h("option", { value: "" }, outcomes.length ? none : "no step here ends with an outcome"),
     outcomes.map((o) => h("option", { value: o, selected: o === chosen }, o)));
 }
 
@@ -43,7 +45,7 @@ function refusal(loop, old) {
   if (loop.first > loop.last) return "The last step of the loop must not come before its first.";
   const other = (state.task.loops || []).find((l) => l !== old && l.first <= loop.last && loop.first <= l.last);
   if (other) return `Steps ${other.first + 1}–${other.last + 1} are in a loop already; loops do not nest or overlap.`;
-  if (!loop.until && !loop.max) return "A loop needs a way out: an outcome to end on, a maximum, or both.";
+  if (!loop.until && !loop.while && !loop.max) return "A loop needs a way out: an outcome to end on, a maximum, or both.";
   if (loop.max !== null && !(Number.isInteger(loop.max) && loop.max >= 1)) return "The maximum is a whole number, at least 1.";
   if (Number(state.task.repeat) > 1) return "A task with a loop does not repeat: set Repeat to 1 first.";
   return "";
@@ -58,9 +60,14 @@ export function editLoop(old) {
   const last = h("select", { id: "loop-last", name: "last" },
     rows.map((r) => stepOption(r, old ? old.last : rows.length - 1)));
   const until = h("select", { id: "loop-until", name: "until" });
+  const goesOn = h("select", { id: "loop-while", name: "while" });
   const max = h("input", { id: "loop-max", name: "max", type: "number", min: 1, step: 1, inputmode: "numeric",
     value: old && old.max ? old.max : "" });
-  const outcomes = () => fillOutcomes(until, Number(first.value), Number(last.value), until.value || (old && old.until));
+  const outcomes = () => {
+    const [f, l] = [Number(first.value), Number(last.value)];
+    fillOutcomes(until, f, l, until.value || (old && old.until), "no outcome: only the maximum");
+    fillOutcomes(goesOn, f, l, goesOn.value || (old && old.while), "whatever the steps report");
+  };
   outcomes();
   first.addEventListener("change", outcomes);
   last.addEventListener("change", outcomes);
@@ -68,6 +75,7 @@ export function editLoop(old) {
   fill($("#loop-fields"),
     field("loop-first", "First step", first), field("loop-last", "Last step", last),
     field("loop-until", "Until", until, "an outcome the loop's steps may end with"),
+    field("loop-while", "While", goesOn, "optional: the loop goes on only while its steps last reported this outcome"),
     field("loop-max", "At most (times)", max, "optional"));
   $("#loop-error").textContent = "";
   return new Promise((resolve) => {
@@ -82,7 +90,7 @@ export function editLoop(old) {
     const submit = (e) => {
       e.preventDefault();
       const loop = { first: Number(first.value), last: Number(last.value), until: until.value || null,
-        max: max.value === "" ? null : Number(max.value) };
+        while: goesOn.value || null, max: max.value === "" ? null : Number(max.value) };
       const why = max.validity.badInput ? "The maximum is a whole number, at least 1." : refusal(loop, old);
       $("#loop-error").textContent = why;
       if (!why) done(loop);

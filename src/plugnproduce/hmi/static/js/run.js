@@ -1,10 +1,11 @@
-// Runs: start and stop, each device's state and the current step live, a loop's iteration, each value
-// as it flows from the step that produced it to the step that used it, the journal, the fault report.
+// Runs: start and stop, each device's state and the current step live, a loop's iteration, the branch
+// taken after each step with branches, each value as it flows from the step that produced it to the step that used it, the journal, the fault report.
 
 import { get, post } from "./api.js";
 import { renderDeviceState } from "./cell.js";
 import { $, announce, fill, h, showValue } from "./dom.js";
 import { loopText } from "./loops.js";
+import { placeKey } from "./places.js";
 import { state, stepPositions, taskBody } from "./state.js";
 
 /** Where step position `n` of the run lies in the editor's task: {row, loop, iteration}. */
@@ -19,15 +20,14 @@ function iterations(run, seq = Infinity) {
   const counts = new Map();
   for (const v of run.visited || []) {
     const at = where(v.step);
-    if (v.seq < seq && at && at.loop && at.row === at.loop.first) counts.set(at.loop, (counts.get(at.loop) || 0) + 1);
+    if (v.seq < seq && at && at.loop && at.top === at.loop.first && !at.branch) counts.set(at.loop, (counts.get(at.loop) || 0) + 1);
   }
   return counts;
 }
 
 function stepName(n) {
   const at = where(n);
-  const s = at ? state.task.steps[at.row] : null;
-  return s ? `step ${at.row + 1} (${s.name || s.command})` : `step ${n}`;
+  return at ? `step ${at.number} (${at.step.name || at.step.command})` : `step ${n}`;
 }
 
 function valueItem(record, iteration) {
@@ -38,6 +38,20 @@ function valueItem(record, iteration) {
     : `${record.value} = ${value}, used by ${stepName(record.step)} as ${record.parameter} on ${record.device}`;
   return h("li", { class: produced ? "produced" : "used", dataset: { value: record.value, iteration: iteration || "" } },
     iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
+}
+
+/** A journal record of the branch a run took after a step with branches (or that it took none). */
+function branchItem(record, run) {
+  const at = where(record.step);
+  const next = where(record.next);
+  if (!at) return null;
+  const iteration = at.loop ? iterations(run, record.seq).get(at.loop) : null;
+  const name = (p) => `step ${p.number} (${p.step.name || p.step.command})`;
+  const taken = record.branch ? `the ${record.branch} branch taken` : "no branch taken";
+  const text = `${name(at)} ended with ${record.outcome}: ${taken}${next ? `, ${name(next)} next` : ""}`;
+  return h("li", { class: record.branch ? "branch-taken" : "no-branch",
+    dataset: { outcome: record.outcome, branch: record.branch || "", place: placeKey(at.place), iteration: iteration || "" } },
+  iteration ? h("span", { class: "badge" }, `iteration ${iteration}`) : null, " ", text);
 }
 
 function renderFlow(run) {
@@ -51,6 +65,9 @@ function renderFlow(run) {
   });
   fill($("#run-values"), items);
   $("#run-values-box").hidden = items.length === 0;
+  const taken = (run.branches || []).map((record) => branchItem(record, run)).filter(Boolean);
+  fill($("#run-branches"), taken);
+  $("#run-branches-box").hidden = taken.length === 0;
 }
 
 function statusText(run) {
@@ -146,7 +163,7 @@ export function renderRun() {
 export function takeRecord({ run: id, record, text }) {
   if (!state.run || state.run.run !== id) {
     state.run = { run: id, task: null, status: "running", steps: null, step: null, states: {}, faults: [], end: null,
-      lines: [], seq: 0, visited: [], values: [] };
+      lines: [], seq: 0, visited: [], values: [], branches: [] };
   }
   const run = state.run;
   if (record.seq <= run.seq) return; // already in the run's view
@@ -161,6 +178,7 @@ export function takeRecord({ run: id, record, text }) {
       run.visited.push({ step: record.step, seq: record.seq });
       break;
     case "value": run.values.push(record); break;
+    case "branch": run.branches.push(record); break;
     case "state":
       run.states[record.device] = record.state;
       break;

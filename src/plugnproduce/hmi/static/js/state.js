@@ -1,5 +1,7 @@
 // What the page knows: the cell, the offered commands, the processes, the task being edited, the run.
 
+import { numberOf, placeKey, rowsOf } from "./places.js";
+
 const TASK_KEY = "pnp-task";
 
 export const state = {
@@ -8,7 +10,9 @@ export const state = {
   pluggable: false,
   catalogue: [],
   processes: new Map(), // command -> process (roles, parameters)
-  task: { name: "task", description: "", repeat: 1, steps: [], loops: [] }, // loops: [{first, last, until, max}] (rows)
+  // steps: the task's steps, each with its branches (`on: {OUTCOME: [steps]}`); loops: [{first, last, until, while, max}]
+  // (indices of the task's steps, not of its branches' steps)
+  task: { name: "task", description: "", repeat: 1, steps: [], loops: [] },
   check: null, // the last check (with repairs) of the task as it is
   run: null, // {run, status, step, states, faults, lines}
   generated: [], // charts of the last generation
@@ -46,8 +50,11 @@ export function loadTask() {
   }
 }
 
+/** A step as the API takes it; a branch on an outcome holds its steps (`on: {NoPartFound: [...]}`). */
 function stepBody(s) {
-  return { ...(s.name ? { name: s.name } : {}), command: s.command, bind: s.bind || {}, params: s.params || {} };
+  const on = Object.entries(s.on || {}).filter(([, steps]) => steps.length);
+  return { ...(s.name ? { name: s.name } : {}), command: s.command, bind: s.bind || {}, params: s.params || {},
+    ...(on.length ? { on: Object.fromEntries(on.map(([outcome, steps]) => [outcome, steps.map(stepBody)])) } : {}) };
 }
 
 /** The loop whose body holds editor row `row`, if any. */
@@ -62,7 +69,8 @@ export function taskBody(task = state.task) {
     const loop = loopOf(row, task);
     if (!loop) steps.push(stepBody(s));
     else if (row === loop.first) {
-      steps.push({ loop: { ...(loop.until ? { until: loop.until } : {}), ...(loop.max ? { max: loop.max } : {}),
+      steps.push({ loop: { ...(loop.until ? { until: loop.until } : {}), ...(loop.while ? { while: loop.while } : {}),
+        ...(loop.max ? { max: loop.max } : {}),
         steps: task.steps.slice(loop.first, loop.last + 1).map(stepBody) } });
     }
   });
@@ -71,6 +79,10 @@ export function taskBody(task = state.task) {
 
 /** A task from the API as the editor holds it: one row per step, each loop as the rows it spans. */
 export function editorTask(body) {
+  if (rowsOf(body.steps).some((r) => r.depth > 0 && r.step.loop)) {
+    throw new Error("This task has a loop inside a branch: the editor builds loops of the task's steps only; "
+      + "edit that task file by hand.");
+  }
   const steps = [];
   const loops = [];
   for (const item of body.steps) {
@@ -79,24 +91,35 @@ export function editorTask(body) {
       continue;
     }
     const { until, max, steps: inner } = item.loop;
-    loops.push({ first: steps.length, last: steps.length + inner.length - 1, until: until || null, max: max || null });
+    loops.push({ first: steps.length, last: steps.length + inner.length - 1, until: until || null,
+      while: item.loop.while || null, max: max || null });
     steps.push(...inner);
   }
   return { name: body.name, description: body.description || "", repeat: body.repeat || 1, steps, loops };
 }
 
 /**
- * Where each step position of a run lies in the editor: {row, loop, iteration} (iteration 1, or 2 for
- * "2 and later"). A loop's body counts twice in the positions, as the task's step numbers do.
+ * Where each step position of a run lies in the editor: {row, top, place, number, step, loop, iteration,
+ * branch}. Positions number the steps as the server does: a step, then its branches' steps; a loop's body
+ * twice (iteration 1, then 2 for "2 and later"). `top` is the index of the task's step the position is, or
+ * lies in a branch of; `branch` is the innermost branch holding it ({place of its step, outcome}) or null.
  */
 export function stepPositions(task = state.task) {
+  const rows = new Map(rowsOf(task.steps).map((r) => [placeKey(r.place), r.row]));
   const out = [null];
-  task.steps.forEach((_, row) => {
-    const loop = loopOf(row, task);
-    if (!loop) out.push({ row, loop: null, iteration: 1 });
-    else if (row === loop.last) {
+  const walk = (step, place, at) => {
+    out.push({ ...at, row: rows.get(placeKey(place)), place, number: numberOf(task.steps, place), step });
+    for (const [outcome, inner] of Object.entries(step.on || {})) {
+      inner.forEach((s, j) => walk(s, [...place, outcome, j], { ...at, branch: { place, outcome } }));
+    }
+  };
+  const add = (top, loop, iteration) => walk(task.steps[top], [top], { top, loop, iteration, branch: null });
+  task.steps.forEach((_, top) => {
+    const loop = loopOf(top, task);
+    if (!loop) add(top, null, 1);
+    else if (top === loop.last) {
       for (const iteration of [1, 2]) {
-        for (let r = loop.first; r <= loop.last; r++) out.push({ row: r, loop, iteration });
+        for (let r = loop.first; r <= loop.last; r++) add(r, loop, iteration);
       }
     }
   });
