@@ -7,7 +7,8 @@ the step can go on with takes no branch; an outcome that ends the step's loop
 (``until``) never reaches its branches). The check runs on the **default path** (no
 branch where an outcome takes none, else the first reachable one) and on one path per
 other branch (taking it and the branches it lies in), so every step is checked
-from the device states it really starts from; at most :data:`MAX_PATHS` paths.
+from the device states it really starts from; at most :data:`MAX_PATHS` paths of
+:data:`MAX_PATH_STEPS` steps in all.
 
 The steps after a step's branches are generated once, for one set of device states:
 every way on from the step (each reachable branch, and going on without one) must leave
@@ -31,6 +32,8 @@ from plugnproduce.reasoning.results import CheckResult, Problem, Reason, StepChe
 
 MAX_PATHS = 100
 """Most paths a task's check runs (one per branch, and the default one)."""
+MAX_PATH_STEPS = 200_000
+"""Most steps the paths of one task's check hold together (a 10,000-step task: 20 paths)."""
 
 
 @dataclass(frozen=True)
@@ -92,6 +95,8 @@ def task_paths(task: Task, processes: dict[str, ProcessDescription], taxonomy: T
     for b in task.branches:
         if b.first in on_default:
             continue
+        if len(paths) > MAX_PATHS or sum(len(p.positions) for p in paths) > MAX_PATH_STEPS:
+            break  # more than can be checked: the check refuses the task
         choices = dict(default)
         choices.update({a.step: a for a in task.branches if a.holds(b.step)})
         choices[b.step] = b

@@ -13,6 +13,7 @@ from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
 from plugnproduce.reasoning.branches import (
+    MAX_PATH_STEPS,
     MAX_PATHS,
     check_paths,
     join_problems,
@@ -113,9 +114,10 @@ def _branched(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Pr
     """The check of a task with branches: each of its paths (:mod:`plugnproduce.reasoning.branches`)."""
     by_id = {p.id: p for p in processes}
     paths = task_paths(task, by_id, taxonomy)
-    if len(paths) > MAX_PATHS:
-        where = Where(task.file, task.branches[MAX_PATHS - 1].line)
-        text = f"the task has {len(paths)} paths through its branches; at most {MAX_PATHS} are checked"
+    if len(paths) > MAX_PATHS or sum(len(p.positions) for p in paths) > MAX_PATH_STEPS:
+        where = Where(task.file, paths[-1].branch.line if paths[-1].branch else None)
+        text = (f"the task has more paths through its branches than are checked: at most {MAX_PATHS} paths of "
+                f"{MAX_PATH_STEPS} steps in all")
         problem = Problem(1, task.steps[0].command, "too_many_paths", Reason("too_many_paths", text, (), (where,)),
                           where)
         return CheckResult(task.name, cell.name, False, (problem,), ())
