@@ -5,18 +5,17 @@
 import { editStep } from "./dialog.js";
 import { $, fill, h } from "./dom.js";
 import { numberOf, stepAt, withList } from "./places.js";
-import { state } from "./state.js";
+import { outcomeChoices, outcomeText, state } from "./state.js";
 
 function label(command) {
   const p = state.processes.get(command);
   return p ? p.label : command;
 }
 
-/** The outcomes the process of `owner` may end with that have no branch there yet (`keep` stays offered). */
+/** The outcome choices of `owner`'s process that have no branch there yet (`keep` stays offered). */
 export function freeOutcomes(owner, keep) {
-  const p = state.processes.get(owner.command);
   const taken = Object.keys(owner.on || {});
-  return ((p && p.outcomes) || []).filter((o) => o === keep || !taken.includes(o));
+  return outcomeChoices(owner.command).filter((c) => c.outcome === keep || !taken.includes(c.outcome));
 }
 
 /** A branch in words: "If step 2 (Localise part) ends with NoPartFound". */
@@ -107,7 +106,7 @@ function fillChoices(edit) {
   const owner = stepAt(state.task.steps, edit.place);
   const outcomes = freeOutcomes(owner, edit.old);
   fill($("#branch-outcome"), outcomes.length ? null : h("option", { value: "" }, "no outcome left to branch on"),
-    outcomes.map((o) => h("option", { value: o, selected: o === edit.old }, o)));
+    outcomes.map((c) => h("option", { value: c.outcome, selected: c.outcome === edit.old }, outcomeText(c))));
   fill($("#branch-command"), commands().map((c) => h("option", { value: c }, label(c))));
   $("#branch-title").textContent = edit.old
     ? `Edit branch: ${branchText(state.task.steps, edit.place, edit.old)}`
