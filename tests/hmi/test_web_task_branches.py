@@ -268,8 +268,13 @@ def test_an_imported_branch_in_a_branch_is_listed_as_written_and_a_loop_in_a_bra
         f"If step 1 ({_label(LOCALIZE)}) ends with PartFound:", f"If step 1.2 ({_label(LOCALIZE)}) ends with BinEmpty:",
         f"If step 1 ({_label(LOCALIZE)}) ends with BinEmpty:"])
     expect(page.locator("#steps li.step[data-place='0/PartFound/0'] .add-branch")).to_have_count(0)  # no outcome
-    expect(page.locator("#verdict .ok, #verdict .bad")).to_be_visible()  # checked: no check is pending
     screenshot(page, "task-editor-nested-branches")
+    page.get_by_role("button", name="Move step 1.1 (scan bin) down").click()
+    expect(numbers).to_have_text(["1", "1.1", "1.1.1", "1.2", "1.3", "2"])
+    page.get_by_role("button", name="Remove step 1.1.1 (scan bin)").click()  # the branch's only step: it goes
+    expect(page.locator("#steps .branch-head")).to_have_count(2)
+    expect(numbers).to_have_text(["1", "1.1", "1.2", "1.3", "2"])
+    expect(page.locator("#verdict .ok, #verdict .bad")).to_be_visible()  # checked: no check is pending
     looped = NESTED.replace(b"        - command: scan-bin\n        - command: localize-part",
                             b"        - loop: {max: 2, steps: [{command: scan-bin}]}\n        - command: localize-part")
     page.locator("#import").set_input_files(files=[{"name": "looped.yaml", "mimeType": "application/yaml",
@@ -277,4 +282,4 @@ def test_an_imported_branch_in_a_branch_is_listed_as_written_and_a_loop_in_a_bra
     expect(page.locator("#verdict .error")).to_have_text(
         "This task has a loop inside a branch: the editor builds loops of the task's steps only; edit that task file "
         "by hand.")
-    expect(page.locator("#steps li.step")).to_have_count(6)
+    expect(page.locator("#steps li.step")).to_have_count(5)  # the task as it was
