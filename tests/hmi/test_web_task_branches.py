@@ -186,6 +186,9 @@ def test_a_finding_in_a_branch_shows_at_its_row_with_its_path_and_the_branch_is_
     expect(finding.locator(".path")).to_have_text("loop iteration 1, branch PartFound at step 1")
     expect(finding).to_contain_text("device 'gripper' (role 'gripper') is in state 'closed'")
     expect(page.locator("#steps li.step[data-place='0'] .problem")).to_have_count(0)
+    repair = page.locator("#repair-list li.repair").first  # the repairs come back with the loop written out
+    expect(repair.locator(".unrolls")).to_contain_text("would write the loops and branches out step by step")
+    expect(repair.locator(".apply")).to_be_disabled()
     screenshot(page, "task-editor-branch-finding")
     page.get_by_role("button", name="Edit the PartFound branch of step 1").click()
     page.get_by_role("button", name="Remove branch step 2 (pick)").click()
