@@ -39,3 +39,31 @@ def test_a_link_to_the_librarys_output_of_the_wrong_type_is_refused(tmp_path: Pa
     assert result.returncode == 1
     assert (f"{task}:13: loop iteration 1: step 2 (pick): parameter pick_pose takes part_type from found, "
             "a string; the parameter takes a Pose") in result.stdout
+
+
+BRANCHING = LIBRARY / "tasks" / "clear-bin-or-look-again.yaml"
+
+
+def test_a_library_task_branches_on_the_librarys_own_outcome_and_runs(tmp_path: Path) -> None:
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(BRANCHING), "--sim", "--bin-parts", "2", "--bin-seed", "5", "--journal", str(journal))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    records = [json.loads(line) for line in journal.read_text(encoding="utf-8").splitlines()]
+    taken = [(r["outcome"], r["branch"]) for r in records if r["kind"] == "branch"]
+    assert taken == [("PartFound", "PartFound")] * 2 + [("BinEmpty", None)]
+    assert [r["command"] for r in records if r["kind"] == "step"][-1] == "move-to"
+
+
+def test_verify_proves_the_library_task_on_every_outcome_its_process_declares() -> None:
+    result = pnp("verify", str(BRANCHING), "--cell", str(CELL), "--json")
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert json.loads(result.stdout)["verdict"] == "proved"
+
+
+def test_a_misspelt_library_outcome_is_refused_at_its_line(tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text(BRANCHING.read_text(encoding="utf-8").replace("#PartOccluded", "#PartOcluded"), encoding="utf-8")
+    result = pnp("check", str(task), "--cell", str(CELL))
+    assert result.returncode == 1
+    assert (f"{task}:19: step 1 (find-part): branch PartOcluded: PartOcluded is not an outcome of the ontology; "
+            "did you mean PartOccluded") in result.stdout

@@ -129,3 +129,17 @@ def test_an_unreachable_branch_is_refused_by_the_check_too(tmp_path: Path) -> No
     [problem] = [p for p in result.problems if p.kind == "bad_flow"]
     assert problem.where.line == line_of(path, "NoPartFund:")
     assert "did you mean NoPartFound or PartFound?" in problem.text
+
+
+def test_a_step_in_a_branch_is_explained_from_the_states_it_starts_from(tmp_path: Path) -> None:
+    # move-to (step 4) starts where localize left the robot, not where place (step 3, the other branch) did
+    explanation = service.explain_step(TASKS / "bin-picking-then-home.yaml", CELL, 4)
+    [robot] = [r.text for r in explanation.states if "device 'robot'" in r.text]
+    assert "step 3" not in robot and "its initial state" in robot and explanation.plausible
+
+
+def test_a_task_with_more_paths_than_are_checked_is_refused_not_checked_for_ever(tmp_path: Path) -> None:
+    text = "task: many\nsteps:\n" + "  - command: localize-part\n    on:\n      PartFound: [{command: scan-bin}]\n" * 150
+    result, _ = checked(tmp_path, text)
+    assert [p.kind for p in result.problems] == ["too_many_paths"] and not result.plausible
+    assert "at most 100 paths" in result.problems[0].text

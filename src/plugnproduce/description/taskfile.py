@@ -21,6 +21,8 @@ from plugnproduce.ontology.vocabulary import concept_iri, concept_value
 from plugnproduce.safeio import PlainDumper, parse_yaml_bytes, read_bytes
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")
+_OUTCOME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}|https?://[^\s#<>\"]{1,200}#[A-Za-z][A-Za-z0-9_]{0,63}")
+"""An outcome: the local name of a ``pnp`` concept, or the full IRI of a library's own."""
 
 
 def _mapping(node: yaml.Node, path: Path, what: str) -> dict[str, yaml.Node]:
@@ -138,8 +140,9 @@ def _step_and_branches(flat: _Flat, node: yaml.Node, m: dict[str, yaml.Node], in
     _mapping(on, flat.path, "on")  # keys plain and once each
     for key, body in on.value:
         line = key.start_mark.line + 1
-        if not _NAME.fullmatch(str(key.value)):
-            raise DescriptionError(f"on names outcomes such as NoPartFound; found {excerpt(repr(key.value))}",
+        if not _OUTCOME.fullmatch(str(key.value)):
+            raise DescriptionError(f"on names outcomes such as NoPartFound (or a library's by its IRI); found "
+                                   f"{excerpt(repr(key.value))}",
                                    flat.path, line)
         if not isinstance(body, yaml.SequenceNode) or not body.value:
             raise DescriptionError(f"branch {excerpt(key.value)} needs its steps, a non-empty list", flat.path, line)
@@ -169,8 +172,9 @@ def _outcome(m: dict[str, yaml.Node], key: str, p: Path) -> str | None:
     if key not in m:
         return None
     value = _plain(m[key])
-    if not isinstance(value, str) or not _NAME.fullmatch(value):
-        raise DescriptionError(f"{key} names an outcome such as BinEmpty; found {excerpt(repr(value))}", p,
+    if not isinstance(value, str) or not _OUTCOME.fullmatch(value):
+        raise DescriptionError(f"{key} names an outcome such as BinEmpty (or a library's by its IRI); found "
+                               f"{excerpt(repr(value))}", p,
                                m[key].start_mark.line + 1)
     return concept_iri(value)
 

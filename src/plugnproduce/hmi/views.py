@@ -177,8 +177,8 @@ def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
 
 def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[str, Any]:
     """What a run's journal says so far: status, current step (and every step position entered, from which
-    a loop's iterations are counted), every device's state, the values that flowed, the branch taken after
-    each step with branches, the fault if any."""
+    a loop's iterations are counted), every device's state, the values that flowed, the branches taken, the
+    fault if any."""
     start = next((r for r in records if r["kind"] == "start"), {})
     end = next((r for r in records if r["kind"] == "end"), None)
     steps = [r for r in records if r["kind"] == "step"]

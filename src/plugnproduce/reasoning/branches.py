@@ -7,7 +7,8 @@ the step can go on with takes no branch; an outcome that ends the step's loop
 (``until``) never reaches its branches). The check runs on the **default path** (no
 branch where an outcome takes none, else the first reachable one) and on one path per
 other branch (taking it and the branches it lies in), so every step is checked
-from the device states it really starts from; at most :data:`MAX_PATHS` paths.
+from the device states it really starts from; at most :data:`MAX_PATHS` paths of
+:data:`MAX_PATH_STEPS` steps in all.
 
 The steps after a step's branches are generated once, for one set of device states:
 every way on from the step (each reachable branch, and going on without one) must leave
@@ -31,6 +32,8 @@ from plugnproduce.reasoning.results import CheckResult, Problem, Reason, StepChe
 
 MAX_PATHS = 100
 """Most paths a task's check runs (one per branch, and the default one)."""
+MAX_PATH_STEPS = 200_000
+"""Most steps the paths of one task's check hold together (a 10,000-step task: 20 paths)."""
 
 
 @dataclass(frozen=True)
@@ -92,6 +95,8 @@ def task_paths(task: Task, processes: dict[str, ProcessDescription], taxonomy: T
     for b in task.branches:
         if b.first in on_default:
             continue
+        if len(paths) > MAX_PATHS or sum(len(p.positions) for p in paths) > MAX_PATH_STEPS:
+            break  # more than can be checked: the check refuses the task
         choices = dict(default)
         choices.update({a.step: a for a in task.branches if a.holds(b.step)})
         choices[b.step] = b
@@ -194,13 +199,32 @@ def check_paths(task: Task, paths: list[Path], check: Check) -> PathChecks:
 _STEP = re.compile(r"\bstep (\d+)\b")
 
 
-def renumbered(problem: Problem, positions: tuple[int, ...]) -> Problem:
-    """A straight path's problem with its step numbers (in its text too) the task's positions."""
+def renumbered_text(text: str, positions: tuple[int, ...]) -> str:
+    """A straight path's sentence with its step numbers the task's positions."""
     def position(m: re.Match[str]) -> str:
         n = int(m.group(1))
         return f"step {positions[n - 1]}" if 1 <= n <= len(positions) else m.group(0)
 
-    reason = dataclasses.replace(problem.reason, text=_STEP.sub(position, problem.reason.text))
+    return _STEP.sub(position, text)
+
+
+def on_a_path(task: Task, index: int, processes: dict[str, ProcessDescription], taxonomy: Taxonomy,
+              check: Check | None = None) -> tuple[Task, tuple[int, ...]]:
+    """A path through the task's branches that runs position ``index``, as a straight task, and its positions:
+    the first on which ``check`` finds a problem at the step (the first that runs it, without ``check``)."""
+    paths = [p for p in task_paths(task, processes, taxonomy) if index in p.positions]
+    for path in paths if check is not None else ():
+        straight = _straight(task, path.positions)
+        assert check is not None
+        if any(p.step == path.positions.index(index) + 1 for p in check(straight).problems):
+            return straight, path.positions
+    path = paths[0] if paths else Path(None, tuple(range(1, len(task.steps) + 1)))
+    return _straight(task, path.positions), path.positions
+
+
+def renumbered(problem: Problem, positions: tuple[int, ...]) -> Problem:
+    """A straight path's problem with its step numbers (in its text too) the task's positions."""
+    reason = dataclasses.replace(problem.reason, text=renumbered_text(problem.reason.text, positions))
     step = positions[problem.step - 1] if 1 <= problem.step <= len(positions) else positions[-1]
     return dataclasses.replace(problem, step=step, reason=reason)
 

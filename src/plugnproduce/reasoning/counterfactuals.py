@@ -115,7 +115,8 @@ def needed_states(result: CheckResult, task: Task, n: int, cell: Cell, taxonomy:
     """For a step that is not plausible: the chart states its devices would have to be in when it starts, each
     confirmed by checking the step alone from the states the devices are in then, with that one changed."""
     step = result.steps[n - 1]
-    alone = dataclasses.replace(task, steps=(dataclasses.replace(task.steps[n - 1], index=1),))
+    alone = dataclasses.replace(task, steps=(dataclasses.replace(task.steps[n - 1], index=1),), loops=(), branches=(),
+                                repeat=1)
     out: list[Counterfactual] = []
     for p in result.problems:
         if p.step != n or p.kind != "wrong_state" or p.device is None or p.needed is None:

@@ -12,7 +12,16 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import render, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.accepts import not_accepted
-from plugnproduce.reasoning.branches import MAX_PATHS, check_paths, join_problems, task_paths
+from plugnproduce.reasoning.branches import (
+    MAX_PATH_STEPS,
+    MAX_PATHS,
+    check_paths,
+    join_problems,
+    on_a_path,
+    renumbered,
+    renumbered_text,
+    task_paths,
+)
 from plugnproduce.reasoning.contracts import beyond_limits, normalised
 from plugnproduce.reasoning.controlflow import loop_problems, on_path
 from plugnproduce.reasoning.dataflow import link_problems, unreported
@@ -105,9 +114,10 @@ def _branched(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Pr
     """The check of a task with branches: each of its paths (:mod:`plugnproduce.reasoning.branches`)."""
     by_id = {p.id: p for p in processes}
     paths = task_paths(task, by_id, taxonomy)
-    if len(paths) > MAX_PATHS:
-        where = Where(task.file, task.branches[MAX_PATHS - 1].line)
-        text = f"the task has {len(paths)} paths through its branches; at most {MAX_PATHS} are checked"
+    if len(paths) > MAX_PATHS or sum(len(p.positions) for p in paths) > MAX_PATH_STEPS:
+        where = Where(task.file, paths[-1].branch.line if paths[-1].branch else None)
+        text = (f"the task has more paths through its branches than are checked: at most {MAX_PATHS} paths of "
+                f"{MAX_PATH_STEPS} steps in all")
         problem = Problem(1, task.steps[0].command, "too_many_paths", Reason("too_many_paths", text, (), (where,)),
                           where)
         return CheckResult(task.name, cell.name, False, (problem,), ())
@@ -128,6 +138,12 @@ def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,
     """Why step ``n`` (1-based) is (not) plausible: each device it uses, its state and what the step needs."""
     if not 1 <= n <= len(task.steps):
         raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+    if task.branches:  # along a path that runs the step, so that its states are the ones it starts from
+        straight, positions = on_a_path(task, n, {p.id: p for p in processes}, taxonomy)
+        ex = explain_step(straight, cell, positions.index(n) + 1, taxonomy, processes)
+        states = tuple(dataclasses.replace(r, text=renumbered_text(r.text, positions)) for r in ex.states)
+        return dataclasses.replace(ex, step=n, states=states,
+                                   problems=tuple(renumbered(p, positions) for p in ex.problems))
     task, _ = normalised(task, processes)
     model, ctx = run_check(task, cell, taxonomy, processes)
     left = {(a.i, a.d): a.j for a in model[s.LeftBy]}

@@ -138,8 +138,9 @@ def repaired_task(model: Model, task: Task) -> Task:
         old = task.steps[run.i - 1]
         params = {k: v for k, v in old.params.items() if (run.i, k) not in resets}
         steps.append(Step(index, run.p, bind, params, old.line, dict(old.param_lines), old.name))
-    loops = task.loops if len(steps) == len(task.steps) else ()  # a loop's steps kept in place: still the loop
-    return Task(task.name, tuple(steps), task.file, task.description, folded_repeat(steps, task.repeat), loops)
+    kept = len(steps) == len(task.steps)  # a loop's or branch's steps kept in place: still the loop, the branch
+    return Task(task.name, tuple(steps), task.file, task.description, folded_repeat(steps, task.repeat),
+                task.loops if kept else (), task.branches if kept else ())
 
 
 def folded_repeat(steps: list[Step], most: int) -> int:

@@ -3,6 +3,7 @@ rule instances of ``rules/*.lp`` (ASP), the ontology axioms (OWL) and the chart 
 
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -13,6 +14,7 @@ from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning import counterfactuals, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.axioms import Axiom, Ontology
+from plugnproduce.reasoning.branches import on_a_path, renumbered_text
 from plugnproduce.reasoning.counterfactuals import Counterfactual
 from plugnproduce.reasoning.derivation import Node, asp
 from plugnproduce.reasoning.facts import fact_book
@@ -352,6 +354,11 @@ def explain_plausible(task: Task, n: int, cell: Cell, taxonomy: Taxonomy, ontolo
     :func:`sideeffects.assess`)."""
     if not 1 <= n <= len(task.steps):
         raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+    if task.branches:  # along the path that makes the step (not) plausible, numbered as the task numbers it
+        straight, positions = on_a_path(task, n, {p.id: p for p in processes}, taxonomy,
+                                        lambda t: check(t, cell, taxonomy, processes))
+        ex = explain_plausible(straight, positions.index(n) + 1, cell, taxonomy, ontology, processes, language)
+        return _renumbered(ex, positions, task.path(n))
     result = check(task, cell, taxonomy, processes)
     w = words(cell, taxonomy, ontology, processes, language)
     tree = step_tree(w, result, task, n)
@@ -362,3 +369,18 @@ def explain_plausible(task: Task, n: int, cell: Cell, taxonomy: Taxonomy, ontolo
     return Explanation("plausible", f"step {n}", False, tree, tuple(states),
                        None if states else f"no state of its devices alone makes step {n} plausible; "
                                            f"see the repairs")
+
+
+def _renumbered(ex: Explanation, positions: tuple[int, ...], path: str | None) -> Explanation:
+    """An explanation found on a straight path, with the task's step numbers and the step's path named."""
+    def node(n: Node) -> Node:
+        return dataclasses.replace(n, text=renumbered_text(n.text, positions),
+                                   detail=renumbered_text(n.detail, positions), children=tuple(map(node, n.children)))
+
+    flips = tuple(dataclasses.replace(c, text=renumbered_text(c.text, positions),
+                                      step=positions[c.step - 1] if c.step and c.step <= len(positions) else c.step)
+                  for c in ex.counterfactuals)
+    subject = renumbered_text(ex.subject, positions) + (f" ({path})" if path else "")
+    none = renumbered_text(ex.none_exists, positions) if ex.none_exists else None
+    return dataclasses.replace(ex, subject=subject, derivation=node(ex.derivation), counterfactuals=flips,
+                               none_exists=none)
