@@ -191,6 +191,10 @@ def test_a_finding_in_a_branch_shows_at_its_row_with_its_path_and_the_branch_is_
     expect(repair.locator(".apply")).to_be_disabled()
     screenshot(page, "task-editor-branch-finding")
     page.get_by_role("button", name="Edit the PartFound branch of step 1").click()
+    expect(page.locator("#branch-title")).to_have_text(
+        f"Edit branch: If step 1 ({_label(LOCALIZE)}) ends with PartFound")
+    expect(page.locator("#branch-steps li")).to_have_count(2)
+    screenshot(page, "dialog-branch")
     page.get_by_role("button", name="Remove branch step 2 (pick)").click()
     _branch_step(page, "place", "step 1.2 in the PartFound branch of step 1")
     _save_step(page)

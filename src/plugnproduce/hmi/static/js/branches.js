@@ -6,11 +6,7 @@ import { editStep } from "./dialog.js";
 import { $, fill, h } from "./dom.js";
 import { numberOf, stepAt, withList } from "./places.js";
 import { outcomeChoices, outcomeText, state } from "./state.js";
-
-function label(command) {
-  const p = state.processes.get(command);
-  return p ? p.label : command;
-}
+import { label, paramSummary } from "./steptext.js";
 
 /** The outcome choices of `owner`'s process that have no branch there yet (`keep` stays offered). */
 export function freeOutcomes(owner, keep) {
@@ -79,8 +75,10 @@ class BranchEdit {
     return h("li", { class: "step", dataset: { command: step.command } },
       h("div", { class: "step-head" },
         h("span", { class: "step-no", "aria-hidden": "true" }, String(j + 1)),
-        h("span", { class: "step-main step-cmd" }, label(step.command), " ", h("code", {}, step.command),
-          step.name ? h("span", { class: "badge step-name" }, step.name) : null),
+        h("div", { class: "step-main" },
+          h("span", { class: "step-cmd" }, label(step.command), " ", h("code", {}, step.command),
+            step.name ? h("span", { class: "badge step-name" }, step.name) : null),
+          h("span", { class: "step-detail" }, paramSummary(step))),
         h("span", { class: "step-actions" },
           button("edit", "Edit", `Edit ${name}`, () => this.open(j)),
           button("up", "↑", `Move ${name} up`, () => this.change(j, -1), j === 0),

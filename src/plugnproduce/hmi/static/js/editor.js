@@ -9,7 +9,8 @@ import { $, announce, fill, h } from "./dom.js";
 import { editLoop, loopText } from "./loops.js";
 import { listAt, numberOf, placeKey, stepAt, withList, withStep } from "./places.js";
 import { changed, editorTask, saveTask, state, taskBody } from "./state.js";
-import { label, taskItems } from "./tasklist.js";
+import { label } from "./steptext.js";
+import { taskItems } from "./tasklist.js";
 
 let checkTimer = null;
 let checkSeq = 0;
