@@ -138,7 +138,7 @@ async def test_yaml_import_errors_name_the_file_and_line(client: httpx.AsyncClie
     text = b"task: t\nsteps:\n  - command: pick\n    speed: 3\n"
     res = await client.post("/api/task/import?filename=mine.yaml", content=text, headers=YAML)
     assert res.status_code == 400
-    assert res.json()["detail"] == "mine.yaml:4: step: unknown key 'speed'; expected one of bind, command, name, params"
+    assert res.json()["detail"] == "mine.yaml:4: step: unknown key 'speed'; expected one of bind, command, name, on, params"
 
 
 async def test_yaml_import_refuses_aliases(client: httpx.AsyncClient) -> None:
