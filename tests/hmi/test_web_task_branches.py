@@ -290,3 +290,22 @@ def test_an_imported_branch_in_a_branch_is_listed_as_written_and_a_loop_in_a_bra
         "This task has a loop inside a branch: the editor builds loops of the task's steps only; edit that task file "
         "by hand.")
     expect(page.locator("#steps li.step")).to_have_count(5)  # the task as it was
+
+
+SLOW_GRIPPER = "gripper:delay-event:gripper_closed:1"
+"""The simulated gripper reports closed a second late (within its 2 s timeout): time to watch the run."""
+
+
+@pytest.mark.parametrize("served", [SLOW_GRIPPER], indirect=True)
+def test_while_a_branch_runs_its_head_and_its_step_are_marked(page: Page) -> None:
+    shipped = SHIPPED.read_text(encoding="utf-8").replace("max: 100", "max: 1")
+    page.locator("#import").set_input_files(files=[{"name": "once.yaml", "mimeType": "application/yaml",
+                                                    "buffer": shipped.encode()}])
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    page.get_by_role("button", name="Start run").click()
+    expect(page.locator("#run-states tr[data-device='gripper'] .badge")).to_have_text("closing")
+    expect(page.locator("#steps li.step.running")).to_have_attribute("data-place", "0/PartFound/0")
+    expect(page.locator("#steps .branch-head.running")).to_have_attribute("data-outcome", "PartFound")
+    screenshot(page, "run-branch-in-progress")
+    expect(page.locator("#run-status")).to_contain_text("succeeded")
+    expect(page.locator("#steps .branch-head.running")).to_have_count(0)
