@@ -97,3 +97,11 @@ async def test_a_branch_in_a_branch_counts_its_rows_as_written(client: httpx.Asy
     assert back["steps"][0]["on"]["PartFound"][1]["on"]["BinEmpty"][0]["command"] == "place"
     result = (await client.post("/api/task/validate", json=task)).json()
     assert {(p["row"], p["field"]) for p in result["problems"]} == {(3, "steps[3].params.speed")}
+
+
+async def test_a_process_offers_the_outcomes_a_branch_may_name_with_the_ones_they_cover(
+        client: httpx.AsyncClient) -> None:
+    processes = {p["command"]: p for p in (await client.get("/api/processes")).json()}
+    choices = {c["outcome"]: c["covers"] for c in processes["localize-part"]["outcome_choices"]}
+    assert choices == {"PartFound": ["PartFound"], "BinEmpty": ["BinEmpty"], "NoPartFound": ["BinEmpty"]}
+    assert processes["pick"]["outcome_choices"] == []

@@ -60,7 +60,8 @@ def _build_until_empty(page: Page) -> None:
     page.get_by_role("button", name="Add loop").click()
     dialog = page.locator("#loop-dialog")
     expect(dialog).to_be_visible()
-    expect(page.locator("#loop-until option")).to_have_text(["no outcome: only the maximum", "PartFound", "BinEmpty"])
+    expect(page.locator("#loop-until option")).to_have_text(["no outcome: only the maximum", "PartFound", "BinEmpty",
+                                                             "NoPartFound (reported as BinEmpty)"])
     page.locator("#loop-until").select_option("BinEmpty")
     page.locator("#loop-max").fill("100")
     dialog.get_by_role("button", name="Save loop").click()

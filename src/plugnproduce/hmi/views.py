@@ -81,9 +81,23 @@ def output_json(o: Output, taxonomy: Taxonomy) -> dict[str, Any]:
             "quantity": taxonomy.label(o.quantity)}
 
 
+def outcome_choices(p: ProcessDescription, taxonomy: Taxonomy) -> list[dict[str, Any]]:
+    """The outcomes a branch on a step of ``p`` (or a loop's ``until``/``while``) may name: each outcome ``p``
+    may end with, then each more general outcome they fall under (``NoPartFound`` for ``BinEmpty``), with the
+    outcomes of ``p`` it covers."""
+    ends = list(dict.fromkeys(p.outcomes))
+    broader = [o for o in taxonomy.classes_of_kind("Outcome") if o not in ends]
+    choices = []
+    for o in ends + broader:
+        covers = [concept_value(e) for e in ends if taxonomy.is_a(e, o)]
+        if covers:
+            choices.append({"outcome": concept_value(o), "label": taxonomy.label(o), "covers": covers})
+    return choices
+
+
 def process_json(p: ProcessDescription, taxonomy: Taxonomy) -> dict[str, Any]:
     """A process: its command, label, roles (required skill, start and end states), parameters, the outputs
-    later steps may take and the outcomes it may end with (as a loop's ``until`` names them)."""
+    later steps may take, the outcomes it may end with, and the outcomes a branch or loop on it may name."""
     return {
         "command": p.id,
         "label": p.label,
@@ -94,6 +108,7 @@ def process_json(p: ProcessDescription, taxonomy: Taxonomy) -> dict[str, Any]:
         "parameters": [parameter_json(x, taxonomy) for x in p.parameters],
         "outputs": [output_json(o, taxonomy) for o in p.outputs],
         "outcomes": [concept_value(o) for o in dict.fromkeys(p.outcomes)],
+        "outcome_choices": outcome_choices(p, taxonomy),
         "chart": f"/api/charts/process/{p.id}.svg",
     }
 
@@ -162,8 +177,8 @@ def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
 
 def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[str, Any]:
     """What a run's journal says so far: status, current step (and every step position entered, from which
-    a loop's iterations are counted), every device's state, the values that flowed, the branch taken after
-    each step with branches, the fault if any."""
+    a loop's iterations are counted), every device's state, the values that flowed, the branches taken, the
+    fault if any."""
     start = next((r for r in records if r["kind"] == "start"), {})
     end = next((r for r in records if r["kind"] == "end"), None)
     steps = [r for r in records if r["kind"] == "step"]

@@ -5,18 +5,13 @@
 import { editStep } from "./dialog.js";
 import { $, fill, h } from "./dom.js";
 import { numberOf, stepAt, withList } from "./places.js";
-import { state } from "./state.js";
+import { outcomeChoices, outcomeText, state } from "./state.js";
+import { label, paramSummary } from "./steptext.js";
 
-function label(command) {
-  const p = state.processes.get(command);
-  return p ? p.label : command;
-}
-
-/** The outcomes the process of `owner` may end with that have no branch there yet (`keep` stays offered). */
+/** The outcome choices of `owner`'s process that have no branch there yet (`keep` stays offered). */
 export function freeOutcomes(owner, keep) {
-  const p = state.processes.get(owner.command);
   const taken = Object.keys(owner.on || {});
-  return ((p && p.outcomes) || []).filter((o) => o === keep || !taken.includes(o));
+  return outcomeChoices(owner.command).filter((c) => c.outcome === keep || !taken.includes(c.outcome));
 }
 
 /** A branch in words: "If step 2 (Localise part) ends with NoPartFound". */
@@ -80,8 +75,10 @@ class BranchEdit {
     return h("li", { class: "step", dataset: { command: step.command } },
       h("div", { class: "step-head" },
         h("span", { class: "step-no", "aria-hidden": "true" }, String(j + 1)),
-        h("span", { class: "step-main step-cmd" }, label(step.command), " ", h("code", {}, step.command),
-          step.name ? h("span", { class: "badge step-name" }, step.name) : null),
+        h("div", { class: "step-main" },
+          h("span", { class: "step-cmd" }, label(step.command), " ", h("code", {}, step.command),
+            step.name ? h("span", { class: "badge step-name" }, step.name) : null),
+          h("span", { class: "step-detail" }, paramSummary(step))),
         h("span", { class: "step-actions" },
           button("edit", "Edit", `Edit ${name}`, () => this.open(j)),
           button("up", "↑", `Move ${name} up`, () => this.change(j, -1), j === 0),
@@ -107,7 +104,7 @@ function fillChoices(edit) {
   const owner = stepAt(state.task.steps, edit.place);
   const outcomes = freeOutcomes(owner, edit.old);
   fill($("#branch-outcome"), outcomes.length ? null : h("option", { value: "" }, "no outcome left to branch on"),
-    outcomes.map((o) => h("option", { value: o, selected: o === edit.old }, o)));
+    outcomes.map((c) => h("option", { value: c.outcome, selected: c.outcome === edit.old }, outcomeText(c))));
   fill($("#branch-command"), commands().map((c) => h("option", { value: c }, label(c))));
   $("#branch-title").textContent = edit.old
     ? `Edit branch: ${branchText(state.task.steps, edit.place, edit.old)}`

@@ -9,7 +9,8 @@ import { $, announce, fill, h } from "./dom.js";
 import { editLoop, loopText } from "./loops.js";
 import { listAt, numberOf, placeKey, stepAt, withList, withStep } from "./places.js";
 import { changed, editorTask, saveTask, state, taskBody } from "./state.js";
-import { label, taskItems } from "./tasklist.js";
+import { label } from "./steptext.js";
+import { taskItems } from "./tasklist.js";
 
 let checkTimer = null;
 let checkSeq = 0;
@@ -166,15 +167,25 @@ function applyRepair(repair) {
   $("#check").focus();
 }
 
+/** How many loops and branches a task's items hold. */
+function flowCount(items) {
+  return items.reduce((n, item) => (item.loop ? n + 1 + flowCount(item.loop.steps)
+    : n + Object.values(item.on || {}).reduce((m, inner) => m + 1 + flowCount(inner), 0)), 0);
+}
+
 function repairItem(r) {
   const added = r.added_devices.length ? h("p", { class: "hint" }, `Needs ${r.added_devices.join(", ")} plugged in.`) : null;
+  // a repaired task with fewer loops or branches has them written out step by step: it is not the operator's task
+  const unrolls = flowCount(r.task.steps) < flowCount(taskBody().steps);
   return h("li", { class: "repair", dataset: { rank: r.rank } },
     h("div", { class: "repair-text" },
       h("ul", { class: "edits" }, r.edits.map((e) => h("li", {}, e.text))),
       h("span", { class: "cost" }, `cost ${r.cost}`), added,
-      (r.side_effects || []).map((e) => h("p", { class: "side-effect", dataset: { kind: e.kind } }, `Side effect: ${e.text}`))),
+      (r.side_effects || []).map((e) => h("p", { class: "side-effect", dataset: { kind: e.kind } }, `Side effect: ${e.text}`)),
+      unrolls ? h("p", { class: "hint unrolls" }, "Applying it here would write the loops and branches out step by step: "
+        + "make these changes through the dialogs.") : null),
     h("button", { type: "button", class: "apply primary", "aria-label": `Apply repair ${r.rank}: ${r.edits.map((e) => e.text).join("; ")}`,
-      onclick: () => applyRepair(r) }, "Apply"));
+      disabled: unrolls, onclick: () => applyRepair(r) }, "Apply"));
 }
 
 /** Show the last check: the verdict, each problem at its step, and the repairs. */

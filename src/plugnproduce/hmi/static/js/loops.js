@@ -3,7 +3,7 @@
 
 import { $, fill, h } from "./dom.js";
 import { rowsOf } from "./places.js";
-import { state } from "./state.js";
+import { outcomeChoices, outcomeText, state } from "./state.js";
 
 /** A loop in words: "Loop over steps 1–3 until BinEmpty, at most 100 times". */
 export function loopText(loop) {
@@ -20,12 +20,15 @@ function stepOption(row, chosen) {
   return h("option", { value: row, selected: row === chosen }, `${row + 1}: ${p ? p.label : s.command}${s.name ? ` (${s.name})` : ""}`);
 }
 
-/** The outcomes the processes of steps first..last (and of their branches' steps) may end with, each once, in order. */
+/** The outcomes a loop over steps first..last (and their branches' steps) may name, each once, in order. */
 function outcomesOf(first, last) {
   const out = [];
   for (const { step } of rowsOf(state.task.steps.slice(first, last + 1))) {
-    const p = state.processes.get(step.command);
-    for (const o of (p && p.outcomes) || []) if (!out.includes(o)) out.push(o);
+    for (const c of outcomeChoices(step.command)) {
+      const known = out.find((o) => o.outcome === c.outcome);
+      if (!known) out.push({ ...c, covers: [...c.covers] });
+      else known.covers.push(...c.covers.filter((x) => !known.covers.includes(x)));
+    }
   }
   return out;
 }
@@ -33,7 +36,7 @@ function outcomesOf(first, last) {
 function fillOutcomes(select, first, last, chosen, none) {
   const outcomes = outcomesOf(first, last);
   fill(select, h("option", { value: "" }, outcomes.length ? none : "no step here ends with an outcome"),
-    outcomes.map((o) => h("option", { value: o, selected: o === chosen }, o)));
+    outcomes.map((c) => h("option", { value: c.outcome, selected: c.outcome === chosen }, outcomeText(c))));
 }
 
 function field(id, text, input, hint) {

@@ -80,8 +80,9 @@ function statusText(run) {
   }
 }
 
+/** Mark the step running now, and the head of each branch it lies in (the branch the run has taken). */
 function markCurrentStep(run) {
-  document.querySelectorAll("#steps .step").forEach((li) => {
+  document.querySelectorAll("#steps .step, #steps .branch-head").forEach((li) => {
     li.classList.remove("running");
     li.removeAttribute("aria-current");
   });
@@ -91,6 +92,10 @@ function markCurrentStep(run) {
   if (li) {
     li.classList.add("running");
     li.setAttribute("aria-current", "step");
+  }
+  for (let k = 1; k < at.place.length; k += 2) {
+    const head = $(`#steps .branch-head[data-place="${placeKey(at.place.slice(0, k))}"][data-outcome="${CSS.escape(at.place[k])}"]`);
+    if (head) head.classList.add("running");
   }
 }
 

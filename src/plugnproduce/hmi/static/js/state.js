@@ -33,6 +33,21 @@ export function offer(command) {
   return state.commands ? state.commands.offered.find((o) => o.command === command) : undefined;
 }
 
+/**
+ * The outcomes a branch on a step of `command` (or a loop over it) may name, as the server describes them:
+ * [{outcome, label, covers}], those the process may end with, then the more general ones they fall under.
+ */
+export function outcomeChoices(command) {
+  const p = state.processes.get(command);
+  return (p && p.outcome_choices) || [];
+}
+
+/** An outcome choice in words: "BinEmpty", or "NoPartFound (reported as BinEmpty)" for a more general one. */
+export function outcomeText(choice) {
+  const same = choice.covers.length === 1 && choice.covers[0] === choice.outcome;
+  return same ? choice.outcome : `${choice.outcome} (reported as ${choice.covers.join(" or ")})`;
+}
+
 export function saveTask() {
   try {
     localStorage.setItem(TASK_KEY, JSON.stringify(state.task));

@@ -3,25 +3,11 @@
 // Every step's item carries its row (the server's numbering of the editor's rows) and its place.
 
 import { branchText, freeOutcomes } from "./branches.js";
-import { h, showValue } from "./dom.js";
+import { h } from "./dom.js";
 import { loopText } from "./loops.js";
 import { numberOf, placeKey } from "./places.js";
 import { loopOf, offer, state } from "./state.js";
-
-export function label(command) {
-  const p = state.processes.get(command);
-  return p ? p.label : command;
-}
-
-function paramSummary(step) {
-  const process = state.processes.get(step.command);
-  const units = new Map(process ? process.parameters.map((p) => [p.name, p.unit]) : []);
-  const parts = Object.entries(step.params || {}).map(([k, v]) => (v && v.from
-    ? `${k.replace(/_/g, " ")} ← ${v.output.replace(/_/g, " ")} of ${v.from}`
-    : `${k.replace(/_/g, " ")} ${showValue(v, units.get(k))}`));
-  const binds = Object.entries(step.bind || {}).map(([role, dev]) => `${role} → ${dev}`);
-  return [...binds, ...parts].join(" · ") || "defaults";
-}
+import { label, paramSummary } from "./steptext.js";
 
 function button(cls, text, aria, onclick, disabled = false) {
   return h("button", { type: "button", class: `${cls} quiet`, "aria-label": aria, disabled, onclick }, text);
