@@ -23,9 +23,12 @@ import asyncio
 import concurrent.futures
 import logging
 import multiprocessing
+import signal
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from multiprocessing import forkserver
 from typing import Any, TypeVar
 
 from fastapi import HTTPException, Request, status
@@ -96,15 +99,15 @@ class Work:
         """Start the worker processes in the background (each is given the knowledge and the catalogue once);
         the first expensive request waits for them. Call on the server's event loop."""
         if self._starting is None:
+            _start_forkserver()
             self._starting = asyncio.ensure_future(asyncio.to_thread(self._new_pool))
         return self._starting
 
     def _new_pool(self) -> ProcessPool:
-        context = multiprocessing.get_context("forkserver")  # workers forked from a clean, single-threaded server
-        context.set_forkserver_preload(PRELOAD)
+        """The pool, its workers started (in this thread, not with the first request)."""
         pool = ProcessPool(self.limits.workers, initializer=jobs.start_worker,
-                           initargs=(self._knowledge, self._catalogue, self.limits.memory), context=context)
-        pool.schedule(jobs.ready)  # starts the workers now, not with the first request
+                           initargs=(self._knowledge, self._catalogue, self.limits.memory), context=_context())
+        pool.schedule(jobs.ready)
         return pool
 
     async def _pool(self) -> ProcessPool:
@@ -200,6 +203,28 @@ class Work:
             raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE,
                                 f"{what} stopped: its worker process ended (code {exc.exitcode}); "
                                 "try again or try a shorter task") from None
+
+
+def _context() -> multiprocessing.context.ForkServerContext:
+    """Workers are forked from a clean, single-threaded fork server that has imported :data:`PRELOAD`."""
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(PRELOAD)
+    return context
+
+
+def _start_forkserver() -> None:
+    """Start the fork server with Ctrl-C ignored, which it and every worker forked from it keep: a Ctrl-C at
+    the terminal is for the server, which then stops its workers (multiprocessing's resource tracker ignores
+    it the same way). Only the main thread may change how a signal is handled; elsewhere the fork server
+    starts with the first pool as usual."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    _context()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 async def _disconnected(request: Request) -> None:
