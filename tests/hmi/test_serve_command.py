@@ -179,3 +179,30 @@ def test_issue_15_serve_stops_on_a_signal_while_a_request_is_being_worked_on(sig
     for answer in answers:  # none when the request had not reached the server yet
         assert answer.status_code in (200, 503), answer.text
         assert answer.status_code == 200 or "the HMI is stopping" in answer.json()["detail"]
+
+
+@pytest.mark.parametrize("checked", [False, True], ids=["workers-starting", "after-a-check"])
+def test_issue_15_ctrl_c_at_the_terminal_stops_serve_and_its_workers_quietly(checked: bool) -> None:
+    """Ctrl-C at a terminal reaches every process of the foreground group: the server's worker processes
+    (and the server they are forked from) leave it to the server and print nothing."""
+    proc = subprocess.Popen([*SERVE, "--sim"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)  # its own process group, as a terminal's foreground job
+    out = Lines(proc.stdout)
+    url = out.next().strip().rsplit(" ", 1)[1]
+    assert httpx.get(url + "api/cell", timeout=120).status_code == 200  # serving; its workers may still start
+    if checked:  # the workers are up and have worked
+        step = _busy_task(1)["steps"][:2]  # type: ignore[index]
+        res = httpx.post(url + "api/task/check", json={"name": "t", "steps": step}, timeout=120)
+        assert res.status_code == 200 and res.json()["plausible"] is True
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        code = proc.wait(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.stderr is not None and proc.stdout is not None
+    err = proc.stderr.read()
+    proc.stdout.close()
+    proc.stderr.close()
+    assert code == 0, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert "".join(out.rest()).strip().endswith("stopped")

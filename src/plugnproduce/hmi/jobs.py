@@ -42,7 +42,7 @@ def start_worker(knowledge: Knowledge, catalogue: list[DeviceDescription], memor
     """Initialise a worker process: keep the server's knowledge and catalogue; let a job use at most ``memory``
     bytes of address space more than the worker has now (a job over it fails with MemoryError); leave Ctrl-C
     to the server, which stops its workers."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # should it arrive all the same
     _worker.knowledge, _worker.catalogue = knowledge, catalogue
     if memory is not None:
         limit = _address_space() + memory

@@ -23,9 +23,12 @@ import asyncio
 import concurrent.futures
 import logging
 import multiprocessing
+import signal
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from multiprocessing import forkserver
 from typing import Any, TypeVar
 
 from fastapi import HTTPException, Request, status
@@ -59,6 +62,16 @@ pays for importing them."""
 
 RETRY_AFTER = "5"
 """Seconds a refused client is told to wait before it asks again."""
+
+
+@dataclass(frozen=True)
+class _Asked:
+    """One expensive request: what it asks for ("the check"), where ("POST /api/task/check"), and what to
+    advise when it is over its budget."""
+
+    what: str
+    where: str
+    advice: str
 
 
 @dataclass(frozen=True)
@@ -96,15 +109,15 @@ class Work:
         """Start the worker processes in the background (each is given the knowledge and the catalogue once);
         the first expensive request waits for them. Call on the server's event loop."""
         if self._starting is None:
+            _start_forkserver()
             self._starting = asyncio.ensure_future(asyncio.to_thread(self._new_pool))
         return self._starting
 
     def _new_pool(self) -> ProcessPool:
-        context = multiprocessing.get_context("forkserver")  # workers forked from a clean, single-threaded server
-        context.set_forkserver_preload(PRELOAD)
+        """The pool, its workers started (in this thread, not with the first request)."""
         pool = ProcessPool(self.limits.workers, initializer=jobs.start_worker,
-                           initargs=(self._knowledge, self._catalogue, self.limits.memory), context=context)
-        pool.schedule(jobs.ready)  # starts the workers now, not with the first request
+                           initargs=(self._knowledge, self._catalogue, self.limits.memory), context=_context())
+        pool.schedule(jobs.ready)
         return pool
 
     async def _pool(self) -> ProcessPool:
@@ -126,9 +139,11 @@ class Work:
         for job in list(self._jobs):
             job.cancel()
 
-    async def run(self, request: Request, what: str, function: Callable[..., T], *args: Any) -> T:
+    async def run(self, request: Request, what: str, function: Callable[..., T], *args: Any,
+                  advice: str = "try a shorter task") -> T:
         """Run ``function(*args)`` in a worker within the budget; ``what`` names the work in messages
-        ("the check"). Stops the job when its client disconnects."""
+        ("the check"), ``advice`` says what to do when it is over its budget. Stops the job when its client
+        disconnects."""
         if self._active >= self.limits.workers + self.limits.waiting:
             raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE,
                                 f"the HMI is busy with {self._active} checks, repairs and the like "
@@ -136,32 +151,32 @@ class Work:
                                 "try again in a moment", headers={"Retry-After": RETRY_AFTER})
         self._active += 1
         try:
-            return await self._job(request, what, function, args)
+            return await self._job(_Asked(what, f"{request.method} {request.url.path}", advice), request,
+                                   function, args)
         finally:
             self._active -= 1
 
-    async def _job(self, request: Request, what: str, function: Callable[..., T], args: tuple[Any, ...]) -> T:
+    async def _job(self, asked: _Asked, request: Request, function: Callable[..., T], args: tuple[Any, ...]) -> T:
         waiting = asyncio.ensure_future(self._pool())
         self._waiting.add(waiting)
         try:
             pool = await waiting
         except asyncio.CancelledError:  # the server stops while the workers start
-            raise _stopping(what) from None
+            raise _stopping(asked.what) from None
         finally:
             self._waiting.discard(waiting)
         job: concurrent.futures.Future[T] = pool.schedule(jobs.call, (function, *args), timeout=self.limits.seconds)
         self._jobs.add(job)
-        where = f"{request.method} {request.url.path}"
-        log.debug("%s: %s scheduled", where, what)
+        log.debug("%s: %s scheduled", asked.where, asked.what)
         started = time.monotonic()
         try:
-            return await self._outcome(request, job, what, where)
+            return await self._outcome(asked, request, job)
         finally:
             job.cancel()  # no effect once it has ended; stops it if this request was cancelled
             self._jobs.discard(job)
-            log.debug("%s: %s ended after %.1f s", where, what, time.monotonic() - started)
+            log.debug("%s: %s ended after %.1f s", asked.where, asked.what, time.monotonic() - started)
 
-    async def _outcome(self, request: Request, job: concurrent.futures.Future[T], what: str, where: str) -> T:
+    async def _outcome(self, asked: _Asked, request: Request, job: concurrent.futures.Future[T]) -> T:
         result = asyncio.wrap_future(job)
         gone = asyncio.ensure_future(_disconnected(request))
         either: set[asyncio.Future[Any]] = {result, gone}
@@ -169,37 +184,59 @@ class Work:
             done, _ = await asyncio.wait(either, return_when=asyncio.FIRST_COMPLETED)
         except asyncio.CancelledError:  # the server stops: end this request quietly, its job with it
             job.cancel()
-            raise _stopping(what) from None
+            raise _stopping(asked.what) from None
         finally:
             gone.cancel()
         if result not in done:
             job.cancel()
-            log.info("%s: %s stopped: the client closed the connection", where, what)
-            raise _stopping(what)
-        return self._answer(result, what, where)
+            log.info("%s: %s stopped: the client closed the connection", asked.where, asked.what)
+            raise _stopping(asked.what)
+        return self._answer(asked, result)
 
-    def _answer(self, result: asyncio.Future[T], what: str, where: str) -> T:
+    def _answer(self, asked: _Asked, result: asyncio.Future[T]) -> T:
         """The job's result, or its error as the HTTP error a client is told."""
         try:
             return result.result()
         except (asyncio.CancelledError, concurrent.futures.CancelledError):
-            raise _stopping(what) from None
+            raise _stopping(asked.what) from None
         except TimeoutError as exc:
             if exc.__cause__ is not None:  # raised by the job itself (with its remote traceback), not the budget
                 raise
-            log.warning("%s: %s stopped: over its budget of %g s", where, what, self.limits.seconds)
+            log.warning("%s: %s stopped: over its budget of %g s", asked.where, asked.what, self.limits.seconds)
             raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT,
-                                f"{what} took longer than {self.limits.seconds:g} s; try a shorter task") from None
+                                f"{asked.what} took longer than {self.limits.seconds:g} s; {asked.advice}") from None
         except (jobs.OverMemory, MemoryError):
-            log.warning("%s: %s stopped: over its memory budget", where, what)
+            log.warning("%s: %s stopped: over its memory budget", asked.where, asked.what)
             raise HTTPException(status.HTTP_413_CONTENT_TOO_LARGE,
-                                f"{what} needed more than the {_mib(self.limits.memory)} MiB of memory "
-                                "a request may use; try a shorter task") from None
+                                f"{asked.what} needed more than the {_mib(self.limits.memory)} MiB of memory "
+                                f"a request may use; {asked.advice}") from None
         except ProcessExpired as exc:
-            log.warning("%s: %s stopped: its worker ended with code %s", where, what, exc.exitcode)
+            log.warning("%s: %s stopped: its worker ended with code %s", asked.where, asked.what, exc.exitcode)
             raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE,
-                                f"{what} stopped: its worker process ended (code {exc.exitcode}); "
-                                "try again or try a shorter task") from None
+                                f"{asked.what} stopped: its worker process ended (code {exc.exitcode}); "
+                                f"try again, or {asked.advice}") from None
+
+
+def _context() -> multiprocessing.context.ForkServerContext:
+    """Workers are forked from a clean, single-threaded fork server that has imported :data:`PRELOAD`."""
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(PRELOAD)
+    return context
+
+
+def _start_forkserver() -> None:
+    """Start the fork server with Ctrl-C ignored, which it and every worker forked from it keep: a Ctrl-C at
+    the terminal is for the server, which then stops its workers (multiprocessing's resource tracker ignores
+    it the same way). Only the main thread may change how a signal is handled; elsewhere the fork server
+    starts with the first pool as usual."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    _context()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 async def _disconnected(request: Request) -> None:

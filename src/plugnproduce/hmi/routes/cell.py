@@ -73,7 +73,8 @@ async def explain_command(command: str, request: Request, hub: Hub = Depends(hub
     tree (rules, ontology axioms, chart states, each with its line) and the counterfactuals the reasoner
     confirms (catalogue devices to plug in or swap in; for an offered command, the devices it rests on).
     Runs in a worker under the time budget, like a check."""
-    return await work.run(request, "the explanation", jobs.explain_command, hub.cell, command)
+    return await work.run(request, "the explanation", jobs.explain_command, hub.cell, command,
+                          advice="try again with fewer devices in the cell")
 
 
 @router.get("/processes", dependencies=read, summary="Every known process with its roles and parameters")
