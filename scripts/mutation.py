@@ -75,11 +75,11 @@ GUARDS = (
           ("x__escaped", "x__attr", "x__checked", "x__name", "x__decimal", "x__write_pose", "x__value", "x__positive",
            "x_encode", "x_decode", "x__decode_document", "x__number", "x__integer", "x__pose", "x__decode_event")),
     Guard("executor-faults", ("src/plugnproduce/executor/run.py",),
-          ("tests/executor/test_run.py", "tests/executor/test_faults.py"),
-          ("xǁTaskRunǁrun", "xǁTaskRunǁstop", "xǁTaskRunǁdevice_lost", "xǁTaskRunǁ_connect", "xǁTaskRunǁsend",
-           "xǁTaskRunǁ_request", "xǁTaskRunǁ_answers", "xǁTaskRunǁ_safe_stop", "xǁTaskRunǁ_stop_device",
-           "xǁTaskRunǁ_on_event", "xǁTaskRunǁ_on_lost", "xǁTaskRunǁ_on_anomaly", "xǁTaskRunǁ_on_step",
-           "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail", "xǁTaskRunǁ_outcome")),
+          ("tests/executor/test_faults.py", "tests/executor/test_run.py"),
+          ("xǁTaskRunǁstop", "xǁTaskRunǁdevice_lost", "xǁTaskRunǁsend", "xǁTaskRunǁ_request",
+           "xǁTaskRunǁ_safe_stop", "xǁTaskRunǁ_stop_device", "xǁTaskRunǁ_on_event", "xǁTaskRunǁ_on_lost",
+           "xǁTaskRunǁ_on_anomaly", "xǁTaskRunǁ_on_step", "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail",
+           "xǁTaskRunǁ_outcome")),
 )
 
 PLUGIN = "mutation_fresh_caches"
