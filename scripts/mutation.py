@@ -57,7 +57,7 @@ GUARDS = (
           ("tests/statechart/test_evaluator_guards.py", "tests/statechart/test_evaluator_budgets.py",
            "tests/statechart/test_interpreter.py")),
     Guard("safeio", ("src/plugnproduce/safeio.py",),
-          ("tests/test_safeio.py", "tests/test_safeio_yaml.py")),
+          ("tests/test_safeio_guards.py", "tests/test_safeio.py", "tests/test_safeio_yaml.py")),
     Guard("upnp-trust", ("src/plugnproduce/protocols/upnp/boundary.py", "src/plugnproduce/protocols/upnp/client.py",
                          "src/plugnproduce/protocols/upnp/discovery.py"),
           ("tests/protocols/test_upnp_trust.py", "tests/protocols/test_upnp_loopback.py",
