@@ -242,6 +242,18 @@ def test_range_may_be_as_long_as_the_limit_and_not_longer() -> None:
         evaluate(f"range({MAX_ITEMS + 1})")
 
 
+@pytest.mark.parametrize(("source", "value"), [("1 ** 1000000", 1), ("(-1) ** 1000001", -1), ("0 ** 1000000", 0),
+                                             ("2 ** 65536 == 1 << 65536", True), ("(-2) ** 3", -8)])
+def test_a_power_whose_result_is_small_enough_is_computed(source: str, value: object) -> None:
+    assert evaluate(source) == value
+
+
+@pytest.mark.parametrize("source", ["2 ** 65537", "(-2) ** 65537", "10 ** 30000", "3 ** 70000"])
+def test_a_power_whose_result_would_be_too_large_is_refused(source: str) -> None:
+    with pytest.raises(EvaluationError, match=r"\*\* .* would exceed"):
+        evaluate(source)
+
+
 def test_a_power_is_refused_by_the_size_of_its_result_even_to_the_first() -> None:
     assert evaluate("(1 << 60000) ** 1 == 1 << 60000") is True
     with pytest.raises(EvaluationError, match="a 120001-bit integer \\*\\* 1 would exceed"):
