@@ -129,9 +129,9 @@ def equivalents(path: Path = EQUIVALENT_FILE) -> dict[tuple[str, str, str], str]
     for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
         if not line.strip() or line.startswith("#"):
             continue
-        parts = [p.strip() for p in line.split(" | ")]
+        parts = [p.strip() for p in line.split(" || ")]
         if len(parts) != 4:
-            raise SystemExit(f"{path.relative_to(ROOT)}:{number}: expected 'function | before | after | why'")
+            raise SystemExit(f"{path.relative_to(ROOT)}:{number}: expected 'function || before || after || why'")
         found[(parts[0], parts[1], parts[2])] = parts[3]
     return found
 
