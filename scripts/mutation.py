@@ -68,7 +68,7 @@ GUARDS = (
           ("tests/discovery/test_served.py", "tests/discovery/test_live_cell.py"),
           ("x_read_served", "x__safe_name")),
     Guard("tokens", ("src/plugnproduce/hmi/security.py",),
-          ("tests/hmi/test_security.py", "tests/hmi/test_route_tokens.py", "tests/hmi/test_http_api.py")),
+          ("tests/hmi/test_security.py", "tests/hmi/test_route_tokens.py")),
     Guard("xirp-codec", ("src/plugnproduce/protocols/xirp/codec.py", "src/plugnproduce/protocols/xirp/decoding.py"),
           ("tests/protocols/test_xirp_guards.py", "tests/protocols/test_xirp_messages.py",
            "tests/protocols/test_xirp_robustness.py"),
