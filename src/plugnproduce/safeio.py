@@ -281,9 +281,6 @@ def parse_yaml_bytes(data: bytes, source: str | Path) -> yaml.Node:
     return node
 
 
-MAX_YAML_DEPTH = 64
-"""Deepest YAML nesting accepted."""
-
 MAX_DIGITS = 30
 """Longest integer (in digits) a description may hold."""
 
@@ -337,11 +334,6 @@ MAX_TRIPLES = 50_000
 """Most triples in one Turtle file (a description has tens, an ontology extension hundreds)."""
 
 _PREFIX = re.compile(r"^[ \t]*(@prefix|prefix)\b", re.IGNORECASE | re.MULTILINE)
-
-
-def read_turtle_text(path: str | Path) -> str:
-    """Read a Turtle file as text, bounded in size and prefixes (rdflib's Turtle parser expands no entities)."""
-    return _turtle_text(read_bytes(path), path)
 
 
 def _turtle_text(data: bytes, source: str | Path) -> str:

@@ -134,6 +134,12 @@ async def sized(request: web.Request) -> web.Response:
     return web.Response(body=b"z" * int(request.query["size"]))
 
 
+async def plain(request: web.Request) -> web.Response:
+    response = web.Response(body="caf\u00e9".encode())
+    response.headers["Content-Type"] = "text/xml"  # no charset: UTF-8 is assumed
+    return response
+
+
 async def latin(request: web.Request) -> web.Response:
     return web.Response(body="caf\u00e9".encode("latin-1"), content_type="text/xml", charset="utf-8")
 
@@ -144,6 +150,7 @@ async def server() -> AsyncIterator[str]:
     app.router.add_get("/redirect", redirect)
     app.router.add_get("/sized", sized)
     app.router.add_get("/latin", latin)
+    app.router.add_get("/plain", plain)
     runner = web.AppRunner(app)
     await runner.setup()
     site = web.TCPSite(runner, "127.0.0.1", 0)
@@ -165,6 +172,10 @@ async def test_an_answer_up_to_the_limit_is_read_and_one_byte_more_is_refused(se
     assert (await get(NoRedirectRequester(5.0, 100), f"{server}/sized?size=100")).body == "z" * 100
     with pytest.raises(UpnpCommunicationError, match="larger than the 100 bytes accepted"):
         await get(NoRedirectRequester(5.0, 100), f"{server}/sized?size=101")
+
+
+async def test_an_answer_without_a_charset_is_read_as_utf8(server: str) -> None:
+    assert (await get(NoRedirectRequester(5.0, 100), f"{server}/plain")).body == "caf\u00e9"
 
 
 async def test_an_answer_that_is_not_its_declared_encoding_is_a_communication_error(server: str) -> None:

@@ -262,6 +262,13 @@ def _too_large(what: str) -> EvaluationError:
     return EvaluationError(f"{what} would exceed the restricted evaluator's limits")
 
 
+def _shown(value: Any) -> str:
+    """An operand as a message names it: an integer too long to print, by its size."""
+    if isinstance(value, int) and value.bit_length() > 64:
+        return f"a {value.bit_length()}-bit integer"
+    return repr(value)
+
+
 def _size(value: Any) -> int | None:
     return len(value) if isinstance(value, str | bytes | list | tuple) else None
 
@@ -270,11 +277,11 @@ def _binop(op: str, left: Any, right: Any) -> Any:
     if op == "Pow":
         if (isinstance(left, int) and isinstance(right, int) and right > 0 and abs(left) > 1
                 and right * max(abs(left).bit_length() - 1, 1) > MAX_INT_BITS):
-            raise _too_large(f"{left!r} ** {right!r}")
+            raise _too_large(f"{_shown(left)} ** {_shown(right)}")
         return left**right
     if op == "LShift":
         if isinstance(right, int) and right > MAX_INT_BITS:
-            raise _too_large(f"shifting left by {right}")
+            raise _too_large(f"shifting left by {_shown(right)}")
         return left << right
     for seq, times in ((left, right), (right, left)):  # Mult
         size = _size(seq)
@@ -292,12 +299,12 @@ def _iterate(iterable: Any) -> Any:
 
 
 def _method(target: Any, name: str, *args: Any, **kwargs: Any) -> Any:
-    if isinstance(target, str) and name == "join" and args:
+    if isinstance(target, str | bytes) and name == "join" and args:  # bytes too: b''.join and b.replace multiply
         parts = list(_iterate(args[0]))
-        if sum(len(p) if isinstance(p, str) else 0 for p in parts) + len(target) * len(parts) > MAX_ITEMS:
+        if sum(len(p) if isinstance(p, str | bytes) else 0 for p in parts) + len(target) * len(parts) > MAX_ITEMS:
             raise _too_large("joining these strings")
         args = (parts, *args[1:])
-    if isinstance(target, str) and name == "replace" and len(args) >= 2 and isinstance(args[1], str):
+    if isinstance(target, str | bytes) and name == "replace" and len(args) >= 2 and isinstance(args[1], str | bytes):
         if len(target) + (len(target) + 1) * len(args[1]) > MAX_ITEMS:
             raise _too_large("this replace")
     return getattr(target, name)(*args, **kwargs)

@@ -1,0 +1,86 @@
+"""Safe parsing at its limits: what is accepted just below each bound and refused just above,
+each refusal naming the file and line; YAML read with the nodes the pure-Python loader makes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from plugnproduce.errors import HostileInputError, UnreadableError
+from plugnproduce.safeio import (
+    MAX_DIGITS,
+    MAX_XML_DEPTH,
+    MAX_YAML_DEPTH,
+    PlainDumper,
+    parse_xml,
+    parse_yaml_bytes,
+)
+from tests.test_safeio_yaml import _signature
+
+
+def nested_sequences(levels: int) -> str:
+    """A value inside ``levels`` nested lists, counted with the value: ``[[1]]`` is 3 levels."""
+    return "[" * (levels - 1) + "1" + "]" * (levels - 1)
+
+
+def nested_mappings(levels: int) -> str:
+    """A value inside ``levels - 1`` nested mappings (block style, the way descriptions are written)."""
+    lines = [" " * i + "a:" for i in range(levels - 1)]
+    return "\n".join(lines) + " 1\n"
+
+
+@pytest.mark.parametrize("nested", [nested_sequences, nested_mappings])
+def test_a_value_as_deep_as_the_limit_is_read_and_one_level_more_is_refused(nested) -> None:  # type: ignore[no-untyped-def]
+    parse_yaml_bytes(nested(MAX_YAML_DEPTH).encode(), "deep.yaml")
+    with pytest.raises(HostileInputError, match="nested") as caught:
+        parse_yaml_bytes(nested(MAX_YAML_DEPTH + 1).encode(), "deep.yaml")
+    assert caught.value.file == "deep.yaml"
+
+
+@pytest.mark.parametrize("number", ["9" * MAX_DIGITS, "-" + "9" * MAX_DIGITS, "1_" + "0" * (MAX_DIGITS - 1)])
+def test_an_integer_of_the_longest_length_is_read(number: str) -> None:
+    node = parse_yaml_bytes(f"speed: {number}\n".encode(), "task.yaml")
+    assert isinstance(node, yaml.MappingNode) and node.value[0][1].value == number
+
+
+@pytest.mark.parametrize(("text", "line", "needle"), [
+    (f"a: 1\nspeed: {'9' * (MAX_DIGITS + 1)}\n", 2, f"an integer of {MAX_DIGITS + 1} digits"),
+    ("a: 1\nb: 2\nforce: .NaN\n", 3, ".NaN is not a number"),
+    ("force: -.inf\n", 1, "-.inf is not a number"),
+])
+def test_a_number_no_device_can_be_given_is_refused_at_its_file_and_line(text: str, line: int, needle: str) -> None:
+    with pytest.raises(UnreadableError, match=needle) as caught:
+        parse_yaml_bytes(text.encode(), "task.yaml")
+    assert (caught.value.file, caught.value.line) == ("task.yaml", line)
+
+
+def test_quoted_plain_block_and_untagged_scalars_are_read_as_the_pure_python_loader_reads_them() -> None:
+    text = "a: 'x'\nb: \"y\"\nc: z\nd: |\n  block\ne: >\n  folded\nf: ! 12\ng: !!str 13\n"
+    assert _signature(parse_yaml_bytes(text.encode(), "t.yaml")) == \
+        _signature(yaml.compose(text, Loader=yaml.SafeLoader))
+
+
+@pytest.mark.parametrize("text", ["", "# only a comment\n"])
+def test_an_empty_yaml_document_is_refused_at_line_1(text: str) -> None:
+    with pytest.raises(UnreadableError, match="empty YAML document") as caught:
+        parse_yaml_bytes(text.encode(), "empty.yaml")
+    assert caught.value.line == 1
+
+
+def test_a_value_shared_by_two_places_is_written_out_at_each_and_reads_back() -> None:
+    pose = [0.1, 0.2, 0.3]
+    text = yaml.dump({"first": pose, "second": pose}, Dumper=PlainDumper)
+    assert "&" not in text and "*" not in text
+    parse_yaml_bytes(text.encode(), "task.yaml")  # anchors and aliases would be refused here
+
+
+def test_an_xml_file_is_read_with_the_hardened_parser_naming_the_file(tmp_path: Path) -> None:
+    good, deep = tmp_path / "chart.scxml", tmp_path / "deep.scxml"
+    good.write_text("<scxml><state id='a'/></scxml>", encoding="utf-8")
+    assert parse_xml(good).getroot()[0].get("id") == "a"
+    deep.write_text("<a>" * (MAX_XML_DEPTH + 1) + "</a>" * (MAX_XML_DEPTH + 1), encoding="utf-8")
+    with pytest.raises(HostileInputError, match="nested") as caught:
+        parse_xml(deep)
+    assert caught.value.file == str(deep)
