@@ -109,7 +109,8 @@ def test_serve_sim_works_on_a_simulated_bin_of_the_given_parts() -> None:
         lines += [out.next().strip(), out.next().strip()]
         url, token = lines[0].rsplit(" ", 1)[1], lines[2].removeprefix("token: ")
         yaml = (service.builtin("tasks") / "bin-picking-until-empty.yaml").read_bytes()
-        task = httpx.post(url + "api/task/import", content=yaml, headers={"Content-Type": "application/yaml"}).json()
+        task = httpx.post(url + "api/task/import", content=yaml, headers={"Content-Type": "application/yaml"},
+                          timeout=120).json()
         res = httpx.post(url + "api/runs", json={"task": task}, headers={"Authorization": f"Bearer {token}"},
                          timeout=120)
         assert res.status_code == 202, res.text
