@@ -10,12 +10,14 @@ import yaml
 
 from plugnproduce.errors import HostileInputError, UnreadableError
 from plugnproduce.safeio import (
+    MAX_BYTES,
     MAX_DIGITS,
     MAX_XML_DEPTH,
     MAX_YAML_DEPTH,
     PlainDumper,
     parse_xml,
     parse_yaml_bytes,
+    parse_yaml_node,
 )
 from tests.test_safeio_yaml import _signature
 
@@ -84,3 +86,26 @@ def test_an_xml_file_is_read_with_the_hardened_parser_naming_the_file(tmp_path: 
     with pytest.raises(HostileInputError, match="nested") as caught:
         parse_xml(deep)
     assert caught.value.file == str(deep)
+
+
+@pytest.mark.parametrize(("text", "line"), [("a: \x07\nb: 1\nc: 2\n", 1), ("\n\nc: \x07\n", 3), ("\x07", 1)])
+def test_a_character_yaml_does_not_allow_is_refused_at_its_line(text: str, line: int) -> None:
+    with pytest.raises(UnreadableError, match="expected printable text") as caught:
+        parse_yaml_bytes(text.encode(), "task.yaml")
+    assert (caught.value.file, caught.value.line) == ("task.yaml", line)
+
+
+def test_yaml_of_the_largest_size_is_read_and_one_byte_more_is_refused() -> None:
+    text = b"a: 1\n#" + b"x" * (MAX_BYTES - 7) + b"\n"
+    assert len(text) == MAX_BYTES
+    parse_yaml_bytes(text, "big.yaml")
+    with pytest.raises(HostileInputError, match=f"at most {MAX_BYTES}"):
+        parse_yaml_bytes(text + b"\n", "big.yaml")
+
+
+def test_yaml_nested_deeper_than_the_reader_goes_is_refused_naming_the_file(tmp_path: Path) -> None:
+    deep = tmp_path / "deep.yaml"
+    deep.write_text("[" * (MAX_YAML_DEPTH + 1), encoding="utf-8")
+    with pytest.raises(HostileInputError, match="nested more than") as caught:
+        parse_yaml_node(deep)
+    assert (caught.value.file, caught.value.line) == (str(deep), 1)
