@@ -148,6 +148,8 @@ def repair(
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
             for x in r.side_effects:
                 typer.echo(f"  side effect: {x.text}")
+            if r.repair.unrolls:
+                typer.echo(f"  note: {r.repair.unrolls}")
             typer.echo("  resulting task:")
             typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.repair.task).splitlines()), nl=False)
     if not result.plausible and not repairs:

@@ -121,23 +121,30 @@ def repair(
 # ------------------------------------------------------------------ reading a model back
 
 
-def repaired_task(model: Model, task: Task) -> Task:
-    """The task the model's edits produce; ``repeat`` kept when every round was repaired alike."""
+def repaired_runs(model: Model, task: Task) -> list[tuple[int, Step]]:
+    """The repaired task's steps in order, each with the original step position it keeps (0 if inserted)."""
     plays: dict[int, dict[str, str]] = {}
     for p in model[s.Plays]:
         if p.explicit:
             plays.setdefault(p.s, {})[p.r] = p.d
     resets = {(e.e.arguments[0].number, e.e.arguments[1].string) for e in model[s.Edit] if e.e.name == "reset"}
-    steps: list[Step] = []
+    out: list[tuple[int, Step]] = []
     for run in sorted(model[s.Runs], key=lambda r: r.s):
         bind = dict(sorted(plays.get(run.s, {}).items()))
-        index = len(steps) + 1
+        index = len(out) + 1
         if run.i == 0:
-            steps.append(Step(index, run.p, bind, {}))
+            out.append((0, Step(index, run.p, bind, {})))
             continue
         old = task.steps[run.i - 1]
         params = {k: v for k, v in old.params.items() if (run.i, k) not in resets}
-        steps.append(Step(index, run.p, bind, params, old.line, dict(old.param_lines), old.name))
+        out.append((run.i, Step(index, run.p, bind, params, old.line, dict(old.param_lines), old.name)))
+    return out
+
+
+def repaired_task(model: Model, task: Task) -> Task:
+    """The task the model's edits produce, flat; ``repeat`` kept when every round was repaired alike (loops and
+    branches are lifted onto the written task afterwards, :mod:`plugnproduce.reasoning.lifting`)."""
+    steps = [st for _, st in repaired_runs(model, task)]
     kept = len(steps) == len(task.steps)  # a loop's or branch's steps kept in place: still the loop, the branch
     return Task(task.name, tuple(steps), task.file, task.description, folded_repeat(steps, task.repeat),
                 task.loops if kept else (), task.branches if kept else ())
@@ -161,7 +168,7 @@ def read_repair(model: Model, rank: int, task: Task, book: FactBook, devices: di
     edits = sorted((reader.read(e.e) for e in model[s.Edit]), key=lambda e: (e.step or 0, e.kind, e.text))
     added = tuple(sorted(e.device for e in edits if e.kind == "add" and e.device))
     return Repair(rank, model.cost[0] / 100 if model.cost else 0.0, tuple(edits),
-                  repaired_task(model, task), added)
+                  repaired_task(model, task), added, tuple(i for i, _ in repaired_runs(model, task)))
 
 
 class _EditReader:

@@ -251,11 +251,16 @@ class Repair:
     edits: tuple[Edit, ...]
     task: Task
     added_devices: tuple[str, ...] = ()
+    origins: tuple[int, ...] = field(default=(), compare=False, repr=False)
+    """For each step of the flat repaired task, the original step position it keeps (0 if inserted)."""
+    unrolls: str | None = None
+    """Why the resulting task writes the original's loops and branches out step by step (None: it keeps them)."""
 
     def to_json(self) -> dict[str, object]:
-        """A JSON-ready dict (the task as its steps)."""
+        """A JSON-ready dict (the task as its steps; ``unrolls`` says whether it writes loops and branches out)."""
         steps = [{"command": s.command, **({"bind": dict(s.bind)} if s.bind else {}),
                   **({"params": {n: plain_value(v) for n, v in s.params.items()}} if s.params else {})}
                  for s in self.task.steps]
         return {"rank": self.rank, "cost": self.cost, "edits": [e.to_json() for e in self.edits],
-                "added_devices": list(self.added_devices), "task": {"task": self.task.name, "steps": steps}}
+                "added_devices": list(self.added_devices), "task": {"task": self.task.name, "steps": steps},
+                "unrolls": self.unrolls is not None, **({"note": self.unrolls} if self.unrolls else {})}

@@ -61,7 +61,7 @@ import clingo
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.reasoning import repairs, solver
+from plugnproduce.reasoning import lifting, repairs, solver
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program
@@ -94,6 +94,8 @@ class _Part:
     edits: tuple[clingo.Symbol, ...]
     steps: tuple[Step, ...]
     left_in: tuple[tuple[str, str], ...]
+    origins: tuple[int, ...] = ()
+    """The original (whole-task) step position each of :attr:`steps` keeps, 0 if inserted."""
 
 
 def shifted(term: clingo.Symbol, offset: int) -> clingo.Symbol:
@@ -198,10 +200,13 @@ def repair(
     per_gap: int = repairs.PER_GAP,
     max_inserts: int | None = None,
 ) -> list[Repair]:
-    """The ``top`` cheapest distinct repairs of ``task`` in ``cell``: whole if short, else window by window."""
+    """The ``top`` cheapest distinct repairs of ``task`` in ``cell``: whole if short, else window by window;
+    each lifted onto the written task, its loops and branches kept where that is plausible (:mod:`lifting`)."""
     if len(task.steps) <= WHOLE_UP_TO or max_inserts is not None:
-        return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap, max_inserts)
-    return windowed_repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
+        found = repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap, max_inserts)
+    else:
+        found = windowed_repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
+    return lifting.lifted(found, task, cell, taxonomy, processes, catalogue or ())
 
 
 def windowed_repair(
@@ -342,7 +347,9 @@ class _Solver:
                    self.chain.task.file)
         edits = tuple(shifted(e.e, w.first - 1) for e in model[s.Edit])
         left = tuple(sorted((a.d, a.x) for a in model[s.LeftIn]))
-        return _Part(w, model.cost[0] if model.cost else 0, edits, repairs.repaired_task(model, sub).steps, left)
+        runs = repairs.repaired_runs(model, sub)
+        origins = tuple(i + w.first - 1 if i else 0 for i, _ in runs)
+        return _Part(w, model.cost[0] if model.cost else 0, edits, tuple(st for _, st in runs), left, origins)
 
     def read(self, rank: int, combo: tuple[int, tuple[_Part, ...], tuple[str, ...]],
              reader: repairs._EditReader) -> Repair:
@@ -352,13 +359,17 @@ class _Solver:
         edits = sorted((reader.read(t) for t in terms), key=lambda e: (e.step or 0, e.kind, e.text))
         task = self.chain.task
         steps: list[Step] = []
+        origins: list[int] = []
         start = 1
         for p in parts:
             steps += task.steps[start - 1:p.window.first - 1]
+            origins += range(start, p.window.first)
             steps += p.steps
+            origins += p.origins
             start = p.window.last + 1
         steps += task.steps[start - 1:]
+        origins += range(start, len(task.steps) + 1)
         steps = [replace(st, index=k) for k, st in enumerate(steps, start=1)]
         repaired = Task(task.name, tuple(steps), task.file, task.description,
                         repairs.folded_repeat(steps, task.repeat))
-        return Repair(rank, cost / 100, tuple(edits), repaired, added)
+        return Repair(rank, cost / 100, tuple(edits), repaired, added, tuple(origins))

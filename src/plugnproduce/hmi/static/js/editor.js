@@ -175,15 +175,15 @@ function flowCount(items) {
 
 function repairItem(r) {
   const added = r.added_devices.length ? h("p", { class: "hint" }, `Needs ${r.added_devices.join(", ")} plugged in.`) : null;
-  // a repaired task with fewer loops or branches has them written out step by step: it is not the operator's task
-  const unrolls = flowCount(r.task.steps) < flowCount(taskBody().steps);
+  // a repair that writes the loops and branches out step by step (the server says so) is not the operator's task
+  const unrolls = r.unrolls ?? flowCount(r.task.steps) < flowCount(taskBody().steps);
   return h("li", { class: "repair", dataset: { rank: r.rank } },
     h("div", { class: "repair-text" },
       h("ul", { class: "edits" }, r.edits.map((e) => h("li", {}, e.text))),
       h("span", { class: "cost" }, `cost ${r.cost}`), added,
       (r.side_effects || []).map((e) => h("p", { class: "side-effect", dataset: { kind: e.kind } }, `Side effect: ${e.text}`)),
-      unrolls ? h("p", { class: "hint unrolls" }, "Applying it here would write the loops and branches out step by step: "
-        + "make these changes through the dialogs.") : null),
+      unrolls ? h("p", { class: "hint unrolls" }, r.note ? `${r.note}. Make these changes through the dialogs.`
+        : "Applying it here would write the loops and branches out step by step: make these changes through the dialogs.") : null),
     h("button", { type: "button", class: "apply primary", "aria-label": `Apply repair ${r.rank}: ${r.edits.map((e) => e.text).join("; ")}`,
       disabled: unrolls, onclick: () => applyRepair(r) }, "Apply"));
 }
