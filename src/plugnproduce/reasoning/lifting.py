@@ -144,6 +144,28 @@ def _insert_groups(w: _Written, repair: Repair) -> list[tuple[list[Gap], list[St
     return [(list(gaps), steps) for (gaps, _), steps in groups.items()]
 
 
+def _swapped(w: _Written, repair: Repair) -> list[_Node]:
+    """The written items with the repair's swaps of two neighbouring flat steps done to their written steps."""
+    pairs = {(("step", w.canon(e.step)), ("step", w.canon(e.step + 1))) for e in repair.edits
+             if e.kind == "swap" and e.step is not None}
+    done: set[tuple[Key, Key]] = set()
+
+    def walk(items: list[_Node]) -> list[_Node]:
+        out = [dataclasses.replace(n, body=walk(n.body), branches=[(b, walk(body)) for b, body in n.branches])
+               for n in items]
+        for a, b in pairs:
+            at = next((k for k, n in enumerate(out[:-1]) if n.key == a and out[k + 1].key == b), None)
+            if at is not None:
+                out[at], out[at + 1] = out[at + 1], out[at]
+                done.add((a, b))
+        return out
+
+    items = walk(w.items)
+    if done != pairs:
+        raise _Unliftable("it swaps steps that are not neighbours in one list of the task file")
+    return items
+
+
 def _rebuild(items: list[_Node], container: Key, steps: dict[int, Step | None],
              inserts: dict[Gap, list[_Node]]) -> list[_Node]:
     """The items with the repair's edits applied."""
@@ -203,6 +225,7 @@ class _Flat:
 def _placements(w: _Written, repair: Repair) -> list[Task]:
     """The written tasks the repair may stand for, the flat order's own placement first."""
     steps = _written_steps(w, {q: s for q, s in zip(repair.origins, repair.task.steps, strict=True) if q})
+    items = _swapped(w, repair)
     groups = _insert_groups(w, repair)
     out: list[Task] = []
     for choice in itertools.islice(itertools.product(*(gaps for gaps, _ in groups)), MAX_PLACEMENTS):
@@ -214,7 +237,7 @@ def _placements(w: _Written, repair: Repair) -> list[Task]:
             inserts[gap] = nodes
         else:
             flat = _Flat()
-            flat.add(_rebuild(w.items, ("top",), steps, inserts))
+            flat.add(_rebuild(items, ("top",), steps, inserts))
             t = w.task
             out.append(Task(t.name, tuple(flat.steps), t.file, t.description, 1, tuple(flat.loops),
                             tuple(flat.branches)))
@@ -229,8 +252,6 @@ def lift(repair: Repair, task: Task, cell: Cell, taxonomy: Taxonomy,
         return repair
     flat = dataclasses.replace(repair.task, loops=(), branches=())
     w = _Written(task)
-    if sorted(q for q in repair.origins if q) != [q for q in repair.origins if q]:
-        return dataclasses.replace(repair, task=flat, unrolls=UNROLLS + "it reorders steps of the flat task")
     try:
         candidates = _placements(w, repair)
     except _Unliftable as e:

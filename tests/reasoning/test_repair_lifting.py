@@ -1,0 +1,142 @@
+"""Repairs of tasks with loops and branches come back as the user wrote the task: the loop (its ``until`` and
+``max``) and the branches kept, the edits in the loop's body or the branch's steps, and the result plausible on
+every path; a repair the written task cannot hold keeps its flat steps and says so."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from plugnproduce import service
+from plugnproduce.cli import app
+from plugnproduce.description.model import Task
+from plugnproduce.description.taskfile import parse_task
+from plugnproduce.reasoning import Repair
+from tests.reasoning.conftest import BIN_PICKING, TASKS
+
+UNTIL_EMPTY = (TASKS / "bin-picking-until-empty.yaml").read_text(encoding="utf-8")
+NO_PLACE = UNTIL_EMPTY[: UNTIL_EMPTY.index("        - command: place")]  # the body never lets the part go
+CLOSED_FIRST = UNTIL_EMPTY.replace("steps:\n  - loop:", "steps:\n  - command: close-gripper\n"
+                                   "    bind: {gripper: gripper}\n  - loop:")
+PICK = """          params:
+            pick_pose: {from: localize, output: part_pose}
+            grip_force: 45
+"""
+TWO_PICKS_IN_A_BRANCH = f"""task: branch-then-scan
+steps:
+  - name: localize
+    command: localize-part
+    params: {{exposure: 25}}
+    on:
+      PartFound:
+        - command: pick
+{PICK}        - command: pick
+{PICK}        - command: place
+      NoPartFound:
+        - command: move-to
+          params:
+            target_pose: [0.30, 0.00, 0.40, 0, 180, 0]
+  - command: scan-bin
+"""
+LIBRARY = Path(__file__).parents[1] / "data" / "libraries" / "part-finding"
+
+
+def _file(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "task.yaml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _repair(repairs: list[Repair], text: str) -> Repair:
+    return next(r for r in repairs if [e.text for e in r.edits] == [text])
+
+
+def _commands(task: Task, first: int, last: int) -> list[str]:
+    return [s.command for s in task.steps[first - 1:last]]
+
+
+def test_a_step_inserted_in_a_loop_body_keeps_the_loop(tmp_path: Path) -> None:
+    path = _file(tmp_path, NO_PLACE)
+    r = _repair(service.repair(path, BIN_PICKING), "insert place before step 3 (localize-part)")
+    assert r.unrolls is None
+    [loop] = r.task.loops
+    assert (loop.until or "").endswith("#BinEmpty") and loop.max == 100
+    assert _commands(r.task, loop.entry, loop.first - 1) == ["localize-part", "pick", "place"]
+    assert service.check(r.task, BIN_PICKING).plausible
+
+
+def test_a_step_inserted_before_a_loop_goes_before_the_loop(tmp_path: Path) -> None:
+    path = _file(tmp_path, CLOSED_FIRST)
+    r = _repair(service.repair(path, BIN_PICKING), "insert open-gripper before step 2 (localize-part)")
+    assert r.unrolls is None
+    [loop] = r.task.loops
+    assert _commands(r.task, 1, loop.entry - 1) == ["close-gripper", "open-gripper"]
+    assert _commands(r.task, loop.entry, loop.first - 1) == ["localize-part", "pick", "place"]
+    assert service.check(r.task, BIN_PICKING).plausible
+
+
+def test_a_step_inserted_in_a_branch_keeps_the_branches(tmp_path: Path) -> None:
+    path = _file(tmp_path, TWO_PICKS_IN_A_BRANCH)
+    r = _repair(service.repair(path, BIN_PICKING), "insert place before step 3 (pick)")
+    assert r.unrolls is None
+    found, none = r.task.branches
+    assert [found.outcome.rsplit("#")[1], none.outcome.rsplit("#")[1]] == ["PartFound", "NoPartFound"]
+    assert _commands(r.task, found.first, found.last) == ["pick", "place", "pick", "place"]
+    assert _commands(r.task, none.first, none.last) == ["move-to"]
+    assert r.task.steps[-1].command == "scan-bin" and r.task.steps[-1].index not in range(none.first, none.last + 1)
+    assert service.check(r.task, BIN_PICKING).plausible
+
+
+def test_a_repair_the_loop_cannot_hold_keeps_its_flat_steps_and_says_why(tmp_path: Path) -> None:
+    path = _file(tmp_path, CLOSED_FIRST)  # opening before the pick of every iteration fails once place opened it
+    r = _repair(service.repair(path, BIN_PICKING), "insert open-gripper before step 3 (pick)")
+    assert r.unrolls is not None and r.unrolls.startswith("this repair writes the task's loops and branches out")
+    assert "not plausible" in r.unrolls
+    assert r.task.loops == () and len(r.task.steps) == 8
+    assert r.to_json()["unrolls"] is True and r.to_json()["note"] == r.unrolls
+
+
+def test_pnp_repair_prints_the_resulting_task_with_its_loop(tmp_path: Path) -> None:
+    result = CliRunner().invoke(app, ["repair", str(_file(tmp_path, CLOSED_FIRST)), "--cell", str(BIN_PICKING)])
+    assert result.exit_code == 0, result.output
+    chunks = result.stdout.split("\nrepair ")[1:]
+    kept = next(c for c in chunks if "insert open-gripper before step 2" in c)
+    text = kept.split("resulting task:\n")[1]
+    assert "note:" not in kept and "- loop:" in text
+    task = parse_task("\n".join(line[4:] for line in text.splitlines()).encode(), "repaired.yaml")
+    [loop] = task.loops
+    assert (loop.until or "").endswith("#BinEmpty") and loop.max == 100
+    flagged = next(c for c in chunks if "insert open-gripper before step 3" in c)
+    assert "  note: this repair writes the task's loops and branches out step by step" in flagged
+
+
+def test_pnp_repair_prints_the_resulting_task_with_its_branches(tmp_path: Path) -> None:
+    path = _file(tmp_path, TWO_PICKS_IN_A_BRANCH)
+    result = CliRunner().invoke(app, ["repair", str(path), "--cell", str(BIN_PICKING), "--json"])
+    assert result.exit_code == 0, result.output
+    repairs = json.loads(result.stdout)["repairs"]
+    inserted = next(r for r in repairs if r["edits"][0]["text"] == "insert place before step 3 (pick)")
+    assert inserted["unrolls"] is False and "note" not in inserted
+    text = CliRunner().invoke(app, ["repair", str(path), "--cell", str(BIN_PICKING)]).stdout
+    chunk = text.split("insert place before step 3")[1].split("\nrepair ")[0]
+    assert "'on':\n        PartFound:" in chunk
+
+
+@pytest.mark.parametrize(("edit", "kept"), [
+    ("insert open-gripper before step 3 (move-to)", True),  # at the end of the PartFound branch
+    ("insert open-gripper before step 5 (pick)", False),  # every iteration would open an open gripper
+])
+def test_a_library_task_with_its_own_outcome_keeps_its_loop_and_branches(tmp_path: Path, edit: str,
+                                                                         kept: bool) -> None:
+    text = (LIBRARY / "tasks" / "clear-bin-or-look-again.yaml").read_text(encoding="utf-8")
+    path = _file(tmp_path, text.replace("              - command: place\n", ""))
+    knowledge = service.knowledge((LIBRARY,))
+    r = _repair(service.repair(path, BIN_PICKING, knowledge=knowledge), edit)
+    assert (r.unrolls is None) == kept
+    if kept:
+        found = next(b for b in r.task.branches if b.outcome.endswith("#PartFound"))
+        assert _commands(r.task, found.first, found.last) == ["pick", "open-gripper"]
+        assert len(r.task.loops) == 1 and service.check(r.task, BIN_PICKING, knowledge).plausible
