@@ -120,6 +120,9 @@ def test_pnp_repair_prints_the_resulting_task_with_its_branches(tmp_path: Path) 
     repairs = json.loads(result.stdout)["repairs"]
     inserted = next(r for r in repairs if r["edits"][0]["text"] == "insert place before step 3 (pick)")
     assert inserted["unrolls"] is False and "note" not in inserted
+    [localize, scan] = inserted["task"]["steps"]  # the task as its file writes it
+    assert [s["command"] for s in localize["on"]["PartFound"]] == ["pick", "place", "pick", "place"]
+    assert scan["command"] == "scan-bin"
     text = CliRunner().invoke(app, ["repair", str(path), "--cell", str(BIN_PICKING)]).stdout
     chunk = text.split("insert place before step 3")[1].split("\nrepair ")[0]
     assert "'on':\n        PartFound:" in chunk
@@ -140,3 +143,13 @@ def test_a_library_task_with_its_own_outcome_keeps_its_loop_and_branches(tmp_pat
         found = next(b for b in r.task.branches if b.outcome.endswith("#PartFound"))
         assert _commands(r.task, found.first, found.last) == ["pick", "open-gripper"]
         assert len(r.task.loops) == 1 and service.check(r.task, BIN_PICKING, knowledge).plausible
+
+
+def test_a_loop_long_enough_to_be_repaired_window_by_window_keeps_its_loop(tmp_path: Path) -> None:
+    move = "        - command: move-to\n          params: {target_pose: [0.30, 0.00, 0.40, 0, 180, 0]}\n"
+    path = _file(tmp_path, NO_PLACE + 20 * move)  # 44 steps once the body is written twice
+    repairs = service.repair(path, BIN_PICKING)
+    assert repairs and all(r.unrolls is None and len(r.task.loops) == 1 for r in repairs)
+    [loop] = repairs[0].task.loops
+    assert _commands(repairs[0].task, loop.entry, loop.first - 1).count("open-gripper") == 1
+    assert service.check(repairs[0].task, BIN_PICKING).plausible

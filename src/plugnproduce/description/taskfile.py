@@ -274,6 +274,11 @@ def _entries(task: Task, start: int, end: int, in_loop: bool = False) -> list[di
     return out
 
 
+def task_entries(task: Task) -> list[dict[str, object]]:
+    """The task's items as the task file writes them (one round): steps with their ``on``, and loops."""
+    return _entries(task, 1, len(task.one_round()))
+
+
 def task_to_yaml(task: Task, block: bool = False) -> str:
     """Write a task as a task file (one round of its steps when it repeats): the one task writer.
 
@@ -284,6 +289,6 @@ def task_to_yaml(task: Task, block: bool = False) -> str:
         doc["description"] = task.description
     if task.repeat != 1:
         doc["repeat"] = task.repeat
-    doc["steps"] = _entries(task, 1, len(task.one_round()))
+    doc["steps"] = task_entries(task)
     return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=False if block else None,
                      allow_unicode=True)

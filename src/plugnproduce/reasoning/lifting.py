@@ -260,7 +260,7 @@ def lift(repair: Repair, task: Task, cell: Cell, taxonomy: Taxonomy,
     for written in candidates:
         result = check(written, cell, taxonomy, processes)
         if result.plausible:
-            return dataclasses.replace(repair, task=written)
+            return dataclasses.replace(repair, task=written, origins=())
         first_problem = first_problem or (result.problems[0].text if result.problems else "")
     why = (f"kept in the loop or branch it is not plausible ({first_problem})" if candidates
            else "the loop's iterations repair it differently")

@@ -6,6 +6,7 @@ import re
 from dataclasses import dataclass, field
 
 from plugnproduce.description.model import Task, Where, plain_value
+from plugnproduce.description.taskfile import task_entries
 
 _CURIE = re.compile(r" \((?:[A-Za-z][\w-]*:[\w-]+|https?://[^)\s]+)\)")
 """The ``(prefix:Term)`` a reason's text adds after each label for the engineer."""
@@ -252,15 +253,18 @@ class Repair:
     task: Task
     added_devices: tuple[str, ...] = ()
     origins: tuple[int, ...] = field(default=(), compare=False, repr=False)
-    """For each step of the flat repaired task, the original step position it keeps (0 if inserted)."""
+    """For each step of the flat repaired task, the original step position it keeps (0 if inserted); empty once
+    the repair is lifted onto the written task (:mod:`plugnproduce.reasoning.lifting`)."""
     unrolls: str | None = None
     """Why the resulting task writes the original's loops and branches out step by step (None: it keeps them)."""
 
     def to_json(self) -> dict[str, object]:
-        """A JSON-ready dict (the task as its steps; ``unrolls`` says whether it writes loops and branches out)."""
-        steps = [{"command": s.command, **({"bind": dict(s.bind)} if s.bind else {}),
-                  **({"params": {n: plain_value(v) for n, v in s.params.items()}} if s.params else {})}
-                 for s in self.task.steps]
+        """A JSON-ready dict: the task as its steps (as the task file writes them when it has loops or branches),
+        and ``unrolls``: whether it writes the original's loops and branches out step by step (``note``: why)."""
+        steps = task_entries(self.task) if self.task.loops or self.task.branches else [
+            {"command": s.command, **({"bind": dict(s.bind)} if s.bind else {}),
+             **({"params": {n: plain_value(v) for n, v in s.params.items()}} if s.params else {})}
+            for s in self.task.steps]
         return {"rank": self.rank, "cost": self.cost, "edits": [e.to_json() for e in self.edits],
                 "added_devices": list(self.added_devices), "task": {"task": self.task.name, "steps": steps},
                 "unrolls": self.unrolls is not None, **({"note": self.unrolls} if self.unrolls else {})}
