@@ -109,3 +109,8 @@ def test_a_chart_served_under_a_plain_name_of_up_to_100_characters_is_matched(na
 def test_a_chart_served_under_a_name_that_is_not_a_plain_file_name_is_refused(name: str, shown: str) -> None:
     with pytest.raises(DescriptionError, match=f"expected the chart it serves \\({re.escape(shown)}\\)$"):
         read("gripper", turtle=("<gripper.scxml>", f"<{name}>"), chart_url=f"{BASE}/{name}")
+
+
+def test_a_chart_served_without_a_file_name_is_the_chart_named_chart_scxml() -> None:
+    device = read("gripper", turtle=("<gripper.scxml>", "<chart.scxml>"), chart_url="http://127.0.0.1:8000/")
+    assert device.id == "gripper"
