@@ -9,6 +9,7 @@ names it is read under stay inside its own folder.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -91,3 +92,25 @@ def test_an_error_in_the_served_chart_names_the_chart_url() -> None:
         read_served(broken, found, service.knowledge().taxonomy)
     assert str(caught.value).startswith(f"{BASE}/gripper.scxml"), str(caught.value)
     assert Path("/served").as_posix() not in str(caught.value)
+
+
+@pytest.mark.parametrize("name", ["XGripper-2.scxml", "g" * 94 + ".scxml"])
+def test_a_chart_served_under_a_plain_name_of_up_to_100_characters_is_matched(name: str) -> None:
+    device = read("gripper", turtle=("<gripper.scxml>", f"<{name}>"), chart_url=f"{BASE}/{name}")
+    assert device.id == "gripper"
+
+
+@pytest.mark.parametrize(("name", "shown"), [
+    ("g" * 95 + ".scxml", "g" * 95 + ".scxm"),
+    (".gripper.scxml", "gripper.scxml"),
+    ("grip%20per.scxml", "grip_20per.scxml"),
+    ("...", "unnamed"),
+])
+def test_a_chart_served_under_a_name_that_is_not_a_plain_file_name_is_refused(name: str, shown: str) -> None:
+    with pytest.raises(DescriptionError, match=f"expected the chart it serves \\({re.escape(shown)}\\)$"):
+        read("gripper", turtle=("<gripper.scxml>", f"<{name}>"), chart_url=f"{BASE}/{name}")
+
+
+def test_a_chart_served_without_a_file_name_is_the_chart_named_chart_scxml() -> None:
+    device = read("gripper", turtle=("<gripper.scxml>", "<chart.scxml>"), chart_url="http://127.0.0.1:8000/")
+    assert device.id == "gripper"

@@ -8,6 +8,8 @@ is made. Redirects are not followed (they could lead elsewhere) and answers are 
 from __future__ import annotations
 
 import asyncio
+import re
+import uuid
 from collections.abc import AsyncIterator
 
 import pytest
@@ -21,6 +23,7 @@ from async_upnp_client.exceptions import (
 )
 
 from plugnproduce.errors import RemoteError
+from plugnproduce.protocols.upnp import SsdpNetwork, UpnpDeviceServer, device_type_for
 from plugnproduce.protocols.upnp.boundary import (
     NoRedirectRequester,
     TrustedRequester,
@@ -30,6 +33,7 @@ from plugnproduce.protocols.upnp.boundary import (
 )
 from plugnproduce.protocols.upnp.client import UpnpDeviceClient
 from plugnproduce.protocols.upnp.discovery import FoundDevice, SearchHit, describe
+from tests.protocols.test_upnp_loopback import FILES, SPEC, Recorder, free_udp_port
 
 
 @pytest.mark.parametrize(("url", "host"), [
@@ -189,13 +193,69 @@ async def test_an_unreachable_device_is_a_connection_error(server: str) -> None:
 
 
 async def test_a_device_that_does_not_answer_in_time_is_a_timeout() -> None:
-    async def silent(reader: object, writer: object) -> None:
-        await asyncio.sleep(30)
+    done = asyncio.Event()
 
-    listening = await asyncio.start_server(silent, "127.0.0.1", 0)  # type: ignore[arg-type]
+    async def silent(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        await done.wait()  # reads the request, never answers
+        writer.close()
+
+    listening = await asyncio.start_server(silent, "127.0.0.1", 0)
     port = listening.sockets[0].getsockname()[1]
     try:
         with pytest.raises(UpnpConnectionTimeoutError):
             await get(NoRedirectRequester(0.2, 100), f"http://127.0.0.1:{port}/d.xml")
     finally:
+        done.set()
         listening.close()
+        await listening.wait_closed()
+        await asyncio.sleep(0)  # let the handler close its side
+
+
+# --- a device whose description names its files elsewhere ---------------------------------
+
+
+class Elsewhere(UpnpDeviceServer):
+    """A device whose description names its chart (or none) where it likes."""
+
+    def __init__(self, chart_url: str | None) -> None:
+        super().__init__(f"robot-{uuid.uuid4().hex[:8]}", "Hostile robot", device_type_for("Robot"), SPEC,
+                         Recorder(), files=FILES, network=SsdpNetwork(port=free_udp_port()))
+        self.chart_url = chart_url
+
+    async def _description(self, request: web.Request) -> web.Response:
+        text = (await super()._description(request)).text or ""
+        if self.chart_url is None:
+            text = re.sub(r"<pnp:chartURL[^>]*>[^<]*</pnp:chartURL>", "", text)
+        else:
+            text = text.replace("/pnp/robot.scxml", self.chart_url)
+        return web.Response(text=text, content_type="text/xml", charset="utf-8")
+
+
+@pytest.mark.parametrize(("chart_url", "needle"), [
+    ("http://10.0.0.9/robot.scxml", "points at host 10.0.0.9"),
+    ("//10.0.0.9/robot.scxml", "points at host 10.0.0.9"),
+    ("file:///etc/passwd", "expected an http URL"),
+])
+async def test_a_chart_named_on_another_host_is_refused_before_any_request(chart_url: str, needle: str) -> None:
+    async with Elsewhere(chart_url) as device:
+        async with await UpnpDeviceClient.connect(str(device.location), "127.0.0.1", timeout=30.0) as client:
+            with pytest.raises(UntrustedUrlError, match=f"^pnp:chartURL of .*{needle}"):
+                await client.fetch_files()
+
+
+async def test_a_description_naming_no_chart_is_a_remote_error() -> None:
+    async with Elsewhere(None) as device:
+        async with await UpnpDeviceClient.connect(str(device.location), "127.0.0.1", timeout=30.0) as client:
+            with pytest.raises(RemoteError, match="has no pnp:chartURL element"):
+                await client.fetch_files()
+
+
+async def test_a_device_describing_itself_with_another_udn_is_refused() -> None:
+    async with Elsewhere("/pnp/robot.scxml") as device:
+        found = FoundDevice("uuid:someone-else", str(device.location), "type", "name", "127.0.0.1")
+        with pytest.raises(RemoteError, match="describes itself as .*; discovered as uuid:someone-else"):
+            await UpnpDeviceClient.from_found(found, timeout=30.0)
+        with pytest.raises(RemoteError, match="its description names UDN .*; it was discovered as uuid:someone-else"):
+            await describe(SearchHit("uuid:someone-else", str(device.location), "127.0.0.1"), timeout=30.0)
+        hit = await describe(SearchHit(device.udn.upper(), str(device.location), "127.0.0.1"), timeout=30.0)
+        assert (hit.udn, hit.source_host, hit.friendly_name) == (device.udn.upper(), "127.0.0.1", "Hostile robot")
