@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import difflib
 import json
 import os
 import re
@@ -212,27 +213,32 @@ def _function_start(source: str, function: str) -> int:
     return 1
 
 
-def _survivor(key: str, file: str, work: Path) -> Survivor:
-    """Where a surviving mutant is, and the lines it changed (from ``mutmut show``)."""
-    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src")}
-    shown = subprocess.run([sys.executable, "-m", "mutmut", "show", key], cwd=work, env=env,
-                           capture_output=True, text=True).stdout
-    start = _function_start((work / file).read_text(encoding="utf-8"), key.rsplit(".", 1)[-1].split("__mutmut_")[0])
-    line, before, after, offset = start, [], [], None
-    for text in shown.splitlines():
-        hunk = re.match(r"@@ -(\d+)", text)
-        if hunk:
-            offset = int(hunk.group(1)) - 1
-        elif offset is None or text.startswith(("---", "+++")):
-            continue
-        elif text.startswith("-"):
-            if not before:
-                line = start + offset
-            before.append(text[1:].strip())
-        elif text.startswith("+"):
-            after.append(text[1:].strip())
-        elif not before:
-            offset += 1
+def _functions(mutated: str) -> dict[str, str]:
+    """The source of every function of a mutated module, by name (methods included)."""
+    tree = ast.parse(mutated)
+    found: dict[str, str] = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            found[node.name] = ast.get_source_segment(mutated, node) or ""
+    return found
+
+
+def _survivor(key: str, file: str, work: Path, functions: dict[str, str]) -> Survivor:
+    """Where a surviving mutant is, and the lines it changed (the mutant's function against the original)."""
+    name = key.rsplit(".", 1)[-1]
+    function = name.split("__mutmut_")[0]
+    original = functions.get(function + "__mutmut_orig", "").splitlines()
+    mutant = [line.replace(name, function + "__mutmut_orig", 1) for line in functions.get(name, "").splitlines()]
+    start = _function_start((work / file).read_text(encoding="utf-8"), function)
+    before: list[str] = []
+    after: list[str] = []
+    line = start
+    for tag, i1, i2, j1, j2 in difflib.SequenceMatcher(a=original, b=mutant, autojunk=False).get_opcodes():
+        if tag != "equal":
+            if not before and not after:
+                line = start + i1
+            before += [t.strip() for t in original[i1:i2]]
+            after += [t.strip() for t in mutant[j1:j2]]
     return Survivor(key, f"{file}:{line}", " ".join(before), " ".join(after))
 
 
@@ -249,6 +255,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
         _prepare(guard, work)
         _run_mutmut(guard, work, jobs)
     codes = _results(guard, work)
+    functions = {f: _functions((work / "mutants" / f).read_text(encoding="utf-8")) for f in guard.files}
     counts: Counter[str] = Counter()
     lines: list[str] = []
     for key, code in sorted(codes.items(), key=lambda kv: kv[0]):
@@ -261,7 +268,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
             continue
         file = next(f for f in guard.files if key.startswith(Path(f).with_suffix("").as_posix()
                                                             .removeprefix("src/").replace("/", ".") + "."))
-        s = _survivor(key, file, work)
+        s = _survivor(key, file, work, functions[file])
         why = known.get((s.function, s.before, s.after))
         status = "equivalent" if why is not None else _SURVIVED.get(code, f"exit {code}")
         counts["equivalent" if why is not None else "survived"] += 1
