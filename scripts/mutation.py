@@ -4,6 +4,7 @@
     python scripts/mutation.py evaluator tokens   # some of them (names below, or --list)
     python scripts/mutation.py --jobs 2 --work build/mutation
     python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
+                                                  # (a whole run again if the module's test files changed)
 
 For each guard module, mutmut (3.x, the ``test`` extra) makes small changes to its guard
 functions, one at a time (``<`` for ``<=``, ``and`` for ``or``, a string or number changed,
@@ -34,6 +35,7 @@ import shutil
 import subprocess
 import sys
 import time
+import tomllib
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -168,6 +170,12 @@ def _prepare(guard: Guard, work: Path) -> None:
     (work / "src" / f"{PLUGIN}.py").write_text(PLUGIN_TEXT, encoding="utf-8")
 
 
+def _selected_tests(work: Path) -> list[str]:
+    """The test files a prepared work folder runs (mutmut starts afresh when they change)."""
+    settings = tomllib.loads((work / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["mutmut"]
+    return list(settings["pytest_add_cli_args_test_selection"])
+
+
 def _refresh_tests(work: Path) -> None:
     """The checkout's tests, copied again into a prepared work folder (to test the survivors again)."""
     for where in (work / "tests", work / "mutants" / "tests"):
@@ -246,7 +254,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
               again: bool = False) -> dict[str, int]:
     """Mutate one guard module (``again``: test only the last run's survivors), print its figures and survivors."""
     started = time.monotonic()
-    if again and (work / "mutants").is_dir():
+    if again and (work / "mutants").is_dir() and _selected_tests(work) == list(guard.tests):
         _refresh_tests(work)
         survivors = [k for k, code in _results(guard, work).items() if code not in _KILLED and code not in _TIMEOUT]
         if survivors:
