@@ -4,6 +4,7 @@
     python scripts/mutation.py evaluator tokens   # some of them (names below, or --list)
     python scripts/mutation.py --jobs 2 --work build/mutation
     python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
+                                                  # (a whole run again if the module's test files changed)
 
 For each guard module, mutmut (3.x, the ``test`` extra) makes small changes to its guard
 functions, one at a time (``<`` for ``<=``, ``and`` for ``or``, a string or number changed,
@@ -26,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import difflib
 import json
 import os
 import re
@@ -33,6 +35,7 @@ import shutil
 import subprocess
 import sys
 import time
+import tomllib
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -167,6 +170,12 @@ def _prepare(guard: Guard, work: Path) -> None:
     (work / "src" / f"{PLUGIN}.py").write_text(PLUGIN_TEXT, encoding="utf-8")
 
 
+def _selected_tests(work: Path) -> list[str]:
+    """The test files a prepared work folder runs (mutmut starts afresh when they change)."""
+    settings = tomllib.loads((work / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["mutmut"]
+    return list(settings["pytest_add_cli_args_test_selection"])
+
+
 def _refresh_tests(work: Path) -> None:
     """The checkout's tests, copied again into a prepared work folder (to test the survivors again)."""
     for where in (work / "tests", work / "mutants" / "tests"):
@@ -212,27 +221,32 @@ def _function_start(source: str, function: str) -> int:
     return 1
 
 
-def _survivor(key: str, file: str, work: Path) -> Survivor:
-    """Where a surviving mutant is, and the lines it changed (from ``mutmut show``)."""
-    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src")}
-    shown = subprocess.run([sys.executable, "-m", "mutmut", "show", key], cwd=work, env=env,
-                           capture_output=True, text=True).stdout
-    start = _function_start((work / file).read_text(encoding="utf-8"), key.rsplit(".", 1)[-1].split("__mutmut_")[0])
-    line, before, after, offset = start, [], [], None
-    for text in shown.splitlines():
-        hunk = re.match(r"@@ -(\d+)", text)
-        if hunk:
-            offset = int(hunk.group(1)) - 1
-        elif offset is None or text.startswith(("---", "+++")):
-            continue
-        elif text.startswith("-"):
-            if not before:
-                line = start + offset
-            before.append(text[1:].strip())
-        elif text.startswith("+"):
-            after.append(text[1:].strip())
-        elif not before:
-            offset += 1
+def _functions(mutated: str) -> dict[str, str]:
+    """The source of every function of a mutated module, by name (methods included)."""
+    tree = ast.parse(mutated)
+    found: dict[str, str] = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            found[node.name] = ast.get_source_segment(mutated, node) or ""
+    return found
+
+
+def _survivor(key: str, file: str, work: Path, functions: dict[str, str]) -> Survivor:
+    """Where a surviving mutant is, and the lines it changed (the mutant's function against the original)."""
+    name = key.rsplit(".", 1)[-1]
+    function = name.split("__mutmut_")[0]
+    original = functions.get(function + "__mutmut_orig", "").splitlines()
+    mutant = [line.replace(name, function + "__mutmut_orig", 1) for line in functions.get(name, "").splitlines()]
+    start = _function_start((work / file).read_text(encoding="utf-8"), function)
+    before: list[str] = []
+    after: list[str] = []
+    line = start
+    for tag, i1, i2, j1, j2 in difflib.SequenceMatcher(a=original, b=mutant, autojunk=False).get_opcodes():
+        if tag != "equal":
+            if not before and not after:
+                line = start + i1
+            before += [t.strip() for t in original[i1:i2]]
+            after += [t.strip() for t in mutant[j1:j2]]
     return Survivor(key, f"{file}:{line}", " ".join(before), " ".join(after))
 
 
@@ -240,7 +254,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
               again: bool = False) -> dict[str, int]:
     """Mutate one guard module (``again``: test only the last run's survivors), print its figures and survivors."""
     started = time.monotonic()
-    if again and (work / "mutants").is_dir():
+    if again and (work / "mutants").is_dir() and _selected_tests(work) == list(guard.tests):
         _refresh_tests(work)
         survivors = [k for k, code in _results(guard, work).items() if code not in _KILLED and code not in _TIMEOUT]
         if survivors:
@@ -249,6 +263,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
         _prepare(guard, work)
         _run_mutmut(guard, work, jobs)
     codes = _results(guard, work)
+    functions = {f: _functions((work / "mutants" / f).read_text(encoding="utf-8")) for f in guard.files}
     counts: Counter[str] = Counter()
     lines: list[str] = []
     for key, code in sorted(codes.items(), key=lambda kv: kv[0]):
@@ -261,7 +276,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
             continue
         file = next(f for f in guard.files if key.startswith(Path(f).with_suffix("").as_posix()
                                                             .removeprefix("src/").replace("/", ".") + "."))
-        s = _survivor(key, file, work)
+        s = _survivor(key, file, work, functions[file])
         why = known.get((s.function, s.before, s.after))
         status = "equivalent" if why is not None else _SURVIVED.get(code, f"exit {code}")
         counts["equivalent" if why is not None else "survived"] += 1

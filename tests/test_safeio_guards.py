@@ -12,12 +12,17 @@ from plugnproduce.errors import HostileInputError, UnreadableError
 from plugnproduce.safeio import (
     MAX_BYTES,
     MAX_DIGITS,
+    MAX_XML_ATTRIBUTES,
     MAX_XML_DEPTH,
+    MAX_XML_ELEMENTS,
     MAX_YAML_DEPTH,
     PlainDumper,
     parse_xml,
+    parse_xml_bytes,
     parse_yaml_bytes,
     parse_yaml_node,
+    read_bytes,
+    shown,
 )
 from tests.test_safeio_yaml import _signature
 
@@ -109,3 +114,38 @@ def test_yaml_nested_deeper_than_the_reader_goes_is_refused_naming_the_file(tmp_
     with pytest.raises(HostileInputError, match="nested more than") as caught:
         parse_yaml_node(deep)
     assert (caught.value.file, caught.value.line) == (str(deep), 1)
+
+
+def test_xml_at_each_bound_is_read_and_one_more_is_refused() -> None:
+    parse_xml_bytes(("<a>" * MAX_XML_DEPTH + "</a>" * MAX_XML_DEPTH).encode(), "deep.xml")
+    attributes = " ".join(f'a{i}="1"' for i in range(MAX_XML_ATTRIBUTES))
+    parse_xml_bytes(f"<a {attributes}/>".encode(), "wide.xml")
+    with pytest.raises(HostileInputError, match=f"an element with {MAX_XML_ATTRIBUTES + 1} attributes"):
+        parse_xml_bytes(f'<a {attributes} z="1"/>'.encode(), "wide.xml")
+    many = "<a>" + "<b/>" * (MAX_XML_ELEMENTS - 1) + "</a>"
+    parse_xml_bytes(many.encode(), "many.xml")
+    with pytest.raises(HostileInputError, match=f"more than {MAX_XML_ELEMENTS} XML elements") as caught:
+        parse_xml_bytes(many.replace("</a>", "<b/></a>").encode(), "many.xml")
+    assert caught.value.file == "many.xml"
+
+
+def test_malformed_xml_is_one_line_at_its_line_naming_the_file() -> None:
+    with pytest.raises(UnreadableError, match="^chart.scxml:3: malformed XML: ") as caught:
+        parse_xml_bytes(b"<a>\n<b>\n</a>", "chart.scxml")
+    assert "line 3" not in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_a_file_of_the_largest_size_is_read_and_one_byte_more_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "d.ttl"
+    path.write_bytes(b"#" * 100)
+    assert read_bytes(path, limit=100) == b"#" * 100
+    path.write_bytes(b"#" * 101)
+    with pytest.raises(HostileInputError, match="101 bytes; at most 100") as caught:
+        read_bytes(path, limit=100)
+    assert caught.value.file == str(path)
+
+
+def test_a_path_from_the_input_is_shown_whole_up_to_200_characters_and_by_its_ends_beyond() -> None:
+    assert shown("d/" + "x" * 198) == "d/" + "x" * 198
+    long = "d/" + "x" * 199
+    assert shown(long) != long and len(shown(long)) < 130 and shown(long).startswith("d/x")

@@ -37,6 +37,13 @@ def test_a_token_shorter_than_16_characters_is_refused_at_line_1(tmp_path: Path,
     assert (caught.value.file, caught.value.line) == (str(path), 1)
 
 
+def test_an_empty_token_file_is_said_to_hold_no_character(tmp_path: Path) -> None:
+    path = tmp_path / "token"
+    path.write_text("\n \n", encoding="utf-8")
+    with pytest.raises(DescriptionError, match="found 0$"):
+        read_token(path)
+
+
 def test_a_missing_token_file_is_refused_naming_it(tmp_path: Path) -> None:
     with pytest.raises(DescriptionError, match="cannot read the token file") as caught:
         read_token(tmp_path / "none")
@@ -173,6 +180,7 @@ async def test_a_declared_length_over_the_limit_is_refused_before_reading(limite
     res = await limited.post("/", content=b"x" * 11)
     assert res.status_code == 413
     assert res.json() == {"detail": "the request body is larger than the 10 bytes accepted"}
+    assert res.headers["content-type"] == "application/json"
     assert res.headers["content-length"] == str(len(res.content))
 
 

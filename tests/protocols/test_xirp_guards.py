@@ -147,3 +147,45 @@ def test_a_value_of_no_xirp_type_is_refused_naming_the_types() -> None:
 def test_a_version_or_sequence_number_must_be_a_positive_integer(message: Hello | Event) -> None:
     with pytest.raises(MessageError, match="expected a positive integer"):
         encode(message)
+
+
+@pytest.mark.parametrize("declared", ["utf-8", "UTF-8", "utf8", "UTF8"])
+def test_a_message_declaring_utf8_in_any_spelling_is_read(declared: str) -> None:
+    data = f'<?xml version="1.0" encoding="{declared}"?><request xmlns="{NAMESPACE}" id="7" name="Go"/>'.encode()
+    assert decode(data) == Request("7", "Go", {})
+
+
+def test_a_message_declaring_another_encoding_is_refused_naming_it() -> None:
+    data = f'<?xml version="1.0" encoding="ISO-8859-1"?><request xmlns="{NAMESPACE}" id="7" name="Go"/>'.encode()
+    with pytest.raises(MessageError, match="^peer: declared encoding ISO-8859-1; expected UTF-8$") as caught:
+        decode(data)
+    assert (caught.value.code, caught.value.ref) == ("malformed", "7")
+
+
+def test_an_invalid_request_is_refused_in_one_line_naming_its_id_and_not_the_namespace() -> None:
+    with pytest.raises(MessageError, match="^message from x: not a valid XIRP message: ") as caught:
+        decode(request('<bogus name="p"/>'), "message from x")
+    text = str(caught.value)
+    assert (caught.value.code, caught.value.ref) == ("malformed", "7")
+    assert NAMESPACE not in text and "{" not in text and "line" not in text and "\n" not in text
+    assert "bogus" in text
+
+
+def test_an_invalid_message_other_than_a_request_names_no_id() -> None:
+    data = f'<response xmlns="{NAMESPACE}" id="7"><bogus/></response>'.encode()
+    with pytest.raises(MessageError, match="not a valid XIRP message") as caught:
+        decode(data)
+    assert caught.value.ref is None
+
+
+def test_an_invalid_request_with_an_id_no_reply_could_carry_names_no_id() -> None:
+    data = f'<request xmlns="{NAMESPACE}" id="bad id" name="Go"/>'.encode()
+    with pytest.raises(MessageError, match="not a valid XIRP message") as caught:
+        decode(data)
+    assert caught.value.ref is None
+
+
+@pytest.mark.parametrize("name", ["has space", ["Go"], 7])
+def test_a_request_name_that_is_not_a_name_is_refused_saying_what_a_name_is(name: object) -> None:
+    with pytest.raises(MessageError, match=r"is refused; expected letters, digits, '_', '\.', '-'"):
+        encode(Request("7", name, {}))  # type: ignore[arg-type]

@@ -254,6 +254,19 @@ def test_a_power_whose_result_would_be_too_large_is_refused(source: str) -> None
         evaluate(source)
 
 
+def test_a_sequence_may_be_repeated_up_to_the_limit_and_not_beyond() -> None:
+    assert len(evaluate(f"'a' * {MAX_ITEMS}")) == MAX_ITEMS  # type: ignore[arg-type]
+    with pytest.raises(EvaluationError, match="exceed"):
+        evaluate(f"[0] * {MAX_ITEMS + 1}")
+
+
+@pytest.mark.parametrize(("source", "shown"), [("(2 ** 63) ** 2000", "9223372036854775808 ** 2000"),
+                                               ("(2 ** 64) ** 2000", "a 65-bit integer ** 2000")])
+def test_a_refused_power_names_an_operand_of_up_to_64_bits_by_its_value(source: str, shown: str) -> None:
+    with pytest.raises(EvaluationError, match=re.escape(shown) + " would exceed"):
+        evaluate(source)
+
+
 def test_a_power_is_refused_by_the_size_of_its_result_even_to_the_first() -> None:
     assert evaluate("(1 << 60000) ** 1 == 1 << 60000") is True
     with pytest.raises(EvaluationError, match="a 120001-bit integer \\*\\* 1 would exceed"):
