@@ -68,10 +68,23 @@ def test_issue_15_a_percent_encoded_nul_in_the_chart_name_is_a_refusal_not_a_cra
         read("gripper", turtle=("<gripper.scxml>", "<gripper%00.scxml>"))
 
 
-@pytest.mark.parametrize("endpoint", ["xirp://10.0.0.9:7000", "xirp://localhost:7000", "xirp://127.0.0.2:7000"])
+@pytest.mark.parametrize("endpoint", ["xirp://10.0.0.9:7000", "xirp://127.0.0.2:7000", "xirp://localhost.example:7000"])
 def test_an_xirp_endpoint_on_another_host_is_refused(endpoint: str) -> None:
     with pytest.raises(UntrustedUrlError, match="found at 127.0.0.1 names XIRP endpoint .* on another host"):
         read("gripper", turtle=('"xirp://127.0.0.1:0"', f'"{endpoint}"'))
+
+
+@pytest.mark.parametrize("endpoint", ["xirp://localhost:7000", "xirp://LocalHost:7000"])
+def test_issue_15_a_device_found_on_loopback_may_name_its_endpoint_localhost(endpoint: str) -> None:
+    """``localhost`` always names this machine; the device is then reached at the address it was found at."""
+    assert read("gripper", turtle=('"xirp://127.0.0.1:0"', f'"{endpoint}"')).endpoint == "xirp://127.0.0.1:7000"
+
+
+def test_a_device_found_elsewhere_may_not_name_its_endpoint_localhost() -> None:
+    files, found = served("gripper", turtle=('"xirp://127.0.0.1:0"', '"xirp://localhost:7000"'),
+                          location="http://10.0.0.9:8000/files/device.xml")
+    with pytest.raises(UntrustedUrlError, match="found at 10.0.0.9 names XIRP endpoint .* on another host"):
+        read_served(files, found, service.knowledge().taxonomy)
 
 
 @pytest.mark.parametrize("udn", ["uuid:../../etc", "uuid:" + "a" * 3000, "..", "uuid:dev/1 ?#"])

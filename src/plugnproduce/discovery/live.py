@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import ipaddress
 import logging
 import re
 from collections.abc import AsyncIterator, Collection
@@ -45,7 +46,7 @@ from plugnproduce.protocols.upnp import (
     UpnpDeviceClient,
     describe,
 )
-from plugnproduce.protocols.xirp import parse_endpoint
+from plugnproduce.protocols.xirp import format_endpoint, parse_endpoint
 
 _LOGGER = logging.getLogger(__name__)
 
@@ -265,9 +266,18 @@ def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> D
                                exc.line) from exc
     if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
         return replace(device, endpoint=found.location)
-    host = urlparse(found.location).hostname
-    if parse_endpoint(device.endpoint)[0] != host:
+    host = urlparse(found.location).hostname or ""
+    named_host, port = parse_endpoint(device.endpoint)
+    if named_host != host and not (named_host.lower() == "localhost" and _is_loopback(host)):
         raise UntrustedUrlError(f"device {excerpt(device.id)} found at {host} names XIRP endpoint "
                                 f"{excerpt(device.endpoint)} "
                                 "on another host; refused")
-    return device
+    return replace(device, endpoint=format_endpoint(host, port))  # reached where it was found, never by name
+
+
+def _is_loopback(host: str) -> bool:
+    """Whether ``host`` is a loopback address (``localhost`` always names this machine)."""
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
