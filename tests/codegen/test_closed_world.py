@@ -15,7 +15,8 @@ from plugnproduce.resources import descriptions_path
 from tests.codegen.conftest import generate
 from tests.conftest import edit
 
-VALID_TASKS = ["bin-picking", "bin-picking-localized", "bin-picking-then-home", "bin-picking-until-empty",
+VALID_TASKS = ["bin-picking", "bin-picking-in-rounds", "bin-picking-localized", "bin-picking-then-home",
+               "bin-picking-until-empty",
                "pick-and-place"]
 
 

@@ -98,7 +98,7 @@ def test_task_yaml_round_trip(tmp_path: Path, name: str) -> None:
         ("task: t\nsteps:\n  - loop:\n      steps:\n        - command: pick\n", 4,
          "a loop needs a way out: 'until: OUTCOME', 'max: N' or both"),
         ("task: t\nsteps:\n  - loop:\n      max: 2\n      steps:\n        - loop: {max: 2, steps: []}\n", 6,
-         "a loop inside a loop is not supported"),
+         "a loop needs 'steps', a non-empty list"),
         ("task: t\nrepeat: 2\nsteps:\n  - loop: {max: 2, steps: [{command: pick}]}\n", 4,
          "a task with a loop cannot also repeat"),
         ("task: t\nsteps:\n  - command: pick\n    params:\n      pick_pose: {from: a}\n", 5,

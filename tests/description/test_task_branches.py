@@ -85,8 +85,8 @@ def test_a_loop_may_go_on_while_an_outcome_comes() -> None:
         ("task: t\nrepeat: 2\nsteps:\n  - command: pick\n    on: {NoPartFound: [{command: place}]}\n", 5,
          "a task with a branch cannot also repeat"),
         ("task: t\nsteps:\n  - loop:\n      max: 2\n      steps:\n        - command: pick\n          on:\n"
-         "            NoPartFound:\n              - loop: {max: 2, steps: [{command: place}]}\n", 9,
-         "a loop inside a loop is not supported"),
+         "            NoPartFound:\n              - loop: {max: 2, steps: []}\n", 9,
+         "a loop needs 'steps', a non-empty list"),
         ("task: t\nsteps:\n  - command: pick\n    on:\n      NoPartFound:\n        - name: a\n          command: x\n"
          "  - name: a\n    command: place\n", 8, "step name 'a' appears twice"),
     ],

@@ -80,3 +80,15 @@ async def test_a_malformed_loop_or_link_is_refused_with_its_finding(client: http
     res = await client.post("/api/task/check", json=task)
     assert res.status_code == 422
     assert detail in res.json()["detail"]
+
+
+async def test_a_loop_inside_a_loop_imports_nested_as_written(client: httpx.AsyncClient) -> None:
+    rounds = service.builtin("tasks", "bin-picking-in-rounds.yaml")
+    res = await client.post("/api/task/import?filename=rounds.yaml", content=rounds.read_bytes(), headers=YAML)
+    assert res.status_code == 200, res.text
+    [outer] = res.json()["steps"]
+    assert outer["loop"]["max"] == 3
+    inner, home = outer["loop"]["steps"]
+    assert (inner["loop"]["until"], inner["loop"]["max"]) == ("BinEmpty", 3)
+    assert [s["command"] for s in inner["loop"]["steps"]] == ["localize-part", "pick", "place"]
+    assert home["command"] == "move-to"

@@ -293,6 +293,13 @@ def test_an_imported_branch_in_a_branch_is_listed_as_written_and_a_loop_in_a_bra
         "This task has a loop inside a branch: the editor builds loops of the task's steps only; edit that task file "
         "by hand.")
     expect(page.locator("#steps li.step")).to_have_count(5)  # the task as it was
+    inner = service.builtin("tasks", "bin-picking-in-rounds.yaml").read_bytes()
+    page.locator("#import").set_input_files(files=[{"name": "rounds.yaml", "mimeType": "application/yaml",
+                                                    "buffer": inner}])
+    expect(page.locator("#verdict .error")).to_have_text(
+        "This task has a loop inside a loop: the editor builds loops of the task's steps only; edit that task file "
+        "by hand.")
+    expect(page.locator("#steps li.step")).to_have_count(5)  # not mangled: the task as it was
 
 
 SLOW_GRIPPER = "gripper:delay-event:gripper_closed:1"

@@ -16,6 +16,12 @@ step first applies these rules, in this order:
 5. a branch's first step is next, but the outcome its step reported
    (``pnp_branch_N``, N the step's position) does not take the branch: skip its steps.
 
+Loops nest: a loop inside another's body is a loop record in each copy of that body, each
+with its own ``pnp_rounds_N`` (N its place in :attr:`Task.loops`). The rules of an inner
+loop come before those of the loops around it, so an outcome ends the innermost loop whose
+``until`` it falls under; and when a loop runs its later iterations' body again it sets the
+counters of the loops inside that body back to 0, so that they loop again.
+
 ``pnp_rounds_N`` counts the iterations of loop N (-1 once it has ended). An outcome takes
 the branch of the most specific outcome it falls under; the conditions list the
 outcomes the step's process declares. The chart's size does not depend on how often a
@@ -93,15 +99,29 @@ def flow_data(task: Task) -> list[Data]:
 def flow_transitions(task: Task, target: str, outcomes: Outcomes) -> list[Transition]:
     """The loops' and branches' rules, as eventless transitions of the state that picks the next step (``target``)."""
     out: list[Transition] = []
-    for n, loop in enumerate(task.loops, start=1):
-        out += _loop_transitions(n, loop, target, outcomes)
+    numbered = list(enumerate(task.loops, start=1))
+    for n, loop in sorted(numbered, key=lambda nl: (nl[1].last - nl[1].entry, nl[0])):  # inner loops first
+        inside = tuple(m for m, lp in numbered if loop.first <= lp.entry <= loop.last)
+        nested = any(lp.entry <= loop.entry and loop.last <= lp.last for lp in task.loops if lp != loop)
+        out += _loop_transitions(n, loop, target, outcomes, _Nesting(inside, nested))
     for b in sorted(task.branches, key=lambda b: b.first):
         skip = f"{STEP} == {b.first - 1} and {_none_of(branch_variable(b.step), outcomes.branches[b])}"
         out.append(Transition(cond=skip, targets=[target], actions=[Assign(location=STEP, expr=str(b.last))]))
     return out
 
 
-def _loop_transitions(n: int, loop: Loop, target: str, outcomes: Outcomes) -> list[Transition]:
+@dataclass(frozen=True)
+class _Nesting:
+    """Where a loop lies among the others."""
+
+    inside: tuple[int, ...]
+    """The loops (1-based) inside its later iterations' body: their counters restart with each iteration."""
+    nested: bool
+    """Whether it lies in another loop's body (its ``while`` keeps ``pnp_outcome`` for the outer loops)."""
+
+
+def _loop_transitions(n: int, loop: Loop, target: str, outcomes: Outcomes, nesting: _Nesting) -> list[Transition]:
+    """One loop's rules, as transitions back to ``target``."""
     count = rounds(n)
     # positions are 0-based in the chart: the step just ended is pnp_step - 1
     entry, first, after = loop.entry - 1, loop.first - 1, loop.last
@@ -115,16 +135,17 @@ def _loop_transitions(n: int, loop: Loop, target: str, outcomes: Outcomes) -> li
                       (STEP, str(after)), (OUTCOME, "None"), (count, "-1")))
     if n in outcomes.goes_on:
         stop = _none_of(OUTCOME, outcomes.goes_on[n])
-        out.append(go(f"{STEP} == {first} and {count} == 0 and {stop}", (STEP, str(after)), (OUTCOME, "None"),
-                      (count, "-1")))
-        out.append(go(f"{STEP} == {after} and {count} >= 1 and {stop}", (OUTCOME, "None"), (count, "-1")))
+        keep: tuple[tuple[str, str], ...] = () if nesting.nested else ((OUTCOME, "None"),)
+        out.append(go(f"{STEP} == {first} and {count} == 0 and {stop}", (STEP, str(after)), *keep, (count, "-1")))
+        out.append(go(f"{STEP} == {after} and {count} >= 1 and {stop}", *keep, (count, "-1")))
     if loop.max == 1:
         out.append(go(f"{STEP} == {first} and {count} == 0", (STEP, str(after)), (count, "-1")))
     out.append(go(f"{STEP} == {first} and {count} == 0", (count, "1")))
     again = f"{STEP} == {after} and {count} >= 1"
     if loop.max is not None:
         again += f" and {count} + 1 < {loop.max}"
-    out.append(go(again, (count, f"{count} + 1"), (STEP, str(first))))
+    restart = tuple((rounds(m), "0") for m in nesting.inside)
+    out.append(go(again, (count, f"{count} + 1"), (STEP, str(first)), *restart))
     if loop.max is not None:
         out.append(go(f"{STEP} == {after} and {count} >= 1", (count, "-1")))
     return out

@@ -140,8 +140,8 @@ def _produces(task: Task, step: Step, process: ProcessDescription,
     wanted = consumed.get(step.name or "", set())
     out = tuple((o.role, o.name, output_variable(step.name or "", o.name))
                 for o in process.outputs if o.name in wanted)
-    loop, role = task.loop_at(step.index), process.outcome_role()
-    if loop is not None and role is not None and (loop.until or loop.while_outcome):
+    role = process.outcome_role()
+    if role is not None and any(lp.until or lp.while_outcome for lp in task.loops_at(step.index)):
         out += ((role.name, "outcome", OUTCOME),)
     if role is not None and task.branches_of(step.index):
         out += ((role.name, "outcome", branch_variable(step.index)),)

@@ -75,9 +75,19 @@ class Branch:
         return f"branch {_local(self.outcome)} at step {self.step}"
 
 
+def outermost_first(loops: list[Loop] | tuple[Loop, ...]) -> tuple[Loop, ...]:
+    """The loops in the order of their first positions, a loop before the loops inside its body."""
+    return tuple(sorted(loops, key=lambda lp: (lp.entry, -lp.last)))
+
+
+def enclosing(loops: tuple[Loop, ...], index: int) -> tuple[Loop, ...]:
+    """The loops whose bodies (either copy) hold step position ``index``, outermost first."""
+    return tuple(lp for lp in outermost_first(loops) if lp.entry <= index <= lp.last)
+
+
 def path_name(loops: tuple[Loop, ...], branches: tuple[Branch, ...], index: int) -> str | None:
     """The path a step position lies on, outermost first (``loop iteration 2 and later, branch
     NoPartFound at step 7``); None on the straight path."""
-    parts = [lp.path(index) for lp in loops if lp.path(index)]
+    parts = [lp.path(index) for lp in outermost_first(loops) if lp.path(index)]
     parts += [b.path for b in sorted(branches, key=lambda b: b.first) if b.holds(index)]
     return ", ".join(p for p in parts if p) or None

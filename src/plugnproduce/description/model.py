@@ -14,7 +14,7 @@ from typing import Literal
 
 from plugnproduce.description.flow import Branch as Branch
 from plugnproduce.description.flow import Loop as Loop
-from plugnproduce.description.flow import path_name
+from plugnproduce.description.flow import enclosing, outermost_first, path_name
 from plugnproduce.statechart.model import Chart
 
 Protocol = Literal["xirp", "upnp"]
@@ -358,8 +358,16 @@ class Task:
         return self.steps[: len(self.steps) // max(self.repeat, 1)]
 
     def loop_at(self, index: int) -> Loop | None:
-        """The loop whose body (either copy) holds step position ``index``, if any."""
-        return next((lp for lp in self.loops if lp.entry <= index <= lp.last), None)
+        """The outermost loop whose body (either copy) holds step position ``index``, if any."""
+        return next(iter(self.loops_at(index)), None)
+
+    def loops_at(self, index: int) -> tuple[Loop, ...]:
+        """The loops whose bodies (either copy) hold step position ``index``, outermost first."""
+        return enclosing(self.loops, index)
+
+    def loop_starting(self, index: int, end: int) -> Loop | None:
+        """The outermost loop that starts at step position ``index`` and ends by position ``end``, if any."""
+        return next((lp for lp in outermost_first(self.loops) if lp.entry == index and lp.last <= end), None)
 
     def branches_of(self, index: int) -> tuple[Branch, ...]:
         """The branches on the outcome of the step at position ``index``, in the order written."""

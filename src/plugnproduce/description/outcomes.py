@@ -57,7 +57,8 @@ def flow_findings(task: Task, processes: dict[str, ProcessDescription], taxonomy
         if _written(task, b.step):
             yield from _branch_findings(task, b, processes, taxonomy)
     for loop in task.loops:
-        yield from _loop_findings(task, loop, processes, taxonomy)
+        if _written(task, loop.entry):  # a loop inside another's later iterations: its copy, found already
+            yield from _loop_findings(task, loop, processes, taxonomy)
 
 
 def _unknown(iri: str, taxonomy: Taxonomy) -> str | None:
@@ -78,12 +79,12 @@ def _branch_findings(task: Task, b: Branch, processes: dict[str, ProcessDescript
     process = processes.get(step.command)
     if process is None:
         return  # an unknown command is a finding of its own
-    siblings, loop = task.branches_of(b.step), task.loop_at(b.step)
-    until = loop.until if loop is not None else None
-    goes_on = tuple(o for o in process.outcomes if until is None or not taxonomy.is_a(o, until))
+    siblings = task.branches_of(b.step)
+    goes_on = tuple(o for o in process.outcomes if ending_loop(task, b.step, o, taxonomy) is None)
     if taken_by(b, siblings, goes_on, taxonomy):
         return
     taking = taken_by(b, siblings, process.outcomes, taxonomy)
+    until = next((u for o in taking if (u := ending_loop(task, b.step, o, taxonomy)) is not None), None)
     if taking and until is not None:
         names = ", ".join(local_name(o) for o in taking)
         yield FlowFinding(b.line, b.step, step.command, f"{head} is unreachable: the outcome that would take it "
@@ -96,10 +97,31 @@ def _branch_findings(task: Task, b: Branch, processes: dict[str, ProcessDescript
     yield FlowFinding(b.line, b.step, step.command, f"{head} is unreachable: {why}")
 
 
+def loop_ending(task: Task, index: int, outcome: str, taxonomy: Taxonomy) -> Loop | None:
+    """The innermost loop around step position ``index`` whose ``until`` ``outcome`` falls under, if any:
+    the loop that outcome ends."""
+    return next((lp for lp in reversed(task.loops_at(index))
+                 if lp.until is not None and taxonomy.is_a(outcome, lp.until)), None)
+
+
+def ending_loop(task: Task, index: int, outcome: str, taxonomy: Taxonomy) -> str | None:
+    """The ``until`` of the loop ``outcome`` ends at step position ``index`` (:func:`loop_ending`), if any."""
+    loop = loop_ending(task, index, outcome, taxonomy)
+    return loop.until if loop is not None else None
+
+
 def body_outcomes(task: Task, loop: Loop, processes: dict[str, ProcessDescription]) -> tuple[str, ...]:
     """The outcomes the steps of a loop's body can end with."""
     body = task.steps[loop.entry - 1: loop.first - 1]
     return tuple(dict.fromkeys(o for s in body if s.command in processes for o in processes[s.command].outcomes))
+
+
+def _ends_on(task: Task, loop: Loop, until: str, processes: dict[str, ProcessDescription],
+             taxonomy: Taxonomy) -> bool:
+    """Whether a step of the loop's body can end with an outcome under ``until`` that no inner loop ends first."""
+    return any(taxonomy.is_a(o, until) and loop_ending(task, s.index, o, taxonomy) == loop
+               for s in task.steps[loop.entry - 1: loop.first - 1] if s.command in processes
+               for o in processes[s.command].outcomes)
 
 
 def _loop_findings(task: Task, loop: Loop, processes: dict[str, ProcessDescription],
@@ -118,6 +140,10 @@ def _loop_findings(task: Task, loop: Loop, processes: dict[str, ProcessDescripti
             yield FlowFinding(loop.line, loop.entry, first.command,
                               f"loop {word} {local_name(iri)}: no step of its body can end with that outcome, "
                               f"so {effect}; its steps' outcomes: {known}")
+        elif word == "until" and not _ends_on(task, loop, iri, processes, taxonomy):
+            yield FlowFinding(loop.line, loop.entry, first.command,
+                              f"loop until {local_name(iri)}: every step of its body that can end with that outcome "
+                              "lies in an inner loop that ends on it first, so the loop never ends on it")
         elif word == "while" and loop.max is None and loop.until is None and \
                 set(falling_under(iri, outcomes, taxonomy)) == set(outcomes):
             yield FlowFinding(loop.line, loop.entry, first.command,

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import yaml
 
-from plugnproduce.description.flow import Branch, Loop
+from plugnproduce.description.flow import Branch, Loop, outermost_first
 from plugnproduce.description.model import Link, Step, Task, plain_value
 from plugnproduce.errors import DescriptionError, excerpt
 from plugnproduce.ontology.vocabulary import concept_iri, concept_value
@@ -96,24 +96,21 @@ def parse_task(data: bytes, source: str | Path) -> Task:
                                f"{len(steps_node.value) * repeat}; at most {Task.MAX_STEPS} are accepted",
                                p, steps_node.start_mark.line + 1)
     flat = _Flat(p, repeat=repeat)
-    _items(flat, steps_node.value, in_loop=False)
+    _items(flat, steps_node.value)
     if len(flat.steps) * repeat > Task.MAX_STEPS:
         raise DescriptionError(f"the task makes {len(flat.steps) * repeat} steps; at most {Task.MAX_STEPS} are "
                                "accepted", p, steps_node.start_mark.line + 1)
     description = _plain(top["description"]) if "description" in top else ""
     task = Task.repeated(str(_plain(top["task"])), flat.steps, str(p), str(description or ""), repeat)
-    return dataclasses.replace(task, loops=tuple(flat.loops), branches=tuple(flat.branches))
+    return dataclasses.replace(task, loops=outermost_first(flat.loops), branches=tuple(flat.branches))
 
 
-def _items(flat: _Flat, nodes: list[yaml.Node], in_loop: bool) -> None:
+def _items(flat: _Flat, nodes: list[yaml.Node]) -> None:
     """Flatten a list of steps and loops (a task's, a loop's body or a branch's) onto ``flat``."""
     for node in nodes:
         m = _mapping(node, flat.path, "step")
         if "loop" not in m:
-            _step_and_branches(flat, node, m, in_loop)
-        elif in_loop:
-            raise DescriptionError("a loop inside a loop is not supported (nor in a branch inside a "
-                                   "loop); flatten the inner one", flat.path, node.start_mark.line + 1)
+            _step_and_branches(flat, node, m)
         elif flat.repeat != 1:
             raise DescriptionError("a task with a loop cannot also repeat; put its steps in the loop", flat.path,
                                    node.start_mark.line + 1)
@@ -124,7 +121,7 @@ def _items(flat: _Flat, nodes: list[yaml.Node], in_loop: bool) -> None:
                                    "accepted", flat.path, node.start_mark.line + 1)
 
 
-def _step_and_branches(flat: _Flat, node: yaml.Node, m: dict[str, yaml.Node], in_loop: bool) -> None:
+def _step_and_branches(flat: _Flat, node: yaml.Node, m: dict[str, yaml.Node]) -> None:
     """One step, then the steps of each of its branches (``on: {OUTCOME: [...]}``) in the order written."""
     step = _step(node, m, flat.path, flat.names, len(flat.steps) + 1)
     flat.steps.append(step)
@@ -147,7 +144,7 @@ def _step_and_branches(flat: _Flat, node: yaml.Node, m: dict[str, yaml.Node], in
         if not isinstance(body, yaml.SequenceNode) or not body.value:
             raise DescriptionError(f"branch {excerpt(key.value)} needs its steps, a non-empty list", flat.path, line)
         first = len(flat.steps) + 1
-        _items(flat, body.value, in_loop)
+        _items(flat, body.value)
         flat.branches.append(Branch(step.index, concept_iri(str(key.value)), first, len(flat.steps), line))
 
 
@@ -198,13 +195,19 @@ def _loop(flat: _Flat, item: dict[str, yaml.Node]) -> None:
     body = m.get("steps")
     if not isinstance(body, yaml.SequenceNode) or not body.value:
         raise DescriptionError("a loop needs 'steps', a non-empty list", p, line)
-    entry, known = len(flat.steps) + 1, len(flat.branches)
-    _items(flat, body.value, in_loop=True)
+    entry, known, inner = len(flat.steps) + 1, len(flat.branches), len(flat.loops)
+    _items(flat, body.value)
     first = len(flat.steps) + 1
     n = first - entry
+    if len(flat.steps) + n > Task.MAX_STEPS:
+        raise DescriptionError(f"the task makes more than {Task.MAX_STEPS} steps; at most {Task.MAX_STEPS} are "
+                               "accepted", p, line)
     flat.steps += [dataclasses.replace(s, index=s.index + n) for s in flat.steps[entry - 1:]]
     flat.branches += [dataclasses.replace(b, step=b.step + n, first=b.first + n, last=b.last + n)
                       for b in flat.branches[known:]]
+    # a loop inside the body appears in each copy of it, with positions of its own
+    flat.loops += [dataclasses.replace(lp, entry=lp.entry + n, first=lp.first + n, last=lp.last + n)
+                   for lp in flat.loops[inner:]]
     flat.loops.append(Loop(entry, first, len(flat.steps), until, most, line, goes_on))
 
 
@@ -254,17 +257,17 @@ def _loop_entry(task: Task, loop: Loop) -> dict[str, object]:
         out["while"] = concept_value(loop.while_outcome)
     if loop.max is not None:
         out["max"] = loop.max
-    out["steps"] = _entries(task, loop.entry, loop.first - 1, in_loop=True)
+    out["steps"] = _entries(task, loop.entry, loop.first - 1)
     return out
 
 
-def _entries(task: Task, start: int, end: int, in_loop: bool = False) -> list[dict[str, object]]:
+def _entries(task: Task, start: int, end: int) -> list[dict[str, object]]:
     """The file's items for step positions ``start`` to ``end``: steps with their branches, and loops
-    (none ``in_loop``: loops do not nest)."""
+    (with the loops inside their bodies)."""
     out: list[dict[str, object]] = []
     i = start
     while i <= end:
-        loop = None if in_loop else next((lp for lp in task.loops if lp.entry == i), None)
+        loop = task.loop_starting(i, end)
         if loop is not None:
             out.append({"loop": _loop_entry(task, loop)})
             i = loop.last + 1

@@ -125,24 +125,24 @@ def _loop_json(task: Task, loop: Loop) -> dict[str, Any]:
         head["while"] = concept_value(loop.while_outcome)
     if loop.max is not None:
         head["max"] = loop.max
-    return {"loop": {**head, "steps": _items(task, loop.entry, loop.first - 1, loop)}}
+    return {"loop": {**head, "steps": _items(task, loop.entry, loop.first - 1)}}
 
 
-def _items(task: Task, first: int, last: int, inside: Loop | None = None) -> list[dict[str, Any]]:
+def _items(task: Task, first: int, last: int) -> list[dict[str, Any]]:
     """The items of step positions ``first`` to ``last`` as the task file nests them: a step with its branches
     (``on``), a loop holding its body once."""
     items: list[dict[str, Any]] = []
     index = first
     while index <= last:
-        loop = task.loop_at(index)
-        if loop is not None and loop is not inside and index == loop.entry:
+        loop = task.loop_starting(index, last)
+        if loop is not None:
             items.append(_loop_json(task, loop))
             index = loop.last + 1
             continue
         item = _step_json(task.steps[index - 1])
         branches = task.branches_of(index)
         if branches:
-            item["on"] = {concept_value(b.outcome): _items(task, b.first, b.last, inside) for b in branches}
+            item["on"] = {concept_value(b.outcome): _items(task, b.first, b.last) for b in branches}
         items.append(item)
         index = max([index] + [b.last for b in branches]) + 1
     return items
@@ -163,8 +163,8 @@ def editor_rows(task: Task) -> dict[int, tuple[int, int]]:
     one_round = len(task.one_round())
     row = 0
     for s in task.steps:
-        loop = task.loop_at(s.index)
-        if loop is not None and s.index >= loop.first:
+        loop = next((lp for lp in task.loops_at(s.index) if s.index >= lp.first), None)
+        if loop is not None:
             rows[s.index] = (rows[s.index - (loop.first - loop.entry)][0], 2)
             continue
         if s.index > one_round:

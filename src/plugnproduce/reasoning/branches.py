@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 from plugnproduce.description.flow import Branch
 from plugnproduce.description.model import ProcessDescription, Task, Where
-from plugnproduce.description.outcomes import branch_of
+from plugnproduce.description.outcomes import branch_of, ending_loop
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.results import CheckResult, Problem, Reason, StepCheck
 
@@ -61,9 +61,7 @@ def ways_on(task: Task, index: int, processes: dict[str, ProcessDescription],
     siblings = task.branches_of(index)
     if process is None or not process.outcomes:
         return (), True
-    loop = task.loop_at(index)
-    goes_on = [o for o in process.outcomes
-               if loop is None or loop.until is None or not taxonomy.is_a(o, loop.until)]
+    goes_on = [o for o in process.outcomes if ending_loop(task, index, o, taxonomy) is None]
     taken = [branch_of(o, siblings, taxonomy) for o in goes_on]
     return tuple(b for b in siblings if b in taken), None in taken or not goes_on
 

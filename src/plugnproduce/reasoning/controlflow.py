@@ -20,6 +20,7 @@ import dataclasses
 from collections.abc import Callable, Iterator
 
 from plugnproduce.description.model import Loop, ProcessDescription, Task, Where
+from plugnproduce.description.outcomes import loop_ending
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.branches import Path, covering, renumbered
@@ -81,7 +82,7 @@ def _exits(task: Task, loop: Loop, processes: dict[str, ProcessDescription], tax
     until = loop.until
     for step in task.steps[loop.entry - 1 : loop.last]:
         process = processes.get(step.command)
-        if process is None or not any(taxonomy.is_a(o, until) for o in process.outcomes):
+        if process is None or not any(loop_ending(task, step.index, o, taxonomy) == loop for o in process.outcomes):
             continue
         route = tuple(i for i in covering(paths, step.index).positions if i <= step.index) + rest
         straight = dataclasses.replace(task, steps=tuple(dataclasses.replace(task.steps[p - 1], index=i + 1)

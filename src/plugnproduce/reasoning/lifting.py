@@ -251,6 +251,8 @@ def lift(repair: Repair, task: Task, cell: Cell, taxonomy: Taxonomy,
     if not (task.loops or task.branches) or len(repair.origins) != len(repair.task.steps):
         return repair
     flat = dataclasses.replace(repair.task, loops=(), branches=())
+    if any(len(task.loops_at(lp.entry)) > 1 for lp in task.loops):
+        return dataclasses.replace(repair, task=flat, unrolls=UNROLLS + "the task has a loop inside a loop")
     w = _Written(task)
     try:
         candidates = _placements(w, repair)

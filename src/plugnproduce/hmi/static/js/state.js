@@ -98,6 +98,10 @@ export function editorTask(body) {
     throw new Error("This task has a loop inside a branch: the editor builds loops of the task's steps only; "
       + "edit that task file by hand.");
   }
+  if (body.steps.some((item) => item.loop && rowsOf(item.loop.steps || []).some((r) => r.step.loop))) {
+    throw new Error("This task has a loop inside a loop: the editor builds loops of the task's steps only; "
+      + "edit that task file by hand.");
+  }
   const steps = [];
   const loops = [];
   for (const item of body.steps) {

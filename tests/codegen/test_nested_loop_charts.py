@@ -1,0 +1,54 @@
+"""Generated charts for a loop inside a loop: W3C-valid, not unrolled, inner counters restarted."""
+
+from __future__ import annotations
+
+from plugnproduce import service
+from plugnproduce.codegen import generate_task
+from plugnproduce.codegen.closed_world import closed_world_chart
+from plugnproduce.description.loader import parse_task
+from plugnproduce.description.model import Cell, ProcessDescription
+from plugnproduce.resources import descriptions_path
+from plugnproduce.statechart import parse_chart, schema_problems
+from plugnproduce.statechart.model import Assign, Transition, walk
+from tests.codegen.conftest import bind_by_skill
+from tests.codegen.test_loops_and_links import run, size
+
+ROUNDS = (descriptions_path() / "tasks" / "bin-picking-in-rounds.yaml").read_text(encoding="utf-8")
+
+
+def generated(text: str, cell: Cell, processes: dict[str, ProcessDescription]) -> tuple[bytes, bytes]:
+    task = parse_task(text.encode(), "task.yaml")
+    out = generate_task(task, cell, bind_by_skill(task, cell, processes), processes, service.knowledge().taxonomy)
+    return out.task_chart(), closed_world_chart(out, cell)
+
+
+def test_the_nested_chart_is_w3c_valid(bin_picking_cell, processes) -> None:
+    chart, closed = generated(ROUNDS, bin_picking_cell, processes)
+    assert schema_problems(chart, "task.scxml") == []
+    assert schema_problems(closed, "closed.scxml") == []
+
+
+def test_the_chart_does_not_grow_with_either_maximum(bin_picking_cell, processes) -> None:
+    few, _ = generated(ROUNDS, bin_picking_cell, processes)
+    many, _ = generated(ROUNDS.replace("max: 3", "max: 50000"), bin_picking_cell, processes)
+    assert size(few) == size(many)
+
+
+def test_each_copy_of_the_inner_loop_counts_its_own_iterations(bin_picking_cell, processes) -> None:
+    chart, _ = generated(ROUNDS, bin_picking_cell, processes)
+    counters = {a.location for a in walk(parse_chart(chart, "task.scxml"))
+                if isinstance(a, Assign) and a.location.startswith("pnp_rounds_")}
+    assert counters == {"pnp_rounds_1", "pnp_rounds_2", "pnp_rounds_3"}
+
+
+def test_another_outer_iteration_restarts_the_inner_loop_of_its_body(bin_picking_cell, processes) -> None:
+    chart, _ = generated(ROUNDS, bin_picking_cell, processes)
+    again = [t for t in walk(parse_chart(chart, "task.scxml"))
+             if isinstance(t, Transition) and "pnp_rounds_1 + 1 < 3" in (t.cond or "")]
+    assert [[(a.location, a.expr) for a in t.actions if isinstance(a, Assign)] for t in again] == [
+        [("pnp_rounds_1", "pnp_rounds_1 + 1"), ("pnp_step", "7"), ("pnp_rounds_3", "0")]]
+
+
+def test_the_closed_world_runs_the_nested_loops_to_done(bin_picking_cell, processes) -> None:
+    _, closed = generated(ROUNDS, bin_picking_cell, processes)
+    assert run(closed) == {"done"}
