@@ -5,9 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from plugnproduce import service
+from tests.reasoning.test_flow_check import CELL, TASKS, checked, line_of
 
-TASKS = service.builtin("tasks")
-CELL = service.builtin("cells", "bin-picking.yaml")
 THEN_HOME = (TASKS / "bin-picking-then-home.yaml").read_text(encoding="utf-8")
 
 GRIPPER_CLOSED = """task: closed
@@ -22,16 +21,6 @@ steps:
       pick_pose: {from: localize, output: part_pose}
   - command: place
 """
-
-
-def checked(tmp_path: Path, text: str) -> tuple[service.reasoning.CheckResult, Path]:
-    path = tmp_path / "task.yaml"
-    path.write_text(text, encoding="utf-8")
-    return service.check(path, CELL), path
-
-
-def line_of(path: Path, text: str) -> int:
-    return next(i for i, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if text in line)
 
 
 def test_the_shipped_branching_task_is_plausible() -> None:
