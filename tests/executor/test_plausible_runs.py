@@ -2,7 +2,9 @@
 
 Every shipped task on every shipped cell: where ``check`` calls it plausible, ``pnp run --sim``
 must end ``succeeded``; a plausible task that fails to run is a test failure. Where it is not
-plausible, ``pnp run`` refuses it before any command goes out.
+plausible, ``pnp run`` refuses it before any command goes out. A task with loops runs on a
+simulated bin of a few parts, as in a real cell: its loops end when the bin is empty (without a
+bin the simulated localiser finds a part every time, and the loops run to their maximum).
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ def test_a_shipped_task_runs_on_a_shipped_cell_if_and_only_if_check_calls_it_pla
         cell: Path, task: Path, tmp_path: Path) -> None:
     plausible = service.check(task, cell).plausible
     journal = tmp_path / "run.jsonl"
-    result = pnp("run", str(task), "--cell", str(cell), "--sim", "--journal", str(journal))
+    parts = ["--bin-parts", "2", "--bin-seed", "1"] if service.task(task).loops else []
+    result = pnp("run", str(task), "--cell", str(cell), "--sim", "--journal", str(journal), *parts)
     if plausible:
         assert result.returncode == 0, result.stdout + result.stderr
         assert result.stdout.rstrip().splitlines()[-1] == f"succeeded; journal {journal}"

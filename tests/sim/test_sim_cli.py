@@ -48,7 +48,8 @@ def simulated_cell(env: dict[str, str], tmp_path: Path) -> Iterator[Path]:
 
 
 def test_discover_lists_the_four_devices(simulated_cell: Path, env: dict[str, str]) -> None:
-    result = subprocess.run(command("discover", "--json"), env=env, capture_output=True, text=True, timeout=60)
+    search = command("discover", "--json", "--timeout", "10")  # a busy machine answers late
+    result = subprocess.run(search, env=env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     found = json.loads(result.stdout)
     assert sorted(d["id"] for d in found["devices"]) == ["binpicking-pc", "gripper", "robot", "sensor3d"]
