@@ -440,6 +440,12 @@ def new_run_id(task_name: str) -> str:
     return f"{time.strftime('%Y%m%d-%H%M%S')}-{task_name}-{secrets.token_hex(2)}"
 
 
+DISCOVERY_SECONDS = 10.0
+"""How long a run or a live check waits for the cell's devices on the network, unless told."""
+SIMULATED_DISCOVERY_SECONDS = 60.0
+"""The same for the devices a run simulates itself: they are up, so only a busy machine delays their answers."""
+
+
 async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cell:
     """Wait until discovery has found every wanted device; the live cell's devices with their real endpoints."""
     deadline = asyncio.get_running_loop().time() + timeout
@@ -462,7 +468,7 @@ async def run_task(
     journal: Path | None = None,
     observer: RecordObserver | None = None,
     started: Callable[[TaskRun], None] | None = None,
-    discovery_timeout: float = 10.0,
+    discovery_timeout: float | None = None,
     progress: Callable[[str], None] | None = None,
     knowledge: Knowledge | None = None,
     bin_parts: int | None = None,
@@ -474,9 +480,10 @@ async def run_task(
     With ``simulate`` the cell's devices are simulated for the run, on a private SSDP network,
     with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`), working on a
     simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given. ``started`` is
-    given the run once it exists (to stop it); ``progress`` is told each phase as it begins
-    (checking, generating, starting devices, discovering, running). The task is checked and generated
-    from the state each device reports once discovered (:func:`reported_states`), or, with
+    given the run once it exists (to stop it); ``discovery_timeout`` bounds the wait for the devices
+    (default :data:`DISCOVERY_SECONDS`, simulated: :data:`SIMULATED_DISCOVERY_SECONDS`); ``progress`` is told
+    each phase as it begins (checking, generating, starting devices, discovering, running). The task is
+    checked and generated from the state each device reports once discovered (:func:`reported_states`), or, with
     ``assume_initial``, from the charts' initial states before discovery. Raises :class:`ImplausibleTask`
     before any command goes out.
     """
@@ -503,7 +510,8 @@ async def run_task(
         wanted = [d.id for d in the_cell.devices]
         live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
                                                         expected=wanted))
-        devices = await find_devices(live, wanted, discovery_timeout)
+        devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
+                                                                         else DISCOVERY_SECONDS))
         if generated is None:
             say("asking each device its state; checking the task from there")
             generated = plan_run(the_task, the_cell.reported(await reported_states(devices)), k, progress=say)
@@ -543,7 +551,7 @@ async def reported_states(devices: Cell, timeout: float | None = None) -> dict[s
 
 
 async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
-                    discovery_timeout: float = 10.0) -> Cell:
+                    discovery_timeout: float = DISCOVERY_SECONDS) -> Cell:
     """The cell with each device in the state it reports: its devices found by discovery (on the network
     ``PNP_SSDP_PORT`` names) and asked their states. For ``check``, ``repair`` and ``explain`` on a live cell."""
     from plugnproduce.discovery import LiveCell

@@ -41,8 +41,20 @@ def simulated_cell(env: dict[str, str], tmp_path: Path) -> Iterator[Path]:
 
 
 def pnp(env: dict[str, str], *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "plugnproduce", *args], capture_output=True, text=True, timeout=120,
-                          env=env)
+    """``pnp ARGS``, waiting up to 60 s for the devices: a fully loaded machine answers discovery late."""
+    return subprocess.run([sys.executable, "-m", "plugnproduce", *args, "--discovery-timeout", "60"],
+                          capture_output=True, text=True, timeout=180, env=env)
+
+
+def test_a_cell_whose_devices_do_not_answer_is_bad_input_after_the_discovery_timeout(
+        env: dict[str, str], tmp_path: Path) -> None:
+    """Nothing runs on this private network: the run names the missing devices and the wait it gave them."""
+    done = subprocess.run([sys.executable, "-m", "plugnproduce", "run", PICK_AND_PLACE, "--cell", CELL,
+                           "--discovery-timeout", "0.5"], capture_output=True, text=True, timeout=120, env=env)
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        "error: device(s) robot, gripper, sensor3d, binpicking-pc of the cell not found on the network within 0.5 s"]
+    assert not (tmp_path / "runs").exists() or not any((tmp_path / "runs").iterdir()), "no journal: nothing ran"
 
 
 def task(folder: Path, name: str, *commands: str) -> str:

@@ -41,6 +41,9 @@ def knowledge(cell: str | Path | None = None) -> Knowledge:
 
 
 JSON_OPTION = typer.Option(False, "--json", help="Machine-readable output.")
+DISCOVERY_OPTION = typer.Option(None, "--discovery-timeout", metavar="SECONDS", min=0.1, max=3600,
+                                help="Most seconds to wait for the cell's devices on the network (default 10; "
+                                     "60 for simulated devices). The wait ends as soon as all have answered.")
 
 
 QUIET_LOGGERS = ("rdflib.term",)

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, TextIO
 
 import typer
 
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
+from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, fail, knowledge
 from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.lazy import lazy_module
 
@@ -33,13 +33,13 @@ LIVE_OPTION = typer.Option(False, "--live", help="Find the cell's devices on the
                                                  "each reports, not from its chart's initial state.")
 
 
-def _cell(cell: Path, live: bool) -> Path | Cell:
+def _cell(cell: Path, live: bool, discovery_timeout: float | None) -> Path | Cell:
     """The cell file, or with ``live`` the cell with each device in the state it reports."""
     if not live:
         return cell
     import asyncio
 
-    return asyncio.run(service.live_cell(cell, knowledge(cell)))
+    return asyncio.run(service.live_cell(cell, knowledge(cell), discovery_timeout or service.DISCOVERY_SECONDS))
 VERBOSE_OPTION = typer.Option(False, "--verbose", "-v",
                               help="The engineer's view: ontology terms, rule instances, axioms and file:line.")
 
@@ -91,12 +91,13 @@ def _print_problems(result: reasoning.CheckResult, verbose: bool) -> None:
 @app.command()
 @boundary
 def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
-          live: bool = LIVE_OPTION, verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION) -> None:
+          live: bool = LIVE_OPTION, discovery_timeout: float | None = DISCOVERY_OPTION,
+          verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Check that a task is plausible: each step finds its devices in the states it starts from.
 
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
     """
-    result = service.check(task, _cell(cell, live), knowledge(cell))
+    result = service.check(task, _cell(cell, live, discovery_timeout), knowledge(cell))
     if json_out:
         emit_json(result.to_json())
     else:
@@ -116,6 +117,7 @@ def repair(
                                           help="Devices a repair may add (a folder)."),
     top: int = typer.Option(3, "--top", min=1, max=20, metavar="K", help="How many distinct repairs, cheapest first."),
     live: bool = LIVE_OPTION,
+    discovery_timeout: float | None = DISCOVERY_OPTION,
     verbose: bool = VERBOSE_OPTION,
     json_out: bool = JSON_OPTION,
 ) -> None:
@@ -124,7 +126,7 @@ def repair(
     A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
-    the_cell = _cell(cell, live)
+    the_cell = _cell(cell, live, discovery_timeout)
     result = service.check(task, the_cell, knowledge(cell))
     repairs = [] if result.plausible else service.assessed_repairs(task, the_cell, catalogue, top, knowledge(cell))
     players = service.catalogue_players(result, knowledge(cell))

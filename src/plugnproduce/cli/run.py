@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, knowledge
+from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.cli.generate import refuse
 from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.executor.journal import describe
@@ -39,6 +39,7 @@ def run(
     assume_initial: bool = typer.Option(False, "--assume-initial",
                                         help="Plan from the charts' initial states, not the states the devices "
                                              "report."),
+    discovery_timeout: float | None = DISCOVERY_OPTION,
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Find the devices, ask each its state, check and generate the task from there, run it, and journal every
@@ -73,7 +74,8 @@ def run(
             report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
                                                   observer=show, started=started, progress=phases,
                                                   knowledge=knowledge(cell), bin_parts=bin_parts, bin_seed=bin_seed,
-                                                  assume_initial=assume_initial))
+                                                  assume_initial=assume_initial,
+                                                  discovery_timeout=discovery_timeout))
             phases.close(last_done=True)
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)
