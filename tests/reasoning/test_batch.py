@@ -117,6 +117,52 @@ def test_answers_agree_with_the_full_reasoner_on_random_configurations(library: 
     assert any(r.plausible for r in found) and any(not r.plausible for r in found)
 
 
+LOCALIZE = """  - command: localize-part
+    bind: {sensor: sensor3d, localizer: binpicking-pc}
+    params: {exposure: 25, part_type: bracket}
+    on:
+"""
+
+
+def test_a_task_with_branches_is_answered_on_every_path_as_check_answers_it(tmp_path: Path) -> None:
+    """Read in file order, the branch steps below look like one straight line: the first task (the gripper closed
+    only when no part is found, so the two ways on leave it differently) would pass, the second (closed either
+    way, twice in a row as written) would not; the check decides path by path, and so does the batch."""
+    one_way = write(tmp_path, "one.yaml", "task: close-when-empty\nsteps:\n" + LOCALIZE
+                    + "      NoPartFound:\n        - command: close-gripper\n")
+    either_way = write(tmp_path, "either.yaml", "task: close-either-way\nsteps:\n" + LOCALIZE
+                       + "      PartFound:\n        - command: close-gripper\n"
+                       + "      NoPartFound:\n        - command: close-gripper\n")
+    the_tasks = [service.task(one_way), service.task(either_way)]
+    (row,) = service.batch([Configuration("paper", PAPER)], service.catalogue(), the_tasks, workers=1)
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert row.plausible == tuple(t.name for t in the_tasks if service.check(t, cell).plausible) == ("close-either-way",)
+    assert row.purchase is not None and row.purchase.impossible == (
+        "step 2 of close-when-empty: a branch leaves device gripper in another state than the other ways on from its "
+        "step; adding devices cannot cure it")
+
+
+@pytest.mark.parametrize("name", ["bin-picking-until-empty", "bin-picking-then-home", "bin-picking-in-rounds"])
+def test_shipped_tasks_with_loops_branches_and_links_are_answered_as_check_answers_them(name: str) -> None:
+    """Around the paper's cell (devices taken away, others added): the batch's answer is the check's, and the
+    cheapest purchase makes the task plausible."""
+    k = service.knowledge()
+    rng = random.Random(name)
+    others = sorted(d.id for d in k.devices if d.id not in PAPER)
+    configs = [Configuration(f"c{n}", tuple(rng.sample(PAPER, rng.randint(2, 4)) + rng.sample(others, rng.randint(0, 3))))
+               for n in range(12)]
+    the_task = task(name)
+    found = list(service.batch(configs, list(k.devices), [the_task], workers=1, knowledge=k))
+    assert [r.plausible for r in found] == [p for _, p in _reasoner(configs, [the_task], k)]
+    assert any(r.plausible for r in found) and any(not r.plausible for r in found)
+    by_id = {d.id: d for d in k.devices}
+    for config, row in zip(configs, found, strict=True):
+        if row.purchase is not None and row.purchase.options:
+            added = row.purchase.options[0][0]
+            cell = Cell("bought", tuple(by_id[d] for d in (*config.devices, *added)))
+            assert service.check(the_task, cell, k).plausible, (config, added)
+
+
 def test_purchases_are_the_cheapest_sets_an_exhaustive_search_finds() -> None:
     catalogue = service.catalogue()
     e = engine(catalogue, tasks(), service.knowledge().taxonomy, service.knowledge().processes, top=3)

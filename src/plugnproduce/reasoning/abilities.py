@@ -15,7 +15,7 @@ from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
+from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning import solver
@@ -53,6 +53,28 @@ class TaskSpec:
 
     name: str
     steps: tuple[StepSpec, ...]
+    flow: Task | None = None
+    """The task itself when it has loops, branches or data links: what its paths, loop iterations and links
+    need is the full check's (:class:`FullCheck`), run once per answer's key."""
+
+
+@dataclass(frozen=True)
+class FullCheck:
+    """The full plausibility check (:mod:`plugnproduce.reasoning.plausibility`) of a task in a configuration."""
+
+    catalogue: tuple[DeviceDescription, ...]
+    """The catalogue devices, in bit order."""
+    taxonomy: Taxonomy
+    processes: tuple[ProcessDescription, ...]
+
+    def findings(self, task: Task, mask: int) -> tuple[tuple[str, int, str, str], ...]:
+        """Why ``task`` is not plausible in the configuration ``mask`` (empty: it is), as the check says."""
+        from plugnproduce.reasoning.plausibility import check
+
+        devices = tuple(d for n, d in enumerate(self.catalogue) if mask >> n & 1)
+        result = check(task, Cell("configuration", devices), self.taxonomy, self.processes)
+        return tuple(sorted({(p.kind, p.step, p.role or "", p.device or "") for p in result.problems},
+                            key=lambda f: (f[1], f)))
 
 
 @dataclass(frozen=True)
@@ -80,6 +102,7 @@ class Abilities:
     tasks: tuple[TaskSpec, ...]
     bits: dict[str, int]
     """Each catalogue device's bit."""
+    full: FullCheck
 
     def bit(self, device: str) -> int:
         """The bit of a catalogue device (0 when it is not in the catalogue)."""
@@ -110,9 +133,10 @@ def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str,
         concepts=_concepts(dev_atoms, index),
         leaves=_leaves(dev_atoms, index),
         recovers=_recovers(dev_atoms, index),
-        tasks=tuple(_task(name, normalised(t, processes)[0], processes, bad, _refusing(devices, processes, taxonomy),
-                          devices) for name, t in tasks),
+        tasks=tuple(_task(name, t, processes, bad, _refusing(devices, processes, taxonomy), devices)
+                    for name, t in tasks),
         bits={d.id: 1 << n for n, d in enumerate(devices)},
+        full=FullCheck(tuple(devices), taxonomy, tuple(processes)),
     )
 
 
@@ -159,8 +183,9 @@ def _refusing(devices: Sequence[DeviceDescription], processes: Sequence[ProcessD
             for p in processes for par in p.parameters}
 
 
-def _task(name: str, task: Task, processes: Sequence[ProcessDescription], bad: set[tuple[str, int]],
+def _task(name: str, written: Task, processes: Sequence[ProcessDescription], bad: set[tuple[str, int]],
           refusing: dict[tuple[str, str], int], devices: Sequence[DeviceDescription]) -> TaskSpec:
+    task = normalised(written, processes)[0]
     by_id = {p.id: p for p in processes}
     steps = []
     for step in task.steps:
@@ -176,4 +201,5 @@ def _task(name: str, task: Task, processes: Sequence[ProcessDescription], bad: s
                        for n, v in sorted(sent.items()) if v is not None)
         steps.append(StepSpec(step.index, p.id if p is not None else None, roles, unknown,
                               (name, step.index) in bad, refusals, tuple(b for b in beyond if b[1])))
-    return TaskSpec(name, tuple(steps))
+    flow = task.loops or task.branches or any(step.links() for step in task.steps)
+    return TaskSpec(name, tuple(steps), written if flow else None)

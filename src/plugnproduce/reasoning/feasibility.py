@@ -15,6 +15,9 @@ those of ``offered.lp``, ``resolve.lp`` and ``chain.lp``, applied to the per-dev
   ``not_accepted`` (accepts.py); a value sent to a bound device (given or the default) beyond
   that device's own limits is ``device_limit`` (contracts.py).
 
+A task with loops, branches or data links is answered by the full check instead (every path, every loop
+iteration, every link; :class:`.abilities.FullCheck`), once per key as below.
+
 A task's answer depends only on, for each role it leaves to the configuration, whether none, one
 (which) or several of the devices that can play it are present, and on whether each device it
 names is present: answers are remembered by that key, and offered processes by the set of roles
@@ -99,6 +102,8 @@ Binding = tuple[tuple[str, int], ...]
 
 
 def _findings(ab: Abilities, task: TaskSpec, mask: int) -> tuple[Finding, ...]:
+    if task.flow is not None:
+        return ab.full.findings(task.flow, mask)
     out: list[Finding] = []
     unbound = False
     bindings: list[Binding] = []

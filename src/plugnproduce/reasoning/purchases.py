@@ -32,7 +32,13 @@ KINDS = {
     "stuck": "device {device} cannot play role {role} from the state it is in",
     "not_accepted": "device {device} (role {role}) accepts no command for a parameter value given",
     "device_limit": "device {device} (role {role}) refuses a value sent to it by its own limits",
+    "loop_fixpoint": "device {device} ends a loop iteration in another state than the iteration began in",
+    "branch_join": "a branch leaves device {device} in another state than the other ways on from its step",
+    "bad_link": "a value taken from an earlier step's output does not fit",
+    "bad_flow": "a loop or branch cannot work as written",
 }
+"""The findings of a straight task; a task with loops, branches or links has those of the full check, which
+``pnp check`` explains (:func:`describe` names their kind)."""
 
 
 @dataclass(frozen=True)
@@ -61,7 +67,8 @@ def describe(feasibility: Feasibility, task: int, finding: Finding) -> str:
     """A finding in words: ``step 2 of pick-and-place: no device can play role gripper``."""
     kind, step, role, device = finding
     name = feasibility.abilities.tasks[task].name
-    return f"step {step} of {name}: " + KINDS[kind].format(role=role, device=device)
+    text = KINDS.get(kind, f"a finding of kind {kind} (pnp check says why)").format(role=role, device=device)
+    return f"step {step} of {name}: {text}"
 
 
 def purchase(feasibility: Feasibility, mask: int, top: int = 1) -> Purchase | None:
