@@ -105,10 +105,10 @@ def parse_xml_bytes(data: bytes, source: str | Path) -> etree._ElementTree:
         root = etree.fromstring(data, parser=_PARSER)
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if exc.lineno else None
-        msg = exc.msg.split(f", line {line}")[0] if exc.msg else "malformed XML"
+        msg = exc.msg.split(f", line {line}")[0] if exc.msg else "the parser gave no reason"
         raise UnreadableError(f"malformed XML: {tidy(shorten_words(msg))}", source, line) from exc
     tree = root.getroottree()
-    if tree.docinfo.internalDTD is not None or tree.docinfo.doctype:  # an encoding the search did not know
+    if tree.docinfo.internalDTD is not None:  # an encoding the search did not know (any DOCTYPE makes one)
         raise HostileInputError("DOCTYPE/ENTITY declarations are refused (entity expansion is not allowed); "
                                 "expected a plain XML document", source, 1)
     _check_depth(root, source)
@@ -210,7 +210,7 @@ def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
             elif isinstance(event, yaml.CollectionStartEvent):
                 kind = yaml.SequenceNode if isinstance(event, yaml.SequenceStartEvent) else yaml.MappingNode
                 tag = event.tag if event.tag not in (None, "!") else resolver.resolve(kind, None, event.implicit)
-                collection = kind(tag, [], _mark(event.start_mark), None, flow_style=event.flow_style)
+                collection = kind(tag, [], _mark(event.start_mark), flow_style=event.flow_style)  # end mark: at its end
                 if len(stack) >= MAX_YAML_DEPTH:
                     raise HostileInputError(f"YAML nested more than {MAX_YAML_DEPTH} levels deep; at most "
                                             f"{MAX_YAML_DEPTH} are accepted", source, _mark(event.start_mark).line + 1)
@@ -270,7 +270,8 @@ def parse_yaml_bytes(data: bytes, source: str | Path) -> yaml.Node:
         what = exc.problem or exc.context or "malformed YAML"
         raise UnreadableError(f"malformed YAML: {tidy(what)}", source, line) from exc
     except yaml.reader.ReaderError as exc:  # a character YAML does not allow (NUL, other controls)
-        line = text.count("\n", 0, max(exc.position, 0)) + 1
+        # the refused character is its first occurrence (libyaml gives its position in bytes, not characters)
+        line = text[:text.find(chr(exc.character))].count("\n") + 1
         raise UnreadableError(f"malformed YAML: {tidy(exc.reason)} (character #x{exc.character:04x}); "
                               "expected printable text", source, line) from exc
     except yaml.YAMLError as exc:
