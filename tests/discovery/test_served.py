@@ -87,6 +87,13 @@ def test_a_device_found_elsewhere_may_not_name_its_endpoint_localhost() -> None:
         read_served(files, found, service.knowledge().taxonomy)
 
 
+@pytest.mark.parametrize("location", ["http:///files/device.xml", "file:///files/device.xml"])
+def test_a_device_found_at_a_location_without_a_host_may_name_no_xirp_endpoint(location: str) -> None:
+    files, found = served("gripper", location=location)
+    with pytest.raises(UntrustedUrlError, match=f"found at {location} names XIRP endpoint .* on another host"):
+        read_served(files, found, service.knowledge().taxonomy)
+
+
 @pytest.mark.parametrize("udn", ["uuid:../../etc", "uuid:" + "a" * 3000, "..", "uuid:dev/1 ?#"])
 def test_whatever_a_device_calls_itself_its_own_chart_is_found(udn: str) -> None:
     assert read("gripper", udn=udn).id == "gripper"

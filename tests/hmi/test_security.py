@@ -3,12 +3,13 @@ the bearer header, the answer a refused client gets, the page's headers and the 
 
 from __future__ import annotations
 
-from collections.abc import AsyncIterator
+import locale
+from collections.abc import AsyncIterator, Iterator
 from pathlib import Path
 
 import httpx
 import pytest
-from starlette.types import Receive, Scope, Send
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from plugnproduce.errors import DescriptionError
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders, is_loopback, new_token, read_token
@@ -50,6 +51,32 @@ def test_a_missing_token_file_is_refused_naming_it(tmp_path: Path) -> None:
     assert caught.value.file == str(tmp_path / "none")
 
 
+@pytest.fixture
+def ascii_locale() -> Iterator[None]:
+    """The process's locale is C (ASCII), as on a machine where no UTF-8 locale is set."""
+    before = locale.setlocale(locale.LC_CTYPE)
+    locale.setlocale(locale.LC_CTYPE, "C")
+    try:
+        yield
+    finally:
+        locale.setlocale(locale.LC_CTYPE, before)
+
+
+@pytest.mark.usefixtures("ascii_locale")
+def test_the_token_file_is_read_as_utf8_whatever_the_locale(tmp_path: Path) -> None:
+    path = tmp_path / "token"
+    path.write_bytes("geheimes-Passwort-für-die-Zelle\n".encode())
+    assert read_token(path) == "geheimes-Passwort-für-die-Zelle"
+
+
+def test_a_token_file_that_is_not_utf8_is_refused_naming_it(tmp_path: Path) -> None:
+    path = tmp_path / "token"
+    path.write_bytes("geheimes-Passwort-für-die-Zelle\n".encode("latin-1"))
+    with pytest.raises(DescriptionError, match=r"the token file is not UTF-8 text \(byte 20\)$") as caught:
+        read_token(path)
+    assert caught.value.file == str(path)
+
+
 def test_a_new_token_is_32_random_url_safe_characters_and_reads_back(tmp_path: Path) -> None:
     tokens = {new_token() for _ in range(20)}
     assert len(tokens) == 20
@@ -66,6 +93,7 @@ def test_a_new_token_is_32_random_url_safe_characters_and_reads_back(tmp_path: P
     ("127.0.0.1", True), ("127.45.6.7", True), ("::1", True), ("::1%lo", True), ("localhost", True),
     ("203.0.113.7", False), ("10.0.0.1", False), ("fe80::1%eth0", False), ("::ffff:203.0.113.7", False),
     ("localhost.example.org", False), ("127.0.0.1.example.org", False), ("", False), (None, False),
+    ("::1%", False), ("127.0.0.1%lo", False),
 ])
 def test_only_loopback_addresses_count_as_this_host(host: str | None, loopback: bool) -> None:
     assert is_loopback(host) is loopback
@@ -117,6 +145,17 @@ async def test_a_refused_client_is_told_how_to_send_the_token(hmi: Hmi) -> None:
         assert "Authorization: Bearer TOKEN" in res.json()["detail"]
 
 
+@pytest.mark.parametrize(("headers", "code"), [({}, 401), ({"Authorization": "Bearer wrong-token-0123456789"}, 401),
+                                             ({"Authorization": f"Bearer {TOKEN}"}, 200)])
+async def test_a_client_without_an_address_reads_only_with_the_token(hmi: Hmi, headers: dict[str, str],
+                                                                     code: int) -> None:
+    """A server that knows no client address (one on a Unix socket) passes none: not loopback, so the token."""
+    transport = httpx.ASGITransport(app=hmi.app, client=None)  # type: ignore[arg-type]
+    async with httpx.AsyncClient(transport=transport, base_url="http://127.0.0.1") as c:
+        res = await c.get("/api/processes", headers=headers)
+    assert res.status_code == code
+
+
 async def test_a_read_from_ipv6_loopback_needs_no_token(hmi: Hmi) -> None:
     res = await status(hmi, ("::1", 50000), "GET", "/api/processes")
     assert res.status_code == 200
@@ -135,6 +174,57 @@ async def test_the_page_and_the_api_carry_the_strict_policy_and_the_docs_do_not(
         res = await status(hmi, ("127.0.0.1", 1), "GET", url)
         assert res.status_code == 200 and "content-security-policy" not in res.headers
         assert res.headers["x-content-type-options"] == "nosniff"
+
+
+async def test_the_headers_are_added_to_a_response_that_starts_without_any() -> None:
+    """An ASGI application may leave the headers out of its response's start: the middleware adds its own."""
+    async def bare(scope: Scope, receive: Receive, send: Send) -> None:
+        await send({"type": "http.response.start", "status": 204})
+        await send({"type": "http.response.body", "body": b""})
+
+    transport = httpx.ASGITransport(app=SecurityHeaders(bare))
+    async with httpx.AsyncClient(transport=transport, base_url="http://127.0.0.1") as c:
+        res = await c.get("/api/cell")
+    assert res.status_code == 204 and res.headers["x-content-type-options"] == "nosniff"
+    assert "frame-ancestors 'none'" in res.headers["content-security-policy"]
+
+
+async def _start_header_names(app: ASGIApp, headers: list[tuple[bytes, bytes]]) -> list[bytes]:
+    """The header names an ASGI application sends in the start of its response to a POST of 11 bytes."""
+    sent: list[Message] = []
+
+    async def receive() -> Message:
+        return {"type": "http.request", "body": b"x" * 11, "more_body": False}
+
+    async def send(message: Message) -> None:
+        sent.append(message)
+
+    scope = {"type": "http", "method": "POST", "path": "/", "headers": headers, "query_string": b""}
+    await app(scope, receive, send)
+    return [name for name, _ in sent[0]["headers"]]
+
+
+async def test_header_names_are_sent_in_lower_case_as_asgi_requires() -> None:
+    """A server sends the names as given, and HTTP/2 refuses a response with a name in upper case."""
+    names = await _start_header_names(SecurityHeaders(echo), [])
+    assert {b"x-content-type-options", b"referrer-policy", b"content-security-policy"} <= set(names)
+    names = await _start_header_names(BodyLimit(echo, limit=10), [(b"content-length", b"11")])
+    assert names == [b"content-type", b"content-length"]
+
+
+async def test_the_server_starts_and_stops_the_application_through_its_middlewares(hmi: Hmi) -> None:
+    """A server sends the lifespan (startup, then shutdown) through the security middlewares to the application."""
+    incoming = [{"type": "lifespan.startup"}, {"type": "lifespan.shutdown"}]
+    sent: list[str] = []
+
+    async def receive() -> Message:
+        return incoming.pop(0)
+
+    async def send(message: Message) -> None:
+        sent.append(message["type"])
+
+    await hmi.app({"type": "lifespan", "asgi": {"version": "3.0", "spec_version": "2.0"}, "state": {}}, receive, send)
+    assert sent == ["lifespan.startup.complete", "lifespan.shutdown.complete"]
 
 
 # --- the body limit, on a small application ----------------------------------------------

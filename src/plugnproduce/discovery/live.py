@@ -266,12 +266,11 @@ def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> D
                                exc.line) from exc
     if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
         return replace(device, endpoint=found.location)
-    host = urlparse(found.location).hostname or ""
+    host = urlparse(found.location).hostname  # None: found at no host, so no endpoint is on its host
     named_host, port = parse_endpoint(device.endpoint)
-    if named_host != host and not (named_host.lower() == "localhost" and _is_loopback(host)):
-        raise UntrustedUrlError(f"device {excerpt(device.id)} found at {host} names XIRP endpoint "
-                                f"{excerpt(device.endpoint)} "
-                                "on another host; refused")
+    if host is None or (named_host != host and not (named_host.lower() == "localhost" and _is_loopback(host))):
+        raise UntrustedUrlError(f"device {excerpt(device.id)} found at {host or excerpt(found.location)} "
+                                f"names XIRP endpoint {excerpt(device.endpoint)} on another host; refused")
     return replace(device, endpoint=format_endpoint(host, port))  # reached where it was found, never by name
 
 

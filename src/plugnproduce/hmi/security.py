@@ -33,6 +33,8 @@ def read_token(path: str | Path) -> str:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
         raise DescriptionError(f"cannot read the token file: {exc.strerror or exc}", p) from exc
+    except UnicodeDecodeError as exc:
+        raise DescriptionError(f"the token file is not UTF-8 text (byte {exc.start + 1})", p) from exc
     token = text.strip().splitlines()[0].strip() if text.strip() else ""
     if len(token) < 16:
         raise DescriptionError(f"the token must be at least 16 characters on the first line; found {len(token)}", p, 1)
@@ -40,11 +42,11 @@ def read_token(path: str | Path) -> str:
 
 
 def is_loopback(host: str | None) -> bool:
-    """Whether a client address is on the loopback interface."""
+    """Whether a client address is on the loopback interface (an IPv6 address may carry its zone, ``::1%lo``)."""
     if not host:
         return False
     try:
-        return ipaddress.ip_address(host.split("%", 1)[0]).is_loopback
+        return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return host == "localhost"
 
@@ -94,7 +96,7 @@ class SecurityHeaders:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
-        path: str = scope.get("path", "")
+        path: str = scope["path"]
         strict = not (path.startswith("/docs") or path.startswith("/redoc"))
 
         async def with_headers(message: Message) -> None:
@@ -125,7 +127,7 @@ class BodyLimit:
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
-        declared = dict(scope.get("headers", [])).get(b"content-length", b"")
+        declared = dict(scope["headers"]).get(b"content-length", b"")
         if declared.isdigit() and int(declared) > self.limit:
             await _too_large(send, self.limit)
             return
