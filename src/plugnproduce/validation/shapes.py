@@ -4,12 +4,15 @@ from __future__ import annotations
 
 from functools import lru_cache
 from pathlib import Path
+from typing import Any
 
 import rdflib
 from pyshacl import validate as shacl_validate
 from pyshacl.errors import ValidationFailure
 from rdflib.namespace import SH
+from rdflib.plugins.sparql import prepareQuery
 from rdflib.plugins.sparql.operators import register_custom_function
+from rdflib.plugins.sparql.sparql import Query
 
 from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.errors import OntologyError, tidy
@@ -35,6 +38,26 @@ def verbatim(term: rdflib.term.Node) -> rdflib.Literal:
 register_custom_function(VERBATIM, verbatim, override=True)  # type: ignore[arg-type]  # the hint is for raw=True
 
 
+@lru_cache(maxsize=256)
+def _prepared(text: str) -> Query:
+    return prepareQuery(text)
+
+
+class _PreparedQueries(rdflib.Graph):
+    """A data graph whose SPARQL queries are parsed once per text.
+
+    pySHACL sends a SPARQL constraint's text again for every focus node it checks, and rdflib parses
+    it each time: most of a validation's time went to parsing the same few queries.
+    """
+
+    def query(self, query_object: Any, processor: Any = "sparql", result: Any = "sparql",  # noqa: D102 (rdflib's)
+              initNs: Any = None, initBindings: Any = None, use_store_provided: bool = True,  # noqa: N803
+              **kwargs: Any) -> Any:
+        if isinstance(query_object, str) and not initNs and not kwargs:
+            query_object = _prepared(query_object)
+        return super().query(query_object, processor, result, initNs, initBindings, use_store_provided)
+
+
 @lru_cache(maxsize=4)
 def shapes_graph(path: Path | None = None) -> rdflib.Graph:
     """The shapes file, parsed once."""
@@ -47,12 +70,14 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
     A shape pySHACL cannot run (a SPARQL constraint it refuses, say ``{ SELECT ?x }`` in a
     query's comment, read as a nested select) raises :class:`OntologyError` in one line.
     """
+    data = _PreparedQueries(store=kg.graph.store, identifier=kg.graph.identifier)  # the same triples, not a copy
     conforms, results, _ = shacl_validate(
-        kg.graph,
+        data,
         shacl_graph=shapes if shapes is not None else shapes_graph(),
         inference="none",
         advanced=True,
         allow_warnings=True,
+        inplace=True,  # else the advanced mode copies the data graph into a plain one (and the queries with it)
     )
     if isinstance(results, ValidationFailure):  # pySHACL returns, not raises, a shape it could not run
         raise OntologyError(f"the SHACL shapes could not be run: {tidy(results.message)}")
