@@ -10,7 +10,7 @@ from __future__ import annotations
 import asyncio
 import re
 import uuid
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Awaitable, Callable
 
 import pytest
 from aiohttp import web
@@ -22,7 +22,7 @@ from async_upnp_client.exceptions import (
     UpnpConnectionTimeoutError,
 )
 
-from plugnproduce.errors import RemoteError
+from plugnproduce.errors import ProtocolConnectionError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.upnp import SsdpNetwork, UpnpDeviceServer, device_type_for
 from plugnproduce.protocols.upnp.boundary import (
     NoRedirectRequester,
@@ -31,7 +31,7 @@ from plugnproduce.protocols.upnp.boundary import (
     check_trusted,
     resolve_trusted,
 )
-from plugnproduce.protocols.upnp.client import UpnpDeviceClient
+from plugnproduce.protocols.upnp.client import UpnpDeviceClient, load_device
 from plugnproduce.protocols.upnp.discovery import FoundDevice, SearchHit, describe
 from tests.protocols.test_upnp_loopback import FILES, SPEC, Recorder, free_udp_port
 
@@ -110,10 +110,41 @@ async def test_a_follow_up_request_to_another_host_never_leaves_the_controller()
     assert (answer.status_code, answer.body, inner.urls) == (200, "answer", ["http://127.0.0.1:81/x"])
 
 
+def test_a_host_name_that_only_case_folds_to_the_trusted_one_is_another_host() -> None:
+    """``ß`` upper-cases to ``SS``: ``straße`` is still not ``strasse`` (host names are compared lower-cased)."""
+    with pytest.raises(UntrustedUrlError, match="points at host straße.example"):
+        check_trusted("http://straße.example/d.xml", "strasse.example", "device x")
+    assert check_trusted("http://STRASSE.example/d.xml", "strasse.example", "device x")
+
+
 async def test_describe_refuses_a_description_on_another_host_before_connecting() -> None:
     hit = SearchHit("uuid:gripper", "http://10.0.0.9:1/d.xml", "127.0.0.1")
-    with pytest.raises(UntrustedUrlError, match="discovered at 127.0.0.1"):
+    expected = ("device uuid:gripper at http://10.0.0.9:1/d.xml: 'http://10.0.0.9:1/d.xml' points at host 10.0.0.9, "
+                "but the device was discovered at 127.0.0.1")
+    with pytest.raises(UntrustedUrlError, match="^" + re.escape(expected)):
         await describe(hit, timeout=30.0)
+
+
+async def test_an_unreachable_description_is_a_connection_error_naming_the_device() -> None:
+    hit = SearchHit("uuid:gripper", "http://127.0.0.1:1/d.xml", "127.0.0.1")
+    expected = "reading the description of device uuid:gripper at http://127.0.0.1:1/d.xml: cannot connect"
+    with pytest.raises(ProtocolConnectionError, match="^" + re.escape(expected)):
+        await describe(hit, timeout=30.0)
+
+
+class Silent(UpnpRequester):
+    """A requester whose requests never end (it has no bound of its own)."""
+
+    async def async_http_request(self, http_request: HttpRequest) -> HttpResponse:
+        await asyncio.Event().wait()
+        raise AssertionError("never answered")
+
+
+async def test_reading_a_description_is_bounded_even_when_the_requester_is_not() -> None:
+    requester = TrustedRequester(Silent(), "127.0.0.1", "device x")
+    async with asyncio.timeout(10.0):  # the test's own guard against a reading that never ends
+        with pytest.raises(ProtocolTimeout, match="^reading the description of device x: no answer in time"):
+            await load_device("http://127.0.0.1:1/d.xml", requester, "device x", 0.05)
 
 
 async def test_connect_refuses_a_location_on_another_host() -> None:
@@ -258,4 +289,55 @@ async def test_a_device_describing_itself_with_another_udn_is_refused() -> None:
         with pytest.raises(RemoteError, match="its description names UDN .*; it was discovered as uuid:someone-else"):
             await describe(SearchHit("uuid:someone-else", str(device.location), "127.0.0.1"), timeout=30.0)
         hit = await describe(SearchHit(device.udn.upper(), str(device.location), "127.0.0.1"), timeout=30.0)
-        assert (hit.udn, hit.source_host, hit.friendly_name) == (device.udn.upper(), "127.0.0.1", "Hostile robot")
+        assert (hit.udn, hit.location, hit.source_host, hit.friendly_name) == \
+            (device.udn.upper(), str(device.location), "127.0.0.1", "Hostile robot")
+
+
+async def test_a_found_device_is_connected_whatever_the_case_of_its_udn_with_the_timeout_given() -> None:
+    async with Elsewhere("/pnp/robot.scxml") as device:
+        for udn in (device.udn.upper(), device.udn.lower()):
+            found = FoundDevice(udn, str(device.location), "type", "name", "127.0.0.1")
+            async with await UpnpDeviceClient.from_found(found, timeout=7.5) as client:
+                assert (client.udn, client.trusted_host, client.timeout) == (device.udn, "127.0.0.1", 7.5)
+
+
+class SecureService(Elsewhere):
+    """A device on loopback whose service description is named with ``https`` on its own host."""
+
+    async def _description(self, request: web.Request) -> web.Response:
+        text = (await super()._description(request)).text or ""
+        text = text.replace("<SCPDURL>/", f"<SCPDURL>https://{request.host}/")
+        return web.Response(text=text, content_type="text/xml", charset="utf-8")
+
+
+async def test_a_service_description_named_over_https_is_refused_naming_the_device() -> None:
+    async with SecureService("/pnp/robot.scxml") as device:
+        what = f"GET for device {device.udn} at {device.location}: 'https://127.0.0.1:"
+        with pytest.raises(UntrustedUrlError, match="^" + re.escape(what) + ".*expected an http URL on host 127.0.0.1"):
+            await describe(SearchHit(device.udn, str(device.location), "127.0.0.1"), timeout=30.0)
+
+
+class Slow(Elsewhere):
+    """A device that answers every HTTP request, each well within the timeout, but only after a while."""
+
+    delay = 0.3
+
+    def _app(self) -> web.Application:
+        app = super()._app()
+
+        @web.middleware
+        async def late(request: web.Request, handler: Callable[[web.Request], Awaitable[web.StreamResponse]]
+                       ) -> web.StreamResponse:
+            await asyncio.sleep(self.delay)
+            return await handler(request)
+
+        app.middlewares.append(late)
+        return app
+
+
+async def test_reading_a_description_is_bounded_as_a_whole_not_per_request() -> None:
+    """A device cannot hold the controller for a timeout per request: description and service description
+    together (two requests of 0.3 s each) take longer than the 0.5 s given."""
+    async with Slow("/pnp/robot.scxml") as device:
+        with pytest.raises(ProtocolTimeout, match="no answer in time"):
+            await describe(SearchHit(device.udn, str(device.location), "127.0.0.1"), timeout=0.5)

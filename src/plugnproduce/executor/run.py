@@ -212,7 +212,7 @@ class TaskRun:
         if self.fault is not None:
             return
         command = Command.parse(event.name)
-        if command is None or command.kind != "request" or target not in self._links:
+        if command is None or command.kind != "request" or target is None or target not in self._links:
             raise PlugNProduceError(f"cannot send {event.name!r} to {target!r}: not a request to a device of the cell")
         params = dict(event.data or {})
         self._record("command", step=self.step, device=target, command=command.name, params=params)
@@ -220,12 +220,11 @@ class TaskRun:
             self._record("value", **value)
         # Whatever becomes of the command is told of the step that sent it and the state its device was in then.
         sent = Fault("", "", self.step, self.command, target, self.device_states.get(target), command.name)
-        task = asyncio.get_running_loop().create_task(self._request(sent, params))
+        task = asyncio.get_running_loop().create_task(self._request(sent, target, command.name, params))
         self._commands.add(task)
         task.add_done_callback(self._commands.discard)
 
-    async def _request(self, sent: Fault, params: Mapping[str, Any]) -> None:
-        device, name = sent.device or "", sent.request or ""
+    async def _request(self, sent: Fault, device: str, name: str, params: Mapping[str, Any]) -> None:
         timeout = self.cell.device(device).command_timeout
         try:
             await self._links[device].request(name, params, timeout)
@@ -329,7 +328,7 @@ class TaskRun:
             self._fail(self._fault("timeout", device, f"no event from {device} within "
                                                       f"{self.cell.device(device).command_timeout:g} s"))
         elif not step.transitions and event.name != FAULT_EVENT and self.fault is None:
-            device = event.name.split(".", 1)[0]
+            device = event.name.partition(".")[0]
             self._fail(self._fault("unexpected", device, f"event {event.name.split('.', 3)[-1]} is not what the "
                                                          "task waits for now"))
 
@@ -343,7 +342,7 @@ class TaskRun:
             self.fault = fault
             self._faulted.set()
         self._record("fault", **fault.to_json(), first=first)
-        if first and self.interpreter.running:
+        if first:  # a chart not (or no longer) running never reads it
             self._loop.queue(FAULT_EVENT)
 
     def _outcome(self) -> str:

@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TypeVar
-from urllib.parse import urljoin, urlsplit
+from urllib.parse import SplitResult, urljoin, urlsplit
 
 import aiohttp
 from async_upnp_client.client import UpnpRequester
@@ -111,13 +111,12 @@ def _host_key(host: str) -> str:
 def check_trusted(url: str, trusted_host: str, what: str) -> str:
     """Return ``url`` if it is an ``http`` URL on ``trusted_host``; else raise :class:`UntrustedUrlError`."""
     try:
-        parts = urlsplit(url)
-        host = parts.hostname
+        parts: SplitResult | None = urlsplit(url)
     except ValueError:
-        host = None
         parts = None
-    if parts is None or parts.scheme != "http" or host is None:
+    if parts is None or parts.scheme != "http" or parts.hostname is None:
         raise UntrustedUrlError(f"{what}: {excerpt(url)!r} is refused; expected an http URL on host {trusted_host}")
+    host = parts.hostname
     if _host_key(host) != _host_key(trusted_host):
         raise UntrustedUrlError(
             f"{what}: {excerpt(url)!r} points at host {excerpt(host)}, but the device was discovered at "

@@ -40,6 +40,9 @@ if TYPE_CHECKING:
 _LOGGER = logging.getLogger(__name__)
 _EMPTY_PROPERTYSET = '<e:propertyset xmlns:e="urn:schemas-upnp-org:event-1-0"/>'
 
+TIMEOUT = 10.0
+"""Seconds each exchange with a device may take, unless the client or a call is given another bound."""
+
 
 class VariableChange(NamedTuple):
     """An evented state variable of a device took a new value (after a GENA NOTIFY)."""
@@ -85,14 +88,14 @@ class UpnpDeviceClient:
         """Changes of evented variables after :meth:`subscribe`, when no ``on_change`` callback was given."""
 
     @classmethod
-    async def connect(cls, location: str, trusted_host: str, *, timeout: float = 10.0) -> UpnpDeviceClient:
+    async def connect(cls, location: str, trusted_host: str, *, timeout: float = TIMEOUT) -> UpnpDeviceClient:
         """Read the device description at ``location``; every URL must be on ``trusted_host``."""
         what = f"device at {location}"
         requester = TrustedRequester(NoRedirectRequester(timeout, MAX_BYTES), trusted_host, what)
         return cls(await load_device(location, requester, what, timeout), requester, timeout)
 
     @classmethod
-    async def from_found(cls, found: FoundDevice, *, timeout: float = 10.0) -> UpnpDeviceClient:
+    async def from_found(cls, found: FoundDevice, *, timeout: float = TIMEOUT) -> UpnpDeviceClient:
         """Connect to a discovered device, trusting only the address it answered from."""
         client = await cls.connect(found.location, found.source_host, timeout=timeout)
         if client.udn.lower() != found.udn.lower():

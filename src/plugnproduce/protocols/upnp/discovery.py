@@ -44,6 +44,9 @@ _LOGGER = logging.getLogger(__name__)
 MAX_CANDIDATES = 8
 """Most places kept per UDN (an announcer cycling through description URLs costs no more)."""
 
+DESCRIBE_TIMEOUT = 5.0
+"""Seconds reading a discovered device's description may take, unless the caller gives another bound."""
+
 
 @dataclass(frozen=True)
 class SearchHit:
@@ -214,7 +217,7 @@ class DeviceSearch:
         await self._changed.wait_for(lambda: True if done() else None, timeout, f"SSDP search for {self.search_target}")
 
 
-async def describe(found: SearchHit | Advertisement, *, timeout: float = 5.0) -> FoundDevice:
+async def describe(found: SearchHit | Advertisement, *, timeout: float = DESCRIBE_TIMEOUT) -> FoundDevice:
     """Read the description of a device seen by SSDP, from the address it was seen at only.
 
     A description URL on another host than ``found.source_host`` is refused with
@@ -246,7 +249,7 @@ async def discover(
     *,
     network: SsdpNetwork = LOOPBACK,
     search_target: str = SERVICE_TYPE,
-    describe_timeout: float = 5.0,
+    describe_timeout: float = DESCRIBE_TIMEOUT,
     expected: Collection[str] = (),
 ) -> Discovery:
     """Search for devices for ``timeout`` seconds, then read each one's description.
