@@ -48,6 +48,13 @@ def test_an_expression_of_as_many_parts_as_the_limit_is_evaluated_and_one_part_m
     assert len(Evaluator(trusted=True).expr(at_limit + " + [1]").evaluate({})) == items + 1
 
 
+def test_a_sum_too_deep_to_guard_is_refused_naming_it_though_short_and_of_few_parts() -> None:
+    source = "+".join(["1"] * 600)  # 1199 characters, 1799 parts: within both limits
+    with pytest.raises(EvaluationError, match=r"^cannot evaluate '1\+1\+1.*\+1': the expression is nested too deeply$"):
+        evaluate(source)
+    assert Evaluator(trusted=True).expr(source).evaluate({}) == 600
+
+
 @pytest.mark.parametrize(("source", "value"), [
     ("2**10", 1024),
     ("(-3) ** 3", -27),

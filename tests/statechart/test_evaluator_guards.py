@@ -140,6 +140,16 @@ def test_an_expression_python_warns_about_evaluates_without_a_warning(source: st
         assert evaluate(source, trusted, x=1) == value
 
 
+def test_a_refused_expression_names_itself_and_what_is_not_allowed() -> None:
+    with pytest.raises(EvaluationError, match=r"^cannot evaluate 'open\(path\)': not allowed by the restricted "
+                                              r"evaluator: calling 'open' is not allowed$"):
+        evaluate("open(path)", path="secret.txt")
+
+
+def test_a_trusted_chart_may_write_true_false_and_null_as_its_untrusted_expressions_may() -> None:
+    assert evaluate("[true, false, null]", TRUSTED) == evaluate("[true, false, null]") == [True, False, None]
+
+
 def test_an_expression_that_fails_when_evaluated_names_itself_and_the_error() -> None:
     with pytest.raises(EvaluationError, match=r"^ZeroDivisionError in 'x / 0': division by zero$"):
         evaluate("x / 0", x=1)
