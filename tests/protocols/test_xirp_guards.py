@@ -168,7 +168,22 @@ def test_an_invalid_request_is_refused_in_one_line_naming_its_id_and_not_the_nam
     text = str(caught.value)
     assert (caught.value.code, caught.value.ref) == ("malformed", "7")
     assert NAMESPACE not in text and "{" not in text and "line" not in text and "\n" not in text
-    assert "bogus" in text
+    assert text.endswith(": Element 'bogus': This element is not expected."
+                         " Expected is one of ( decimal, integer, boolean, string, pose ).")
+
+
+@pytest.mark.parametrize(("xml", "reason"), [
+    (f'<x:decimal xmlns:x="{NAMESPACE}/ext" name="p">1</x:decimal>',
+     "Element '{xirp/ext}decimal': This element is not expected."),
+    ('<decimal xmlns="urn:example:units" name="p">1</decimal>',
+     "Element '{urn:example:units}decimal': This element is not expected."),
+], ids=["extending XIRP's", "another"])
+def test_a_value_in_a_namespace_other_than_xirps_is_refused_naming_that_namespace(xml: str, reason: str) -> None:
+    """XIRP's own namespace is written ``xirp`` (or left out), so a foreign one stands out against the expected names."""
+    with pytest.raises(MessageError) as caught:
+        decode(request(xml))
+    expected = " Expected is one of ( decimal, integer, boolean, string, pose )."
+    assert str(caught.value) == f"peer: not a valid XIRP message: {reason}{expected}"
 
 
 def test_an_invalid_message_other_than_a_request_names_no_id() -> None:

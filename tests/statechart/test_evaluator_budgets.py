@@ -6,9 +6,11 @@ instead of hanging, exhausting memory or raising past the interpreter.
 
 from __future__ import annotations
 
+import ast
+
 import pytest
 
-from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator
+from plugnproduce.statechart.runtime.evaluator import MAX_NODES, EvaluationError, Evaluator
 
 
 def evaluate(source: str, **data: object) -> object:
@@ -34,6 +36,23 @@ def evaluate(source: str, **data: object) -> object:
 def test_a_costly_expression_is_an_evaluation_error(source: str, needle: str) -> None:
     with pytest.raises(EvaluationError, match=needle):
         evaluate(source, s="ab" * 100_000)
+
+
+def test_an_expression_of_as_many_parts_as_the_limit_is_evaluated_and_one_part_more_refused() -> None:
+    items = MAX_NODES - 3  # a part per item, and the list, its context and the expression around them
+    at_limit = f"[{', '.join(['1'] * items)}]"
+    assert sum(1 for _ in ast.walk(ast.parse(at_limit, mode="eval"))) == MAX_NODES
+    assert evaluate(at_limit) == [1] * items
+    with pytest.raises(EvaluationError, match=f"the expression has more than {MAX_NODES} parts"):
+        evaluate(f"[{', '.join(['1'] * (items + 1))}]")
+    assert len(Evaluator(trusted=True).expr(at_limit + " + [1]").evaluate({})) == items + 1
+
+
+def test_a_sum_too_deep_to_guard_is_refused_naming_it_though_short_and_of_few_parts() -> None:
+    source = "+".join(["1"] * 600)  # 1199 characters, 1799 parts: within both limits
+    with pytest.raises(EvaluationError, match=r"^cannot evaluate '1\+1\+1.*\+1': the expression is nested too deeply$"):
+        evaluate(source)
+    assert Evaluator(trusted=True).expr(source).evaluate({}) == 600
 
 
 @pytest.mark.parametrize(("source", "value"), [

@@ -10,6 +10,7 @@ refused before anything of it runs, and the file's content never reaches the cha
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -125,6 +126,33 @@ def test_an_expression_at_the_length_limit_is_accepted_and_one_longer_refused() 
     with pytest.raises(EvaluationError, match="at most 10000"):
         evaluate(at_limit + " ")
     assert evaluate(at_limit + " ", TRUSTED) == 1
+
+
+@pytest.mark.parametrize("trusted", [False, True], ids=["untrusted", "trusted"])
+@pytest.mark.parametrize(("source", "value"), [
+    ("x is 1", True),  # SyntaxWarning: "is" with a literal
+    ("'C:\\data'", "C:\\data"),  # an invalid escape: DeprecationWarning (SyntaxWarning from Python 3.12)
+], ids=["is literal", "invalid escape"])
+def test_an_expression_python_warns_about_evaluates_without_a_warning(source: str, value: object,
+                                                                     trusted: bool) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # as ``python -W error`` would: a warning must not even be raised
+        assert evaluate(source, trusted, x=1) == value
+
+
+def test_a_refused_expression_names_itself_and_what_is_not_allowed() -> None:
+    with pytest.raises(EvaluationError, match=r"^cannot evaluate 'open\(path\)': not allowed by the restricted "
+                                              r"evaluator: calling 'open' is not allowed$"):
+        evaluate("open(path)", path="secret.txt")
+
+
+def test_a_trusted_chart_may_write_true_false_and_null_as_its_untrusted_expressions_may() -> None:
+    assert evaluate("[true, false, null]", TRUSTED) == evaluate("[true, false, null]") == [True, False, None]
+
+
+def test_an_expression_that_fails_when_evaluated_names_itself_and_the_error() -> None:
+    with pytest.raises(EvaluationError, match=r"^ZeroDivisionError in 'x / 0': division by zero$"):
+        evaluate("x / 0", x=1)
 
 
 def test_a_syntax_error_is_an_evaluation_error_naming_it() -> None:
@@ -292,10 +320,20 @@ def test_a_trusted_script_whose_first_line_is_indented_deeper_is_an_indentation_
 
 
 def test_a_trusted_script_python_warns_about_still_runs() -> None:
-    run = Evaluator(trusted=True).script("same = 1 is 1", "chart")  # SyntaxWarning: "is" with a literal
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # as ``python -W error`` would: a warning must not even be raised
+        run = Evaluator(trusted=True).script("same = 1 is 1\npath = 'C:\\data'", "chart")  # "is" with a literal, '\d'
     namespace: dict[str, object] = {}
     run(namespace)
-    assert namespace["same"] is True
+    assert (namespace["same"], namespace["path"]) == (True, "C:\\data")
+
+
+def test_a_warning_of_a_trusted_chart_names_the_expression_or_the_script_it_came_from() -> None:
+    trusted = Evaluator(trusted=True)
+    with pytest.warns(UserWarning, match="careful") as caught:
+        trusted.expr("__import__('warnings').warn('careful')").evaluate({})
+        trusted.script("import warnings\nwarnings.warn('careful')", "chart")({})
+    assert [(w.filename, w.lineno) for w in caught] == [("<scxml>", 1), ("<scxml script>", 2)]
 
 
 def test_a_trusted_script_with_a_syntax_error_fails_when_run_naming_it() -> None:

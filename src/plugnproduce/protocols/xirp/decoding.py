@@ -122,7 +122,7 @@ def _decode_document(data: bytes, source: str) -> Message:
     try:
         schema().assertValid(root)
     except etree.DocumentInvalid as exc:
-        reason = str(exc.args[0] if exc.args else exc).replace(_NS, "").replace(_NS[1:-1], "xirp")
+        reason = str(exc).replace(_NS, "").replace(_NS[1:-1], "xirp")
         reason = tidy(_LINE_SUFFIX.sub("", reason))  # a message is one document: its line says nothing
         ref = root.get("id") if root.tag == _NS + "request" else None
         ref = ref if ref is not None and ID_PATTERN.fullmatch(ref) else None

@@ -121,8 +121,8 @@ class Evaluator:
             raise ExecutionError(f"{where}: <script> runs arbitrary code and is refused; create the interpreter "
                                  "with trusted=True to run it, and only for charts you trust")
         try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", SyntaxWarning)
+            with warnings.catch_warnings():  # as for expressions
+                warnings.simplefilter("ignore")
                 code = compile(textwrap.dedent(source).strip("\n"), "<scxml script>", "exec")
         except SyntaxError as exc:
             problem = f"syntax error in <script> ({exc.msg})"
@@ -199,13 +199,14 @@ def _compile(source: str, trusted: bool) -> Expr:
     try:
         if not trusted and len(source) > MAX_SOURCE:
             raise _Refused(f"the expression is {len(source)} characters long; at most {MAX_SOURCE} are allowed")
+        # Python's advice on the chart's style (``x is 1``, ``'C:\data'``) is no error, whatever the warning filters
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SyntaxWarning)
+            warnings.simplefilter("ignore")
             tree = ast.parse(source.strip(), mode="eval")
-        if not trusted:
-            _check(tree)
-            tree = ast.fix_missing_locations(_Guard().visit(tree))
-        return Expr(source, compile(tree, "<scxml>", "eval"), None)
+            if not trusted:
+                _check(tree)
+                tree = ast.fix_missing_locations(_Guard().visit(tree))
+            return Expr(source, compile(tree, "<scxml>", "eval"), None)  # compiling warns again
     except SyntaxError as exc:
         return Expr(source, None, f"syntax error ({exc.msg})")
     except _Refused as exc:
