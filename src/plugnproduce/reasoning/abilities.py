@@ -22,6 +22,7 @@ from plugnproduce.reasoning import solver
 from plugnproduce.reasoning.accepts import accepts
 from plugnproduce.reasoning.contracts import normalised, refuses
 from plugnproduce.reasoning.facts import device_facts, process_facts, task_facts
+from plugnproduce.reasoning.plausibility import check
 from plugnproduce.reasoning.terms import Atom, program
 
 PR = tuple[str, str]
@@ -69,8 +70,6 @@ class FullCheck:
 
     def findings(self, task: Task, mask: int) -> tuple[tuple[str, int, str, str], ...]:
         """Why ``task`` is not plausible in the configuration ``mask`` (empty: it is), as the check says."""
-        from plugnproduce.reasoning.plausibility import check
-
         devices = tuple(d for n, d in enumerate(self.catalogue) if mask >> n & 1)
         result = check(task, Cell("configuration", devices), self.taxonomy, self.processes)
         return tuple(sorted({(p.kind, p.step, p.role or "", p.device or "") for p in result.problems},
