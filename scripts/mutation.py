@@ -151,7 +151,7 @@ def _prepare(guard: Guard, work: Path) -> None:
         "only_mutate": list(guard.files),
         "also_copy": ["ontology", "rules", "descriptions"],
         "pytest_add_cli_args_test_selection": list(guard.tests),
-        "pytest_add_cli_args": ["-p", "no:cacheprovider", "-p", PLUGIN],
+        "pytest_add_cli_args": ["-p", "no:cacheprovider", "-p", PLUGIN, "-n", "0"],  # in mutmut's process
         # Each mutant runs in a process forked from a server that collected the tests but ran none, and
         # the plugin below empties the package's caches before each test, so that no value computed by
         # the unmutated code (a compiled expression, a checked name) hides the mutant.
