@@ -43,7 +43,7 @@ def simulated_cell(env: dict[str, str], tmp_path: Path) -> Iterator[Path]:
         time.sleep(0.05)
     yield state
     up.send_signal(signal.SIGINT)  # Ctrl-C
-    assert up.wait(timeout=10) == 0, log.read_text()
+    assert up.wait(timeout=60) == 0, log.read_text()  # a fully loaded machine stops it late
     assert "stopped" in log.read_text()
 
 
@@ -79,7 +79,7 @@ def test_unplugging_the_gripper_removes_pick_and_plugging_brings_it_back(
         assert "pick" in change["offered"]
     finally:
         watch.terminate()
-        watch.wait(timeout=10)
+        watch.wait(timeout=60)
         lines.rest()
         assert watch.stdout is not None
         watch.stdout.close()
