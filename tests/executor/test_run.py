@@ -43,7 +43,7 @@ async def test_bin_picking_runs_to_the_end_and_the_journal_has_every_command_in_
 FAULTS = {
     "gripper:drop-response:Close": ("timeout", "command Close: no answer within 2 s"),
     "gripper:error-response:Close": ("refused", "fault injected"),
-    "gripper:disconnect:Close": ("lost", "connection"),
+    "gripper:disconnect:Close": ("lost", "command Close: request Close: device 'gripper' at "),  # names the command
     "gripper:drop-event:gripper_closed": ("timeout", "no event from gripper within 2 s"),
     "gripper:delay-event:gripper_closed:3": ("timeout", "no event from gripper within 2 s"),
     "gripper:duplicate-event:gripper_closed": ("anomaly", "twice"),
