@@ -154,6 +154,14 @@ async def test_yaml_import_refuses_what_a_cross_site_form_could_send(client: htt
     assert res.status_code == 415 and "send the task as application/yaml" in res.json()["detail"]
 
 
+@pytest.mark.parametrize("kind", ["application/yaml; charset=utf-8", "Application/YAML", " text/x-yaml ;q=1"])
+async def test_yaml_import_takes_each_spelling_of_a_yaml_type(client: httpx.AsyncClient, kind: str) -> None:
+    """Media types are case-insensitive and may carry parameters (RFC 9110): each is YAML all the same."""
+    res = await client.post("/api/task/import", content=b"task: t\nsteps:\n  - command: pick\n",
+                            headers={"content-type": kind})
+    assert res.status_code == 200 and res.json()["name"] == "t"
+
+
 async def test_an_oversized_chunked_body_is_refused_as_it_streams(client: httpx.AsyncClient) -> None:
     async def chunks() -> AsyncIterator[bytes]:
         for _ in range(200):  # 12.5 MiB in all, with no content-length
