@@ -113,7 +113,7 @@ async def test_a_device_unplugged_mid_task_stops_the_run(tmp_path: Path, taxonom
     generated = service.generate(TASK, cell).task
     network = upnp.private_network()
     async with SimulatedCell(cell, network=network) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], 5.0)
+        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
 
         def unplug_after_first_gripper_event(record: dict[str, object]) -> None:
             if record["kind"] == "event" and record["device"] == "gripper":
@@ -150,7 +150,7 @@ async def test_a_device_cable_pulled_while_it_has_nothing_to_do_stops_the_run(tm
     generated = service.generate(TASK, cell).task
     network = upnp.private_network()
     async with SimulatedCell(cell, network=network) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], 5.0)
+        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
 
         def pull_the_gripper_cable_once_closed(record: dict[str, object]) -> None:
             if record["kind"] == "event" and record["event"] == "gripper_closed" and record["step"] == 1:
@@ -197,7 +197,7 @@ async def test_a_device_gone_before_the_run_stops_the_devices_already_reached(tm
     network = upnp.private_network()
     faults = parse_faults("robot:drop-response:state", cell.devices)
     async with SimulatedCell(cell, network=network, faults=faults) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], 30.0)
+        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
         await sim.unplug("gripper")
         report = await TaskRun(generated, devices, tmp_path / "run.jsonl").run()
     assert report.outcome == "failed"
@@ -237,7 +237,7 @@ async def test_an_event_the_task_does_not_wait_for_stops_the_run_naming_it(tmp_p
     generated = service.generate(TASK, cell).task
     network = upnp.private_network()
     async with SimulatedCell(cell, network=network) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], 30.0)
+        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
 
         def gripper_speaks_up_during_the_first_move(record: dict[str, object]) -> None:
             if record["kind"] == "command" and record["command"] == "MoveTo" and record["step"] == 1:
