@@ -28,8 +28,8 @@ else
     say "system packages already there"
 fi
 
-say "installing the Python package with its test and notebook extras (pip)"
-python -m pip install --quiet --disable-pip-version-check -e ".[test,notebooks]"
+say "installing the Python package with its test and notebook extras (pip, the tested versions)"
+python -m pip install --quiet --disable-pip-version-check -c scripts/constraints.txt -e ".[test,notebooks]"
 
 say "done: try 'pnp capabilities --cell descriptions/cells/bin-picking.yaml'," \
     "'pnp run descriptions/tasks/bin-picking.yaml --sim' or 'jupyter lab notebooks/'"

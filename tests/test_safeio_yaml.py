@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from plugnproduce import safeio
 from plugnproduce.errors import HostileInputError, UnreadableError
 from plugnproduce.safeio import MAX_YAML_DEPTH, _compose_yaml, parse_yaml_node
 
@@ -71,6 +72,27 @@ def test_deep_nesting_is_refused_not_a_crash(tmp_path: Path, depth: int) -> None
     with pytest.raises(HostileInputError, match="nested more than") as found:
         parse_yaml_node(f)
     assert found.value.line == 1
+
+
+LOADERS = [yaml.SafeLoader, *([yaml.CSafeLoader] if hasattr(yaml, "CSafeLoader") else [])]
+
+
+@pytest.mark.parametrize("text", ["[" * 100, "[" * 5_000, "{a: " * 5_000, "".join("  " * n + f"k{n}:\n" for n in range(1_200))],
+                         ids=["flow-100", "flow-5000", "mapping-5000", "block-1200"])
+def test_deep_nesting_gets_one_refusal_whichever_layer_finds_it(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                text: str) -> None:
+    # PyYAML 6.0.4's libyaml stops at about 1,000 levels itself, before our composer sees the events;
+    # the pure-Python parser leaves it to our limit: the user is told the same either way.
+    f = tmp_path / "deep.yaml"
+    f.write_text(text)
+    said = set()
+    for loader in LOADERS:
+        monkeypatch.setattr(safeio, "_YAML_LOADER", loader)
+        with pytest.raises(HostileInputError) as found:
+            parse_yaml_node(f)
+        said.add(str(found.value))
+    assert said == {f"{f}:{found.value.line}: YAML nested more than {MAX_YAML_DEPTH} levels deep; "
+                    f"at most {MAX_YAML_DEPTH} are accepted"}
 
 
 def test_nesting_up_to_the_limit_is_read(tmp_path: Path) -> None:

@@ -174,6 +174,13 @@ def _mark(mark: object) -> yaml.Mark:
     return cast(yaml.Mark, mark)
 
 
+def _too_deep(source: str | Path, line: int | None) -> HostileInputError:
+    """The one refusal of deep nesting, whichever layer finds it first: our composer, or libyaml's
+    scanner (PyYAML 6.0.4 and later stop at about 1,000 levels while reading ahead)."""
+    return HostileInputError(f"YAML nested more than {MAX_YAML_DEPTH} levels deep; at most {MAX_YAML_DEPTH} are "
+                             "accepted", source, line)
+
+
 def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
     """Compose one YAML document into nodes with marks, as ``yaml.compose`` does, but safely.
 
@@ -212,8 +219,7 @@ def _compose_yaml(text: str, source: str | Path) -> yaml.Node | None:
                 tag = event.tag if event.tag not in (None, "!") else resolver.resolve(kind, None, event.implicit)
                 collection = kind(tag, [], _mark(event.start_mark), flow_style=event.flow_style)  # end mark: at its end
                 if len(stack) >= MAX_YAML_DEPTH:
-                    raise HostileInputError(f"YAML nested more than {MAX_YAML_DEPTH} levels deep; at most "
-                                            f"{MAX_YAML_DEPTH} are accepted", source, _mark(event.start_mark).line + 1)
+                    raise _too_deep(source, _mark(event.start_mark).line + 1)
                 stack.append(collection)
                 keys.append(None)
                 continue
@@ -268,6 +274,8 @@ def parse_yaml_bytes(data: bytes, source: str | Path) -> yaml.Node:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
         what = exc.problem or exc.context or "malformed YAML"
+        if "nesting depth" in what:
+            raise _too_deep(source, line) from exc
         raise UnreadableError(f"malformed YAML: {tidy(what)}", source, line) from exc
     except yaml.reader.ReaderError as exc:  # a character YAML does not allow (NUL, other controls)
         # the refused character is its first occurrence (libyaml gives its position in bytes, not characters)
