@@ -212,6 +212,17 @@ def plan(goal_or_path: Goal | str | Path, cell_or_path: CellArg, knowledge: Know
     return make_plan(goal, the_cell, k.taxonomy, k.processes, devices, source=source)
 
 
+def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,
+              knowledge: Knowledge | None = None) -> tuple[str, str]:
+    """A goal without ``until`` as a PDDL domain and problem whose optimal plans cost what :func:`plan` optimises."""
+    from plugnproduce.description.goalfile import Goal, load_goal
+    from plugnproduce.planning.pddl import export
+
+    the_cell, k = _context(cell_or_path, knowledge)
+    return export(goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path), the_cell, k.taxonomy,
+                  k.processes)
+
+
 def catalogue_players(result: reasoning.CheckResult,
                       knowledge: Knowledge | None = None) -> dict[tuple[int, str], list[str]]:
     """For each step role no device of the cell can play: the catalogue devices (built-in and library) that could."""

@@ -27,6 +27,9 @@ else:
 def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (YAML)."), cell: Path = CELL_OPTION,
          output: Path | None = typer.Option(None, "--output", "-o", metavar="TASK",
                                             help="Write the planned task file here (else it is printed)."),
+         pddl: Path | None = typer.Option(None, "--pddl", metavar="DIR",
+                                          help="Also write the goal as PDDL (domain.pddl, problem.pddl) into DIR, "
+                                               "for other planners; not for a goal with until."),
          live: bool = LIVE_OPTION, discovery_timeout: float | None = DISCOVERY_OPTION,
          json_out: bool = JSON_OPTION) -> None:
     """Plan a task from a goal: which process commands, in which order, on which devices, with which values.
@@ -41,6 +44,11 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
     from plugnproduce.ontology.vocabulary import local_name
     from plugnproduce.planning import Unreachable  # here, not at the top: `pnp --help` loads none of it
 
+    if pddl is not None:
+        domain, problem = service.plan_pddl(goal, the_cell, k)
+        pddl.mkdir(parents=True, exist_ok=True)
+        (pddl / "domain.pddl").write_text(domain, encoding="utf-8")
+        (pddl / "problem.pddl").write_text(problem, encoding="utf-8")
     found = service.plan(goal, the_cell, k, source=str(output) if output else None)
     if isinstance(found, Unreachable):
         _unreachable(found, json_out)

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import yaml
 
 from plugnproduce.description.goalfile import Goal
-from plugnproduce.description.model import Cell, DeviceDescription, Parameter, ProcessDescription, Task
+from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
 from plugnproduce.description.outcomes import falling_under
 from plugnproduce.description.taskfile import parse_task, task_to_yaml
 from plugnproduce.errors import DescriptionError
@@ -48,6 +48,8 @@ class Plan:
     """Steps of the plan (of the loop's body, for a goal with ``until``)."""
     blind: tuple[tuple[int, str], ...]
     """(step, parameter) left to its default although the cell could measure it."""
+    wasted: tuple[tuple[int, str], ...] = ()
+    """(step, output) that another command could take, which no later step takes."""
 
 
 @dataclass(frozen=True)
@@ -68,7 +70,7 @@ def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Process
     unreachable goal names the cheapest device whose purchase makes it reachable.
     """
     by_id = {p.id: p for p in processes}
-    _check_goal(goal, cell, taxonomy, by_id)
+    check_goal(goal, cell, taxonomy, by_id)
     found = _search(goal, cell, taxonomy, processes, max_steps)
     if isinstance(found, Model):
         return _written(goal, found, by_id, source or f"{goal.name}.yaml")
@@ -82,7 +84,7 @@ def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Process
 # ------------------------------------------------------------------ the goal against the knowledge
 
 
-def _check_goal(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: dict[str, ProcessDescription]) -> None:
+def check_goal(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: dict[str, ProcessDescription]) -> None:
     """Bad input in the goal file: unknown commands, parameters, roles, devices and concepts."""
     path = goal.file
     for item in goal.achieve:
@@ -126,10 +128,7 @@ def goal_facts(goal: Goal, processes: Sequence[ProcessDescription], taxonomy: Ta
         out += [ps.Fixed(g, n) for n in sorted(item.params)]
         out += [ps.Pinned(g, r, d) for r, d in sorted(item.bind.items())]
     for p in processes:
-        first: dict[tuple[str, str], str] = {}
-        for par in _in_chart_order(p):
-            first.setdefault((par.quantity, par.datatype), par.name)
-        out += [ps.Feeds(p.id, n, q, ty) for (q, ty), n in first.items()]
+        out += [ps.Feeds(p.id, n, q, ty) for n, (q, ty) in feeding(p).items()]
         out += [ps.Gives(p.id, o.name, o.quantity, o.datatype) for o in p.outputs]
         if goal.until is not None and falling_under(goal.until, p.outcomes, taxonomy):
             out.append(ps.Reports(p.id))
@@ -139,12 +138,16 @@ def goal_facts(goal: Goal, processes: Sequence[ProcessDescription], taxonomy: Ta
     return out
 
 
-def _in_chart_order(process: ProcessDescription) -> list[Parameter]:
-    """The parameters in the order the General Process State Chart sends them (role by role, along each
-    region), then those it does not send, by name: of two poses, the first is where the motion goes first."""
+def feeding(process: ProcessDescription) -> dict[str, tuple[str, str]]:
+    """The parameters an earlier output may feed, with their (quantity, datatype): of those with one quantity and
+    datatype, the first the General Process State Chart sends (role by role, along each region; those it does not
+    send after, by name). Of a pick's two poses, the one it moves to first."""
     sent = [n for r in process.roles for state in r.region for n in state.params]
     rank = {n: i for i, n in reversed(list(enumerate(sent)))}
-    return sorted(process.parameters, key=lambda par: (rank.get(par.name, len(rank)), par.name))
+    first: dict[tuple[str, str], str] = {}
+    for par in sorted(process.parameters, key=lambda par: (rank.get(par.name, len(rank)), par.name)):
+        first.setdefault((par.quantity, par.datatype), par.name)
+    return {n: k for k, n in first.items()}
 
 
 def _search(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
@@ -221,7 +224,8 @@ def _written(goal: Goal, model: Model, processes: dict[str, ProcessDescription],
     task = parse_task(yaml.dump(doc, Dumper=PlainDumper, sort_keys=False).encode("utf-8"), source)
     text = f"# Planned by pnp plan from the goal {goal.name} ({len(acts)} steps).\n" + task_to_yaml(task)
     blind = tuple(sorted((b.t, b.n) for b in model[ps.Blind]))
-    return Plan(goal, text, task, len(acts), blind)
+    wasted = tuple(sorted((w.t, w.o) for w in model[ps.Wasted] if w.h == len(acts)))
+    return Plan(goal, text, task, len(acts), blind, wasted)
 
 
 def _names(acts: dict[int, str], sources: set[int]) -> dict[int, str]:
