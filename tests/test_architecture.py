@@ -17,6 +17,7 @@ LAYERS = {
     "executor": 4, "sim": 4, "discovery": 4,
     "verification": 3.5,  # explores the generated program (codegen) in the runtime (statechart)
     "codegen": 3, "reasoning": 3, "validation": 3, "drawing": 3,
+    "planning": 3.2,  # plans from goals with the reasoning layer
     "knowledge": 2.5,  # the loaded libraries: their taxonomy, descriptions and catalogue
     "description": 2,
     "ontology": 1, "statechart": 1, "protocols": 1,

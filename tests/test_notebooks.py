@@ -54,6 +54,16 @@ EXPECTED: dict[str, list[str]] = {
         r"repair 1 \(solver rank \d, cost 3\)",
         r"repair 3 \(solver rank 1, cost 2\): insert open-gripper before step 2 \(bin-pick\)\n +side effect \[drops_part\]",
     ],
+    "planner": [
+        r"planned: 3 steps, repeated until BinEmpty",
+        r"pick_pose: \{from: localize_part, output: part_pose\}",
+        r"plausible: True",
+        r"verified: proved",
+        r"buy: screwdriver 1400",
+        r"ours: \['close-gripper', 'place', 'move-to', 'close-gripper'\]",
+        r"Fast Downward: SOLVED_OPTIMALLY \['close-gripper', 'place', 'move-to', 'close-gripper'\]",
+        r"outcome: succeeded",
+    ],
     "operator": [
         r"→ gripper: Close \{'GripForce': 30\}",
         r"end: succeeded",

@@ -56,3 +56,14 @@ def test_a_lazy_module_loads_on_first_use() -> None:
 def test_a_missing_module_is_an_error_at_once() -> None:
     with pytest.raises(ModuleNotFoundError, match="plugnproduce.nowhere"):
         lazy_module("plugnproduce.nowhere")
+
+
+def test_a_submodule_imported_before_its_lazy_package_is_used_runs_once() -> None:
+    # the import system reads the package's __path__; were that to run the package (which imports the same
+    # submodule), the submodule would run twice and its registry of ASP predicates would exist twice
+    code = ("import sys\nfrom plugnproduce.lazy import lazy_module\n"
+            "lazy_module('plugnproduce.reasoning')\n"
+            "from plugnproduce.reasoning.terms import _REGISTRY\n"
+            "from plugnproduce.reasoning import solver\n"
+            "print(solver.decode.__globals__['_REGISTRY'] is _REGISTRY)")
+    assert _run(code).split() == ["True"]

@@ -12,6 +12,23 @@ import importlib.util
 import sys
 from types import ModuleType
 
+_WHERE = frozenset({"__name__", "__spec__", "__path__", "__loader__", "__package__", "__file__"})
+"""What the import system reads of a parent package to import a submodule."""
+
+
+class _LazyModule(importlib.util._LazyModule):  # type: ignore[name-defined,misc]
+    """A module whose code runs on first use; reading where it is (its ``__path__``) is no use.
+
+    Importing a submodule of a package reads the package's ``__path__``. Were that to run the
+    package's code, which imports the same submodule, the import would then run the submodule a
+    second time, and two copies of it (of its registries, its classes) would exist.
+    """
+
+    def __getattribute__(self, attr: str) -> object:
+        if attr in _WHERE:
+            return ModuleType.__getattribute__(self, attr)
+        return super().__getattribute__(attr)
+
 
 def lazy_module(name: str) -> ModuleType:
     """Return the module *name*, executed on its first attribute access.
@@ -30,6 +47,7 @@ def lazy_module(name: str) -> ModuleType:
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     loader.exec_module(module)
+    module.__class__ = _LazyModule
     parent, _, child = name.rpartition(".")
     if parent:
         setattr(sys.modules[parent], child, module)

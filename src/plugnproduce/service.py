@@ -35,11 +35,13 @@ from plugnproduce.resources import descriptions_path
 if TYPE_CHECKING:  # validation, code generation and execution are imported by the use cases that need them
     from plugnproduce.codegen import GeneratedTask
     from plugnproduce.codegen.outputs import GeneratedChart
+    from plugnproduce.description.goalfile import Goal
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
     from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
     from plugnproduce.ontology.taxonomy import Taxonomy
+    from plugnproduce.planning import Plan, Unreachable
     from plugnproduce.reasoning.impact import Impact
     from plugnproduce.validation import Report
     from plugnproduce.verification import Budget, Verification
@@ -193,6 +195,32 @@ def repair(
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
     return reasoning.repair(_as_task(task_or_path), the_cell, k.taxonomy, k.processes,
                             catalogue=devices, top=top, costs=costs)
+
+
+def plan(goal_or_path: Goal | str | Path, cell_or_path: CellArg, knowledge: Knowledge | None = None,
+         catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+         source: str | None = None) -> Plan | Unreachable:
+    """A task that reaches a goal in a cell, from its devices' states (a cell with reported states plans from
+    those), or why none does, with the cheapest catalogue device (built-in and library) that would make one.
+    ``source`` names the written task file."""
+    from plugnproduce.description.goalfile import Goal, load_goal
+    from plugnproduce.planning import plan as make_plan
+
+    the_cell, k = _context(cell_or_path, knowledge)
+    goal = goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path)
+    devices = list(k.devices) if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
+    return make_plan(goal, the_cell, k.taxonomy, k.processes, devices, source=source)
+
+
+def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,
+              knowledge: Knowledge | None = None) -> tuple[str, str]:
+    """A goal without ``until`` as a PDDL domain and problem whose optimal plans cost what :func:`plan` optimises."""
+    from plugnproduce.description.goalfile import Goal, load_goal
+    from plugnproduce.planning.pddl import export
+
+    the_cell, k = _context(cell_or_path, knowledge)
+    return export(goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path), the_cell, k.taxonomy,
+                  k.processes)
 
 
 def catalogue_players(result: reasoning.CheckResult,

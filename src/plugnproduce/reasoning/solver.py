@@ -8,7 +8,7 @@ by forbidding each found edit set (multi-shot).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Hashable, Sequence
+from collections.abc import Callable, Hashable, Iterable, Iterator, Sequence
 from functools import cache
 
 import clingo
@@ -26,6 +26,7 @@ PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
     "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
     "window": (("roles.lp", "chain.lp", "params.lp", "repair.lp", "window.lp"), "show_window.lp"),
     "derivation": (("roles.lp", "offered.lp", "explain.lp"), "show_derivation.lp"),
+    "plan": (("roles.lp", "offered.lp", "plan.lp"), "show_plan.lp"),
 }
 """The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
 
@@ -36,8 +37,8 @@ def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
     return concerns + (shown,) if show else concerns
 
 
-CAPABILITIES, BINDINGS, OFFERED, CHECK, ABILITIES, REPAIR, WINDOW = (
-    rules(p) for p in ("capabilities", "bindings", "offered", "check", "abilities", "repair", "window"))
+CAPABILITIES, BINDINGS, OFFERED, CHECK, ABILITIES, REPAIR, WINDOW, PLAN = (
+    rules(p) for p in ("capabilities", "bindings", "offered", "check", "abilities", "repair", "window", "plan"))
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""
@@ -128,6 +129,25 @@ def optimise(
         ctl.add(part, [], forbid(best))
         ctl.ground([(part, [])])
     return models
+
+
+def grow(rules: Sequence[str], facts: str, horizons: Iterable[int],
+         arguments: Sequence[str] = OPTIMISE) -> Iterator[tuple[int, Model | None]]:
+    """Incremental solving, the horizon growing one step at a time: for each horizon, the optimal model or None.
+
+    The encodings have program parts ``step(t)`` (what one more step adds) and ``check(t)`` (the goal at
+    horizon t, active while the external ``query(t)`` is true); each horizon grounds only its own parts.
+    """
+    ctl, messages = _control(["--warn=none", *arguments])
+    _ground(ctl, messages, rules, facts)
+    before = None
+    for t in horizons:
+        ctl.ground([("step", [clingo.Number(t)]), ("check", [clingo.Number(t)])])
+        if before is not None:
+            ctl.release_external(before)
+        before = clingo.Function("query", [clingo.Number(t)])
+        ctl.assign_external(before, True)
+        yield t, _optimum(ctl)
 
 
 def _optimum(ctl: clingo.Control) -> Model | None:
