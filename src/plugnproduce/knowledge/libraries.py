@@ -1,6 +1,7 @@
 """Libraries: folders of ontology extensions, devices, processes, cells and tasks.
 
-A library is a folder with any of ``ontology/`` (Turtle TBox extensions), ``devices/``,
+A library is a folder with any of ``ontology/`` (TBox extensions in Turtle, RDF/XML or OWL/XML, with their
+``owl:imports`` resolved inside the library), ``devices/``,
 ``processes/``, ``cells/`` and ``tasks/``. The package's own descriptions and ontology are
 the *built-in* library. :class:`Knowledge` is everything the use cases need, loaded from
 an ordered list of libraries: the taxonomy closure of the combined TBox, the processes
@@ -19,6 +20,7 @@ import rdflib
 from plugnproduce.description.loader import load_device, load_process
 from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.errors import DescriptionError, OntologyError
+from plugnproduce.ontology.sources import with_imports
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
 from plugnproduce.resources import descriptions_path, ontology_path
 
@@ -35,9 +37,11 @@ class Library:
 
     def files(self, kind: str, pattern: str = "*.ttl") -> list[Path]:
         """The files of one kind (``"devices"``, ``"processes"``...) in this library, sorted."""
-        if kind == "ontology":  # every Turtle file but SHACL shapes
-            folder = ontology_path() if self.builtin else self.root / "ontology"
-            return ontology_files(folder) if folder.is_dir() else []
+        if kind == "ontology":  # every Turtle, RDF/XML and OWL/XML file but SHACL shapes, then what they import
+            if self.builtin:
+                return ontology_files(ontology_path())
+            folder = self.root / "ontology"
+            return with_imports(ontology_files(folder), self.root) if folder.is_dir() else []
         return _glob(self.root / kind, pattern)
 
     @property

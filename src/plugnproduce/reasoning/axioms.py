@@ -1,4 +1,5 @@
-"""OWL evidence for explanations: the asserted TBox axioms with the ``file:line`` they are written at, labels in
+"""OWL evidence for explanations: the asserted TBox axioms with the ``file:line`` they are written at (the Turtle
+statement's line; the element's line in RDF/XML and OWL/XML), labels in
 plain words (rdfs:label, by language tag), and minimal justifications of what the reasoner derived.
 
 HermiT (through owlready2) answers *whether* a class is subsumed or implies a skill, but gives no justification.
@@ -20,9 +21,10 @@ import rdflib
 from rdflib.namespace import OWL, RDFS
 
 from plugnproduce.description.model import Where
+from plugnproduce.ontology.sources import read_tbox_file
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import parse_turtle
+from plugnproduce.ontology.xmllines import axiom_line
 
 DEFAULT_LANGUAGE = "en"
 """The language of an untagged rdfs:label."""
@@ -147,12 +149,14 @@ def _line(lines: list[str], g: rdflib.Graph, subject: str, obj: str) -> int | No
 
 
 def _file_axioms(path: Path) -> tuple[list[Axiom], rdflib.Graph]:
-    g, _ = parse_turtle(path)
-    lines = path.read_text(encoding="utf-8").splitlines()
+    tbox = read_tbox_file(path)
+    g, tree = tbox.graph, tbox.tree
+    lines = tbox.text.splitlines()
     out: list[Axiom] = []
 
     def add(kind: str, s: str, o: str, named: str) -> None:
-        out.append(Axiom(kind, s, o, Where(str(path), _line(lines, g, s, named))))
+        line = _line(lines, g, s, named) if tree is None else axiom_line(tree, path, kind, s, o)
+        out.append(Axiom(kind, s, o, Where(str(path), line)))
 
     for s, o in g.subject_objects(RDFS.subClassOf):
         if not isinstance(s, rdflib.URIRef):
