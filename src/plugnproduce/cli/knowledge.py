@@ -29,12 +29,14 @@ def vocab(json_out: bool = JSON_OPTION) -> None:
 @app.command()
 @boundary
 def impact(
-    extensions: list[Path] = typer.Argument(..., help="Turtle TBox files to try on top of the loaded knowledge."),
+    extensions: list[Path] = typer.Argument(..., help="TBox files (Turtle, RDF/XML, OWL/XML) to try on top of "
+                                            "the loaded knowledge."),
     cells: list[Path] = typer.Option([], "--cells", help="Folders (or files) of cells to compare (repeatable; "
                                      "default: every cell of the loaded libraries)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
-    """What a TBox edit does: offered commands per cell, catalogue roles and library tasks, before and after.
+    """What a TBox edit does: offered commands per cell, catalogue roles, library tasks and the validation
+    findings (SHACL shapes, structure) of every catalogue device and cell, before and after.
 
     Exit 0 nothing changes, 1 something changes, 2 bad input.
     """
@@ -55,7 +57,8 @@ def impact(
 def impact_text(doc: dict[str, Any]) -> list[str]:
     """An impact report as lines for a terminal."""
     if not doc["changed"]:
-        return [f"no change: {', '.join(doc['extensions'])} changes no offered command, role or task"]
+        return [f"no change: {', '.join(doc['extensions'])} changes no offered command, role, task or validation "
+                "finding"]
     lines = []
     for c in doc["cells"]:
         lines.append(f"cell {c['cell']}:" + (f" ({c['note']})" if c.get("note") else ""))
@@ -70,4 +73,8 @@ def impact_text(doc: dict[str, Any]) -> list[str]:
     for t in doc["tasks"]:
         now = "plausible" if t["plausible_after"] else "implausible"
         lines.append(f"task {t['task']} in cell {t['cell']}: now {now}")
+    for word, key in (("new violation", "new_violations"), ("cured violation", "cured_violations")):
+        for v in doc.get(key, []):
+            where = f"{v['file']}:{v['line']}" if v["line"] else v["file"]
+            lines.append(f"{word}: {where}: {v['message']}")
     return lines
