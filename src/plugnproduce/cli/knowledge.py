@@ -13,11 +13,19 @@ from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, kn
 
 @app.command()
 @boundary
-def vocab(json_out: bool = JSON_OPTION) -> None:
-    """List the terms of the loaded knowledge (built-in and libraries): device classes with the skills
-    they imply, skills with their mandatory states, state concepts, quantities and processes."""
-    from plugnproduce.knowledge.vocab import vocabulary, vocabulary_text
+def vocab(json_out: bool = JSON_OPTION,
+          tree: bool = typer.Option(False, "--tree", help="The taxonomy as an indented tree per root (devices, "
+                                    "skills, state concepts, quantities, outcomes); equivalent classes on one "
+                                    "line.")) -> None:
+    """List the terms of the loaded knowledge (built-in and libraries): the roots a library's terms subclass,
+    device classes with the skills they imply, skills with their mandatory states, state concepts,
+    quantities, outcomes and processes; equivalent classes are marked "equivalent"."""
+    from plugnproduce.knowledge.vocab import vocabulary, vocabulary_text, vocabulary_tree
 
+    if tree:
+        for line in vocabulary_tree(knowledge().taxonomy):
+            typer.echo(line)
+        return
     words = vocabulary(knowledge())
     if json_out:
         emit_json(words)
