@@ -632,3 +632,13 @@ def _findings(k: Knowledge, files: Sequence[Path]) -> set[tuple[str, int, str]]:
     from plugnproduce.validation import validate_paths
 
     return {(p.file, p.line, p.message) for p in validate_paths(list(files), k).problems}
+
+
+def export_ontology(fmt: str = "rdfxml", inferred: bool = False, knowledge: Knowledge | None = None) -> bytes:
+    """The merged TBox of ``knowledge`` as one ontology in ``fmt`` (``rdfxml``, ``turtle``, ``owlxml``); with
+    ``inferred``, the hierarchy HermiT derived as asserted axioms annotated ``pnp:inferredBy "HermiT"``."""
+    from plugnproduce.ontology.export import merged_tbox, serialise
+
+    k = _k(knowledge)
+    sources = [lib.name for lib in k.libraries] or ["the pnp ontology"]
+    return serialise(merged_tbox(k.tbox(), k.taxonomy, sources, inferred), fmt)
