@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any, cast
 
 import owlready2
+import pyhornedowl
 import pytest
 import rdflib
 from typer.testing import CliRunner
@@ -18,6 +19,7 @@ from typer.testing import CliRunner
 from plugnproduce import service
 from plugnproduce.cli import app
 from plugnproduce.ontology.taxonomy import classify, load_taxonomy, read_tbox
+from plugnproduce.reasoning.axioms import Axiom, load_ontology
 from plugnproduce.resources import ontology_path
 
 runner = CliRunner()
@@ -161,3 +163,22 @@ def test_an_xml_document_that_is_no_ontology_is_named(tmp_path: Path) -> None:
     result = runner.invoke(app, ["--library", str(lab), "vocab"])
     assert result.exit_code == 2
     assert "notes.owl:2: an XML document with root <notes>; expected RDF/XML" in result.stderr
+
+
+def test_every_axiom_of_the_xml_forms_is_found_at_an_element_naming_its_class(tmp_path: Path) -> None:
+    owl = save_as_rdfxml(ontology_path() / "pnp.ttl", tmp_path / "pnp.owl")
+    owx = tmp_path / "pnp.owx"
+    owx.write_text(pyhornedowl.open_ontology_from_file(str(owl)).save_to_string("owx"))
+    taxonomy = load_taxonomy()
+    def said(a: Axiom) -> tuple[str, frozenset[str]]:  # an equivalence may be written either way round
+        return a.kind, frozenset((a.sub, a.sup)) if a.kind == "equivalent" else frozenset((a.sub, "⊑" + a.sup))
+
+    turtle = {said(a) for a in load_ontology([ontology_path() / "pnp.ttl"], taxonomy).axioms}
+    for path in (owl, owx):
+        onto = load_ontology([path], taxonomy)
+        assert {said(a) for a in onto.axioms} == turtle
+        lines = path.read_text().splitlines()
+        for a in onto.axioms:
+            assert a.where.line is not None, a.formula()
+            element = "\n".join(lines[a.where.line - 1:a.where.line + 8])  # the element's opening and body
+            assert a.sup.rsplit("#", 1)[1] in element, (a.formula(), path.name, a.where.line)

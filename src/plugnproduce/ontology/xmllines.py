@@ -53,8 +53,9 @@ class _Iris:
 
 
 def axiom_line(tree: etree._ElementTree, path: Path, kind: str, sub: str, sup: str) -> int | None:
-    """The line of the element stating ``sub ⊑ sup`` (``subclass``), ``sub ≡ sup`` (``equivalent``) or
-    ``sub ⊑ ∃hasSkill.sup`` (``has_skill``); else the line declaring ``sub``; else None."""
+    """The line of the element stating ``sub ⊑ sup`` (``subclass``), ``sub ≡ sup`` (``equivalent``),
+    ``sub ⊑ ∃hasSkill.sup`` (``has_skill``), ``sub ⊑ ∃p.sup`` (``some``) or a definition of ``sub`` naming ``sup``
+    (``defined``); else the line declaring ``sub``; else None."""
     iris = _Iris(tree, path)
     for el, named in _axiom_elements(tree, iris):
         if _matches(kind, named, sub, sup):
@@ -80,4 +81,8 @@ def _matches(kind: str, named: list[str], sub: str, sup: str) -> bool:
         return named == [sub, sup]
     if kind == "equivalent":
         return len(named) == 2 and set(named) == {sub, sup}
+    if kind == "defined":
+        return len(named) > 2 and named[0] == sub and sup in named[1:]
+    if kind == "some":
+        return len(named) == 3 and named[0] == sub and named[2] == sup
     return bool(named) and named[0] == sub and str(PNP.hasSkill) in named and sup in named[1:]
