@@ -88,3 +88,15 @@ def test_an_rdfxml_class_a_library_device_needs_cures_its_violation() -> None:
     assert [v["line"] for v in cured] == [8]
     assert "soft-gripper is of unknown class SoftGripper" in str(cured[0]["message"])
     assert doc["new_violations"] == []
+
+
+def test_an_rdfxml_extension_brings_its_catalog_import(tmp_path: Path) -> None:
+    # Not loaded as a library: the extension alone, whose OWL/XML import its library's catalog maps.
+    lab = Path(__file__).parents[1] / "data" / "libraries" / "protege-lab"
+    cell = tmp_path / "robot-soft.yaml"
+    cell.write_text(f"cell: robot-soft\ndevices:\n  - {BUILTIN / 'devices' / 'robot.ttl'}\n"
+                    f"  - {lab / 'devices' / 'soft-gripper.ttl'}\n")
+    result = runner.invoke(app, ["impact", str(lab / "ontology" / "lab.owl"), "--cells", str(cell), "--json"])
+    assert result.exit_code == 1, result.output
+    added = json.loads(result.stdout)["cells"][0]["added"]
+    assert {"command": "pick", "bindings": ["gripper=soft-gripper robot=robot"]} in added

@@ -146,6 +146,12 @@ def tbox_files(libraries: Sequence[Library]) -> list[Path]:
     return ontology_files(ontology_path()) + [f for lib in libraries if not lib.builtin for f in lib.files("ontology")]
 
 
+def _library_root(tbox_file: Path) -> Path:
+    """Where a TBox file given on its own resolves imports: its library (``LIB/ontology/x.owl``), else its folder."""
+    folder = Path(tbox_file).resolve().parent
+    return folder.parent if folder.name == "ontology" else folder
+
+
 def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Sequence[Path] = (),
                    left_out: Sequence[Path] = ()) -> Knowledge:
     """Load the knowledge of ``libraries`` (default: the built-in one alone).
@@ -155,6 +161,7 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
     library's ``processes/``.
     """
     libs = tuple(libraries) if libraries is not None else (builtin_library(),)
+    extra_tbox = [i for f in extra_tbox for i in with_imports([f], _library_root(f))]
     tbox = [f for f in tbox_files(libs) + [f for f in extra_tbox if f not in tbox_files(libs)] if f not in left_out]
     try:
         taxonomy = load_taxonomy(tbox)
@@ -165,4 +172,5 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
         raise OntologyError(f"{exc} with the extension(s) {', '.join(own)}") from exc
     processes = [load_process(f) for lib in libs for f in lib.files("processes")]
     refuse_duplicates(processes, "process")
-    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(extra_tbox), tuple(left_out))
+    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(dict.fromkeys(extra_tbox)),
+                     tuple(left_out))
