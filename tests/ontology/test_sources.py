@@ -182,3 +182,15 @@ def test_every_axiom_of_the_xml_forms_is_found_at_an_element_naming_its_class(tm
             assert a.where.line is not None, a.formula()
             element = "\n".join(lines[a.where.line - 1:a.where.line + 8])  # the element's opening and body
             assert a.sup.rsplit("#", 1)[1] in element, (a.formula(), path.name, a.where.line)
+
+
+def test_validate_reads_a_library_s_rdfxml_and_owlxml_files(tmp_path: Path) -> None:
+    report = service.validate([LAB])
+    assert report.valid, report.problems
+    assert {"lab.owl", "skills.owx", "soft-gripper.ttl"} <= {Path(f).name for f in report.files}
+    lab = copy_lab(tmp_path)
+    owl = lab / "ontology" / "lab.owl"
+    owl.write_text(owl.read_text().replace("</owl:Class>", "</owl:Klass>", 1))
+    result = runner.invoke(app, ["validate", str(owl)])
+    assert result.exit_code == 2
+    assert result.stdout.startswith(f"{owl}:") and "malformed XML: Opening and ending tag mismatch" in result.stdout
