@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import io
 import json
+import random
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 from typing import Any, cast
 
@@ -14,10 +16,14 @@ import owlready2
 import pyhornedowl
 import pytest
 import rdflib
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from plugnproduce import service
 from plugnproduce.cli import app
+from plugnproduce.errors import DescriptionError
+from plugnproduce.ontology.sources import read_tbox_file
 from plugnproduce.ontology.taxonomy import classify, load_taxonomy, read_tbox
 from plugnproduce.reasoning.axioms import Axiom, load_ontology
 from plugnproduce.resources import ontology_path
@@ -194,3 +200,26 @@ def test_validate_reads_a_library_s_rdfxml_and_owlxml_files(tmp_path: Path) -> N
     result = runner.invoke(app, ["validate", str(owl)])
     assert result.exit_code == 2
     assert result.stdout.startswith(f"{owl}:") and "malformed XML: Opening and ending tag mismatch" in result.stdout
+
+
+@settings(max_examples=80, deadline=None, derandomize=True)
+@given(name=st.sampled_from(["lab.owl", "imports/skills.owx"]), rng=st.randoms(use_true_random=False))
+def test_a_mutated_protege_file_is_read_or_refused_in_one_line(name: str, rng: random.Random) -> None:
+    data = bytearray((LAB / "ontology" / name).read_bytes())
+    for _ in range(rng.randint(1, 6)):  # flip, cut, or repeat a piece
+        at = rng.randrange(len(data))
+        choice = rng.random()
+        if choice < 0.4:
+            data[at] = rng.randrange(256)
+        elif choice < 0.7:
+            del data[at:at + rng.randint(1, 40)]
+        else:
+            data[at:at] = data[at:at + rng.randint(1, 200)] * rng.randint(1, 20)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / Path(name).name
+        path.write_bytes(bytes(data))
+        try:
+            read_tbox_file(path)
+        except DescriptionError as exc:
+            message = exc.location_message()
+            assert "\n" not in message and "Traceback" not in message and message.startswith(str(path))
