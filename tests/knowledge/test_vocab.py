@@ -79,3 +79,11 @@ def test_vocab_tree_includes_a_library_s_classes_under_their_parents() -> None:
     lines = runner.invoke(app, ["--library", str(THREE_FINGER), "vocab", "--tree"]).stdout.splitlines()
     gripper = lines.index("    pnp:Gripper")
     assert "      " + TF + "ThreeFingerGripper" in lines[gripper:]
+
+
+def test_vocab_tree_json_nests_children_and_groups_equivalents() -> None:
+    roots = json.loads(runner.invoke(app, ["vocab", "--tree", "--json"]).stdout)
+    assert [r["kind"] for r in roots] == ["device_classes", "skills", "state_concepts", "quantities", "outcomes"]
+    states = roots[2]["children"]
+    gripper = next(n for n in states if n["names"] == ["pnp:GripperState"])
+    assert {"names": ["pnp:Open", "pnp:Released"], "children": []} in gripper["children"]

@@ -21,12 +21,15 @@ app.add_typer(ontology_app, name="ontology")
 def vocab(json_out: bool = JSON_OPTION,
           tree: bool = typer.Option(False, "--tree", help="The taxonomy as an indented tree per root (devices, "
                                     "skills, state concepts, quantities, outcomes); equivalent classes on one "
-                                    "line.")) -> None:
+                                    "line. With --json: nested nodes of names and children.")) -> None:
     """List the terms of the loaded knowledge (built-in and libraries): the roots a library's terms subclass,
     device classes with the skills they imply, skills with their mandatory states, state concepts,
     quantities, outcomes and processes; equivalent classes are marked "equivalent"."""
-    from plugnproduce.knowledge.vocab import vocabulary, vocabulary_text, vocabulary_tree
+    from plugnproduce.knowledge.vocab import taxonomy_tree, vocabulary, vocabulary_text, vocabulary_tree
 
+    if tree and json_out:
+        emit_json(taxonomy_tree(knowledge().taxonomy))
+        return
     if tree:
         for line in vocabulary_tree(knowledge().taxonomy):
             typer.echo(line)

@@ -123,19 +123,34 @@ def vocabulary_text(vocab: dict[str, list[Entry]]) -> list[str]:
     return lines
 
 
-def vocabulary_tree(taxonomy: Taxonomy) -> list[str]:
-    """The taxonomy as an indented tree per root (devices, skills, state concepts, quantities, outcomes); a class
-    under several parents appears under each; equivalent classes share one line (``pnp:Open ≡ pnp:Released``)."""
-    lines: list[str] = []
+def taxonomy_tree(taxonomy: Taxonomy) -> list[Entry]:
+    """The taxonomy as a tree per root (devices, skills, state concepts, quantities, outcomes): each node names
+    its equivalent classes together (``["pnp:Open", "pnp:Released"]``) and lists its children; a class under
+    several parents appears under each."""
+    out: list[Entry] = []
     for key, root, _ in ROOTS:
         top = PNP_IRI + root
-        members = [top, *taxonomy.classes_of_kind(root)]
         children: dict[str, set[str]] = {}
-        for c in members[1:]:
+        for c in taxonomy.classes_of_kind(root):
             for parent in direct_parents(taxonomy, c, root):
                 children.setdefault(_first(taxonomy, parent), set()).add(_first(taxonomy, c))
-        lines.append(f"{curie(top)}  ({key.replace('_', ' ')})")
-        _branch(taxonomy, top, children, 1, lines, (top,))
+        out.append({"kind": key, "names": [curie(top)], "children": _branch(taxonomy, top, children, (top,))})
+    return out
+
+
+def vocabulary_tree(taxonomy: Taxonomy) -> list[str]:
+    """:func:`taxonomy_tree` as indented lines, equivalent classes on one line (``pnp:Open ≡ pnp:Released``)."""
+    lines: list[str] = []
+
+    def show(node: Entry, depth: int) -> None:
+        lines.append("  " * depth + " ≡ ".join(node["names"]))  # type: ignore[arg-type]
+        for child in node["children"]:  # type: ignore[attr-defined]
+            show(child, depth + 1)
+
+    for root in taxonomy_tree(taxonomy):
+        lines.append(f"{root['names'][0]}  ({str(root['kind']).replace('_', ' ')})")  # type: ignore[index]
+        for child in root["children"]:  # type: ignore[attr-defined]
+            show(child, 1)
     return lines
 
 
@@ -144,11 +159,7 @@ def _first(taxonomy: Taxonomy, iri: str) -> str:
     return min([iri, *_equivalents(taxonomy, iri)])
 
 
-def _branch(taxonomy: Taxonomy, node: str, children: dict[str, set[str]], depth: int, lines: list[str],
-            path: tuple[str, ...]) -> None:
-    for child in sorted(children.get(node, ()), key=curie):
-        if child in path:
-            continue  # a cycle through equivalent classes is one line, not a loop
-        names = " ≡ ".join(curie(c) for c in [child, *_equivalents(taxonomy, child)])
-        lines.append("  " * depth + names)
-        _branch(taxonomy, child, children, depth + 1, lines, (*path, child))
+def _branch(taxonomy: Taxonomy, node: str, children: dict[str, set[str]], path: tuple[str, ...]) -> list[Entry]:
+    return [{"names": [curie(c) for c in [child, *_equivalents(taxonomy, child)]],
+             "children": _branch(taxonomy, child, children, (*path, child))}
+            for child in sorted(children.get(node, ()), key=curie) if child not in path]
