@@ -109,6 +109,9 @@ def test_an_import_the_catalog_does_not_map_is_one_line_naming_the_iri(tmp_path:
     assert result.stderr.strip().splitlines() == [
         f"{owl}:{line_of(owl, SKILLS_IRI)}: owl:imports <{SKILLS_IRI}> is not resolved: no catalog-v001.xml maps it "
         f"and no file of the library {lab} declares that ontology (imports are never fetched from the network)"]
+    checked = runner.invoke(app, ["validate", str(lab)])  # validate: the same line among its findings, exit 2
+    assert checked.exit_code == 2
+    assert result.stderr.strip() in checked.stdout.splitlines()
 
 
 def test_an_import_resolves_to_the_library_file_that_declares_its_iri(tmp_path: Path) -> None:

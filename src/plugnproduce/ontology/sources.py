@@ -167,7 +167,7 @@ def resolve_import(iri: str, importer: TBoxFile, root: Path) -> Path | None:
     for candidate in _library_tbox(root):
         if candidate.resolve() != importer.path.resolve() and iri.rstrip("#/") in _declared(candidate):
             return candidate
-    raise DescriptionError(f"owl:imports <{iri}> is not resolved: no {CATALOG} maps it and no file of the library "
+    raise UnreadableError(f"owl:imports <{iri}> is not resolved: no {CATALOG} maps it and no file of the library "
                            f"{root} declares that ontology (imports are never fetched from the network)",
                            importer.path, _line_naming(importer.text, iri))
 
@@ -187,7 +187,7 @@ def _catalog_entry(catalog: Path, iri: str) -> Path | None:
                              el.get("uri", ""))
             parsed = urlparse(target)
             if parsed.scheme not in ("file", ""):
-                raise DescriptionError(f"{CATALOG} maps <{iri}> to {tidy(target)}, which is not a local file "
+                raise UnreadableError(f"{CATALOG} maps <{iri}> to {tidy(target)}, which is not a local file "
                                        "(imports are never fetched from the network)", catalog, el.sourceline)
             return Path(unquote(parsed.path))
     return None
@@ -197,7 +197,7 @@ def _inside(target: Path, root: Path, importer: TBoxFile, iri: str, how: str) ->
     resolved = target.resolve()
     if not resolved.is_relative_to(root) or not resolved.is_file():
         where = "is outside the library folder" if not resolved.is_relative_to(root) else "does not exist"
-        raise DescriptionError(f"owl:imports <{iri}> is not resolved: {how}, which {where}", importer.path,
+        raise UnreadableError(f"owl:imports <{iri}> is not resolved: {how}, which {where}", importer.path,
                                _line_naming(importer.text, iri))
     return resolved
 
