@@ -23,6 +23,19 @@ EXPECTED: dict[str, list[str]] = {
         r"\+ pick \['gripper=gripper-3f robot=robot'\]",
         r"plausible: True",
         r"outcome: succeeded",
+        r'<owl:imports rdf:resource="http://example.org/protege-lab/skills"/>',  # owlready2 saved RDF/XML
+        r"files classified: pnp\.ttl lab\.owl skills\.owx",  # the import, through the catalog
+        r"valid: True",
+        r"pick +\(\{'gripper': 'soft-gripper', 'robot': 'robot'\},\)",
+        r"every 'soft gripper' has the skill 'can grip' .*@ \(inferred\)",
+        r"\[SoftGripper ⊑ ∃hasSkill\.CanSoftGrip\]  @ lab\.owl:\d+",
+        r"\[CanSoftGrip ⊑ CanGrip\]  @ skills\.owx:\d+",
+        r"catalogue device vacuum-gripper roles gained: \['screw\.screwdriver'\]",
+        r"new violation: vacuum-gripper\.ttl:\d+: .*lacks the mandatory state 'Fastened'",
+        r"device classes in the export: +(\d+) \| in pnp vocab: \1\b",
+        r"SoftGripper is a: \['Gripper', 'GrippingDevice'\]",
+        r"marked: \['HermiT'\]",
+        r"pnp:Open ≡ pnp:Released",
     ],
     "batch-feasibility": [
         r"256 configurations answered",

@@ -12,7 +12,7 @@ import dataclasses
 import os
 import secrets
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -648,7 +648,25 @@ def runs() -> list[RunSummary]:
 def impact(extensions: list[Path], cell_files: list[Path] | None = None,
            knowledge: Knowledge | None = None) -> Impact:
     """What adding the TBox files ``extensions`` to ``knowledge`` changes: offered commands per cell
-    (default: every cell of the loaded libraries), catalogue roles, and the libraries' tasks."""
+    (default: every cell of the loaded libraries), catalogue roles, the libraries' tasks, and the
+    validation findings (shapes, structure) of every catalogue device and cell, before and after."""
     from plugnproduce.reasoning.impact import impact as compute
 
-    return compute(_k(knowledge), extensions, cell_files)
+    return compute(_k(knowledge), extensions, cell_files, _findings)
+
+
+def _findings(k: Knowledge, files: Sequence[Path]) -> set[tuple[str, int, str]]:
+    """What validating ``files`` against ``k`` finds, as (file, line, message)."""
+    from plugnproduce.validation import validate_paths
+
+    return {(p.file, p.line, p.message) for p in validate_paths(list(files), k).problems}
+
+
+def export_ontology(fmt: str = "rdfxml", inferred: bool = False, knowledge: Knowledge | None = None) -> bytes:
+    """The merged TBox of ``knowledge`` as one ontology in ``fmt`` (``rdfxml``, ``turtle``, ``owlxml``); with
+    ``inferred``, the hierarchy HermiT derived as asserted axioms annotated ``pnp:inferredBy "HermiT"``."""
+    from plugnproduce.ontology.export import merged_tbox, serialise
+
+    k = _k(knowledge)
+    sources = [lib.name for lib in k.libraries] or ["the pnp ontology"]
+    return serialise(merged_tbox(k.tbox(), k.taxonomy, sources, inferred), fmt)

@@ -62,3 +62,41 @@ def test_the_impact_of_a_loaded_library_s_own_ontology_file(tmp_path: Path) -> N
     assert result.exit_code == 1, result.output
     assert "+ pick             gripper=gripper-3f robot=robot" in result.stdout
     assert "catalogue device gripper-3f: roles +" in result.stdout
+
+
+def test_a_skill_axiom_is_reported_as_the_device_lacking_the_skill_s_mandatory_states(tmp_path: Path) -> None:
+    ext = tmp_path / "screwing-vacuum.ttl"
+    ext.write_text(SCREWING_VACUUM)
+    result = runner.invoke(app, ["impact", str(ext)])
+    assert result.exit_code == 1
+    device = BUILTIN / "devices" / "vacuum-gripper.ttl"
+    for state in ("Fastened", "ToolIdle"):
+        assert (f"new violation: {device}:6: device vacuum-gripper has skill CanScrew but its Device State Chart "
+                f"lacks the mandatory state '{state}'; expected a state annotated pnp:{state}") in result.stdout
+    doc = json.loads(runner.invoke(app, ["impact", str(ext), "--json"]).stdout)
+    assert [(v["file"], v["line"]) for v in doc["new_violations"]] == [(str(device), 6), (str(device), 6)]
+    assert doc["cured_violations"] == []
+
+
+def test_an_rdfxml_class_a_library_device_needs_cures_its_violation() -> None:
+    # protege-lab is loaded; "before" is the knowledge without lab.owl, where its gripper's class is unknown.
+    lab = Path(__file__).parents[1] / "data" / "libraries" / "protege-lab"
+    result = runner.invoke(app, ["--library", str(lab), "impact", str(lab / "ontology" / "lab.owl"), "--json"])
+    assert result.exit_code == 1, result.output
+    doc = json.loads(result.stdout)
+    cured = [v for v in doc["cured_violations"] if v["file"] == str(lab / "devices" / "soft-gripper.ttl")]
+    assert [v["line"] for v in cured] == [8]
+    assert "soft-gripper is of unknown class SoftGripper" in str(cured[0]["message"])
+    assert doc["new_violations"] == []
+
+
+def test_an_rdfxml_extension_brings_its_catalog_import(tmp_path: Path) -> None:
+    # Not loaded as a library: the extension alone, whose OWL/XML import its library's catalog maps.
+    lab = Path(__file__).parents[1] / "data" / "libraries" / "protege-lab"
+    cell = tmp_path / "robot-soft.yaml"
+    cell.write_text(f"cell: robot-soft\ndevices:\n  - {BUILTIN / 'devices' / 'robot.ttl'}\n"
+                    f"  - {lab / 'devices' / 'soft-gripper.ttl'}\n")
+    result = runner.invoke(app, ["impact", str(lab / "ontology" / "lab.owl"), "--cells", str(cell), "--json"])
+    assert result.exit_code == 1, result.output
+    added = json.loads(result.stdout)["cells"][0]["added"]
+    assert {"command": "pick", "bindings": ["gripper=soft-gripper robot=robot"]} in added

@@ -59,3 +59,32 @@ def test_a_rule_is_found_at_its_line_and_instantiated() -> None:
     assert r.instance({"C": "cell", "P": "pick", "R": "gripper", "D": "gripper"}) == (
         'fillable("cell","pick","gripper") :- member("cell","gripper"), can_play("pick","gripper","gripper").')
     assert rule("roles.lp", "walk", 1).instance({"I": 1}).startswith("walk(P,R,D,2,Y)")
+
+
+def test_a_subsumption_through_a_definition_names_every_asserted_axiom_it_comes_from() -> None:
+    # ClosedWithPart ⊑ HoldingPart: no chain of subclass axioms states it; HermiT derives it from the
+    # definition HoldingPart ≡ GripperState ⊓ ∃holds.Part, which ClosedWithPart meets.
+    k = service.knowledge()
+    onto = load_ontology(k.ontology_files(), k.taxonomy)
+    chain = onto.subsumption(PNP + "ClosedWithPart", PNP + "HoldingPart", k.taxonomy)
+    assert chain is not None
+    assert [a.formula() for a in chain] == ["ClosedWithPart ⊑ Closed", "Closed ⊑ GripperState",
+                                            "ClosedWithPart ⊑ ∃holds.Part", "HoldingPart ≡ GripperState ⊓ ∃holds.Part"]
+    for a in chain:
+        line = Path(a.where.file).read_text(encoding="utf-8").splitlines()[(a.where.line or 0) - 1]
+        assert a.sup.rsplit("#", 1)[1] in line
+
+
+def test_a_class_under_a_defined_class_has_its_skill_justified_by_the_definition(tmp_path: Path) -> None:
+    lib = tmp_path / "lib"
+    (lib / "ontology").mkdir(parents=True)
+    (lib / "ontology" / "grabber.ttl").write_text(
+        "@prefix pnp: <http://plugnproduce.org/ontology#> .\n@prefix owl: <http://www.w3.org/2002/07/owl#> .\n"
+        "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n<http://example.org/g> a owl:Ontology .\n"
+        "<http://example.org/g#Grabber> a owl:Class ;\n    rdfs:subClassOf pnp:GrippingDevice .\n")
+    k = service.knowledge((lib,))
+    onto = load_ontology(k.ontology_files(), k.taxonomy)
+    chain = onto.implied_skill("http://example.org/g#Grabber", PNP + "CanGrip", k.taxonomy)
+    assert chain is not None
+    assert [a.formula() for a in chain] == ["Grabber ⊑ GrippingDevice", "GrippingDevice ≡ Device ⊓ ∃hasSkill.CanGrip"]
+    assert [(Path(a.where.file).name, a.where.line) for a in chain] == [("grabber.ttl", 6), ("pnp.ttl", 303)]  # owl:equivalentClass

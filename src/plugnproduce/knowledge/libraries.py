@@ -1,6 +1,7 @@
 """Libraries: folders of ontology extensions, devices, processes, cells and tasks.
 
-A library is a folder with any of ``ontology/`` (Turtle TBox extensions), ``devices/``,
+A library is a folder with any of ``ontology/`` (TBox extensions in Turtle, RDF/XML or OWL/XML, with their
+``owl:imports`` resolved inside the library), ``devices/``,
 ``processes/``, ``cells/`` and ``tasks/``. The package's own descriptions and ontology are
 the *built-in* library. :class:`Knowledge` is everything the use cases need, loaded from
 an ordered list of libraries: the taxonomy closure of the combined TBox, the processes
@@ -19,6 +20,7 @@ import rdflib
 from plugnproduce.description.loader import load_device, load_process
 from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.errors import DescriptionError, OntologyError
+from plugnproduce.ontology.sources import with_imports
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
 from plugnproduce.resources import descriptions_path, ontology_path
 
@@ -35,9 +37,11 @@ class Library:
 
     def files(self, kind: str, pattern: str = "*.ttl") -> list[Path]:
         """The files of one kind (``"devices"``, ``"processes"``...) in this library, sorted."""
-        if kind == "ontology":  # every Turtle file but SHACL shapes
-            folder = ontology_path() if self.builtin else self.root / "ontology"
-            return ontology_files(folder) if folder.is_dir() else []
+        if kind == "ontology":  # every Turtle, RDF/XML and OWL/XML file but SHACL shapes, then what they import
+            if self.builtin:
+                return ontology_files(ontology_path())
+            folder = self.root / "ontology"
+            return with_imports(ontology_files(folder), self.root) if folder.is_dir() else []
         return _glob(self.root / kind, pattern)
 
     @property
@@ -142,6 +146,12 @@ def tbox_files(libraries: Sequence[Library]) -> list[Path]:
     return ontology_files(ontology_path()) + [f for lib in libraries if not lib.builtin for f in lib.files("ontology")]
 
 
+def _library_root(tbox_file: Path) -> Path:
+    """Where a TBox file given on its own resolves imports: its library (``LIB/ontology/x.owl``), else its folder."""
+    folder = Path(tbox_file).resolve().parent
+    return folder.parent if folder.name == "ontology" else folder
+
+
 def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Sequence[Path] = (),
                    left_out: Sequence[Path] = ()) -> Knowledge:
     """Load the knowledge of ``libraries`` (default: the built-in one alone).
@@ -151,6 +161,7 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
     library's ``processes/``.
     """
     libs = tuple(libraries) if libraries is not None else (builtin_library(),)
+    extra_tbox = [i for f in extra_tbox for i in with_imports([f], _library_root(f))]
     tbox = [f for f in tbox_files(libs) + [f for f in extra_tbox if f not in tbox_files(libs)] if f not in left_out]
     try:
         taxonomy = load_taxonomy(tbox)
@@ -161,4 +172,5 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
         raise OntologyError(f"{exc} with the extension(s) {', '.join(own)}") from exc
     processes = [load_process(f) for lib in libs for f in lib.files("processes")]
     refuse_duplicates(processes, "process")
-    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(extra_tbox), tuple(left_out))
+    return Knowledge(libs, taxonomy, tuple(sorted(processes, key=lambda p: p.id)), tuple(dict.fromkeys(extra_tbox)),
+                     tuple(left_out))

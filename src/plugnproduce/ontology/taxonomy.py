@@ -19,9 +19,10 @@ import rdflib
 from rdflib.namespace import OWL, RDF, RDFS
 
 from plugnproduce.errors import OntologyError
+from plugnproduce.ontology.sources import folder_files, read_tbox_file
 from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, local_name
 from plugnproduce.resources import ontology_path
-from plugnproduce.safeio import parse_turtle
+from plugnproduce.safeio import read_bytes
 
 CACHE_VERSION = 2
 _CAPABILITY_PREFIX = PNP_IRI + "_HasSkill_"
@@ -109,23 +110,25 @@ class Taxonomy:
 
 
 def ontology_files(folder: Path | None = None) -> list[Path]:
-    """The TBox files of an ontology folder: every ``.ttl`` except the SHACL shapes."""
-    folder = folder or ontology_path()
-    return sorted(p for p in folder.glob("*.ttl") if p.name != "shapes.ttl")
+    """The TBox files of an ontology folder: Turtle, RDF/XML and OWL/XML, except the SHACL shapes."""
+    return folder_files(folder or ontology_path())
 
 
 def read_tbox(files: Iterable[Path]) -> rdflib.Graph:
-    """Parse the TBox files into one graph, with ``file: message`` errors."""
+    """Parse the TBox files (any of the three formats) into one graph, with ``file: message`` errors."""
     g = rdflib.Graph()
     for p in files:
-        g += parse_turtle(p)[0]
+        g += read_tbox_file(p).graph
     return g
 
 
 def _digest(files: Iterable[Path]) -> str:
+    """The cache key of a TBox: every file's name and bytes, in order. The format is told by the bytes
+    (see :mod:`~plugnproduce.ontology.sources`), so the same TBox saved as Turtle, RDF/XML or OWL/XML has three
+    keys; imported files are among ``files`` (the libraries list them), so editing one reclassifies."""
     h = hashlib.sha256()
     for p in files:
-        h.update(p.name.encode() + b"\0" + p.read_bytes() + b"\0")
+        h.update(p.name.encode() + b"\0" + read_bytes(p) + b"\0")
     return h.hexdigest()
 
 
@@ -205,7 +208,9 @@ def classify(g: rdflib.Graph, digest: str = "") -> Taxonomy:
         cap.add((i, RDF.type, OWL.Class))
         cap.add((i, OWL.intersectionOf, lst))
         cap.add((c, OWL.equivalentClass, i))
-    nt = (g + cap).serialize(format="nt", encoding="utf-8")
+    merged = g + cap
+    merged.remove((None, OWL.imports, None))  # the files are merged already; owlready2 would fetch imports
+    nt = merged.serialize(format="nt", encoding="utf-8")
     world = owlready2.World()
     try:
         onto = world.get_ontology(PNP_IRI.rstrip("#")).load(fileobj=io.BytesIO(nt), format="ntriples")

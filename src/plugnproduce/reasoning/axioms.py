@@ -1,4 +1,5 @@
-"""OWL evidence for explanations: the asserted TBox axioms with the ``file:line`` they are written at, labels in
+"""OWL evidence for explanations: the asserted TBox axioms with the ``file:line`` they are written at (the Turtle
+statement's line; the element's line in RDF/XML and OWL/XML), labels in
 plain words (rdfs:label, by language tag), and minimal justifications of what the reasoner derived.
 
 HermiT (through owlready2) answers *whether* a class is subsumed or implies a skill, but gives no justification.
@@ -20,9 +21,10 @@ import rdflib
 from rdflib.namespace import OWL, RDFS
 
 from plugnproduce.description.model import Where
+from plugnproduce.ontology.sources import read_tbox_file
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import parse_turtle
+from plugnproduce.ontology.xmllines import axiom_line
 
 DEFAULT_LANGUAGE = "en"
 """The language of an untagged rdfs:label."""
@@ -30,18 +32,31 @@ DEFAULT_LANGUAGE = "en"
 
 @dataclass(frozen=True)
 class Axiom:
-    """One asserted TBox axiom: ``sub ⊑ sup`` (kind ``subclass``), ``sub ≡ sup`` (``equivalent``) or
-    ``sub ⊑ ∃hasSkill.sup`` (``has_skill``), and where it is written."""
+    """One asserted TBox axiom and where it is written: ``sub ⊑ sup`` (kind ``subclass``), ``sub ≡ sup``
+    (``equivalent``), ``sub ⊑ ∃hasSkill.sup`` (``has_skill``), ``sub ⊑ ∃prop.sup`` (``some``), or a definition
+    ``sub ≡ C1 ⊓ ∃p.C2 ⊓ …`` (``defined``, its conjuncts in ``parts`` as (property or "", class)).
+
+    A definition also yields the subclass and restriction axioms it entails (``sub ⊑ C1``…), each shown as
+    the definition it comes from (``shown``)."""
 
     kind: str
     sub: str
     sup: str
     where: Where
+    prop: str = ""
+    parts: tuple[tuple[str, str], ...] = ()
+    shown: str = ""
 
     def formula(self) -> str:
         """The axiom in DL notation with local names, e.g. ``ParallelGripper ⊑ ∃hasSkill.CanParallelGrip``."""
+        if self.shown:
+            return self.shown
         a, b = local_name(self.sub), local_name(self.sup)
-        return {"subclass": f"{a} ⊑ {b}", "equivalent": f"{a} ≡ {b}"}.get(self.kind, f"{a} ⊑ ∃hasSkill.{b}")
+        if self.kind == "defined":
+            return f"{a} ≡ " + " ⊓ ".join(f"∃{local_name(p)}.{local_name(c)}" if p else local_name(c)
+                                          for p, c in self.parts)
+        return {"subclass": f"{a} ⊑ {b}", "equivalent": f"{a} ≡ {b}",
+                "some": f"{a} ⊑ ∃{local_name(self.prop)}.{b}"}.get(self.kind, f"{a} ⊑ ∃hasSkill.{b}")
 
 
 class Labels:
@@ -78,7 +93,8 @@ class Ontology:
     """The asserted axioms of the TBox files, indexed for justification search, and their labels."""
 
     def __init__(self, axioms: Iterable[Axiom], labels: Labels):
-        self.axioms = tuple(axioms)
+        self.axioms = tuple(a for a in axioms if a.kind != "defined")
+        self.definitions = tuple(a for a in axioms if a.kind == "defined")
         self.labels = labels
         self._out: dict[str, list[Axiom]] = {}
         for a in self.axioms:
@@ -93,14 +109,47 @@ class Ontology:
             return None
         if sub == sup:
             return ()
-        return self._search(sub, lambda a, _: a.kind != "has_skill", (sup, 0))
+        return self._named(sub, sup) or self._by_definition(sub, sup, taxonomy)
+
+    def _named(self, sub: str, sup: str) -> tuple[Axiom, ...] | None:
+        """The shortest chain of named subclass/equivalence axioms from ``sub`` up to ``sup``."""
+        return () if sub == sup else self._search(sub, lambda a, _: a.kind in ("subclass", "equivalent"), (sup, 0))
+
+    def _by_definition(self, sub: str, sup: str, taxonomy: Taxonomy) -> tuple[Axiom, ...] | None:
+        """``sub ⊑ sup`` through a definition ``D ≡ C1 ⊓ ∃p.C2 …`` with ``D ⊑ sup``: ``sub`` meets every conjunct."""
+        for d in self.definitions:
+            if not (taxonomy.is_a(sub, d.sub) and taxonomy.is_a(d.sub, sup)) or sub == d.sub:
+                continue
+            chain: list[Axiom] = []
+            for prop, cls in d.parts:
+                part = self._some(sub, prop, cls, taxonomy) if prop else self._named(sub, cls)
+                if part is None:
+                    break
+                chain += part
+            else:
+                tail = self._named(d.sub, sup)
+                if tail is not None:
+                    return tuple(dict.fromkeys([*chain, d, *tail]))
+        return None
+
+    def _some(self, sub: str, prop: str, cls: str, taxonomy: Taxonomy) -> tuple[Axiom, ...] | None:
+        """The shortest chain ``sub ⊑ … ⊑ X``, ``X ⊑ ∃prop.F``, ``F ⊑ … ⊑ cls`` of asserted axioms."""
+        best: tuple[Axiom, ...] | None = None
+        for a in self.axioms:
+            if a.prop != prop or not (taxonomy.is_a(sub, a.sub) and taxonomy.is_a(a.sup, cls)):
+                continue
+            up, down = self._named(sub, a.sub), self._named(a.sup, cls)
+            if up is not None and down is not None and (best is None or len(up) + len(down) + 1 < len(best)):
+                best = (*up, a, *down)
+        return best
 
     def implied_skill(self, cls: str, skill: str, taxonomy: Taxonomy) -> tuple[Axiom, ...] | None:
         """The shortest chain ``cls ⊑ … ⊑ ∃hasSkill.S1``, ``S1 ⊑ … ⊑ skill``, when the reasoner derives that a
         device of class ``cls`` has ``skill``."""
         if skill not in taxonomy.implied_skills.get(cls, frozenset()):
             return None
-        return self._search(cls, lambda a, phase: a.kind != "has_skill" or phase == 0, (skill, 1))
+        return self._search(cls, lambda a, phase: a.kind in ("subclass", "equivalent")
+                            or (a.kind == "has_skill" and phase == 0), (skill, 1))
 
     def _search(self, start: str, usable: Callable[[Axiom, int], bool],
                 goal: tuple[str, int]) -> tuple[Axiom, ...] | None:
@@ -147,25 +196,63 @@ def _line(lines: list[str], g: rdflib.Graph, subject: str, obj: str) -> int | No
 
 
 def _file_axioms(path: Path) -> tuple[list[Axiom], rdflib.Graph]:
-    g, _ = parse_turtle(path)
-    lines = path.read_text(encoding="utf-8").splitlines()
+    tbox = read_tbox_file(path)
+    g, tree = tbox.graph, tbox.tree
+    lines = tbox.text.splitlines()
     out: list[Axiom] = []
 
-    def add(kind: str, s: str, o: str, named: str) -> None:
-        out.append(Axiom(kind, s, o, Where(str(path), _line(lines, g, s, named))))
+    def where(kind: str, s: str, o: str) -> Where:
+        return Where(str(path), _line(lines, g, s, o) if tree is None else axiom_line(tree, path, kind, s, o))
 
     for s, o in g.subject_objects(RDFS.subClassOf):
         if not isinstance(s, rdflib.URIRef):
             continue
         if isinstance(o, rdflib.URIRef):
-            add("subclass", str(s), str(o), str(o))
-        elif g.value(o, OWL.onProperty) == PNP.hasSkill and isinstance(g.value(o, OWL.someValuesFrom), rdflib.URIRef):
-            skill = str(g.value(o, OWL.someValuesFrom))
-            add("has_skill", str(s), skill, skill)
+            out.append(Axiom("subclass", str(s), str(o), where("subclass", str(s), str(o))))
+        elif (some := _some_of(g, o)) is not None:
+            prop, filler = some
+            kind = "has_skill" if prop == str(PNP.hasSkill) else "some"
+            out.append(Axiom(kind, str(s), filler, where("has_skill" if kind == "has_skill" else "some", str(s),
+                                                         filler), prop))
     for s, o in g.subject_objects(OWL.equivalentClass):
         if isinstance(s, rdflib.URIRef) and isinstance(o, rdflib.URIRef):
-            add("equivalent", str(s), str(o), str(o))
+            out.append(Axiom("equivalent", str(s), str(o), where("equivalent", str(s), str(o))))
+        elif isinstance(s, rdflib.URIRef) and (parts := _conjuncts(g, o)):
+            out += _definition(str(s), parts, where("defined", str(s), next(c for _, c in parts)))
     return out, g
+
+
+def _some_of(g: rdflib.Graph, node: rdflib.term.Node) -> tuple[str, str] | None:
+    """``(property, filler)`` of a restriction ``∃property.filler`` with a named property and filler."""
+    prop, filler = g.value(node, OWL.onProperty), g.value(node, OWL.someValuesFrom)
+    if isinstance(prop, rdflib.URIRef) and isinstance(filler, rdflib.URIRef):
+        return str(prop), str(filler)
+    return None
+
+
+def _conjuncts(g: rdflib.Graph, node: rdflib.term.Node) -> tuple[tuple[str, str], ...]:
+    """The conjuncts of ``C1 ⊓ ∃p.C2 ⊓ …`` as (property or "", class); nothing if one is of another form."""
+    head = g.value(node, OWL.intersectionOf)
+    if head is None:
+        return ()
+    parts: list[tuple[str, str]] = []
+    for item in rdflib.collection.Collection(g, head):
+        some = None if isinstance(item, rdflib.URIRef) else _some_of(g, item)
+        if isinstance(item, rdflib.URIRef):
+            parts.append(("", str(item)))
+        elif some is not None:
+            parts.append(some)
+        else:
+            return ()
+    return tuple(parts)
+
+
+def _definition(cls: str, parts: tuple[tuple[str, str], ...], where: Where) -> list[Axiom]:
+    """The definition ``cls ≡ parts`` and the axioms it entails (``cls ⊑`` each conjunct), shown as it."""
+    d = Axiom("defined", cls, parts[0][1], where, parts=parts)
+    entailed = [Axiom("subclass" if not p else "has_skill" if p == str(PNP.hasSkill) else "some", cls, c, where, p,
+                      shown=d.formula()) for p, c in parts]
+    return [d, *entailed]
 
 
 def load_ontology(files: Iterable[Path], taxonomy: Taxonomy) -> Ontology:

@@ -8,7 +8,7 @@ it is plausible.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,6 +21,12 @@ from plugnproduce.knowledge.libraries import Knowledge, library_folders, load_kn
 Bindings = dict[str, set[str]]
 """Offered command → its role bindings, each written ``role=device ...``."""
 
+Finding = tuple[str, int, str]
+"""A validation finding: file, line (0 for none), message."""
+
+Validator = Callable[[Knowledge, Sequence[Path]], set[Finding]]
+"""Validates description files (devices, cells) against a knowledge: shapes, schema and structure."""
+
 
 @dataclass
 class Impact:
@@ -30,21 +36,28 @@ class Impact:
     cells: list[dict[str, object]] = field(default_factory=list)
     catalogue: list[dict[str, object]] = field(default_factory=list)
     tasks: list[dict[str, object]] = field(default_factory=list)
+    new_violations: list[dict[str, object]] = field(default_factory=list)
+    """Findings of the validation (shapes, structure) of catalogue devices and cells that the edit brings."""
+    cured_violations: list[dict[str, object]] = field(default_factory=list)
+    """Findings the edit removes."""
 
     @property
     def changed(self) -> bool:
         """Whether anything changes."""
-        return bool(self.cells or self.catalogue or self.tasks)
+        return bool(self.cells or self.catalogue or self.tasks or self.new_violations or self.cured_violations)
 
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         return {"extensions": self.extensions, "changed": self.changed, "cells": self.cells,
-                "catalogue": self.catalogue, "tasks": self.tasks}
+                "catalogue": self.catalogue, "tasks": self.tasks, "new_violations": self.new_violations,
+                "cured_violations": self.cured_violations}
 
 
-def impact(before: Knowledge, extensions: Sequence[Path], cell_files: Iterable[Path] | None = None) -> Impact:
+def impact(before: Knowledge, extensions: Sequence[Path], cell_files: Iterable[Path] | None = None,
+           validate: Validator | None = None) -> Impact:
     """The impact of adding ``extensions`` (TBox files) to ``before``, on ``cell_files`` (default: the
-    libraries' cells), the catalogue and the libraries' tasks."""
+    libraries' cells), the catalogue and the libraries' tasks; with ``validate``, also the validation
+    findings of every catalogue device and every cell that the edit brings or removes."""
     extensions = [p.resolve() for p in extensions]
     after = load_knowledge(before.libraries, tuple(before.extra_tbox) + tuple(extensions))
     before = load_knowledge(before.libraries, before.extra_tbox, tuple(before.left_out) + tuple(extensions))
@@ -58,7 +71,21 @@ def impact(before: Knowledge, extensions: Sequence[Path], cell_files: Iterable[P
             result.cells.append({"cell": str(f), **note, **change})
     result.catalogue = _catalogue_change(before, after)
     result.tasks = _task_changes(before, pairs)
+    if validate is not None:
+        result.new_violations, result.cured_violations = _violations(before, after, cells, validate)
     return result
+
+
+def _violations(before: Knowledge, after: Knowledge, cells: Sequence[Path],
+                validate: Validator) -> tuple[list[dict[str, object]], list[dict[str, object]]]:
+    """The findings on the catalogue devices and the cells after the edit but not before, and the other way."""
+    files = sorted({f for lib in after.libraries for f in lib.files("devices")} | set(cells))
+    old, new = validate(before, files), validate(after, files)
+
+    def listed(found: set[Finding]) -> list[dict[str, object]]:
+        return [{"file": f, "line": n or None, "message": m} for f, n, m in sorted(found)]
+
+    return listed(new - old), listed(old - new)
 
 
 def _cell(path: Path, k: Knowledge) -> tuple[Cell | None, Knowledge]:

@@ -55,7 +55,10 @@ class Words:
 def axiom_node(w: Words, a: Axiom) -> Node:
     """One asserted axiom in plain words."""
     sub, sup = w.label(a.sub), w.label(a.sup)
-    text = {"subclass": f"'{sub}' is a kind of '{sup}'", "equivalent": f"'{sub}' means the same as '{sup}'"}.get(
+    text = {"subclass": f"'{sub}' is a kind of '{sup}'", "equivalent": f"'{sub}' means the same as '{sup}'",
+            "some": f"every '{sub}' {w.label(a.prop)} some '{sup}'",
+            "defined": f"'{sub}' is defined as " + " and ".join(
+                f"{w.label(p)} some '{w.label(c)}'" if p else f"'{w.label(c)}'" for p, c in a.parts)}.get(
         a.kind, f"every '{sub}' has the skill '{sup}'")
     return Node("owl", text, a.formula(), a.where)
 

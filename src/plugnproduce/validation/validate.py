@@ -25,6 +25,7 @@ from plugnproduce.description.loader import (
 from plugnproduce.description.model import ProcessDescription, Task, Where
 from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
 from plugnproduce.knowledge import Knowledge, Library, library_folders, load_knowledge
+from plugnproduce.ontology.sources import read_tbox_file
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.resources import ontology_path
@@ -36,7 +37,9 @@ from plugnproduce.validation.names import chart_name_problems, turtle_name_probl
 from plugnproduce.validation.shapes import shape_problems
 from plugnproduce.validation.structure import device_problems, process_problems, task_problems
 
-SUFFIXES = {".ttl", ".scxml", ".yaml", ".yml"}
+XML_TBOX = {".owl", ".rdf", ".owx"}
+"""TBox files as Protégé saves them (RDF/XML, OWL/XML): read, and classified with the knowledge."""
+SUFFIXES = {".ttl", ".scxml", ".yaml", ".yml", *XML_TBOX}
 
 
 def expand(paths: Iterable[str | Path]) -> list[Path]:
@@ -73,6 +76,8 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
         try:
             if not f.is_file():
                 report.add(Problem(str(f), 0, "no such file", unreadable=True))
+            elif f.suffix.lower() in XML_TBOX:
+                read_tbox_file(f)  # read (and refused if hostile or malformed); classified with the knowledge
             elif f.suffix == ".scxml":
                 for e in schema_problems(read_bytes(f), f):
                     report.add(Problem.from_error(e))
@@ -113,12 +118,16 @@ def validate_tasks(tasks: Iterable[Task], knowledge: Knowledge | None = None) ->
 def _with_extensions(knowledge: Knowledge, files: list[Path], report: Report) -> Knowledge:
     """The knowledge with the TBox files among ``files`` and those of the libraries the files sit in."""
     known = set(knowledge.ontology_files())
-    extra = {f.resolve() for f in files if f.suffix == ".ttl" and f not in known and _is_tbox(f)}
+    extra = {f.resolve() for f in files if f not in known and f.is_file()
+             and (f.suffix.lower() in XML_TBOX or (f.suffix == ".ttl" and _is_tbox(f)))}
     builtin = ontology_path().resolve()
     for root in {p.resolve() for f in files for p in f.resolve().parents[:3] if (p / "ontology").is_dir()}:
         if (root / "ontology").resolve() == builtin:
             continue
-        extra |= {t for t in Library(root).files("ontology") if t not in known}
+        try:
+            extra |= {t for t in Library(root).files("ontology") if t not in known}
+        except DescriptionError as exc:  # a malformed file or an unresolved import: a finding at its line
+            report.add(Problem.from_error(exc))
     if not extra:
         return knowledge
     try:
