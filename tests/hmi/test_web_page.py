@@ -15,7 +15,7 @@ from plugnproduce import service
 from tests.hmi.conftest import AUTH, Served, screenshot
 from tests.lines import WAIT
 
-expect.set_options(timeout=30_000)  # a bound, not a speed: CI runs the suite on a fully loaded machine
+expect.set_options(timeout=WAIT * 1000)  # the suite's limit, not a speed: CI runs the suite on a loaded machine
 
 CHART_SHOWN = "() => { const i = document.querySelector('#chart-img'); return i.complete && i.naturalWidth > 0; }"
 """The chart picture has loaded (a function, not an expression: the page's policy forbids eval)."""
