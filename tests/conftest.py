@@ -2,15 +2,32 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
 import shutil
+import signal
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy
 from plugnproduce.resources import descriptions_path
+from tests.processes import ours, running_descendants
 
 DESCRIPTIONS = descriptions_path()
+
+
+@pytest.fixture(scope="session", autouse=True)
+def no_process_outlives_the_suite() -> Iterator[None]:
+    """At the end of the session (of each worker), no ``pnp``/``python -m plugnproduce`` process a test started is
+    still running: a leaked one is killed, and the session fails naming it."""
+    yield
+    leaked = [(pid, cmd) for pid, cmd in running_descendants() if ours(cmd)]
+    for pid, _ in leaked:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    assert leaked == [], "processes started by the tests outlived them: " + "; ".join(f"{p} {c}" for p, c in leaked)
 
 
 @pytest.fixture(scope="session")

@@ -12,6 +12,8 @@ import pytest
 
 from plugnproduce import service
 from plugnproduce.cli.pipes import QuietPipe
+from tests.lines import WAIT
+from tests.processes import stop
 
 TASKS = service.builtin("tasks")
 CELL = str(service.builtin("cells", "bin-picking.yaml"))
@@ -22,11 +24,14 @@ def closed_early(*args: str) -> tuple[int, str]:
     proc = subprocess.Popen([sys.executable, "-m", "plugnproduce", *args],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert proc.stdout is not None and proc.stderr is not None
-    proc.stdout.readline()
-    proc.stdout.close()
-    err = proc.stderr.read()
-    proc.stderr.close()
-    return proc.wait(timeout=120), err
+    try:
+        proc.stdout.readline()
+        proc.stdout.close()
+        err = proc.stderr.read()
+        proc.stderr.close()
+        return proc.wait(timeout=WAIT), err
+    finally:
+        stop(proc)  # no effect once it has exited
 
 
 def long_journal(path: Path, events: int = 5000) -> Path:

@@ -14,6 +14,8 @@ from rich.console import Console
 
 from plugnproduce import service
 from plugnproduce.cli.progress import Phases
+from tests.lines import WAIT
+from tests.processes import stop
 
 TASK = str(service.builtin("tasks", "bin-picking.yaml"))
 ESCAPES = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
@@ -44,8 +46,11 @@ def run_with_terminal_stderr(*args: str) -> tuple[int, str, str]:
 
     reader = threading.Thread(target=read)
     reader.start()
-    out, _ = proc.communicate(timeout=120)
-    reader.join(timeout=30)
+    try:
+        out, _ = proc.communicate(timeout=120)
+    finally:
+        stop(proc)  # no effect once it has exited
+    reader.join(timeout=WAIT)
     os.close(master)
     return proc.returncode, out, "\n".join(plain(b"".join(seen).decode("utf-8", "replace")))
 

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
+import os
+import subprocess
+import sys
+
 import pytest
 
 from plugnproduce import service
@@ -44,9 +49,37 @@ def test_no_path_names_device_state_and_concept(catalogue, taxonomy) -> None:
         find_path(catalogue["conveyor"], "stopped", P + "Open", taxonomy)
 
 
-def test_path_search_is_deterministic(catalogue, taxonomy) -> None:
-    paths = {find_path(catalogue["cnc"], "door_closed", P + "MachineIdle", taxonomy) for _ in range(5)}
-    assert len(paths) == 1
+def _walk(path) -> list[tuple[str, str, str | None]]:
+    return [(t.source, t.target, t.request.name if t.request else None) for t in path.steps]
+
+
+def test_path_search_does_not_depend_on_the_order_of_the_chart(catalogue, taxonomy) -> None:
+    """From at_pose two paths of one request reach a Moving state (MoveTo → moving, Home → homing): the tie is
+    broken by what the step hands over, then by state ids, whatever order the chart lists states and transitions."""
+    robot = catalogue["robot"]
+    orders = [robot, dataclasses.replace(robot, states=robot.states[::-1], transitions=robot.transitions[::-1])]
+    orders += [dataclasses.replace(robot, transitions=robot.transitions[k:] + robot.transitions[:k])
+               for k in range(1, len(robot.transitions))]
+    plain = {tuple(_walk(find_path(r, "at_pose", P + "Moving", taxonomy))) for r in orders}
+    with_pose = {tuple(_walk(find_path(r, "at_pose", P + "Moving", taxonomy, frozenset({P + "TargetPose"}))))
+                 for r in orders}
+    assert plain == {(("at_pose", "homing", "Home"),)}
+    assert with_pose == {(("at_pose", "moving", "MoveTo"),)}
+
+
+def test_path_search_does_not_depend_on_the_hash_seed() -> None:
+    code = ("from plugnproduce import service\nfrom plugnproduce.description.paths import find_path\n"
+            "from plugnproduce.ontology.taxonomy import load_taxonomy\n"
+            "robot = next(d for d in service.catalogue() if d.id == 'robot')\n"
+            f"path = find_path(robot, 'at_pose', '{P}Moving', load_taxonomy())\n"
+            "print([(t.source, t.target) for t in path.steps])\n")
+    answers = set()
+    for seed in ("1", "2"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        answers.add(done.stdout.strip())
+    assert answers == {"[('at_pose', 'homing')]"}
 
 
 MOVING = ("robot", "cobot", "scara", "conveyor", "cnc", "screwdriver")

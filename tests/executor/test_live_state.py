@@ -14,6 +14,8 @@ import pytest
 
 from plugnproduce import service
 from plugnproduce.protocols.upnp import private_network
+from tests.lines import WAIT
+from tests.processes import started, stop
 
 CELL = str(service.builtin("cells", "bin-picking.yaml"))
 PICK_AND_PLACE = str(service.builtin("tasks", "pick-and-place.yaml"))
@@ -27,17 +29,15 @@ def env(tmp_path: Path) -> dict[str, str]:
 @pytest.fixture
 def simulated_cell(env: dict[str, str], tmp_path: Path) -> Iterator[Path]:
     state, log = tmp_path / "control.json", tmp_path / "sim.log"
-    with log.open("w") as out:
-        up = subprocess.Popen([sys.executable, "-m", "plugnproduce", "sim", "up", CELL, "--state-file", str(state)],
-                              env=env, stdout=out, stderr=subprocess.STDOUT)
-    deadline = time.monotonic() + 60
-    while not state.exists():
-        assert up.poll() is None, log.read_text()
-        assert time.monotonic() < deadline, "pnp sim up did not come up"
-        time.sleep(0.05)
-    yield tmp_path / "runs"
-    up.send_signal(signal.SIGINT)
-    assert up.wait(timeout=60) == 0, log.read_text()  # a fully loaded machine stops it late
+    with log.open("w") as out, started([sys.executable, "-m", "plugnproduce", "sim", "up", CELL, "--state-file",
+                                        str(state)], env=env, stdout=out, stderr=subprocess.STDOUT) as up:
+        deadline = time.monotonic() + WAIT
+        while not state.exists():  # polling a file the process writes once its devices are announced
+            assert up.poll() is None, log.read_text()
+            assert time.monotonic() < deadline, "pnp sim up did not come up"
+            time.sleep(0.05)
+        yield tmp_path / "runs"
+        assert stop(up, signal.SIGINT) == 0, log.read_text()  # Ctrl-C; a fully loaded machine stops it late
 
 
 def pnp(env: dict[str, str], *args: str) -> subprocess.CompletedProcess[str]:

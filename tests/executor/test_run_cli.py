@@ -9,6 +9,8 @@ import sys
 from pathlib import Path
 
 from plugnproduce import service
+from tests.lines import WAIT
+from tests.processes import stop
 
 TASKS = service.builtin("tasks")
 
@@ -59,9 +61,9 @@ def test_sigterm_stops_the_run_safely_and_the_journal_ends(tmp_path: Path) -> No
             if line.startswith("→"):
                 break
         proc.send_signal(signal.SIGTERM)
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=WAIT)
     finally:
-        proc.kill()
+        stop(proc, signal.SIGKILL)  # no effect once it has exited
     assert proc.returncode == 1, err
     assert "Traceback" not in err
     shown = service.report(journal)

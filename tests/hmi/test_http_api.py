@@ -15,6 +15,7 @@ import yaml
 
 from plugnproduce import service
 from tests.hmi.conftest import AUTH, Hmi, Served
+from tests.lines import WAIT
 
 BIN_PICK = {"command": "bin-pick", "params": {"grip_force": 45, "exposure": 25}}
 PLACE = {"command": "place", "params": {"place_pose": [0.6, -0.2, 0.1, 0, 180, 0], "speed": 80}}
@@ -329,8 +330,10 @@ async def test_discover_json_shows_each_device_with_the_keys_and_values_of_the_h
     """One device view: ``pnp discover --json`` on the HMI's simulated cell and ``GET /api/cell`` agree."""
     over_http = {d["id"]: d for d in (await client.get("/api/cell")).json()["devices"]}
     env = {**os.environ, "PNP_SSDP_PORT": str(hmi.source.network.port)}
-    command = [sys.executable, "-m", "plugnproduce", "discover", "--json", "--timeout", "10"]  # a busy machine answers late
-    done = await asyncio.to_thread(subprocess.run, command, env=env, capture_output=True, text=True, timeout=60)
+    expect = [a for d in sorted(over_http) for a in ("--expect", d)]  # ends once they answered, not at a window
+    command = [sys.executable, "-m", "plugnproduce", "discover", "--json", "--timeout", str(WAIT), *expect]
+    done = await asyncio.to_thread(subprocess.run, command, env=env, capture_output=True, text=True,
+                                   timeout=2 * WAIT)
     assert done.returncode == 0, done.stderr
     discovered = json.loads(done.stdout)["devices"]
     assert sorted(d["id"] for d in discovered) == sorted(over_http)

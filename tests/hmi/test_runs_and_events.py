@@ -12,13 +12,14 @@ import pytest
 
 from plugnproduce.hmi.hub import Hub
 from tests.hmi.conftest import AUTH, Hmi, Served
+from tests.lines import WAIT
 
 TASK = {"name": "pick-and-place", "steps": [{"command": "pick-and-place"}, {"command": "move-to"}]}
 
 
 async def _until_end(client: httpx.AsyncClient, hmi: Hmi, run_id: str) -> dict[str, object]:
     """Wait for the run to end (no polling: the runner says when)."""
-    await asyncio.wait_for(hmi.runner.finished(run_id), 10)
+    await asyncio.wait_for(hmi.runner.finished(run_id), WAIT)
     return dict((await client.get(f"/api/runs/{run_id}")).json())
 
 
@@ -48,7 +49,7 @@ async def test_a_device_lost_during_a_run_is_a_fault(client: httpx.AsyncClient, 
 
     hub.on_run_record = on_record
     run_id = (await client.post("/api/runs", json={"task": TASK}, headers=AUTH)).json()["run"]
-    await asyncio.wait_for(gripper_busy.wait(), 10)
+    await asyncio.wait_for(gripper_busy.wait(), WAIT)
     assert (await client.delete("/api/cell/devices/gripper", headers=AUTH)).status_code == 200
     run = await _until_end(client, hmi, run_id)
     assert run["status"] == "failed"

@@ -8,8 +8,9 @@ from playwright.sync_api import Page, expect
 
 from plugnproduce import service
 from tests.hmi.conftest import screenshot
+from tests.lines import WAIT
 
-expect.set_options(timeout=30_000)  # a bound, not a speed: CI runs the suite on a fully loaded machine
+expect.set_options(timeout=WAIT * 1000)  # the suite's limit, not a speed: CI runs the suite on a loaded machine
 
 
 def test_why_not_shows_the_derivation_and_a_counterfactual_plugs_the_missing_device_in(page: Page) -> None:

@@ -13,8 +13,9 @@ from playwright.sync_api import Page, expect
 
 from plugnproduce import service
 from tests.hmi.conftest import AUTH, Served, screenshot
+from tests.lines import WAIT
 
-expect.set_options(timeout=30_000)  # a bound, not a speed: CI runs the suite on a fully loaded machine
+expect.set_options(timeout=WAIT * 1000)  # the suite's limit, not a speed: CI runs the suite on a loaded machine
 
 CHART_SHOWN = "() => { const i = document.querySelector('#chart-img'); return i.complete && i.naturalWidth > 0; }"
 """The chart picture has loaded (a function, not an expression: the page's policy forbids eval)."""
@@ -167,7 +168,7 @@ def test_a_run_on_the_simulated_cell_shows_its_step_and_device_states_to_the_end
     expect(running).to_have_attribute("aria-current", "step")
     expect(page.locator("#run-states tr[data-device='gripper']")).to_have_class("busy")
     screenshot(page, "run-in-progress")
-    expect(page.locator("#run-status")).to_contain_text("succeeded", timeout=15_000)
+    expect(page.locator("#run-status")).to_contain_text("succeeded", timeout=WAIT * 1000)
     expect(page.locator("#run-states tr[data-device='robot'] .badge")).to_have_text("at_pose")
     expect(page.locator("#devices td.state[data-device='robot'] .badge")).to_have_text("at_pose")
     page.locator("#journal-box summary").click()
@@ -185,7 +186,7 @@ def test_a_device_unplugged_during_a_run_shows_the_fault_report(page: Page, serv
     expect(page.locator("#verdict .ok")).to_be_visible()
     page.get_by_role("button", name="Start run").click()
     expect(page.locator("#run-states tr[data-device='gripper'] .badge")).to_have_text("closing")
-    httpx.delete(f"{served.url}/api/cell/devices/gripper", headers=AUTH, timeout=10).raise_for_status()
+    httpx.delete(f"{served.url}/api/cell/devices/gripper", headers=AUTH, timeout=WAIT).raise_for_status()
     fault = page.locator("#fault")
     expect(fault).to_be_visible()
     expect(fault.locator(".fault-message")).to_contain_text("lost: ")

@@ -11,6 +11,7 @@ from playwright.sync_api import Locator, Page, expect
 
 from plugnproduce import service
 from tests.hmi.conftest import screenshot
+from tests.lines import WAIT
 
 CHART_SHOWN = "() => { const i = document.querySelector('#chart-img'); return i.complete && i.naturalWidth > 0; }"
 FITTED = "() => document.querySelector('#chart-frame').dataset.scale !== undefined"
@@ -25,7 +26,7 @@ def test_an_implausible_task_cannot_be_started_and_the_last_run_s_step_is_cleare
     expect(start).to_be_enabled()
     expect(page.locator("#run-start-why")).to_have_text("")
     start.click()
-    expect(page.locator("#run-status")).to_contain_text("succeeded", timeout=15_000)
+    expect(page.locator("#run-status")).to_contain_text("succeeded", timeout=WAIT * 1000)
     expect(page.locator("#run-step")).to_have_text("")  # a finished run has no current step
     page.locator("#import").set_input_files(str(service.builtin("tasks", "bin-picking-invalid.yaml")))
     expect(page.locator("#verdict .bad")).to_be_visible()

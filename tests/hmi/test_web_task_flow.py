@@ -13,8 +13,9 @@ from playwright.sync_api import Page, expect
 from plugnproduce import service
 from plugnproduce.sim.bin import SimulatedBin
 from tests.hmi.conftest import Served, screenshot
+from tests.lines import WAIT
 
-expect.set_options(timeout=30_000)  # a bound, not a speed: CI runs the suite on a fully loaded machine
+expect.set_options(timeout=WAIT * 1000)  # the suite's limit, not a speed: CI runs the suite on a loaded machine
 
 PARTS, SEED = 3, 7
 SHIPPED = service.builtin("tasks", "bin-picking-until-empty.yaml")

@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from plugnproduce import service
 from plugnproduce.sim.bin import SimulatedBin
 
@@ -67,3 +69,30 @@ def test_a_misspelt_library_outcome_is_refused_at_its_line(tmp_path: Path) -> No
     assert result.returncode == 1
     assert (f"{task}:19: step 1 (find-part): branch PartOcluded: PartOcluded is not an outcome of the ontology; "
             "did you mean PartOccluded") in result.stdout
+
+
+MOST_SPECIFIC = LIBRARY / "tasks" / "empty-or-not-found.yaml"
+HOME = [0.3, 0, 0.4, 0, 180, 0]
+"""The BinEmpty branch's pose (the NoPartFound branch's is the viewing pose [0.4, 0.1, 0.45, 0, 180, 0])."""
+
+
+@pytest.mark.parametrize(("parts", "outcome", "branch", "steps"), [
+    (0, "BinEmpty", "BinEmpty", [(1, "find-part"), (3, "move-to")]),
+    (1, "PartFound", "PartFound", [(1, "find-part"), (4, "pick"), (5, "place")]),
+])
+def test_an_outcome_takes_the_branch_of_the_most_specific_outcome_it_falls_under_not_the_first_written(
+        tmp_path: Path, parts: int, outcome: str, branch: str, steps: list[tuple[int, str]]) -> None:
+    """BinEmpty falls under NoPartFound, whose branch is written first (the library's PartOccluded takes it):
+    the empty bin takes the BinEmpty branch and the robot goes home, not to the viewing pose."""
+    assert pnp("check", str(MOST_SPECIFIC), "--cell", str(CELL)).returncode == 0
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(MOST_SPECIFIC), "--sim", "--bin-parts", str(parts), "--bin-seed", "5",
+                 "--journal", str(journal))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    records = [json.loads(line) for line in journal.read_text(encoding="utf-8").splitlines()]
+    assert [(r["outcome"], r["branch"]) for r in records if r["kind"] == "branch"] == [(outcome, branch)]
+    assert [(r["step"], r["command"]) for r in records if r["kind"] == "step"] == steps
+    moves = [r["params"]["TargetPose"] for r in records if r["kind"] == "command" and r["command"] == "MoveTo"]
+    if outcome == "BinEmpty":
+        assert moves == [HOME]
+    assert records[-1]["kind"] == "end" and records[-1]["outcome"] == "succeeded"

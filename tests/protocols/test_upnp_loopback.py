@@ -36,8 +36,7 @@ from plugnproduce.protocols.upnp import (
     discover,
     service_spec_from_chart_events,
 )
-
-WAIT = 5.0  # upper bound of any wait; a passing test takes milliseconds (SSDP answers up to 0.75 s)
+from tests.lines import WAIT
 
 CHART_SPEC = service_spec_from_chart_events({"MoveTo": ["Pose"], "Home": []}, ["arrived"])
 SPEC = ServiceSpec(
@@ -106,7 +105,7 @@ async def test_device_is_found_by_ssdp_search(network: SsdpNetwork, device: Upnp
 
 
 async def test_discover_reads_type_and_name_of_each_device(network: SsdpNetwork, device: UpnpDeviceServer) -> None:
-    found = await discover(1.0, network=network)
+    found = await discover(WAIT, network=network, expected=[device.udn])  # ends once the device has answered
     assert [(d.udn, d.device_type, d.friendly_name) for d in found.devices] == [
         (device.udn, "urn:plugnproduce-org:device:Robot:1", "Test robot")
     ]
@@ -115,7 +114,7 @@ async def test_discover_reads_type_and_name_of_each_device(network: SsdpNetwork,
 
 async def test_discover_ends_once_the_expected_devices_have_answered(network: SsdpNetwork,
                                                                     device: UpnpDeviceServer) -> None:
-    async with asyncio.timeout(WAIT):  # far shorter than the search window
+    async with asyncio.timeout(WAIT):  # the suite's limit, far shorter than the search window
         found = await discover(3600, network=network, expected=[device.udn])
     assert [d.udn for d in found.devices] == [device.udn]
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import uuid
+
 import pytest
 
 from plugnproduce.errors import DescriptionError, ProtocolError
@@ -66,9 +68,12 @@ def test_unusable_specs_are_refused_with_the_reason(build, expected: str) -> Non
 
 def test_device_type_and_udn() -> None:
     assert device_type_for("ParallelGripper") == "urn:plugnproduce-org:device:ParallelGripper:1"
-    assert udn_for("gripper") == udn_for("gripper")
+    # docs/upnp.md: `uuid:` + a name-based UUID (v5) of the device's IRI, so a restarted device keeps its UDN
+    for device in ("gripper", "robot"):
+        named = uuid.uuid5(uuid.NAMESPACE_URL, f"http://plugnproduce.org/devices/{device}")
+        assert udn_for(device) == f"uuid:{named}"
+        assert uuid.UUID(udn_for(device).removeprefix("uuid:")).version == 5
     assert udn_for("gripper") != udn_for("robot")
-    assert udn_for("gripper").startswith("uuid:")
 
 
 def test_url_on_the_discovered_host_is_trusted() -> None:

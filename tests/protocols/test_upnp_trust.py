@@ -33,6 +33,7 @@ from plugnproduce.protocols.upnp.boundary import (
 )
 from plugnproduce.protocols.upnp.client import UpnpDeviceClient, load_device
 from plugnproduce.protocols.upnp.discovery import FoundDevice, SearchHit, describe
+from tests.lines import WAIT
 from tests.protocols.test_upnp_loopback import FILES, SPEC, Recorder, free_udp_port
 
 
@@ -142,7 +143,7 @@ class Silent(UpnpRequester):
 
 async def test_reading_a_description_is_bounded_even_when_the_requester_is_not() -> None:
     requester = TrustedRequester(Silent(), "127.0.0.1", "device x")
-    async with asyncio.timeout(10.0):  # the test's own guard against a reading that never ends
+    async with asyncio.timeout(WAIT):  # the test's own guard against a reading that never ends
         with pytest.raises(ProtocolTimeout, match="^reading the description of device x: no answer in time"):
             await load_device("http://127.0.0.1:1/d.xml", requester, "device x", 0.05)
 

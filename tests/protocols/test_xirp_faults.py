@@ -19,8 +19,8 @@ from plugnproduce.protocols.xirp import (
     XirpClient,
     XirpServer,
 )
+from tests.lines import WAIT
 
-WAIT = 5.0
 HOST = "127.0.0.1"
 SHORT = 0.1  # a time-out the tests expect to run out
 

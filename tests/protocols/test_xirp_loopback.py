@@ -29,8 +29,8 @@ from plugnproduce.protocols.xirp import (
     XirpClient,
     XirpServer,
 )
+from tests.lines import WAIT
 
-WAIT = 5.0  # upper bound of any wait; a passing test takes milliseconds
 HOST = "127.0.0.1"
 GRIPPER = "http://plugnproduce.org/ontology#ParallelGripper"
 FILES = DeviceFiles(

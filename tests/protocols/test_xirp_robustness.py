@@ -30,8 +30,8 @@ from plugnproduce.protocols.xirp import (
     encode_frame,
     frame,
 )
+from tests.lines import WAIT
 
-WAIT = 5.0  # upper bound of any wait; a passing test takes milliseconds
 HOST = "127.0.0.1"
 ROBOT = "http://plugnproduce.org/ontology#Robot"
 

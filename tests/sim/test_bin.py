@@ -15,8 +15,7 @@ from plugnproduce.executor.links import open_link
 from plugnproduce.protocols import upnp
 from plugnproduce.sim.bin import BinError, SimulatedBin
 from plugnproduce.sim.device import SimulatedDevice
-
-WAIT = 5.0
+from tests.lines import WAIT
 
 
 def device(name: str) -> DeviceDescription:

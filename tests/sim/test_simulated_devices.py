@@ -10,8 +10,7 @@ from plugnproduce.errors import ProtocolError, ProtocolTimeout
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.sim.cell import FaultSpecError, SimulatedCell, parse_faults
 from plugnproduce.sim.device import SimulatedDevice
-
-WAIT = 5.0
+from tests.lines import WAIT
 
 
 def device(name: str):

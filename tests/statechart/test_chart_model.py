@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from plugnproduce.statechart import Chart, Final, State, concept, read_chart
+from plugnproduce.statechart import Chart, Final, State, concept, parse_chart, read_chart, write_chart
 from plugnproduce.statechart.model import CONCEPT, Send, Transition, walk
 
 DATA = Path(__file__).parent / "data"
@@ -59,6 +59,14 @@ def test_transition_splits_event_descriptors() -> None:
     assert Transition(targets=["x"]).events == []
 
 
-def test_a_chart_built_in_code_has_no_lines() -> None:
+def test_a_chart_built_in_code_has_no_lines_and_its_written_text_read_back_has_each_states_line() -> None:
+    """Findings on a chart name a line only where one exists: none in code, the written text's once read."""
     chart = Chart(name="built", initial=["a"], children=[State(id="a"), Final(id="done")])
     assert [s.line for s in chart.states()] == [None, None]
+    text = write_chart(chart)
+    again = parse_chart(text, "built.scxml")
+    lines = text.decode().splitlines()
+    where = {s.id: next(n for n, line in enumerate(lines, start=1) if f'id="{s.id}"' in line) for s in chart.states()}
+    assert [(s.id, s.line) for s in again.states()] == [("a", where["a"]), ("done", where["done"])]
+    assert where["a"] != where["done"]
+    assert again == chart  # lines do not take part in comparing nodes

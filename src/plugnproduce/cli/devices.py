@@ -47,19 +47,23 @@ def discover(
     json_out: bool = JSON_OPTION,
     watch: bool = typer.Option(False, "--watch", help="Keep watching: stream plug and unplug events."),
     timeout: float = typer.Option(2.0, metavar="SECONDS", help="Seconds to search for devices."),
+    expect: list[str] = typer.Option([], "--expect", metavar="DEVICE",
+                                     help="A device id to wait for (repeatable): the search ends as soon as every "
+                                          "expected device has answered, at the latest after --timeout."),
 ) -> None:
     """List the devices found on the network (SSDP on loopback), with class and skills."""
     try:
-        asyncio.run(_discover(json_out, watch, timeout))
+        asyncio.run(_discover(json_out, watch, timeout, tuple(expect)))
     except KeyboardInterrupt:
         pass
 
 
-async def _discover(json_out: bool, watch: bool, timeout: float) -> None:
+async def _discover(json_out: bool, watch: bool, timeout: float, expect: tuple[str, ...] = ()) -> None:
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env
 
-    async with LiveCell(knowledge().taxonomy, network=network_from_env(), search_timeout=timeout) as live:
+    async with LiveCell(knowledge().taxonomy, network=network_from_env(), search_timeout=timeout,
+                        expected=expect) as live:
         cell = live.cell
         if json_out and watch:  # one JSON object per line from the first on
             typer.echo(json.dumps({"devices": _device_json(cell), "offered": _offered(cell)}))

@@ -26,6 +26,7 @@ from plugnproduce.codegen.specific import (
     specific_region,
 )
 from plugnproduce.description.model import Cell, ChartTransition, Command, Link, ProcessDescription, Step, Task
+from plugnproduce.description.paths import NoPath
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
@@ -49,7 +50,7 @@ DONE, FAILED = "done", "failed"
 NEXT = "next_step"
 """The state that picks the next step's chart from the plan."""
 __all__ = ["DONE", "FAILED", "NEXT", "PLAN", "STEP", "VALUES", "GeneratedTask", "ImplausibleStep", "StepChart",
-           "generate_task", "specific_name", "step_values", "values_data"]
+           "StuckStep", "generate_task", "specific_name", "step_values", "values_data"]
 
 
 class ImplausibleStep(PlugNProduceError):
@@ -59,6 +60,18 @@ class ImplausibleStep(PlugNProduceError):
         self.step, self.device, self.state, self.needed = step, device, state, needed
         super().__init__(f"step {step.index} ({step.command}): device {device} is in state '{state}', "
                          f"but the step needs {local_name(needed)}")
+
+
+class StuckStep(ImplausibleStep):
+    """A step's device is in a state its role may start from, but its chart has no path from there through
+    the states the role's region visits."""
+
+    def __init__(self, step: Step, device: str, role: str, state: str, why: NoPath):
+        self.step, self.device, self.state, self.needed = step, device, state, why.concept
+        PlugNProduceError.__init__(
+            self, f"step {step.index} ({step.command}): device '{device}' (role '{role}') starts in state "
+                  f"'{state}', but its state chart has no path from there through the states the role's region "
+                  f"visits (none to a state of concept {local_name(why.concept)})")
 
 
 @dataclass
@@ -281,7 +294,10 @@ def _step(
         concept = device.state(state).concept
         if concept is None or not taxonomy.is_a(concept, role.start_concept):
             raise ImplausibleStep(step, device.id, state, role.start_concept)
-        region = specific_region(step.index, process, role, device, state, values, ids, taxonomy)
+        try:
+            region = specific_region(step.index, process, role, device, state, values, ids, taxonomy)
+        except NoPath as exc:
+            raise StuckStep(step, device.id, role.name, state, exc) from exc
         _add_timeouts(region)
         _keep_outputs(step, region, [(o, v) for r, o, v in produces if r == role.name])
         current[device.id] = region.end_state

@@ -97,7 +97,7 @@ class UpnpLink:
         return cls(device.id, client)
 
     async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:
-        await self._client.invoke(name, {k: _lexical(v) for k, v in params.items()}, timeout=timeout)
+        await self._client.invoke(name, {k: upnp.lexical(v) for k, v in params.items()}, timeout=timeout)
 
     async def state(self, timeout: float) -> str:
         results = await self._client.invoke(upnp.STATE_ACTION, {}, timeout=timeout)
@@ -110,11 +110,6 @@ class UpnpLink:
         await self._client.close()
 
 
-def _lexical(value: Any) -> str:
-    """A parameter value in its lexical form, as the chart-derived actions take it (``"x y z rx ry rz"``)."""
-    if isinstance(value, list | tuple):
-        return " ".join(str(v) for v in value)
-    return str(value)
 
 
 async def query_state(device: DeviceDescription, timeout: float) -> str:

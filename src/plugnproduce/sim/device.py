@@ -184,11 +184,27 @@ class SimulatedDevice:
     async def _on_upnp_action(self, action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
         if action == upnp.STATE_ACTION:
             return {upnp.STATE_ARGUMENT: self.state}
+        values = self._upnp_values(action, arguments)
         try:
-            self._accept(action, arguments)
+            self._accept(action, values)
         except LookupError as exc:
             raise upnp.ActionFailed(str(exc), upnp.NOT_ACCEPTED_NOW) from None
         return {"Result": "accepted"}
+
+    def _upnp_values(self, action: str, arguments: Mapping[str, Any]) -> dict[str, Any]:
+        """The action's arguments read as strictly as their datatypes say (a pose joined with commas is refused)."""
+        d = self.description
+        quantities = {local_name(q): q for t in (*d.transitions, *d.stops)
+                      if t.request is not None and t.request.name == action for q in t.accepts}
+        values: dict[str, Any] = {}
+        for name, text in arguments.items():
+            datatype = local_name(d.argument(action, quantities[name]).datatype) if name in quantities else ""
+            try:
+                values[name] = upnp.parse_lexical(text, datatype) if isinstance(text, str) else text
+            except ValueError as exc:
+                raise upnp.ActionFailed(f"device {self.id}: {action} argument {name}: {exc}",
+                                        upnp.ARGUMENT_VALUE_INVALID) from None
+        return values
 
     # --- events out (the chart's I/O processor) ------------------------------------------
 

@@ -21,7 +21,13 @@ from plugnproduce.protocols.upnp.boundary import (
     private_network,
 )
 from plugnproduce.protocols.upnp.client import UpnpDeviceClient, VariableChange
-from plugnproduce.protocols.upnp.device import NOT_ACCEPTED_NOW, ActionFailed, ActionHandler, UpnpDeviceServer
+from plugnproduce.protocols.upnp.device import (
+    ARGUMENT_VALUE_INVALID,
+    NOT_ACCEPTED_NOW,
+    ActionFailed,
+    ActionHandler,
+    UpnpDeviceServer,
+)
 from plugnproduce.protocols.upnp.discovery import (
     Advertisement,
     AdvertisementListener,
@@ -52,8 +58,10 @@ from plugnproduce.protocols.upnp.spec import (
     udn_for,
     with_state_query,
 )
+from plugnproduce.protocols.upnp.values import lexical, parse_lexical
 
 __all__ = [
+    "ARGUMENT_VALUE_INVALID",
     "EVENT_PREFIX",
     "LOOPBACK",
     "NOT_ACCEPTED_NOW",
@@ -84,6 +92,8 @@ __all__ = [
     "describe",
     "device_type_for",
     "is_payload_variable",
+    "lexical",
+    "parse_lexical",
     "payload_of",
     "payload_variable",
     "discover",

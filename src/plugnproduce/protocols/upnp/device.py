@@ -90,6 +90,8 @@ class ActionFailed(Exception):
 
 NOT_ACCEPTED_NOW = 701
 """UPnP error code: the request is not accepted in the device's current state."""
+ARGUMENT_VALUE_INVALID = 600
+"""UPnP error code (Argument Value Invalid): an argument is not its datatype's lexical form."""
 DESCRIPTION_CHARS = 200
 """Most characters of a refusal's message sent as its UPnP error description."""
 
