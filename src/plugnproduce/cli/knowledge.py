@@ -15,7 +15,10 @@ from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, kn
 @boundary
 def vocab(json_out: bool = JSON_OPTION) -> None:
     """List the terms of the loaded knowledge (built-in and libraries): device classes with the skills
-    they imply, skills with their mandatory states, state concepts, quantities and processes."""
+    they imply, skills with their mandatory states, state concepts, quantities and processes.
+
+    Exit 0 listed, 2 bad input (a library that cannot be read).
+    """
     from plugnproduce.knowledge.vocab import vocabulary, vocabulary_text
 
     words = vocabulary(knowledge())
@@ -29,9 +32,11 @@ def vocab(json_out: bool = JSON_OPTION) -> None:
 @app.command()
 @boundary
 def impact(
-    extensions: list[Path] = typer.Argument(..., help="Turtle TBox files to try on top of the loaded knowledge."),
-    cells: list[Path] = typer.Option([], "--cells", help="Folders (or files) of cells to compare (repeatable; "
-                                     "default: every cell of the loaded libraries)."),
+    extensions: list[Path] = typer.Argument(..., metavar="EXTENSION.ttl...",
+                                            help="Turtle TBox files to try on top of the loaded knowledge."),
+    cells: list[Path] = typer.Option([], "--cells", metavar="DIR",
+                                     help="Folders (or files) of cells to compare (repeatable; "
+                                          "default: every cell of the loaded libraries)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """What a TBox edit does: offered commands per cell, catalogue roles and library tasks, before and after.
