@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import os
 import re
 import socket
 import subprocess
@@ -105,6 +106,20 @@ def test_sim_plug_refuses_the_control_address_of_a_stopped_cell(tmp_path: Path,
                                          "--control HOST:PORT")
         with pytest.raises(TimeoutError):
             listener.accept()  # nothing was sent to it
+
+
+def test_sim_plug_says_how_to_go_on_when_the_recorded_cell_does_not_answer(tmp_path: Path,
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("HOME", str(tmp_path))
+    with socket.create_server(("127.0.0.1", 0)) as gone:
+        port = gone.getsockname()[1]  # closed when the block ends: nothing listens there
+    state = tmp_path / ".cache" / "plugnproduce" / "sim-control.json"
+    state.parent.mkdir(parents=True)
+    state.write_text(json.dumps({"host": "127.0.0.1", "port": port, "pid": os.getpid()}))
+    result = runner.invoke(app, ["sim", "plug", "gripper"])
+    assert result.exit_code == 2
+    assert result.stderr.strip() == (f"error: simulated cell at 127.0.0.1:{port} does not answer; start a cell with "
+                                     "'pnp sim up CELL', or name one with --control HOST:PORT")
 
 
 def test_plugging_a_library_device_into_a_cell_without_its_library_hints_library() -> None:

@@ -129,8 +129,9 @@ def _control(op: str, device: str, control_address: str | None) -> None:
     address = _address(control_address)
     try:
         devices = asyncio.run(control.request(address, op, device))
-    except ProtocolConnectionError as exc:  # the address recorded by the cell started last: it has stopped
-        fail(f"error: {control.stopped(*address) if control_address is None else exc}")
+    except ProtocolConnectionError as exc:  # the address the cell started last recorded: it may have stopped
+        hint = "" if control_address else "; start a cell with 'pnp sim up CELL', or name one with --control HOST:PORT"
+        fail(f"error: {exc}{hint}")
     except ProtocolError as exc:
         fail(f"error: {exc}")
     typer.echo(f"{op}ged {device}; running: {', '.join(devices)}")
