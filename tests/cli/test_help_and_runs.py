@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 from plugnproduce import __version__
 from plugnproduce.cli import app
+from plugnproduce.cli.helptext import argument_name
 from plugnproduce.executor.journal import Journal
 
 runner = CliRunner()
@@ -20,10 +21,9 @@ runner = CliRunner()
 
 def commands(group: click.Group, path: tuple[str, ...] = ()) -> Iterator[tuple[tuple[str, ...], click.Command]]:
     """Every command under ``group`` (sub-groups included), with its name path."""
-    for name, command in group.commands.items():
+    for name, command in getattr(group, "commands", {}).items():  # typer's groups are not click.Group
         yield (*path, name), command
-        if isinstance(command, click.Group):
-            yield from commands(command, (*path, name))
+        yield from commands(command, (*path, name))
 
 
 ALL = list(commands(typer.main.get_command(app)))  # type: ignore[arg-type]
@@ -43,10 +43,9 @@ def test_help_shows_no_type_after_flags(path: tuple[str, ...]) -> None:
 
 @pytest.mark.parametrize(("path", "command"), ALL, ids=[" ".join(p) for p, _ in ALL])
 def test_arguments_are_named_in_capitals(path: tuple[str, ...], command: click.Command) -> None:
-    ctx = click.Context(command, info_name=path[-1])
     for param in command.params:
-        if isinstance(param, click.Argument):
-            assert param.make_metavar(ctx).strip("{}[].").isupper(), f"{' '.join(path)}: {param.name}"
+        if param.param_type_name == "argument":  # typer's parameters are not click.Argument
+            assert argument_name(param).split(".")[0].isupper(), f"{' '.join(path)}: {param.name}"
 
 
 def journal(folder: Path, name: str, start: float, outcome: str | None) -> None:

@@ -68,7 +68,7 @@ def test_a_misspelt_library_outcome_is_refused_at_its_line(tmp_path: Path) -> No
     result = pnp("check", str(task), "--cell", str(CELL))
     assert result.returncode == 1
     assert (f"{task}:19: step 1 (find-part): branch PartOcluded: PartOcluded is not an outcome of the ontology; "
-            "did you mean PartOccluded") in result.stdout
+            "did you mean http://example.org/part-finding#PartOccluded") in result.stdout
 
 
 MOST_SPECIFIC = LIBRARY / "tasks" / "empty-or-not-found.yaml"

@@ -68,7 +68,8 @@ def test_unplugging_the_gripper_removes_pick_and_plugging_brings_it_back(
         while "pick" not in seen["offered"]:  # on a busy machine a device may answer after the first search
             seen = json.loads(lines.next())
             assert seen["change"] == "plug", seen
-        control = ["--control", ":".join(map(str, json.loads(simulated_cell.read_text()).values()))]
+        state = json.loads(simulated_cell.read_text())
+        control = ["--control", f"{state['host']}:{state['port']}"]
         subprocess.run(command("sim", "unplug", "gripper", *control), env=env, check=True, timeout=60,
                        capture_output=True)
         change = json.loads(lines.next())

@@ -38,8 +38,8 @@ def test_a_misspelt_device_class_is_named_at_its_line(device_copy) -> None:
     edit(ttl, "a pnp:ParallelGripper", "a pnp:ParalelGripper")
     messages = _messages(ttl)
     assert messages == [f"{ttl}:6: gripper is of unknown class ParalelGripper "
-                        "(http://plugnproduce.org/ontology#ParalelGripper); did you mean ParallelGripper or Gripper "
-                        "or MagneticGripper?"]
+                        "(http://plugnproduce.org/ontology#ParalelGripper); did you mean pnp:ParallelGripper or pnp:Gripper "
+                        "or pnp:MagneticGripper?"]
 
 
 def test_issue_18_a_misspelt_device_class_in_a_cell_is_not_found_0(device_copy, tmp_path: Path) -> None:
@@ -57,7 +57,7 @@ def test_a_misspelt_required_skill_is_a_finding(process_copy) -> None:
     ttl, _ = process_copy("pick")
     edit(ttl, "pnp:requiresSkill pnp:CanGrip", "pnp:requiresSkill pnp:CanGirp")
     found = [m for m in _messages(ttl) if "CanGirp" in m]
-    assert found and "requiresSkill: unknown skill CanGirp" in found[0] and "did you mean CanGrip" in found[0]
+    assert found and "requiresSkill: unknown skill CanGirp" in found[0] and "did you mean pnp:CanGrip" in found[0]
 
 
 def test_a_misspelt_parameter_quantity_is_a_finding(process_copy) -> None:
@@ -103,3 +103,51 @@ def test_a_misspelt_process_command_in_a_task_suggests_the_nearest(tmp_path: Pat
     result = runner.invoke(app, ["check", str(task), "--cell", str(Path(__file__).parents[2] / "descriptions" /
                                                                  "cells" / "bin-picking.yaml")])
     assert "unknown process command 'pik'; did you mean pick?" in result.stdout
+
+
+GLUE = Path(__file__).parent.parent / "data" / "libraries" / "glue-dispensing"
+
+
+def _glue_copy(tmp_path: Path) -> Path:
+    library = tmp_path / "glue"
+    for f in GLUE.rglob("*"):
+        if f.is_file():
+            (library / f.relative_to(GLUE)).parent.mkdir(parents=True, exist_ok=True)
+            (library / f.relative_to(GLUE)).write_bytes(f.read_bytes())
+    return library
+
+
+def test_issue_29_a_library_concept_is_suggested_in_the_form_a_chart_takes(tmp_path: Path) -> None:
+    library = _glue_copy(tmp_path)
+    edit(library / "devices" / "dispenser.scxml", 'pnp:concept="http://example.org/glue#Dispensing"',
+         'pnp:concept="gl:Dispensing"')
+    edit(library / "processes" / "lay-bead.scxml", 'pnp:concept="http://example.org/glue#BeadLaid"',
+         'pnp:concept="http://example.org/glue#BeadLayed"')
+    messages = _messages(library)
+    assert (f"{library}/devices/dispenser.scxml:8: pnp:concept: unknown state concept gl:Dispensing (gl:Dispensing); "
+            "a chart does not expand prefixed names: write the full IRI; did you mean "
+            "http://example.org/glue#Dispensing or Opening?") in messages
+    assert (f"{library}/processes/lay-bead.scxml:9: state 'dispenser_laid' is annotated with BeadLayed, which is "
+            "not a state concept of the ontology; did you mean http://example.org/glue#BeadLaid?") in messages
+
+
+def test_issue_29_a_misspelt_library_quantity_in_turtle_is_suggested_by_its_prefixed_name(tmp_path: Path) -> None:
+    library = _glue_copy(tmp_path)
+    edit(library / "processes" / "lay-bead.ttl", "pnp:quantity gl:BeadLength", "pnp:quantity gl:BeadLenght")
+    found = [m for m in _messages(library) if "BeadLenght" in m]
+    assert found and found[0].endswith("did you mean gl:BeadLength?")
+
+
+def test_issue_29_validate_prints_each_finding_once_from_a_relative_path(tmp_path: Path, monkeypatch) -> None:
+    library = _glue_copy(tmp_path)
+    edit(library / "devices" / "dispenser.scxml", 'pnp:concept="http://example.org/glue#Dispensing"',
+         'pnp:concept="gl:Dispensing"')
+    edit(library / "processes" / "lay-bead.scxml", 'pnp:concept="http://example.org/glue#BeadLaid"',
+         'pnp:concept="BeadLayed"')
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["validate", "glue"])
+    assert result.exit_code == 1
+    lines = result.stdout.splitlines()
+    assert all(line.startswith("glue/") for line in lines), lines
+    assert [line.split(": ")[0] for line in lines] == [
+        "glue/devices/dispenser.scxml:8", "glue/processes/lay-bead.scxml:9", "glue/processes/lay-bead.ttl:14"]

@@ -13,12 +13,13 @@ from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 import typer
 
+from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 
 if TYPE_CHECKING:  # the knowledge is loaded by the commands that need it
     from plugnproduce.knowledge import Knowledge
 
-app = typer.Typer(
+app = PlainTyper(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,

@@ -19,7 +19,10 @@ def draw(
                                     help="Of a task or closed-world chart, the step to draw with its regions."),
 ) -> None:
     """Draw a state chart: regions as clusters, commands on the edges; a task's steps in order,
-    each one box with its process and binding."""
+    each one box with its process and binding.
+
+    Exit 0 drawn, 2 bad input (an unreadable chart, an unknown picture format).
+    """
     from plugnproduce.drawing import draw_chart
 
     typer.echo(f"wrote {draw_chart(chart, output, expand=step)}")

@@ -24,8 +24,8 @@ def refuse(exc: service.ImplausibleTask, consequence: str, json_out: bool) -> No
         emit_json(exc.result.to_json())
     else:
         typer.echo(f"task {exc.result.task} is not plausible in cell {exc.result.cell}; {consequence}", err=True)
-        for p in exc.result.problems:
-            typer.echo(str(p), err=True)
+        for p in exc.result.problems:  # in the words of pnp check
+            typer.echo(f"{p.where}: {p.reason.plain}", err=True)
     raise typer.Exit(1) from None
 
 

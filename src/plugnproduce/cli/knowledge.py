@@ -24,7 +24,10 @@ def vocab(json_out: bool = JSON_OPTION,
                                     "line. With --json: nested nodes of names and children.")) -> None:
     """List the terms of the loaded knowledge (built-in and libraries): the roots a library's terms subclass,
     device classes with the skills they imply, skills with their mandatory states, state concepts,
-    quantities, outcomes and processes; equivalent classes are marked "equivalent"."""
+    quantities, outcomes and processes; equivalent classes are marked "equivalent".
+
+    Exit 0 listed, 2 bad input (a library that cannot be read).
+    """
     from plugnproduce.knowledge.vocab import taxonomy_tree, vocabulary, vocabulary_text, vocabulary_tree
 
     if tree and json_out:
@@ -45,10 +48,12 @@ def vocab(json_out: bool = JSON_OPTION,
 @app.command()
 @boundary
 def impact(
-    extensions: list[Path] = typer.Argument(..., help="TBox files (Turtle, RDF/XML, OWL/XML) to try on top of "
-                                            "the loaded knowledge."),
-    cells: list[Path] = typer.Option([], "--cells", help="Folders (or files) of cells to compare (repeatable; "
-                                     "default: every cell of the loaded libraries)."),
+    extensions: list[Path] = typer.Argument(..., metavar="EXTENSION...",
+                                            help="TBox files (Turtle, RDF/XML, OWL/XML) to try on top of "
+                                                 "the loaded knowledge."),
+    cells: list[Path] = typer.Option([], "--cells", metavar="DIR",
+                                     help="Folders (or files) of cells to compare (repeatable; "
+                                          "default: every cell of the loaded libraries)."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """What a TBox edit does: offered commands per cell, catalogue roles, library tasks and the validation

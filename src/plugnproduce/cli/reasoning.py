@@ -64,6 +64,8 @@ def capabilities(cell: Path = CELL_OPTION, verbose: bool = VERBOSE_OPTION, json_
 
     Each offered command shows one valid role binding and how many there are (every one with
     --all-bindings); with --json also the devices that can fill each role.
+
+    Exit 0 answered (whatever is offered), 2 bad input.
     """
     caps = service.capabilities(cell, knowledge(cell), all_bindings)
     if json_out:
@@ -95,7 +97,8 @@ def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (
           verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Check that a task is plausible: each step finds its devices in the states it starts from.
 
-    Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state).
+    Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state),
+    2 bad input.
     """
     result = service.check(task, _cell(cell, live, discovery_timeout), knowledge(cell))
     if json_out:
@@ -124,7 +127,7 @@ def repair(
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
 
     A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
-    Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
+    Exit 0 when the task is plausible or repairs were found, 1 when no repair exists, 2 bad input.
     """
     the_cell = _cell(cell, live, discovery_timeout)
     result = service.check(task, the_cell, knowledge(cell))
@@ -189,7 +192,13 @@ def explain(
 ) -> None:
     """Why a process command is (not) offered, or why a task's step is (not) plausible: a derivation through the
     rules, the ontology and the state charts, printed as sentences (deepest cause last), and the changes the
-    reasoner confirms would turn the answer around. Exit 1 when the answer is no."""
+    reasoner confirms would turn the answer around.
+
+    Exit 0 when the answer is yes, 1 when it is no, 2 bad input.
+    """
+    if step is None and (Path(target).suffix in {".yaml", ".yml"} or Path(target).is_file()):
+        fail(f"{target} is a task file: name the step to explain, pnp explain {target} --cell {cell} --step N "
+             "(without --step, TARGET is a process command such as pick)")
     if step is None:
         ex = service.explain_process(cell, target, knowledge(cell))
         why = service.explain_offered(cell, target, knowledge(cell), catalogue, language)
@@ -227,6 +236,8 @@ is plausible; otherwise {"options": [{"add": [DEVICE, ...], "cost": N}, ...]}, t
 sets of catalogue devices (pnp:cost; ties: fewer devices) whose addition makes every task
 plausible, or {"options": [], "impossible": "why"} when no set from the catalogue does.
 A .csv output file gets the same columns as CSV.
+
+Exit 0 answered (whatever is feasible), 2 bad input.
 """
 
 

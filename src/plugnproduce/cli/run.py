@@ -94,7 +94,10 @@ def run(
 def report(run_id: str | None = typer.Argument(None, metavar="RUN", help="A run id or a journal file "
                                                "(default: the latest run; 'pnp runs' lists them)."),
            json_out: bool = JSON_OPTION) -> None:
-    """Print a run from its journal: every step, command, event and state, and how it ended (or that it crashed)."""
+    """Print a run from its journal: every step, command, event and state, and how it ended (or that it crashed).
+
+    Exit 0 printed (however the run ended), 2 no such run or an unreadable journal.
+    """
     record = service.report(run_id)
     if json_out:
         emit_json({"journal": str(record.path), "status": record.status, "safe_stop": record.safe_stop,

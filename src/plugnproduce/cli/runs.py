@@ -25,6 +25,8 @@ def runs(json_out: bool = JSON_OPTION) -> None:
     """List the past runs (in PNP_RUNS), newest first: id, task, cell, start, status and duration.
 
     A run without an end is shown as crashed (or it is still running). 'pnp report RUN' prints one.
+
+    Exit 0 listed (none too), 2 an unreadable runs folder.
     """
     past = service.runs()
     if json_out:

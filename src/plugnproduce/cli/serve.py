@@ -90,6 +90,8 @@ def serve(
     """Serve the Generic HMI: the live cell, offered commands, task editor, check/repair, runs.
 
     Prints the page's URL and the bearer token that requests changing the cell or a run need.
+
+    Exit 0 stopped by Ctrl-C or SIGTERM, 2 bad input (options, a cell, a port it cannot listen on).
     """
     import uvicorn
 

@@ -38,7 +38,7 @@ from plugnproduce.description.taskfile import parse_task as parse_task
 from plugnproduce.description.taskfile import task_to_yaml as task_to_yaml
 from plugnproduce.description.units import unit_known
 from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
-from plugnproduce.ontology.names import unknown_class
+from plugnproduce.ontology.names import turtle_spelling, unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.safeio import (
@@ -133,10 +133,12 @@ def device_subject(loaded: Loaded, taxonomy: Taxonomy) -> rdflib.URIRef:
 
 def _unknown_device_class(loaded: Loaded, taxonomy: Taxonomy) -> None:
     """A would-be device (it has a state chart) whose class is unknown: say so at its line."""
+    spell = turtle_spelling(loaded.graph.namespace_manager)
     for s in sorted(set(loaded.graph.subjects(PNP.stateChart)), key=str):
         for c in sorted(loaded.graph.objects(s, RDF.type), key=str):
             if not taxonomy.knows(str(c)):
-                raise DescriptionError(unknown_class(str(s), str(c), taxonomy), loaded.path, loaded.line(str(s)))
+                raise DescriptionError(unknown_class(str(s), str(c), taxonomy, spell), loaded.path,
+                                       loaded.line(str(s)))
 
 
 def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes] | None = None) -> DeviceDescription:

@@ -11,6 +11,7 @@ import dataclasses
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import yaml
 
@@ -293,5 +294,23 @@ def task_to_yaml(task: Task, block: bool = False) -> str:
     if task.repeat != 1:
         doc["repeat"] = task.repeat
     doc["steps"] = task_entries(task)
-    return yaml.dump(doc, Dumper=PlainDumper, sort_keys=False, default_flow_style=False if block else None,
+    return yaml.dump(doc, Dumper=PlainDumper if block else TaskDumper, sort_keys=False, default_flow_style=False,
                      allow_unicode=True)
+
+
+class TaskDumper(PlainDumper):
+    """One style for every step: mappings in block style, a list in flow style only when it holds plain
+    values alone (a pose, ``[0.4, 0.1, 0.2, 0, 180, 0]``)."""
+
+
+def _block_mapping(dumper: yaml.SafeDumper, data: dict[Any, Any]) -> yaml.Node:
+    return dumper.represent_mapping("tag:yaml.org,2002:map", data, flow_style=False)
+
+
+def _sequence(dumper: yaml.SafeDumper, data: list[Any]) -> yaml.Node:
+    plain = all(not isinstance(v, (dict, list)) for v in data)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=plain)
+
+
+TaskDumper.add_representer(dict, _block_mapping)
+TaskDumper.add_representer(list, _sequence)

@@ -16,6 +16,9 @@ from plugnproduce.resources import rules_path
 KINDS = ("answer", "owl", "asp", "chart", "task")
 """Kinds of node: the answer itself, and the three kinds of evidence (plus a step of the task)."""
 
+SOURCE_WORDS = {"answer": "finding", "owl": "ontology", "asp": "rule", "chart": "device chart", "task": "task"}
+"""What a node rests on, in plain words, by kind (a process's chart says so itself: ``source``)."""
+
 
 @dataclass(frozen=True)
 class Node:
@@ -30,10 +33,17 @@ class Node:
     inferred: bool = False
     """OWL: whether the reasoner inferred the fact (no single asserted axiom states it)."""
     children: tuple[Node, ...] = field(default=())
+    source: str = ""
+    """What the node rests on in plain words ("process chart"); default: by kind (:data:`SOURCE_WORDS`)."""
+    fails: bool = False
+    """The node is a reason the answer is no: the failing branch, not a fact that holds."""
 
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict (nested)."""
-        out: dict[str, object] = {"kind": self.kind, "text": self.text}
+        out: dict[str, object] = {"kind": self.kind, "source": self.source or SOURCE_WORDS.get(self.kind, self.kind),
+                                  "text": self.text}
+        if self.fails:
+            out["fails"] = True
         if self.detail:
             out["detail"] = self.detail
         if self.where is not None:
@@ -108,7 +118,8 @@ def rule(file: str, head: str, nth: int = 0) -> Rule:
 
 
 def asp(file: str, head: str, text: str, values: dict[str, object], children: tuple[Node, ...] = (),
-        nth: int = 0) -> Node:
-    """An ASP evidence node: the rule instance of ``head`` in ``file`` that derives the fact ``text`` states."""
+        nth: int = 0, fails: bool = False) -> Node:
+    """An ASP evidence node: the rule instance of ``head`` in ``file`` that derives the fact ``text`` states
+    (``fails``: a reason the answer is no)."""
     r = rule(file, head, nth)
-    return Node("asp", text, r.instance(values), r.where(), children=children)
+    return Node("asp", text, r.instance(values), r.where(), children=children, fails=fails)

@@ -24,6 +24,9 @@ from plugnproduce.reasoning.results import CheckResult
 from plugnproduce.reasoning.schema.derivations import Walk
 from plugnproduce.reasoning.terms import Model
 
+PROCESS_CHART = "process chart"
+"""What a node of a General Process State Chart rests on, in plain words."""
+
 DERIVATION = solver.rules("derivation")
 
 
@@ -144,7 +147,7 @@ def walk_node(w: Words, model: Model, p: str, r: str, d: str) -> Node:
         concept = w.concept(d, x)
         below = [Node("chart", f"the process's state chart has role '{r}' in '{w.label(rs.concept)}' "
                                f"(state {i} of its region)", f"{proc.chart_file} state {rs.id}",
-                      Where(proc.chart_file, rs.line))]
+                      Where(proc.chart_file, rs.line), source=PROCESS_CHART)]
         below += subsumed(w, concept, rs.concept) if concept else []
         if i > 1:
             path = _path(dev, seq[i - 2], x) or []
@@ -223,7 +226,8 @@ def not_offered_tree(w: Words, model: Model, p: str) -> Node:
                                                         f"no state that is '{w.label(b.con)}'",
                            {"C": CELL, "P": p, "R": b.r, "D": b.d, "I": b.i, "K": b.con},
                            (Node("chart", f"role '{b.r}' goes through '{w.label(b.con)}'",
-                                 f"{proc.chart_file} state {rs.id}", Where(proc.chart_file, rs.line)),
+                                 f"{proc.chart_file} state {rs.id}", Where(proc.chart_file, rs.line),
+                                 source=PROCESS_CHART),
                             Node("chart", f"device '{b.d}' has the states {states}", dev.chart_file,
                                  Where(dev.chart_file)))))
     for c in sorted(model[s.Unreachable], key=lambda a: (a.r, a.d, a.i, a.x)):
@@ -235,11 +239,13 @@ def not_offered_tree(w: Words, model: Model, p: str) -> Node:
                                                         f"goes next", {"C": CELL, "P": p, "R": c.r, "D": c.d,
                                                                       "I": c.i, "X": c.x, "K": c.con},
                            (Node("chart", f"role '{c.r}' goes to '{w.label(c.con)}' next",
-                                 f"{proc.chart_file} state {rs.id}", Where(proc.chart_file, rs.line)),
+                                 f"{proc.chart_file} state {rs.id}", Where(proc.chart_file, rs.line),
+                                 source=PROCESS_CHART),
                             Node("chart", f"no path in the state chart of '{c.d}' leads from '{c.x}' there",
                                  f"{w.devices[c.d].chart_file} state {c.x}", w.state_where(c.d, c.x)))))
     return Node("answer", f"{proc.label} is not offered in cell '{w.cell}': some role cannot be filled",
-                f"not offered({CELL},{p})", proc.where, children=tuple(reasons))
+                f"not offered({CELL},{p})", proc.where,
+                children=tuple(dataclasses.replace(n, fails=True) for n in reasons))
 
 
 def _left_by(result: CheckResult, n: int, d: str) -> int:
@@ -267,7 +273,7 @@ def device_at_step(w: Words, result: CheckResult, task: Task, n: int, r: str, d:
     if proc is not None and need is not None:
         rs = proc.role(r).region[0]
         below.append(Node("chart", f"role '{r}' of {proc.label} starts '{w.label(need)}'",
-                          f"{proc.chart_file} state {rs.id}", Where(proc.chart_file, rs.line)))
+                          f"{proc.chart_file} state {rs.id}", Where(proc.chart_file, rs.line), source=PROCESS_CHART))
         if ok and concept is not None:
             below += subsumed(w, concept, need)
         elif concept is not None:
@@ -291,11 +297,11 @@ def step_tree(w: Words, result: CheckResult, task: Task, n: int) -> Node:
                                                            f"'{p.role}' may start from",
                                 {"C": CELL, "T": TASK, "I": n, "R": p.role, "D": p.device, "X": p.state,
                                  "P": step.command, "K": p.needed},
-                                (device_at_step(w, result, task, n, p.role, p.device),)))
+                                (device_at_step(w, result, task, n, p.role, p.device),), fails=True))
         else:
-            children.append(Node("answer", p.reason.plain, p.reason.text, p.where,
-                                 children=tuple(Node("chart", "the problem rests on this line", str(x), x)
-                                                for x in p.reason.where)))
+            children.append(Node("answer", p.reason.plain, p.reason.text, p.where, fails=True,
+                                 children=tuple(Node("chart", "the problem rests on this line", str(x), x,
+                                                     source="description") for x in p.reason.where)))
     troubled = {p.device for p in problems}
     children += [device_at_step(w, result, task, n, r, d) for r, d in step.bindings.items() if d not in troubled]
     verdict = "is not plausible" if problems else "is plausible: every device it uses is where it may start"

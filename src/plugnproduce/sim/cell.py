@@ -94,7 +94,9 @@ class SimulatedCell:
         if device_id in self.devices:
             raise ProtocolError(f"device {device_id!r} is plugged in already")
         if device_id not in self.catalogue:
-            raise ProtocolError(f"no device {device_id!r} to plug in; known: {', '.join(sorted(self.catalogue))}")
+            raise ProtocolError(f"no device {device_id!r} to plug in; known: {', '.join(sorted(self.catalogue))}; "
+                                "a library's device needs the cell started with it: "
+                                "pnp --library LIBRARY sim up CELL")
         device = SimulatedDevice(self.catalogue[device_id], network=self.network, faults=self.faults.get(device_id),
                                  bin=self.bin)
         await device.start()
@@ -108,7 +110,7 @@ class SimulatedCell:
         try:
             device = load_device(path, self.taxonomy or load_taxonomy())
         except DescriptionError as exc:
-            raise ProtocolError(exc.location_message()) from exc
+            raise ProtocolError(exc.location_message() + _library_hint(path)) from exc
         known = self.catalogue.setdefault(device.id, device)
         if known.where != device.where:
             raise ProtocolError(f"{device.where}: device id {device.id!r} is already the catalogue's {known.where}")
@@ -131,6 +133,15 @@ class SimulatedCell:
         if op == "list":
             return sorted(self.devices)
         raise ProtocolError(f"unknown operation {op!r}; expected plug, unplug or list")
+
+
+def _library_hint(path: Path) -> str:
+    """For a device file of a library (``LIB/devices/x.ttl`` beside ``LIB/ontology``): how to start a cell
+    that knows the library's terms."""
+    library = path.resolve().parent.parent
+    if path.resolve().parent.name != "devices" or not (library / "ontology").is_dir():
+        return ""
+    return f"; the cell was started without its library: start it with pnp --library {library} sim up CELL"
 
 
 async def run_simulated_cell(sim: SimulatedCell, state_file: Path, echo: Callable[[str], None]) -> None:

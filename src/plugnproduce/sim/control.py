@@ -11,6 +11,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import os
 from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
@@ -59,7 +60,7 @@ class ControlServer:
         """Record the address for the other ``pnp sim`` commands."""
         path.parent.mkdir(parents=True, exist_ok=True)
         host, port = self.address
-        path.write_text(json.dumps({"host": host, "port": port}))
+        path.write_text(json.dumps({"host": host, "port": port, "pid": os.getpid()}))
 
     async def _serve(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         try:
@@ -91,9 +92,28 @@ def read_state(path: Path | None = None) -> tuple[str, int]:
     p = path or default_state_file()
     try:
         data = json.loads(p.read_text())
-        return str(data["host"]), int(data["port"])
-    except (OSError, ValueError, KeyError) as exc:
+        host, port, pid = str(data["host"]), int(data["port"]), data.get("pid")
+    except (OSError, ValueError, KeyError, AttributeError) as exc:
         raise ProtocolConnectionError("no simulated cell is running (start one with 'pnp sim up CELL')") from exc
+    if isinstance(pid, int) and not _alive(pid):  # its port may be anyone's now: never send it a request
+        raise ProtocolConnectionError(stopped(host, port))
+    return host, port
+
+
+def stopped(host: str, port: int) -> str:
+    """The refusal of the control address of a simulated cell that has stopped."""
+    return (f"the simulated cell started last (control {host}:{port}) has stopped; start one with "
+            "'pnp sim up CELL', or name a running one with --control HOST:PORT")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, ValueError):
+        return True  # a process we may not signal is alive; a number no pid can be is not ours to judge
+    return True
 
 
 async def request(address: tuple[str, int], op: str, device: str = "", timeout: float = 10.0) -> list[str]:

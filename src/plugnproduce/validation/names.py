@@ -15,7 +15,7 @@ import rdflib
 from rdflib.namespace import OWL, RDF, RDFS
 
 from plugnproduce.description.loader import Loaded
-from plugnproduce.ontology.names import unknown_class, unknown_term
+from plugnproduce.ontology.names import turtle_spelling, unknown_class, unknown_term
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, concept_iri, local_name
 from plugnproduce.safeio import parse_xml
@@ -56,6 +56,7 @@ def chart_name_problems(path: Path, taxonomy: Taxonomy) -> Iterator[Problem]:
 def turtle_name_problems(loaded: Loaded, taxonomy: Taxonomy) -> Iterator[Problem]:
     """Unknown classes, skills, quantities and state concepts in a Turtle description."""
     g = loaded.graph
+    spell = turtle_spelling(g.namespace_manager)
     for s, c in sorted(g.subject_objects(RDF.type)):
         if not isinstance(c, rdflib.URIRef) or str(c) in DESCRIPTION_CLASSES or taxonomy.knows(str(c)):
             continue
@@ -64,9 +65,9 @@ def turtle_name_problems(loaded: Loaded, taxonomy: Taxonomy) -> Iterator[Problem
             yield Problem(str(loaded.path), line, f"{local_name(str(s))} is an ontology term ({local_name(str(c))}); "
                           "a description's class axioms are not read: put them in a library's ontology/ folder")
         else:
-            yield Problem(str(loaded.path), line, unknown_class(str(s), str(c), taxonomy))
+            yield Problem(str(loaded.path), line, unknown_class(str(s), str(c), taxonomy, spell))
     for prop, kind in TERM_PROPERTIES.items():
         for s, o in sorted(g.subject_objects(prop)):
-            message = unknown_term(str(o), kind, taxonomy)
+            message = unknown_term(str(o), kind, taxonomy, spell)
             if message:
                 yield Problem(str(loaded.path), loaded.line(str(s)) or 0, f"{local_name(str(prop))}: {message}")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from dataclasses import replace
 from pathlib import Path
 
 import rdflib
@@ -72,6 +73,7 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
     processes: dict[str, ProcessDescription] = {}
     tasks = []
     described: dict[str, Where] = {}
+    named: set[tuple[str, int]] = set()  # where a chart's unknown name is reported already
     for f in files:
         try:
             if not f.is_file():
@@ -83,6 +85,7 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
                     report.add(Problem.from_error(e))
                 for problem in chart_name_problems(f, taxonomy):
                     report.add(problem)
+                    named.add((str(f.resolve()), problem.line))
             elif f.suffix == ".ttl":
                 loaded = read_description(f)
                 _same_iri(loaded, described, report)
@@ -97,8 +100,23 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
     if not report.unreadable:
         say("checking the SHACL shapes")
         for p in shape_problems(kg):
-            report.add(p)
-    return report
+            if (_resolved(p.file), p.line) not in named or "is annotated with" not in p.message:
+                report.add(p)
+    return _once(report, files)
+
+
+def _resolved(file: str) -> str:
+    return str(Path(file).resolve()) if file and not file.startswith("<") else file
+
+
+def _once(report: Report, files: list[Path]) -> Report:
+    """Each problem once, at its file as the user named it (a chart a description names is read by
+    its resolved path)."""
+    given = {str(f.resolve()): str(f) for f in files}
+    once = Report(files=report.files)
+    for p in report.problems:
+        once.add(replace(p, file=given.get(_resolved(p.file), p.file)))
+    return once
 
 
 def validate_tasks(tasks: Iterable[Task], knowledge: Knowledge | None = None) -> Report:

@@ -16,11 +16,13 @@ export function initCell({ onAdd, onChart }) {
     e.preventDefault();
     const device = $("#plug-device").value;
     if (!device) return;
+    const status = $("#plug-status");
+    status.textContent = "";
     try {
       await post("/api/cell/devices", { device }, { auth: true });
-    } catch (err) {
+    } catch (err) {  // said by the button, where the user looks
       announce(err.message);
-      alertError(err);
+      status.textContent = `Not plugged in: ${err.message.replace(/^error: /, "")}`;
     }
   });
 }

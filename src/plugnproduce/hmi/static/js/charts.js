@@ -125,19 +125,33 @@ function renderLinks() {
     h("a", { href: c.scxml, download: c.name }, c.name), ` (${c.kind})`)));
 }
 
+/** Say by the Generate button what generating did: working, what it wrote (a link to the charts), or why not. */
+function generateStatus(text, kind, link = null) {
+  fill($("#generate-status"), h("span", { class: kind }, text), link);
+}
+
 /** Generate the task's code and show its Task State Chart. */
 export async function generate() {
   const caption = $("#chart-caption");
+  const button = $("#generate");
+  button.disabled = true;
+  generateStatus("Generating code…", "hint");
   try {
     const result = await post("/api/task/generate", taskBody());
     if (!result.plausible) {
       caption.textContent = `No code generated: ${result.problems.length ? result.problems[0].text : "the task is not plausible"}`;
+      generateStatus(caption.textContent, "error");
       return;
     }
     if (!result.charts.length) {
       caption.textContent = `No code generated: ${unproved(result.verification)}`;
+      generateStatus(caption.textContent, "error");
       return;
     }
+    const proved = result.verification && result.verification.verdict === "proved"
+      ? " (its program proved over every interleaving)" : "";
+    generateStatus(`Generated ${result.charts.length} charts${proved}. `, "ok",
+      h("a", { href: "#charts" }, "See them under Charts"));
     state.generated = result.charts;
     renderChartChoices();
     renderLinks();
@@ -146,6 +160,9 @@ export async function generate() {
     $("#charts").scrollIntoView({ behavior: "smooth", block: "start" });
   } catch (err) {
     caption.textContent = err.message;
+    generateStatus(`No code generated: ${err.message}`, "error");
+  } finally {
+    button.disabled = false;
   }
 }
 

@@ -51,11 +51,19 @@ function engineerPart(node) {
   return parts.length ? h("span", { class: "engineer-only" }, " ", parts) : null;
 }
 
+/** What a node rests on, in plain words ("rule", "ontology", "device chart"), and for a reason the answer
+ * is no, the mark of the failing branch. */
+function nodeHead(node) {
+  const kind = h("span", { class: `kind kind-${node.kind}` }, node.source || node.kind);
+  const mark = node.fails ? h("span", { class: "fails-mark" }, "✗ why not: ") : null;
+  return [mark, kind, " ", node.text, engineerPart(node)];
+}
+
 function nodeItem(node) {
-  const kind = h("span", { class: `kind kind-${node.kind}` }, node.kind);
-  if (!node.children.length) return h("li", { class: "node" }, kind, " ", node.text, engineerPart(node));
-  return h("li", { class: "node" }, h("details", {},
-    h("summary", {}, kind, " ", node.text, engineerPart(node)), h("ul", {}, node.children.map(nodeItem))));
+  const cls = node.fails ? "node fails" : "node";
+  if (!node.children.length) return h("li", { class: cls }, nodeHead(node));
+  return h("li", { class: cls }, h("details", {},
+    h("summary", {}, nodeHead(node)), h("ul", {}, node.children.map(nodeItem))));
 }
 
 /**
