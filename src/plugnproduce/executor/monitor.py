@@ -64,14 +64,17 @@ class Monitor:
             if chart.binding.get(role) == device and output in params:
                 self._reported[variable] = (step, device)
 
-    def check(self, step: int | None, device: str, request: str,
-              params: Mapping[str, Any]) -> dict[str, Any] | Breach:
-        """The arguments as they go out (numbers in the contract's unit), or the first breach of the contract."""
+    def check(self, step: int | None, device: str, request: str, params: Mapping[str, Any],
+              datamodel: Mapping[str, Any]) -> dict[str, Any] | Breach:
+        """The arguments as they go out (numbers in the contract's unit), or the first breach of the contract.
+
+        ``datamodel`` is the task chart's: the outputs kept there tell which parameter a value comes from.
+        """
         chart, dev = self._step(step), self._cell.device(device)
         out = dict(params)
         for quantity in _accepted(dev, request):
             name, contract = local_name(quantity), dev.argument(request, quantity)
-            source = self._source(chart, dev, contract)
+            source = self._source(chart, dev, contract, params.get(name), datamodel)
             if name not in params:
                 if contract.needed:
                     return Breach(name, None, source.text, "requires it; the request lacks it")
@@ -86,15 +89,25 @@ class Monitor:
         steps = self._generated.steps
         return steps[step - 1] if step is not None and 1 <= step <= len(steps) else None
 
-    def _source(self, chart: StepChart | None, device: DeviceDescription, contract: Argument) -> _Source:
-        """Where the value of ``contract``'s argument comes from, and the unit it is in."""
+    def _source(self, chart: StepChart | None, device: DeviceDescription, contract: Argument, sent: object,
+                datamodel: Mapping[str, Any]) -> _Source:
+        """Where the value ``sent`` for ``contract``'s argument comes from, and the unit it is in."""
         own = _Source(f"{device.id}'s own default", contract.unit)
         if chart is None:
             return own
-        par = next((p for p in chart.process.parameters if p.quantity == contract.quantity
-                    and chart.binding.get(p.role) == device.id), None)
-        if par is None:
+        pars = [p for p in chart.process.parameters if p.quantity == contract.quantity
+                and chart.binding.get(p.role) == device.id]
+        if not pars:
             return own
+
+        def gives(name: str) -> bool:  # several parameters may go to one request (a pick's pose and its lift)
+            value = chart.step.params.get(name)
+            if isinstance(value, Link):
+                return bool(datamodel.get(output_variable(value.step, value.output)) == sent)
+            return value is None or value == sent
+
+        given = [p for p in pars if p.name in chart.step.params and gives(p.name)]
+        par = next(iter(given), None) or next((p for p in pars if gives(p.name)), pars[0])
         step, task = chart.step, self._generated.task
         value = step.params.get(par.name)
         # codegen writes a fixed number in the contract's unit; a value that varies, in its parameter's unit

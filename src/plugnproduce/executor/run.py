@@ -229,7 +229,7 @@ class TaskRun:
         given = dict(event.data or {})
         # Whatever becomes of the command is told of the step that sent it and the state its device was in then.
         sent = Fault("", "", self.step, self.command, target, self.device_states.get(target), command.name)
-        checked = self._monitor.check(self.step, target, command.name, given)
+        checked = self._monitor.check(self.step, target, command.name, given, self.interpreter.dm)
         if isinstance(checked, Breach):
             self._fail(replace(sent, kind="contract", message=checked.message(target, command.name),
                                argument=checked.argument))
@@ -352,7 +352,7 @@ class TaskRun:
 
     def _on_meta(self, meta: MetaEvent) -> None:
         """A state entered: journal a new step, and a device's new state, in the order they happen."""
-        if meta.name != STATE_ENTERED:
+        if meta.name != STATE_ENTERED or self.fault is not None:  # after a fault the chart's states say nothing
             return
         info = self._states.get(meta.data["state"])
         if info is None:
