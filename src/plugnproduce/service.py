@@ -12,7 +12,7 @@ import dataclasses
 import os
 import secrets
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -516,7 +516,7 @@ async def run_task(
             say("asking each device its state; checking the task from there")
             generated = plan_run(the_task, the_cell.reported(await reported_states(devices)), k, progress=say)
         say("running")
-        run = start_run(generated, devices, journal, observer)
+        run = start_run(generated, devices, journal, observer, prefixes=k.prefixes)
         if started is not None:
             started(run)
         follow = asyncio.create_task(_follow_unplugs(live, run))
@@ -577,7 +577,7 @@ def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge 
 
 
 def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
-              observer: RecordObserver | None = None) -> TaskRun:
+              observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> TaskRun:
     """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
     real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
 
@@ -586,7 +586,7 @@ def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
     """
     from plugnproduce.executor.run import TaskRun
 
-    return TaskRun(generated, devices, journal, observer)
+    return TaskRun(generated, devices, journal, observer, prefixes)
 
 
 async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:

@@ -36,7 +36,7 @@ from plugnproduce.codegen.flow import branch_variable
 from plugnproduce.codegen.task import STEP
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
-from plugnproduce.executor import values
+from plugnproduce.executor import outcomes, values
 from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.executor.monitor import Breach, Monitor
@@ -62,8 +62,9 @@ _COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("command", "dev
 class Fault:
     """What stopped a run.
 
-    ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected``, ``chart`` (the task chart
-    broke down) or ``stopped``.
+    ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected``, ``contract`` (an argument
+    beyond the device's contract: the request was not sent), ``outcome`` (an outcome the process does not
+    declare), ``chart`` (the task chart broke down) or ``stopped``.
     """
 
     kind: str
@@ -137,7 +138,7 @@ class TaskRun:
     """One run of a generated task in a cell whose devices carry their real endpoints."""
 
     def __init__(self, generated: GeneratedTask, cell: Cell, journal_path: Path,
-                 observer: RecordObserver | None = None) -> None:
+                 observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> None:
         self.generated = generated
         self.cell = cell
         self.journal_path = journal_path
@@ -154,6 +155,7 @@ class TaskRun:
         self._links: dict[str, DeviceLink] = {}
         self._commands: set[asyncio.Task[None]] = set()
         self._monitor = Monitor(generated, cell)
+        self._prefixes = dict(prefixes or outcomes.DEFAULT_PREFIXES)
         self._unanswered: dict[str, int] = {}
         """Per device, its commands not yet answered (or held back behind another's): its events and the states
         the chart enters for it wait until they are."""
@@ -329,10 +331,28 @@ class TaskRun:
         protocol = self.cell.device(device).protocol
         event = f"{device}.{protocol}.event.{name}"
         self._record("event", step=step, device=device, event=name, params=params)
+        params = self._with_outcome(step, device, params)
+        if self.fault is not None:
+            return
         for value in values.produced(self.generated, step, device, params):
             self._record("value", **value)
         self._monitor.reported(step, device, params)
         self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too
+
+    def _with_outcome(self, step: int | None, device: str, params: dict[str, Any]) -> dict[str, Any]:
+        """``params`` with the outcome the device reports resolved to the local name the chart compares
+        (:mod:`~plugnproduce.executor.outcomes`); an outcome its step's process does not declare is a fault."""
+        chart = self.generated.steps[step - 1] if step is not None and 1 <= step <= len(self.generated.steps) else None
+        role = chart.process.outcome_role() if chart is not None else None
+        if chart is None or role is None or chart.binding.get(role.name) != device or outcomes.PARAM not in params:
+            return params
+        declared = chart.process.outcomes
+        resolved = outcomes.resolve(params[outcomes.PARAM], declared, self._prefixes)
+        if resolved is None:
+            why = outcomes.undeclared(device, params[outcomes.PARAM], chart.process.id, declared)
+            self._fail(self._fault("outcome", device, why))
+            return params
+        return {**params, outcomes.PARAM: local_name(resolved)}
 
     def _journal_held(self) -> None:
         """The events that came from a device whose command was never answered: known, never acted on."""
