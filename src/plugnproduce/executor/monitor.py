@@ -103,7 +103,7 @@ class Monitor:
         def gives(name: str) -> bool:  # several parameters may go to one request (a pick's pose and its lift)
             value = chart.step.params.get(name)
             if isinstance(value, Link):
-                return bool(datamodel.get(output_variable(value.step, value.output)) == sent)
+                return bool(value.applied(datamodel.get(output_variable(value.step, value.output))) == sent)
             return value is None or value == sent
 
         given = [p for p in pars if p.name in chart.step.params and gives(p.name)]
@@ -121,9 +121,10 @@ class Monitor:
 
     def _reported_by(self, link: Link) -> str:
         seen = self._reported.get(output_variable(link.step, link.output))
+        plus = f" plus the offset {list(link.offset)}" if link.offset is not None else ""
         if seen is None:
-            return f"{link.output} of step {link.step}, not reported"
-        return f"{link.output} reported by {seen[1]} at step {seen[0]}"
+            return f"{link.output} of step {link.step}, not reported{plus}"
+        return f"{link.output} reported by {seen[1]} at step {seen[0]}{plus}"
 
     def _output_unit(self, link: Link, fallback: str) -> str:
         producer = next((s for s in self._generated.steps if s.step.name == link.step), None)
