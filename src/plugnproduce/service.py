@@ -173,8 +173,12 @@ def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None,
 
 def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.CheckResult:
     """Whether a task is plausible in a cell: per step its bindings, device states and problems."""
+    from plugnproduce.reasoning.linksafety import link_safety
+
     the_cell, k = _context(cell_or_path, knowledge)
-    return reasoning.check(_as_task(task_or_path), the_cell, k.taxonomy, k.processes)
+    task = _as_task(task_or_path)
+    result = reasoning.check(task, the_cell, k.taxonomy, k.processes)
+    return dataclasses.replace(result, links=link_safety(task, the_cell, result, k.processes))
 
 
 def repair(
