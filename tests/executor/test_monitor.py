@@ -88,3 +88,26 @@ def test_each_argument_is_held_to_the_contract_whatever_it_is(monitor: Monitor, 
 
 def test_an_argument_within_the_contract_goes_out_as_given(monitor: Monitor) -> None:
     assert monitor.check(1, "gripper", "Close", {"GripForce": 45}, {}) == {"GripForce": 45}
+
+
+def test_a_value_that_varies_between_steps_goes_out_in_the_devices_unit(tmp_path: Path) -> None:
+    """Picks 2 and 3 share one chart with different forces: the chart carries them in the process's unit (N), the
+    library's gripper takes kN; each goes out converted and within its limits, never as 50 kN."""
+    library = Path(shutil.copytree(LIBRARY.parent / "adaptive-gripper", tmp_path / "adaptive-gripper"))
+    ttl = library / "devices" / "adaptive-gripper.ttl"
+    ttl.write_text(ttl.read_text(encoding="utf-8").replace(
+        "pnp:cost 2400 .", "pnp:cost 2400 ;\n    pnp:hasArgument dev:adaptive-gripper-force .\n\n"
+        "dev:adaptive-gripper-force a pnp:RequestArgument ;\n    pnp:request \"Close\" ;\n"
+        "    pnp:quantity pnp:GripForce ;\n    pnp:unit \"kN\" ;\n    pnp:minValue 0.01 ; pnp:maxValue 0.06 .\n"),
+        encoding="utf-8")
+    task = tmp_path / "three-forces.yaml"
+    task.write_text("task: three-forces\nsteps:\n  - command: bin-pick\n    bind: {robot: robot, gripper: adaptive-gripper}\n"
+                    "    params: {grip_force: 45}\n  - command: place\n  - command: bin-pick\n"
+                    "    params: {grip_force: 50}\n  - command: place\n  - command: bin-pick\n"
+                    "    params: {grip_force: 55}\n  - command: place\n", encoding="utf-8")
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(task), "--cell", str(library / "cells" / "bin-picking-adaptive.yaml"), "--sim",
+                 "--journal", str(journal))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    forces = [r["params"]["GripForce"] for r in journal_of(journal) if r["kind"] == "command" and r["command"] == "Close"]
+    assert forces == pytest.approx([0.045, 0.05, 0.055])
