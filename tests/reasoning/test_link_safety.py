@@ -63,4 +63,6 @@ def test_a_bad_declared_range_is_one_line_at_its_place(tmp_path: Path, reach: st
     assert result.exit_code == 2, result.output
     (line,) = result.stderr.splitlines()
     assert line.startswith(f"{chart}:19: value part_pose: pnp:maxReach is '{reach}'; expected a finite positive number")
+    validated = runner.invoke(app, ["validate", str(library / "devices")])
+    assert validated.exit_code == 1 and validated.stdout.startswith(f"{chart}:19: value part_pose: pnp:maxReach")
 
