@@ -38,7 +38,8 @@ if TYPE_CHECKING:  # validation, code generation and execution are imported by t
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
-    from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
+    from plugnproduce.executor.report import RunReport
+    from plugnproduce.executor.run import RecordObserver, TaskRun
     from plugnproduce.ontology.taxonomy import Taxonomy
     from plugnproduce.reasoning.impact import Impact
     from plugnproduce.validation import Report
