@@ -39,6 +39,8 @@ def test_a_pose_reported_beyond_reach_ends_the_run_before_the_robot_is_sent_ther
     records = journal_of(journal)
     moves = [r["params"]["TargetPose"] for r in records if r["kind"] == "command" and r["command"] == "MoveTo"]
     assert all(math.dist(pose[:3], (0, 0, 0)) <= REACH for pose in moves)  # nothing beyond the reach went out
+    kinds = [r["kind"] for r in records]
+    assert "state" not in kinds[kinds.index("fault"):]  # no "robot is moving": the MoveTo was never sent
     (fault,) = [r for r in records if r["kind"] == "fault"]
     assert (fault["fault"], fault["step"], fault["device"], fault["request"], fault["argument"]) == \
         ("contract", 2, "robot", "MoveTo", "TargetPose")
