@@ -183,4 +183,7 @@ def test_every_task_plausible_on_a_cell_is_proved_there(task: Path, cell: Path) 
     if not service.check(task, cell).plausible:
         pytest.skip(f"{task.stem} is not plausible on {cell.stem}")
     result = service.verify(task, cell)
+    if cell.stem == "far-part":  # its localizer reports a pose beyond the robot's reach: the closed world sees it
+        assert result.verdict == "refuted" and "reaches at most 1.45 m from its base" in result.problem
+        return
     assert result.verdict == "proved", "\n".join(result.lines())
