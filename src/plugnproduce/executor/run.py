@@ -114,6 +114,8 @@ class TaskRun:
         the chart enters for it wait until they are."""
         self._held: dict[str, list[tuple[int | None, str, dict[str, Any]]]] = {}
         self._unconfirmed: dict[str, list[tuple[int | None, str]]] = {}
+        self._late: Fault | None = None
+        """A timer that fired while its device's command was not answered yet."""
         self.fault: Fault | None = None
         self._faulted = asyncio.Event()
         self.step: int | None = None
@@ -133,6 +135,8 @@ class TaskRun:
                     await self._loop.run()
                 if self.fault is None:  # the chart is done; the commands not yet answered still may fail it
                     await self._answers()
+                if self.fault is None and self._late is not None:
+                    self._fail(self._late)
             except ExecutionError as exc:  # the task chart itself broke down: a fault like any other
                 self._fail(Fault("chart", str(exc), self.step, self.command))
             finally:
@@ -362,10 +366,12 @@ class TaskRun:
             return
         if event.name.startswith("timeout."):
             device = event.name.removeprefix("timeout.")
-            if self._unanswered.get(device):
-                return  # a command to it is not answered yet: that answer's own bounded wait tells of it
-            self._fail(self._fault("timeout", device, f"no event from {device} within "
-                                                      f"{self.cell.device(device).command_timeout:g} s"))
+            late = self._fault("timeout", device, f"no event from {device} within "
+                                                  f"{self.cell.device(device).command_timeout:g} s")
+            if self._unanswered.get(device):  # its command's own bounded wait tells of it first; if that command
+                self._late = self._late or late  # is answered after all, this timeout stands
+                return
+            self._fail(late)
         elif not step.transitions and event.name != FAULT_EVENT and self.fault is None:
             device = event.name.partition(".")[0]
             self._fail(self._fault("unexpected", device, f"event {event.name.split('.', 3)[-1]} is not what the "
