@@ -78,11 +78,16 @@ GUARDS = (
           ("x__escaped", "x__attr", "x__checked", "x__name", "x__decimal", "x__write_pose", "x__value", "x__positive",
            "x_encode", "x_decode", "x__decode_document", "x__number", "x__integer", "x__pose", "x__decode_event")),
     Guard("executor-faults", ("src/plugnproduce/executor/run.py",),
-          ("tests/executor/test_faults.py", "tests/executor/test_run.py"),
+          ("tests/executor/test_faults.py", "tests/executor/test_run.py", "tests/executor/test_unanswered.py"),
           ("xǁTaskRunǁstop", "xǁTaskRunǁdevice_lost", "xǁTaskRunǁsend", "xǁTaskRunǁ_request",
            "xǁTaskRunǁ_safe_stop", "xǁTaskRunǁ_stop_device", "xǁTaskRunǁ_on_event", "xǁTaskRunǁ_on_lost",
            "xǁTaskRunǁ_on_anomaly", "xǁTaskRunǁ_on_step", "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail",
-           "xǁTaskRunǁ_outcome")),
+           "xǁTaskRunǁ_outcome", "xǁTaskRunǁ_send_one", "xǁTaskRunǁ_release", "xǁTaskRunǁ_deliver",
+           "xǁTaskRunǁ_with_outcome")),
+    Guard("executor-monitor", ("src/plugnproduce/executor/monitor.py", "src/plugnproduce/description/contracts.py",
+                               "src/plugnproduce/executor/outcomes.py"),
+          ("tests/executor/test_monitor.py", "tests/executor/test_outcome_names.py",
+           "tests/executor/test_unanswered.py")),
 )
 
 PLUGIN = "mutation_fresh_caches"

@@ -12,7 +12,7 @@ import dataclasses
 import os
 import secrets
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -39,7 +39,8 @@ if TYPE_CHECKING:  # validation, code generation and execution are imported by t
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
-    from plugnproduce.executor.run import RecordObserver, RunReport, TaskRun
+    from plugnproduce.executor.report import RunReport
+    from plugnproduce.executor.run import RecordObserver, TaskRun
     from plugnproduce.ontology.taxonomy import Taxonomy
     from plugnproduce.planning import Plan, Unreachable
     from plugnproduce.reasoning.impact import Impact
@@ -175,8 +176,12 @@ def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None,
 
 def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.CheckResult:
     """Whether a task is plausible in a cell: per step its bindings, device states and problems."""
+    from plugnproduce.reasoning.linksafety import link_safety
+
     the_cell, k = _context(cell_or_path, knowledge)
-    return reasoning.check(_as_task(task_or_path), the_cell, k.taxonomy, k.processes)
+    task = _as_task(task_or_path)
+    result = reasoning.check(task, the_cell, k.taxonomy, k.processes)
+    return dataclasses.replace(result, links=link_safety(task, the_cell, result, k.processes))
 
 
 def repair(
@@ -544,7 +549,7 @@ async def run_task(
             say("asking each device its state; checking the task from there")
             generated = plan_run(the_task, the_cell.reported(await reported_states(devices)), k, progress=say)
         say("running")
-        run = start_run(generated, devices, journal, observer)
+        run = start_run(generated, devices, journal, observer, prefixes=k.prefixes)
         if started is not None:
             started(run)
         follow = asyncio.create_task(_follow_unplugs(live, run))
@@ -605,7 +610,7 @@ def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge 
 
 
 def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
-              observer: RecordObserver | None = None) -> TaskRun:
+              observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> TaskRun:
     """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
     real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
 
@@ -614,7 +619,7 @@ def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
     """
     from plugnproduce.executor.run import TaskRun
 
-    return TaskRun(generated, devices, journal, observer)
+    return TaskRun(generated, devices, journal, observer, prefixes)
 
 
 async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:

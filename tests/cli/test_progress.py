@@ -118,3 +118,48 @@ def test_disabled_phases_print_nothing() -> None:
         phases("checking")
         phases.close(last_done=True)
     assert buf.getvalue() == ""
+
+
+def run_on_a_terminal(*args: str) -> tuple[int, str]:
+    """Run ``pnp ARGS`` with stdout and stderr on one pseudo-terminal, as a user sees it: exit code, raw text."""
+    master, slave = os.openpty()
+    proc = subprocess.Popen([sys.executable, "-m", "plugnproduce", *args], stdout=slave, stderr=slave,
+                            stdin=subprocess.DEVNULL)
+    os.close(slave)
+    seen: list[bytes] = []
+    while True:
+        try:
+            chunk = os.read(master, 65536)
+        except OSError:  # the child has gone and the terminal is closed
+            break
+        if not chunk:
+            break
+        seen.append(chunk)
+    code = proc.wait(timeout=120)
+    os.close(master)
+    return code, b"".join(seen).decode("utf-8", "replace")
+
+
+def test_the_spinner_is_cleared_before_each_event_line(tmp_path: Path) -> None:
+    code, raw = run_on_a_terminal("run", TASK, "--sim", "--journal", str(tmp_path / "run.jsonl"))
+    assert code == 0, raw[-2000:]
+    lines = plain(raw)
+    events = [line for line in lines if line.startswith(("→", "←", "step "))]
+    assert len(events) > 20  # the run's lines are all there
+    shared = [line for line in lines if "running" in line and any(m in line for m in ("→", "←", " is "))]
+    assert shared == [], shared[:3]  # no event line runs on from the spinner's
+
+
+def test_a_fault_run_says_what_was_sent_and_what_is_known_at_the_step_of_the_fault(tmp_path: Path) -> None:
+    code, raw = run_on_a_terminal("run", TASK, "--sim", "--faults", "gripper:drop-response:Close",
+                                  "--journal", str(tmp_path / "run.jsonl"))
+    assert code == 1, raw[-2000:]
+    lines = [line for line in plain(raw) if line and "running:" not in line]
+    close = lines.index("→ gripper: Close {'GripForce': 45}")
+    assert not any(line.startswith("→") for line in lines[close + 1:])  # nothing sent after the unanswered Close
+    assert "gripper is closing" not in lines  # nobody confirmed that the gripper took the Close
+    assert not any(line.startswith(("step 2", "step 3")) for line in lines)  # the run stays at step 1, the fault's
+    assert lines[close + 1] == ("FAULT timeout: command Close: no answer within 2 s; it was sent, and whether gripper "
+                                "carries it out is not known")
+    assert "fault: timeout at step 1 (bin-pick), device gripper in state open, request Close: " \
+           "command Close: no answer within 2 s" in raw

@@ -39,3 +39,14 @@ async def test_a_run_beyond_a_device_limit_is_refused_with_the_finding(client: h
     res = await client.post("/api/runs", json={"task": _task("0.12 kN")}, headers=AUTH)
     assert res.status_code == 409
     assert "takes at most 100 N" in res.json()["detail"]
+
+
+async def test_the_check_proves_a_lift_relative_to_a_reported_pose_as_the_cli_does(client: httpx.AsyncClient) -> None:
+    steps = [{"name": "localize", "command": "localize-part"},
+             {"command": "pick", "params": {"pick_pose": {"from": "localize", "output": "part_pose"},
+                                            "lift_pose": {"from": "localize", "output": "part_pose",
+                                                          "offset": [0, 0, 0.2, 0, 0, 0]}}}]
+    res = await client.post("/api/task/check", json={"name": "t", "steps": steps})
+    assert res.status_code == 200, res.text
+    links = {link["parameter"]: link for link in res.json()["links"]}
+    assert links["lift_pose"]["proven"] is True and "plus an offset of 0.2 m" in links["lift_pose"]["why"]

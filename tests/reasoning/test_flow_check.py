@@ -83,7 +83,7 @@ def test_a_step_after_the_loop_that_cannot_start_where_the_loop_ends_is_refused(
 def test_a_link_to_an_output_the_bound_device_never_reports_is_refused(tmp_path: Path) -> None:
     for f in ("binpicking-pc.ttl", "binpicking-pc.scxml"):
         shutil.copy(service.builtin("devices", f), tmp_path)
-    edit(tmp_path / "binpicking-pc.scxml", '<param name="part_pose" expr="part_pose"/>', "")
+    edit(tmp_path / "binpicking-pc.scxml", '<param name="part_pose" expr="part_pose" pnp:maxReach="1.2"/>', "")
     silent = load_device(tmp_path / "binpicking-pc.ttl", service.knowledge().taxonomy)
     cell = service.cell(CELL).with_device(silent)
     result = service.check(TASKS / "bin-picking-until-empty.yaml", cell)

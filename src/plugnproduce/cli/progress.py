@@ -58,6 +58,16 @@ class Phases:
 
             self._live.update(Spinner("dots", f"{self._phase}: {text}"))
 
+    def echo(self, line: str) -> None:
+        """Print ``line`` on stdout; on a terminal the spinner is cleared first and drawn again below it, so that
+        the two never run together on one line."""
+        if self._live is None or not sys.stdout.isatty():
+            print(line, flush=True)
+            return
+        self._live.stop()  # transient: the spinner's line is erased
+        print(line, flush=True)
+        self._live.start(refresh=True)
+
     @property
     def console(self) -> Console:
         """Where progress goes: the given console, else stderr."""

@@ -107,6 +107,8 @@ def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (
         verdict = "plausible" if result.plausible else f"implausible ({len(result.problems)} problem(s))"
         typer.echo(f"task {result.task} in cell {result.cell}: {verdict}")
         _print_problems(result, verbose)
+        for link in result.links:  # what a device reports is proven here or held to the contract when it comes
+            typer.echo(f"  {link}")
     if not result.plausible:
         raise typer.Exit(1)
 

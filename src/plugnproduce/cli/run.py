@@ -62,7 +62,7 @@ def run(
         if record["kind"] == "step":
             phases.update(f"step {record.get('step')} ({record.get('command')})")
         if not json_out:
-            typer.echo(describe(record))
+            phases.echo(describe(record))
 
     def started(the_run: TaskRun) -> None:
         loop = asyncio.get_running_loop()

@@ -42,11 +42,15 @@ class Flow:
     """A parameter value taken from an earlier step's output: a variable of the task chart's datamodel."""
 
     variable: str
+    offset: tuple[float, ...] | None = None
+    """Added to the output item by item (a pose relative to the one reported)."""
 
     @property
     def expr(self) -> str:
-        """The expression that reads it at run time."""
-        return self.variable
+        """The expression that reads it at run time (with the offset: each item plus its own)."""
+        if self.offset is None:
+            return self.variable
+        return "[" + ", ".join(f"{self.variable}[{i}] + {o!r}" for i, o in enumerate(self.offset)) + "]"
 
 
 def output_variable(step_name: str, output: str) -> str:

@@ -132,7 +132,7 @@ def step_values(step: Step, process: ProcessDescription) -> dict[str, object]:
     A value taken from an earlier step's output becomes a :class:`Flow`: the datamodel variable holding it.
     """
     values: dict[str, object] = {p.name: p.default for p in process.parameters if p.default is not None}
-    values.update({n: Flow(output_variable(v.step, v.output)) if isinstance(v, Link) else v
+    values.update({n: Flow(output_variable(v.step, v.output), v.offset) if isinstance(v, Link) else v
                    for n, v in step.params.items()})
     return values
 

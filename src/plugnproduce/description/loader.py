@@ -31,6 +31,7 @@ from plugnproduce.description.model import (
     Role,
     Where,
 )
+from plugnproduce.description.ranges import output_ranges
 from plugnproduce.description.rdf import term_line
 from plugnproduce.description.taskfile import _mapping, _plain, _unknown_keys
 from plugnproduce.description.taskfile import load_task as load_task
@@ -173,7 +174,7 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
     arguments = tuple(sorted((_argument(loaded, a) for a in loaded.graph.objects(s, PNP.hasArgument)),
                              key=lambda a: (a.request, a.quantity)))
     _check_arguments(arguments, transitions, loaded.path)
-    return DeviceDescription(
+    device = DeviceDescription(
         id=local_name(str(s)),
         iri=str(s),
         label=str(label) if label is not None else local_name(str(s)),
@@ -193,6 +194,11 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         stops=stops,
         arguments=arguments,
     )
+    try:  # a range its chart declares for a value it reports is a number, at its line
+        output_ranges(device)
+    except DescriptionError as exc:
+        raise ContractError(exc.message, exc.file, exc.line) from None
+    return device
 
 
 def _check_arguments(arguments: tuple[Argument, ...], transitions: tuple[ChartTransition, ...], path: Path) -> None:

@@ -290,10 +290,22 @@ class Link:
     step: str
     """The ``name:`` of the step that produces the value."""
     output: str
+    offset: tuple[float, ...] | None = None
+    """For a pose: added to the output, item by item (``[0, 0, 0.2, 0, 0, 0]``: 0.2 m above it)."""
 
-    def to_plain(self) -> dict[str, str]:
+    def to_plain(self) -> dict[str, object]:
         """The link as the task file writes it."""
-        return {"from": self.step, "output": self.output}
+        plain: dict[str, object] = {"from": self.step, "output": self.output}
+        if self.offset is not None:
+            plain["offset"] = list(self.offset)
+        return plain
+
+    def applied(self, value: object) -> object:
+        """The output ``value`` with the offset added (as it is when it is no pose of the offset's length)."""
+        if self.offset is None or not isinstance(value, list | tuple) or len(value) != len(self.offset) or \
+                not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value):
+            return value
+        return [v + o for v, o in zip(value, self.offset, strict=True)]
 
 
 def plain_value(value: object) -> object:

@@ -8,6 +8,7 @@ after the step whose outcome decides. Every error names the file and line.
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -231,10 +232,32 @@ def _link(value: object, path: Path, line: int) -> object:
     """A parameter value, or the earlier step's output it takes (``{from: STEP, output: NAME}``)."""
     if not isinstance(value, dict):
         return value
-    if set(value) != {"from", "output"} or not all(isinstance(v, str) for v in value.values()):
-        raise DescriptionError("a parameter taken from an earlier step reads {from: STEP, output: NAME}; found "
-                               f"{excerpt(repr(value))}", path, line)
-    return Link(str(value["from"]), str(value["output"]))
+    if not {"from", "output"} <= set(value) <= {"from", "output", "offset"} or \
+            not all(isinstance(value[k], str) for k in ("from", "output")):
+        raise DescriptionError("a parameter taken from an earlier step reads {from: STEP, output: NAME} (with "
+                               f"offset: [x, y, z, rx, ry, rz] for a pose); found {excerpt(repr(value))}", path, line)
+    return Link(str(value["from"]), str(value["output"]), _offset(value.get("offset"), path, line))
+
+
+OFFSET_SIZE = 6
+"""An offset is added to a pose: x, y, z (m), rx, ry, rz (deg)."""
+
+
+def _offset(value: object, path: Path, line: int) -> tuple[float, ...] | None:
+    """A link's offset: six finite numbers, or None if it has none."""
+    if value is None:
+        return None
+    numbers: list[float] = []
+    if isinstance(value, list) and len(value) == OFFSET_SIZE:
+        for v in value:
+            try:
+                numbers.append(float(v) if isinstance(v, int | float) and not isinstance(v, bool) else math.nan)
+            except OverflowError:  # a whole number too large for any pose
+                numbers.append(math.inf)
+    if len(numbers) != OFFSET_SIZE or not all(math.isfinite(v) for v in numbers):
+        raise DescriptionError(f"an offset is a pose's change [x, y, z, rx, ry, rz] (metres, degrees): six finite "
+                               f"numbers; found {excerpt(repr(value))}", path, line)
+    return tuple(numbers)
 
 
 def _step_entry(task: Task, s: Step) -> dict[str, object]:

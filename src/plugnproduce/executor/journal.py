@@ -145,6 +145,8 @@ def describe(record: dict[str, Any]) -> str:
         return f"step {record.get('step')}: {record.get('command')}"
     if kind == "command":
         return f"→ {record.get('device')}: {record.get('command')} {record.get('params') or ''}".rstrip()
+    if kind == "event" and record.get("ignored"):
+        return f"← {record.get('device')}: {record.get('event')} (not acted on: {record.get('ignored')})"
     if kind == "event":
         return f"← {record.get('device') or 'chart'}: {record.get('event')}"
     if kind == "state":
@@ -161,8 +163,9 @@ def describe(record: dict[str, Any]) -> str:
         return f"FAULT {record.get('fault')}: {record.get('message')}"
     if kind == "stop":
         if record.get("request") is None:
-            why = f" ({record['answer']})" if record.get("answer") else " (takes no stop request there)"
-            return f"stop {record.get('device')}: left in state {record.get('state')}{why}"
+            if record.get("answer"):
+                return f"stop {record.get('device')}: {record['answer']}; last seen in state {record.get('state')}"
+            return f"stop {record.get('device')}: reports state {record.get('state')}, which takes no stop request"
         return (f"stop {record.get('device')}: {record.get('request')} {record.get('answer')}; "
                 f"now in state {record.get('state')}")
     return f"end: {record.get('outcome')}" + (f" ({record.get('reason')})" if record.get("reason") else "")

@@ -27,7 +27,7 @@ import asyncio
 import contextlib
 import hashlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -36,9 +36,11 @@ from plugnproduce.codegen.flow import branch_variable
 from plugnproduce.codegen.task import STEP
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
-from plugnproduce.executor import values
+from plugnproduce.executor import outcomes, values
 from plugnproduce.executor.journal import Journal
 from plugnproduce.executor.links import DeviceLink, open_link
+from plugnproduce.executor.monitor import Breach, Monitor
+from plugnproduce.executor.report import Fault, RunReport
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
 from plugnproduce.statechart.model import StateNode
@@ -55,51 +57,6 @@ STOP_TIMEOUT = 5.0
 """The longest wait, in seconds, for each answer of the safe stop (a device's command timeout if shorter)."""
 
 _COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("command", "device", "deviceState"))
-
-
-@dataclass(frozen=True)
-class Fault:
-    """What stopped a run.
-
-    ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected``, ``chart`` (the task chart
-    broke down) or ``stopped``.
-    """
-
-    kind: str
-    message: str
-    step: int | None = None
-    command: str | None = None
-    device: str | None = None
-    state: str | None = None
-    """The device's chart state as the controller last saw it (for a request: when it was sent)."""
-    request: str | None = None
-    """The device request the fault concerns, if any."""
-
-    def __str__(self) -> str:
-        where = f"step {self.step} ({self.command})" if self.step is not None else "before the first step"
-        device = f", device {self.device} in state {self.state}" if self.device else ""
-        request = f", request {self.request}" if self.request else ""
-        return f"{self.kind} at {where}{device}{request}: {self.message}"
-
-    def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict."""
-        return {"fault": self.kind, "message": self.message, "step": self.step, "command": self.command,
-                "device": self.device, "state": self.state, "request": self.request}
-
-
-@dataclass
-class RunReport:
-    """How a run ended: ``succeeded``, ``failed`` or ``stopped``, and where each device was left."""
-
-    outcome: str
-    journal: Path
-    fault: Fault | None = None
-    device_states: dict[str, str] = field(default_factory=dict)
-
-    def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict."""
-        return {"outcome": self.outcome, "journal": str(self.journal),
-                "fault": self.fault.to_json() if self.fault else None, "device_states": dict(self.device_states)}
 
 
 @dataclass(frozen=True)
@@ -134,7 +91,7 @@ class TaskRun:
     """One run of a generated task in a cell whose devices carry their real endpoints."""
 
     def __init__(self, generated: GeneratedTask, cell: Cell, journal_path: Path,
-                 observer: RecordObserver | None = None) -> None:
+                 observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> None:
         self.generated = generated
         self.cell = cell
         self.journal_path = journal_path
@@ -150,6 +107,15 @@ class TaskRun:
         self._journal: Journal | None = None
         self._links: dict[str, DeviceLink] = {}
         self._commands: set[asyncio.Task[None]] = set()
+        self._monitor = Monitor(generated, cell)
+        self._prefixes = dict(prefixes or outcomes.DEFAULT_PREFIXES)
+        self._unanswered: dict[str, int] = {}
+        """Per device, its commands not yet answered (or held back behind another's): its events and the states
+        the chart enters for it wait until they are."""
+        self._held: dict[str, list[tuple[int | None, str, dict[str, Any]]]] = {}
+        self._unconfirmed: dict[str, list[tuple[int | None, str]]] = {}
+        self._late: Fault | None = None
+        """A timer that fired while its device's command was not answered yet."""
         self.fault: Fault | None = None
         self._faulted = asyncio.Event()
         self.step: int | None = None
@@ -169,9 +135,12 @@ class TaskRun:
                     await self._loop.run()
                 if self.fault is None:  # the chart is done; the commands not yet answered still may fail it
                     await self._answers()
+                if self.fault is None and self._late is not None:
+                    self._fail(self._late)
             except ExecutionError as exc:  # the task chart itself broke down: a fault like any other
                 self._fail(Fault("chart", str(exc), self.step, self.command))
             finally:
+                self._journal_held()
                 if self.fault is not None or self.interpreter.final_state != DONE:
                     await self._safe_stop()
                 for task in self._commands:
@@ -207,33 +176,66 @@ class TaskRun:
     def send(self, event: Event, target: str | None, type: str) -> None:  # noqa: A002 - the SCXML name
         """The chart's I/O processor: send a device command (it goes out after the macrostep).
 
-        After a fault nothing goes out: the chart is on its way to ``failed``.
+        Each argument is first held to the device's contract (:class:`Monitor`): a breach is a fault, and the
+        request is not sent. A command goes out only once every command sent before it is answered; after a
+        fault nothing goes out: the chart is on its way to ``failed``.
         """
         if self.fault is not None:
             return
         command = Command.parse(event.name)
         if command is None or command.kind != "request" or target is None or target not in self._links:
             raise PlugNProduceError(f"cannot send {event.name!r} to {target!r}: not a request to a device of the cell")
-        params = dict(event.data or {})
-        self._record("command", step=self.step, device=target, command=command.name, params=params)
-        for value in values.used(self.generated, self.step, target, params, self.interpreter.dm):
-            self._record("value", **value)
+        given = dict(event.data or {})
         # Whatever becomes of the command is told of the step that sent it and the state its device was in then.
         sent = Fault("", "", self.step, self.command, target, self.device_states.get(target), command.name)
-        task = asyncio.get_running_loop().create_task(self._request(sent, target, command.name, params))
+        checked = self._monitor.check(self.step, target, command.name, given, self.interpreter.dm)
+        if isinstance(checked, Breach):
+            self._fail(replace(sent, kind="contract", message=checked.message(target, command.name),
+                               argument=checked.argument))
+            return
+        used = values.used(self.generated, self.step, target, given, self.interpreter.dm)
+        earlier = tuple(self._commands)
+        self._unanswered[target] = self._unanswered.get(target, 0) + 1
+        task = asyncio.get_running_loop().create_task(self._request(sent, checked, used, earlier))
         self._commands.add(task)
         task.add_done_callback(self._commands.discard)
 
-    async def _request(self, sent: Fault, device: str, name: str, params: Mapping[str, Any]) -> None:
+    async def _request(self, sent: Fault, params: dict[str, Any], used: list[dict[str, Any]],
+                       earlier: tuple[asyncio.Task[None], ...]) -> None:
+        device, name = sent.device or "", sent.request or ""
+        try:
+            if earlier:  # each bounded by its device's timeout; a fault among them holds this one back for good
+                await asyncio.wait(earlier)
+            if self.fault is not None:
+                return
+            self._record("command", step=sent.step, device=device, command=name, params=params)
+            for value in used:
+                self._record("value", **value)
+            await self._send_one(sent, device, name, params)
+        finally:
+            self._unanswered[device] -= 1
+            if not self._unanswered[device] and self.fault is None:
+                self._release(device)
+
+    async def _send_one(self, sent: Fault, device: str, name: str, params: Mapping[str, Any]) -> None:
         timeout = self.cell.device(device).command_timeout
         try:
             await self._links[device].request(name, params, timeout)
         except ProtocolTimeout:
-            self._fail(replace(sent, kind="timeout", message=f"command {name}: no answer within {timeout:g} s"))
+            self._fail(replace(sent, kind="timeout", message=f"command {name}: no answer within {timeout:g} s; it "
+                               f"was sent, and whether {device} carries it out is not known"))
         except ProtocolConnectionError as exc:
             self._fail(replace(sent, kind="lost", message=f"command {name}: {exc}"))
         except PlugNProduceError as exc:
             self._fail(replace(sent, kind="refused", message=f"command {name}: {exc}"))
+
+    def _release(self, device: str) -> None:
+        """Every command to ``device`` is answered: journal the states the chart entered for it meanwhile, and
+        hand its events that came meanwhile to the chart."""
+        for step, state in self._unconfirmed.pop(device, []):
+            self._enter_state(step, device, state)
+        for step, name, params in self._held.pop(device, []):
+            self._deliver(step, device, name, params)
 
     async def _answers(self) -> None:
         """Wait until every command sent is answered (each bounded by its timeout) or a fault comes first."""
@@ -277,12 +279,45 @@ class TaskRun:
     def _on_event(self, device: str, name: str, params: Mapping[str, Any]) -> None:
         if self.fault is not None:
             return
+        if self._unanswered.get(device):  # an event before the answer to the command that caused it: wait for it
+            self._held.setdefault(device, []).append((self.step, name, dict(params)))
+            return
+        self._deliver(self.step, device, name, dict(params))
+
+    def _deliver(self, step: int | None, device: str, name: str, params: dict[str, Any]) -> None:
         protocol = self.cell.device(device).protocol
         event = f"{device}.{protocol}.event.{name}"
-        self._record("event", step=self.step, device=device, event=name, params=dict(params))
-        for value in values.produced(self.generated, self.step, device, params):
+        self._record("event", step=step, device=device, event=name, params=params)
+        params = self._with_outcome(step, device, params)
+        if self.fault is not None:
+            return
+        for value in values.produced(self.generated, step, device, params):
             self._record("value", **value)
+        self._monitor.reported(step, device, params)
         self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too
+
+    def _with_outcome(self, step: int | None, device: str, params: dict[str, Any]) -> dict[str, Any]:
+        """``params`` with the outcome the device reports resolved to the local name the chart compares
+        (:mod:`~plugnproduce.executor.outcomes`); an outcome its step's process does not declare is a fault."""
+        chart = self.generated.steps[step - 1] if step is not None and 1 <= step <= len(self.generated.steps) else None
+        role = chart.process.outcome_role() if chart is not None else None
+        if chart is None or role is None or chart.binding.get(role.name) != device or outcomes.PARAM not in params:
+            return params
+        declared = chart.process.outcomes
+        resolved = outcomes.resolve(params[outcomes.PARAM], declared, self._prefixes)
+        if resolved is None:
+            why = outcomes.undeclared(device, params[outcomes.PARAM], chart.process.id, declared)
+            self._fail(self._fault("outcome", device, why))
+            return params
+        return {**params, outcomes.PARAM: local_name(resolved)}
+
+    def _journal_held(self) -> None:
+        """The events that came from a device whose command was never answered: known, never acted on."""
+        for device, events in self._held.items():
+            for step, name, params in events:
+                self._record("event", step=step, device=device, event=name, params=params,
+                             ignored="it came before the answer to a command, which never came")
+        self._held.clear()
 
     def _on_lost(self, device: str, reason: str) -> None:
         self._fail(self._fault("lost", device, reason))
@@ -294,7 +329,7 @@ class TaskRun:
 
     def _on_meta(self, meta: MetaEvent) -> None:
         """A state entered: journal a new step, and a device's new state, in the order they happen."""
-        if meta.name != STATE_ENTERED:
+        if meta.name != STATE_ENTERED or self.fault is not None:  # after a fault the chart's states say nothing
             return
         info = self._states.get(meta.data["state"])
         if info is None:
@@ -304,9 +339,15 @@ class TaskRun:
             self._branch_taken(done, self.step)
             self._record("step", step=self.step, command=info.command, bindings=self._bindings.get(self.step, {}))
         if info.device is not None and info.device_state is not None:
-            if self.device_states.get(info.device) != info.device_state:
-                self.device_states[info.device] = info.device_state
-                self._record("state", step=self.step, device=info.device, state=info.device_state)
+            if self._unanswered.get(info.device):  # known only once the command that leads there is answered
+                self._unconfirmed.setdefault(info.device, []).append((self.step, info.device_state))
+            else:
+                self._enter_state(self.step, info.device, info.device_state)
+
+    def _enter_state(self, step: int | None, device: str, state: str) -> None:
+        if self.device_states.get(device) != state:
+            self.device_states[device] = state
+            self._record("state", step=step, device=device, state=state)
 
     def _branch_taken(self, done: int | None, starts: int) -> None:
         """After a step with branches, journal which branch the run takes (``branch: null``: none)."""
@@ -325,8 +366,12 @@ class TaskRun:
             return
         if event.name.startswith("timeout."):
             device = event.name.removeprefix("timeout.")
-            self._fail(self._fault("timeout", device, f"no event from {device} within "
-                                                      f"{self.cell.device(device).command_timeout:g} s"))
+            late = self._fault("timeout", device, f"no event from {device} within "
+                                                  f"{self.cell.device(device).command_timeout:g} s")
+            if self._unanswered.get(device):  # its command's own bounded wait tells of it first; if that command
+                self._late = self._late or late  # is answered after all, this timeout stands
+                return
+            self._fail(late)
         elif not step.transitions and event.name != FAULT_EVENT and self.fault is None:
             device = event.name.partition(".")[0]
             self._fail(self._fault("unexpected", device, f"event {event.name.split('.', 3)[-1]} is not what the "

@@ -38,7 +38,8 @@ def used(generated: GeneratedTask, step: int | None, device: str, params: Mappin
         parameter = s.process.parameter(name)
         carried = local_name(parameter.quantity)
         variable = output_variable(link.step, link.output)
-        if s.binding.get(parameter.role) == device and carried in params and params[carried] == datamodel.get(variable):
+        if s.binding.get(parameter.role) == device and carried in params and \
+                params[carried] == link.applied(datamodel.get(variable)):
             out.append({"value": f"{link.step}.{link.output}", "used": params[carried], "step": step,
                         "device": device, "parameter": name})
     return out

@@ -63,6 +63,8 @@ class ExecutorRunner:
         try:  # planned from the state each device reports, not its chart's initial state
             reported = cell.reported(await service.reported_states(cell))
             generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)
+            prefixes = await asyncio.to_thread(  # how devices may name concepts (pnp:PartFound)
+                lambda: (self._knowledge or service.knowledge()).prefixes)
         except service.StateNotReported as exc:
             raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
         except service.ImplausibleTask as exc:
@@ -75,7 +77,7 @@ class ExecutorRunner:
             started.set()
             observer(run_id, record)
 
-        run = service.start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe)
+        run = service.start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes)
         self._loop = asyncio.get_running_loop()
         running = asyncio.create_task(run.run(), name=f"run {run_id}")
         running.add_done_callback(self._finished)

@@ -48,12 +48,16 @@ def _number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-LINK_HELP = "an earlier step's output {from: STEP, output: NAME}"
+LINK_HELP = "an earlier step's output {from: STEP, output: NAME} (with offset: [x, y, z, rx, ry, rz] for a pose)"
 NAME_SCHEMA = {"type": "string", "maxLength": 200}
 
 
 def _link(value: dict[Any, Any]) -> bool:
-    return set(value) == {"from", "output"} and all(isinstance(v, str) and 0 < len(v) <= 200 for v in value.values())
+    """A link's form (the task reader judges its offset's numbers)."""
+    offset = value.get("offset")
+    return {"from", "output"} <= set(value) <= {"from", "output", "offset"} and \
+        all(isinstance(value[k], str) and 0 < len(value[k]) <= 200 for k in ("from", "output")) and \
+        (offset is None or (isinstance(offset, list) and len(offset) <= 16))
 
 
 def _param_value(value: Any) -> Any:
@@ -72,7 +76,9 @@ ParamValue = Annotated[
     AfterValidator(_param_value),
     WithJsonSchema({"anyOf": [{"type": "number"}, {"type": "string"}, {"type": "boolean"},
                               {"type": "array", "items": {"type": "number"}, "maxItems": 16},
-                              {"type": "object", "properties": {"from": NAME_SCHEMA, "output": NAME_SCHEMA},
+                              {"type": "object", "properties": {"from": NAME_SCHEMA, "output": NAME_SCHEMA,
+                                                                "offset": {"type": "array", "items": {"type": "number"},
+                                                                           "minItems": 6, "maxItems": 6}},
                                "required": ["from", "output"], "additionalProperties": False}]}),
 ]
 

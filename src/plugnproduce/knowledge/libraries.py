@@ -10,6 +10,7 @@ and the catalogue of devices. Two libraries may not define the same process or d
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -22,6 +23,7 @@ from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.errors import DescriptionError, OntologyError
 from plugnproduce.ontology.sources import with_imports
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
+from plugnproduce.ontology.vocabulary import PNP_IRI
 from plugnproduce.resources import descriptions_path, ontology_path
 
 KINDS = ("ontology", "devices", "processes", "cells", "tasks")
@@ -76,6 +78,10 @@ def env_folders(value: str | None) -> list[str]:
     return [part for part in (value or "").split(":") if part.strip()]
 
 
+_PREFIX = re.compile(r"^\s*(?:@prefix|PREFIX)\s+([A-Za-z][\w.-]*):\s*<([^<>\s]*)>", re.MULTILINE)
+"""A prefix a Turtle file declares (``@prefix pnp: <…#> .`` or ``PREFIX pnp: <…#>``)."""
+
+
 @dataclass(frozen=True)
 class Knowledge:
     """The loaded knowledge: taxonomy closure, processes and device catalogue of the libraries."""
@@ -114,6 +120,15 @@ class Knowledge:
     def tbox(self) -> rdflib.Graph:
         """The combined TBox as written (without the reasoner's closure)."""
         return read_tbox(self.ontology_files())
+
+    @cached_property
+    def prefixes(self) -> dict[str, str]:
+        """The prefixes the TBox files bind (``pnp`` → its namespace, and each library's own), by which a device
+        may name a concept (``pnp:PartFound``)."""
+        out = {"pnp": PNP_IRI}
+        for f in self.ontology_files():
+            out.update((m[1], m[2]) for m in _PREFIX.finditer(f.read_text(encoding="utf-8", errors="replace")))
+        return out
 
     def cell_files(self) -> list[Path]:
         """Every cell file of the libraries."""

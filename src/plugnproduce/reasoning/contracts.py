@@ -16,9 +16,9 @@ import dataclasses
 import math
 from collections.abc import Iterator, Sequence
 
+from plugnproduce.description.contracts import breach
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Parameter, ProcessDescription, Task
 from plugnproduce.description.units import Amount, UnitError, convert, read_amount
-from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.facts import DATATYPES
 from plugnproduce.reasoning.results import Problem, Reason, StepCheck
 
@@ -118,35 +118,6 @@ def _beyond_own_range(value: object, par: Parameter) -> bool:
 
 
 def _beyond(value: object, par: Parameter, contract: Argument) -> str | None:
-    """Why ``value`` (in the parameter's unit) breaks the device's contract, or None if it keeps it."""
-    if contract.reach is not None:
-        position = _position(value)
-        if position is not None and math.dist(position, (0.0, 0.0, 0.0)) > contract.reach:
-            distance = math.dist(position, (0.0, 0.0, 0.0))
-            return f"reaches at most {contract.reach:g} m from its base; the pose is {distance:.3g} m away"
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        return None
-    try:
-        number = convert(float(value), par.unit, contract.unit)
-    except UnitError as exc:
-        return (f"takes {local_name(contract.quantity)} in {contract.unit}; the process gives it in "
-                f"{par.unit or 'no unit'} ({exc})")
-    unit = f" {contract.unit}" if contract.unit else ""
-    shown = f"{value:g} {par.unit}".strip() if par.unit != contract.unit else f"{number:g}{unit}"
-    if contract.minimum is not None and number < contract.minimum:
-        return f"takes at least {contract.minimum:g}{unit}; the value is {shown}"
-    if contract.maximum is not None and number > contract.maximum:
-        return f"takes at most {contract.maximum:g}{unit}; the value is {shown}"
-    return None
-
-
-def _position(value: object) -> tuple[float, float, float] | None:
-    """The x, y, z of a pose written as a list or as six numbers in a string."""
-    items = value.split() if isinstance(value, str) else value
-    if not isinstance(items, list | tuple) or len(items) != 6:
-        return None
-    try:
-        x, y, z = (float(v) for v in items[:3])
-    except (TypeError, ValueError):
-        return None
-    return (x, y, z) if all(math.isfinite(v) for v in (x, y, z)) else None
+    """Why ``value`` (in the parameter's unit) breaks the device's contract, or None if it keeps it
+    (the one definition, :func:`plugnproduce.description.contracts.breach`; the type check tells of a wrong type)."""
+    return breach(value, par.unit, contract, types=False)

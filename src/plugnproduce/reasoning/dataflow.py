@@ -25,9 +25,11 @@ from plugnproduce.description.model import (
     Task,
 )
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
 from plugnproduce.reasoning.results import Problem, Reason, StepCheck
 from plugnproduce.statechart.model import Send, walk
+
+POSE = PNP_IRI + "Pose"
 
 
 def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[Problem]:
@@ -86,7 +88,11 @@ def _link_text(step: Step, link: Link, named: dict[str, Step], processes: dict[s
     if link.output not in {o.name for o in process.outputs}:
         outputs = ", ".join(o.name for o in process.outputs) or "none"
         return f"{head}, but {process.id} gives back no {link.output!r}; its outputs: {outputs}", (process.iri,)
-    return _fit(head, process.output(link.output), parameter, taxonomy)
+    output = process.output(link.output)
+    if link.offset is not None and output.datatype != POSE:
+        return (f"{head} with an offset, but {link.output} is a {local_name(output.datatype)}; only a pose takes an "
+                "offset [x, y, z, rx, ry, rz]", (output.datatype,))
+    return _fit(head, output, parameter, taxonomy)
 
 
 def _fit(head: str, output: Output, parameter: Parameter, taxonomy: Taxonomy) -> tuple[str, tuple[str, ...]]:

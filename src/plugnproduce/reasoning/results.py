@@ -148,6 +148,30 @@ class StepCheck:
 
 
 @dataclass(frozen=True)
+class LinkSafety:
+    """One parameter taken from an earlier step's output, and whether the check proves it safe."""
+
+    step: int
+    command: str
+    parameter: str
+    source: str
+    """``STEP.OUTPUT``."""
+    device: str
+    proven: bool
+    why: str
+
+    def __str__(self) -> str:
+        verdict = "proven within the contract" if self.proven else "checked at run time"
+        return f"step {self.step} ({self.command}): {self.parameter} from {self.source}: {verdict} ({self.why})"
+
+    def to_json(self) -> dict[str, object]:
+        """A JSON-ready dict."""
+        return {"step": self.step, "command": self.command, "parameter": self.parameter, "source": self.source,
+                "device": self.device, "proven": self.proven, "why": self.why,
+                "checked": "before the run" if self.proven else "at run time"}
+
+
+@dataclass(frozen=True)
 class CheckResult:
     """The plausibility of a task in a cell."""
 
@@ -157,6 +181,9 @@ class CheckResult:
     problems: tuple[Problem, ...]
     steps: tuple[StepCheck, ...]
     final_states: dict[str, str] = field(default_factory=dict)
+    links: tuple[LinkSafety, ...] = ()
+    """Per value taken from an earlier step's output: proven within its device's contract, or checked at run
+    time (:class:`plugnproduce.reasoning.linksafety.LinkSafety`)."""
 
     def bindings(self) -> list[dict[str, str]]:
         """Role bindings per step (for code generation; complete only when plausible)."""
@@ -166,7 +193,7 @@ class CheckResult:
         """A JSON-ready dict."""
         return {"task": self.task, "cell": self.cell, "plausible": self.plausible,
                 "problems": [p.to_json() for p in self.problems], "steps": [s.to_json() for s in self.steps],
-                "final_states": dict(self.final_states)}
+                "final_states": dict(self.final_states), "links": [link.to_json() for link in self.links]}
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from plugnproduce.description.contracts import breach
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.vocabulary import local_name
 
@@ -31,11 +32,8 @@ def argument_problems(device: DeviceDescription, transition: ChartTransition, ar
                 problems.append(f"lacks the argument {name} that its transition accepts")
         elif not _finite(value):
             problems.append(f"argument {name} is {value!r}, not a finite value")
-        elif isinstance(value, int | float) and not isinstance(value, bool) and (
-                (contract.minimum is not None and value < contract.minimum)
-                or (contract.maximum is not None and value > contract.maximum)):
-            problems.append(f"argument {name} is {value!r}, outside the device's limits "
-                            f"[{contract.minimum}, {contract.maximum}] {contract.unit}".rstrip())
+        elif (why := breach(value, contract.unit, contract, types=False)) is not None:
+            problems.append(f"argument {name} is {value!r}, outside the device's limits: it {why}")
     return problems
 
 
