@@ -63,6 +63,7 @@ from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescr
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import lifting, repairs, solver
 from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program
 from plugnproduce.reasoning.plausibility import TASK
@@ -226,7 +227,8 @@ def windowed_repair(
     changes no cost)."""
     costs = costs or RepairCosts()
     book = fact_book(taxonomy, processes)
-    facts = cell_program(book, cell) + program(task_facts(task, TASK)) + program([s.Check(CELL, TASK)])
+    readable, _ = normalised(task, processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
+    facts = cell_program(book, cell) + program(task_facts(readable, TASK)) + program([s.Check(CELL, TASK)])
     chain = _Chain(task, solver.symbols(solver.CHECK, facts))
     if top < 1 or chain.plausible:  # plausible to the encodings: whatever else check() finds, repair.lp cannot fix
         return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap) if top >= 1 else []
@@ -324,7 +326,8 @@ class _Solver:
         steps = self.chain.task.steps[w.first - 1:w.last]
         sub = Task(self.chain.task.name, tuple(replace(st, index=k) for k, st in enumerate(steps, start=1)),
                    self.chain.task.file)
-        facts = (cell_program(self.book, entering, bought) + program(task_facts(sub, TASK))
+        facts = (cell_program(self.book, entering, bought) + repairs.task_program(sub, [*cell.devices, *bought],
+                                                                                  self.book)
                  + program(repairs.horizon(sub, self.per_gap, None))
                  + program(repairs.cost_facts(costs or self.costs, self.book.processes, bought))
                  + program(s.Catalogue(d.id) for d in bought)
