@@ -250,6 +250,11 @@ def explain_plausible(task_or_path: TaskArg, cell_or_path: CellArg, n: int, know
                                none_exists=None if ex.counterfactuals or edits else ex.none_exists)
 
 
+MORE_REPAIRS = 3
+"""How many times :func:`assessed_repairs` asks the solver (for ``top``, then ``2 top``, ... repairs) while the
+check refuses some of them."""
+
+
 def assessed_repairs(
     task_or_path: TaskArg,
     cell_or_path: CellArg,
@@ -257,13 +262,20 @@ def assessed_repairs(
     top: int = 3,
     knowledge: Knowledge | None = None,
 ) -> list[reasoning.AssessedRepair]:
-    """The repairs of :func:`repair`, each confirmed by checking it again and with its side effects; those that
-    lose a held part or move a device a later step relies on rank below those that do not."""
+    """The repairs of :func:`repair` that checking them again confirms, with their side effects, ranked by their
+    worst side effect, then by cost (:func:`plugnproduce.reasoning.sideeffects.ranking`). When the check refuses
+    some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds."""
     the_cell, k = _context(cell_or_path, knowledge)
     the_task = _as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
-    repairs = repair(the_task, the_cell, devices, top, knowledge=k)
-    return reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
+    asked = top
+    for _ in range(MORE_REPAIRS):
+        repairs = repair(the_task, the_cell, devices, asked, knowledge=k)
+        assessed = reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
+        if len(assessed) >= top or len(repairs) < asked:
+            break
+        asked += top
+    return assessed[:top]
 
 
 def batch(
