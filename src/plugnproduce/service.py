@@ -27,7 +27,7 @@ from plugnproduce.description.loader import (
     parse_task,
     task_to_yaml,
 )
-from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.description.model import Cell, DeviceDescription, Link, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
 from plugnproduce.resources import descriptions_path
@@ -456,6 +456,21 @@ DISCOVERY_SECONDS = 10.0
 """How long a run or a live check waits for the cell's devices on the network, unless told."""
 SIMULATED_DISCOVERY_SECONDS = 60.0
 """The same for the devices a run simulates itself: they are up, so only a busy machine delays their answers."""
+
+DEFAULT_BIN_PARTS = 5
+"""Parts in the simulated bin (placed by seed 0 unless told) that a simulated run of a task taking a reported
+value gets when no bin is asked for (``--bin-parts``)."""
+
+
+def default_bin_parts(task_or_path: TaskArg) -> int | None:
+    """How many parts a simulated bin needs for a run of this task when none was asked for:
+    :data:`DEFAULT_BIN_PARTS` when a step takes a value another step reports (a data link, such as the pose
+    where a localisation found a part), so that the parts it finds are taken out and the bin empties; None for
+    a task that takes no reported value (the simulated devices report their charts' fixed values, and a bin
+    would refuse a move to a fixed pose where no part lies)."""
+    the_task = _as_task(task_or_path)
+    takes = any(isinstance(v, Link) for step in the_task.steps for v in step.params.values())
+    return DEFAULT_BIN_PARTS if takes else None
 
 
 async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cell:
