@@ -22,50 +22,73 @@ from plugnproduce.reasoning.contracts import refuses, why_refused
 from plugnproduce.reasoning.terms import Atom
 
 
-class _Terms:
-    """The answers of :func:`refuses` and :func:`accepts` for the devices with the skill a parameter's role needs
-    (no other device can be bound to it), each asked once per parameter and value."""
+class Refusals:
+    """The answers of :func:`refuses` and :func:`accepts` for one repair: each asked once per device, parameter
+    and value (a device is known by its id: within one repair, the same id is the same device), and only of the
+    devices with the skill a parameter's role needs (no other device can be bound to it)."""
 
-    def __init__(self, devices: Sequence[DeviceDescription], taxonomy: Taxonomy) -> None:
-        self.devices = tuple({d.id: d for d in devices}.values())
+    def __init__(self, taxonomy: Taxonomy) -> None:
         self.taxonomy = taxonomy
-        self._players: dict[str, tuple[DeviceDescription, ...]] = {}
-        self._refusing: dict[tuple[str, str], tuple[str, ...]] = {}
-        self._deaf: dict[str, tuple[str, ...]] = {}
+        self._plays: dict[tuple[str, str], bool] = {}
+        self._refuses: dict[tuple[str, str, str], bool] = {}
+        self._deaf: dict[tuple[str, str], bool] = {}
+        self._defaults: dict[tuple[str, ...], list[Atom]] = {}
 
-    def players(self, proc: ProcessDescription, par: Parameter) -> tuple[DeviceDescription, ...]:
-        """The devices that have the skill the role of ``par`` requires."""
-        if par.iri not in self._players:
-            role = next((r for r in proc.roles if r.name == par.role), None)
-            self._players[par.iri] = tuple(d for d in self.devices if role is not None
-                                           and any(self.taxonomy.is_a(k, role.required_skill) for k in d.skills))
-        return self._players[par.iri]
+    def _players(self, devices: Sequence[DeviceDescription], proc: ProcessDescription,
+                 par: Parameter) -> list[DeviceDescription]:
+        role = next((r for r in proc.roles if r.name == par.role), None)
+        out = []
+        for d in devices:
+            key = (d.id, par.iri)
+            if key not in self._plays:
+                self._plays[key] = role is not None and any(self.taxonomy.is_a(k, role.required_skill)
+                                                            for k in d.skills)
+            if self._plays[key]:
+                out.append(d)
+        return out
 
-    def refusing(self, proc: ProcessDescription, par: Parameter, value: object) -> tuple[str, ...]:
+    def refusing(self, devices: Sequence[DeviceDescription], proc: ProcessDescription, par: Parameter,
+                 value: object) -> list[str]:
         """The devices that could play the role of ``par`` and refuse ``value`` by their own limits."""
-        key = (par.iri, repr(value))
-        if key not in self._refusing:
-            self._refusing[key] = tuple(d.id for d in self.players(proc, par) if refuses(d, value, par))
-        return self._refusing[key]
+        out = []
+        for d in self._players(devices, proc, par):
+            key = (d.id, par.iri, repr(value))
+            if key not in self._refuses:
+                self._refuses[key] = refuses(d, value, par)
+            if self._refuses[key]:
+                out.append(d.id)
+        return out
 
-    def deaf(self, proc: ProcessDescription, par: Parameter) -> tuple[str, ...]:
+    def deaf(self, devices: Sequence[DeviceDescription], proc: ProcessDescription, par: Parameter) -> list[str]:
         """The devices that could play the role of ``par`` and none of whose requests accepts its quantity."""
-        if par.iri not in self._deaf:
-            self._deaf[par.iri] = tuple(d.id for d in self.players(proc, par)
-                                        if not accepts(d, par.quantity, self.taxonomy))
-        return self._deaf[par.iri]
+        out = []
+        for d in self._players(devices, proc, par):
+            key = (d.id, par.iri)
+            if key not in self._deaf:
+                self._deaf[key] = not accepts(d, par.quantity, self.taxonomy)
+            if self._deaf[key]:
+                out.append(d.id)
+        return out
+
+    def defaults(self, devices: Sequence[DeviceDescription], processes: Sequence[ProcessDescription]) -> list[Atom]:
+        """``default_refused/3`` of every parameter's default over ``devices``."""
+        key = tuple(sorted({d.id for d in devices}))
+        if key not in self._defaults:
+            self._defaults[key] = [s.DefaultRefused(proc.id, par.name, d) for proc in processes
+                                   for par in proc.parameters if par.default is not None
+                                   for d in self.refusing(devices, proc, par, par.default)]
+        return self._defaults[key]
 
 
 def refusal_facts(task: Task, name: str, devices: Sequence[DeviceDescription],
-                  processes: Sequence[ProcessDescription], taxonomy: Taxonomy) -> list[Atom]:
+                  processes: Sequence[ProcessDescription], taxonomy: Taxonomy,
+                  known: Refusals | None = None) -> list[Atom]:
     """``value_refused/4`` for each step's values (``task`` with its quantities in their parameters' units) and
-    ``default_refused/3`` for each parameter's default, over ``devices`` (the cell's and the catalogue's)."""
-    terms = _Terms(devices, taxonomy)
-    out: list[Atom] = []
-    for proc in processes:
-        for par in proc.parameters:
-            if par.default is not None:
-                out += [s.DefaultRefused(proc.id, par.name, d) for d in terms.refusing(proc, par, par.default)]
+    ``default_refused/3`` for each parameter's default, over ``devices`` (the cell's and the catalogue's);
+    ``known``: the answers found so far in the same repair."""
+    known = known or Refusals(taxonomy)
+    devices = list({d.id: d for d in devices}.values())
+    out = list(known.defaults(devices, processes))
     by_id = {p.id: p for p in processes}
     for step in task.steps:
         command = by_id.get(step.command)
@@ -73,9 +96,9 @@ def refusal_facts(task: Task, name: str, devices: Sequence[DeviceDescription],
             continue
         for par in command.parameters:
             value = step.params.get(par.name, par.default)
-            refusing = set(terms.refusing(command, par, value)) if value is not None else set()
+            refusing = set(known.refusing(devices, command, par, value)) if value is not None else set()
             if par.name in step.params:
-                refusing.update(terms.deaf(command, par))
+                refusing.update(known.deaf(devices, command, par))
             out += [s.ValueRefused(name, step.index, par.name, d) for d in sorted(refusing)]
     return out
 

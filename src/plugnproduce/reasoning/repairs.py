@@ -23,7 +23,7 @@ from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program
 from plugnproduce.reasoning.plausibility import TASK, check
-from plugnproduce.reasoning.refusals import refusal_facts, reset_reason
+from plugnproduce.reasoning.refusals import Refusals, refusal_facts, reset_reason
 from plugnproduce.reasoning.results import Edit, Repair, RepairCosts
 from plugnproduce.reasoning.terms import Atom, Model, program
 
@@ -85,17 +85,19 @@ def outcome(model: Model, task: Task) -> Hashable:
     return commands, tuple(added)
 
 
-def task_program(task: Task, devices: Sequence[DeviceDescription], book: FactBook) -> str:
+def task_program(task: Task, devices: Sequence[DeviceDescription], book: FactBook,
+                 known: Refusals | None = None) -> str:
     """The facts of a task to repair: its values read in their parameters' units (``"40 %"`` is the number 40, as
     the check reads it; a value that cannot be read stays as written, to be reset), and which of ``devices`` (the
-    cell's and the catalogue's) refuse which of them (:mod:`.refusals`)."""
+    cell's and the catalogue's) refuse which of them (:mod:`.refusals`; ``known``: the answers so far)."""
     readable, _ = normalised(task, book.processes, keep_unreadable=True)
-    return program(task_facts(readable, TASK) + refusal_facts(readable, TASK, devices, book.processes, book.taxonomy))
+    return program(task_facts(readable, TASK)
+                   + refusal_facts(readable, TASK, devices, book.processes, book.taxonomy, known))
 
 
 def _optimise(book: FactBook, task: Task, cell: Cell, extra: Sequence[DeviceDescription], top: int,
-              costs: RepairCosts, per_gap: int, max_inserts: int | None) -> list[Model]:
-    facts = (cell_program(book, cell, extra) + task_program(task, [*cell.devices, *extra], book)
+              costs: RepairCosts, per_gap: int, max_inserts: int | None, known: Refusals) -> list[Model]:
+    facts = (cell_program(book, cell, extra) + task_program(task, [*cell.devices, *extra], book, known)
              + program(horizon(task, per_gap, max_inserts))
              + program(cost_facts(costs, book.processes, extra))
              + program(s.Catalogue(d.id) for d in extra))
@@ -120,10 +122,11 @@ def repair(
     book = fact_book(taxonomy, processes)
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
-    models = _optimise(book, task, cell, (), top, costs, per_gap, max_inserts)
+    known = Refusals(taxonomy)
+    models = _optimise(book, task, cell, (), top, costs, per_gap, max_inserts, known)
     cheapest_add = min((add_cost(costs, d) for d in extra), default=None)
     if cheapest_add is not None and (len(models) < top or models[-1].cost[0] > cheapest_add):
-        models = _optimise(book, task, cell, extra, top, costs, per_gap, max_inserts)
+        models = _optimise(book, task, cell, extra, top, costs, per_gap, max_inserts, known)
     devices = {d.id: d for d in [*extra, *cell.devices]}
     return [read_repair(m, rank, task, book, devices, costs) for rank, m in enumerate(models, start=1)]
 

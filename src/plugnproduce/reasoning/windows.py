@@ -67,6 +67,7 @@ from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program
 from plugnproduce.reasoning.plausibility import TASK
+from plugnproduce.reasoning.refusals import Refusals
 from plugnproduce.reasoning.results import Repair, RepairCosts
 from plugnproduce.reasoning.terms import Model, program
 
@@ -256,6 +257,7 @@ class _Solver:
                  memo: dict[Hashable, list[Model]]):
         self.book, self.chain, self.cell, self.costs, self.per_gap, self.top = book, chain, cell, costs, per_gap, top
         self.memo = memo
+        self.known = Refusals(book.taxonomy)
 
     def best(self, wins: list[Window], extra: list[DeviceDescription]) -> list[Repair] | None:
         """The top repairs (None when some window has no repair within its borders)."""
@@ -326,8 +328,8 @@ class _Solver:
         steps = self.chain.task.steps[w.first - 1:w.last]
         sub = Task(self.chain.task.name, tuple(replace(st, index=k) for k, st in enumerate(steps, start=1)),
                    self.chain.task.file)
-        facts = (cell_program(self.book, entering, bought) + repairs.task_program(sub, [*cell.devices, *bought],
-                                                                                  self.book)
+        facts = (cell_program(self.book, entering, bought)
+                 + repairs.task_program(sub, [*cell.devices, *bought], self.book, self.known)
                  + program(repairs.horizon(sub, self.per_gap, None))
                  + program(repairs.cost_facts(costs or self.costs, self.book.processes, bought))
                  + program(s.Catalogue(d.id) for d in bought)
