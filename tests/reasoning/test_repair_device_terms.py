@@ -120,3 +120,16 @@ def test_the_cli_proposes_the_purchase_with_the_vacuum_reset_first() -> None:
     assert [r["rank"] for r in repairs] == [1, 2, 3] and all(r["confirmed"] for r in repairs)
     assert repairs[0]["added_devices"] == ["vacuum-gripper"] and repairs[0]["cost"] == 9.09
     assert [e["parameter"] for e in repairs[0]["edits"] if e["kind"] == "reset"] == ["vacuum", "vacuum"]
+
+
+def test_a_long_task_repaired_window_by_window_keeps_the_bought_grippers_limit_and_says_why(tmp_path: Path) -> None:
+    cell = tmp_path / "no-gripper.yaml"
+    cell.write_text("cell: no-gripper\ndevices: [robot, sensor3d, binpicking-pc]\n", encoding="utf-8")
+    pair = "  - command: bin-pick\n    params: {grip_force: 120}\n  - command: place\n"
+    task = tmp_path / "long.yaml"
+    task.write_text("task: long\nsteps:\n" + 21 * pair, encoding="utf-8")  # 42 steps: window by window
+    repairs = service.assessed_repairs(task, cell, BUILTIN_DEVICES, 2)
+    bought = next(r for r in repairs if r.repair.added_devices == ("gripper",))
+    resets = [e.text for e in bought.repair.edits if e.kind == "reset"]
+    assert len(resets) == 21 and resets[0] == ("step 1 (bin-pick): reset parameter grip_force to its default 40 "
+                                               "(device 'gripper' takes at most 100 N; the value is 120 N)")

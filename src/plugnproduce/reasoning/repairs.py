@@ -177,14 +177,14 @@ def folded_repeat(steps: list[Step], most: int) -> int:
 def read_repair(model: Model, rank: int, task: Task, book: FactBook, devices: dict[str, DeviceDescription],
                 costs: RepairCosts) -> Repair:
     """A model of repair.lp as a :class:`Repair`."""
-    reader = _EditReader(task, book, devices, costs, lambda i: _bound_at(model, i))
+    reader = _EditReader(task, book, devices, costs, lambda i: bound_at(model, i))
     edits = sorted((reader.read(e.e) for e in model[s.Edit]), key=lambda e: (e.step or 0, e.kind, e.text))
     added = tuple(sorted(e.device for e in edits if e.kind == "add" and e.device))
     return Repair(rank, model.cost[0] / 100 if model.cost else 0.0, tuple(edits),
                   repaired_task(model, task), added, tuple(i for i, _ in repaired_runs(model, task)))
 
 
-def _bound_at(model: Model, i: int) -> dict[str, str]:
+def bound_at(model: Model, i: int) -> dict[str, str]:
     """The devices the repaired task binds to the roles of original step ``i`` (by role)."""
     slots = {r.s for r in model[s.Runs] if r.i == i}
     return {p.r: p.d for p in model[s.Plays] if p.s in slots}

@@ -98,6 +98,9 @@ class _Part:
     left_in: tuple[tuple[str, str], ...]
     origins: tuple[int, ...] = ()
     """The original (whole-task) step position each of :attr:`steps` keeps, 0 if inserted."""
+    reset_bound: tuple[tuple[int, tuple[tuple[str, str], ...]], ...] = ()
+    """For each original step with a value reset: the devices the repair binds to its roles (to say which
+    device's limit the value broke)."""
 
 
 def shifted(term: clingo.Symbol, offset: int) -> clingo.Symbol:
@@ -354,12 +357,18 @@ class _Solver:
         left = tuple(sorted((a.d, a.x) for a in model[s.LeftIn]))
         runs = repairs.repaired_runs(model, sub)
         origins = tuple(i + w.first - 1 if i else 0 for i, _ in runs)
-        return _Part(w, model.cost[0] if model.cost else 0, edits, tuple(st for _, st in runs), left, origins)
+        resets = sorted({e.e.arguments[0].number for e in model[s.Edit] if e.e.name == "reset"})
+        bound = tuple((i + w.first - 1, tuple(sorted(repairs.bound_at(model, i).items()))) for i in resets)
+        return _Part(w, model.cost[0] if model.cost else 0, edits, tuple(st for _, st in runs), left, origins,
+                     bound)
 
     def read(self, rank: int, combo: tuple[int, tuple[_Part, ...], tuple[str, ...]],
              reader: repairs._EditReader) -> Repair:
         """One combination as a :class:`Repair` of the whole task."""
         cost, parts, added = combo
+        bound = {i: dict(b) for p in parts for i, b in p.reset_bound}
+        reader = repairs._EditReader(reader.task, reader.book, reader.devices, reader.costs,
+                                     lambda i: bound.get(i, {}))
         terms = [t for p in parts for t in p.edits] + [clingo.Function("add", [clingo.String(a)]) for a in added]
         edits = sorted((reader.read(t) for t in terms), key=lambda e: (e.step or 0, e.kind, e.text))
         task = self.chain.task
