@@ -27,7 +27,7 @@ from plugnproduce.description.loader import (
     parse_task,
     task_to_yaml,
 )
-from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.description.model import Cell, DeviceDescription, Link, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
 from plugnproduce.resources import descriptions_path
@@ -283,6 +283,11 @@ def explain_plausible(task_or_path: TaskArg, cell_or_path: CellArg, n: int, know
                                none_exists=None if ex.counterfactuals or edits else ex.none_exists)
 
 
+MORE_REPAIRS = 3
+"""How many times :func:`assessed_repairs` asks the solver (for ``top``, then ``2 top``, ... repairs) while the
+check refuses some of them."""
+
+
 def assessed_repairs(
     task_or_path: TaskArg,
     cell_or_path: CellArg,
@@ -290,13 +295,20 @@ def assessed_repairs(
     top: int = 3,
     knowledge: Knowledge | None = None,
 ) -> list[reasoning.AssessedRepair]:
-    """The repairs of :func:`repair`, each confirmed by checking it again and with its side effects; those that
-    lose a held part or move a device a later step relies on rank below those that do not."""
+    """The repairs of :func:`repair` that checking them again confirms, with their side effects, ranked by their
+    worst side effect, then by cost (:func:`plugnproduce.reasoning.sideeffects.ranking`). When the check refuses
+    some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds."""
     the_cell, k = _context(cell_or_path, knowledge)
     the_task = _as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
-    repairs = repair(the_task, the_cell, devices, top, knowledge=k)
-    return reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
+    asked = top
+    for _ in range(MORE_REPAIRS):
+        repairs = repair(the_task, the_cell, devices, asked, knowledge=k)
+        assessed = reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
+        if len(assessed) >= top or len(repairs) < asked:
+            break
+        asked += top
+    return assessed[:top]
 
 
 def batch(
@@ -477,6 +489,21 @@ DISCOVERY_SECONDS = 10.0
 """How long a run or a live check waits for the cell's devices on the network, unless told."""
 SIMULATED_DISCOVERY_SECONDS = 60.0
 """The same for the devices a run simulates itself: they are up, so only a busy machine delays their answers."""
+
+DEFAULT_BIN_PARTS = 5
+"""Parts in the simulated bin (placed by seed 0 unless told) that a simulated run of a task taking a reported
+value gets when no bin is asked for (``--bin-parts``)."""
+
+
+def default_bin_parts(task_or_path: TaskArg) -> int | None:
+    """How many parts a simulated bin needs for a run of this task when none was asked for:
+    :data:`DEFAULT_BIN_PARTS` when a step takes a value another step reports (a data link, such as the pose
+    where a localisation found a part), so that the parts it finds are taken out and the bin empties; None for
+    a task that takes no reported value (the simulated devices report their charts' fixed values, and a bin
+    would refuse a move to a fixed pose where no part lies)."""
+    the_task = _as_task(task_or_path)
+    takes = any(isinstance(v, Link) for step in the_task.steps for v in step.params.values())
+    return DEFAULT_BIN_PARTS if takes else None
 
 
 async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cell:

@@ -63,3 +63,24 @@ def test_a_bin_needs_simulated_devices() -> None:
     result = pnp("run", str(TASKS / "bin-picking-until-empty.yaml"), "--cell",
                  str(service.builtin("cells", "bin-picking.yaml")), "--bin-parts", "3")
     assert result.returncode == 2 and "--bin-parts works on simulated devices" in result.stderr
+
+
+def test_with_sim_alone_the_task_empties_a_default_bin_of_five_parts_and_says_so(tmp_path: Path) -> None:
+    # Without --bin-parts the simulated devices used to report their charts' fixed pose: the loop picked the
+    # same pose up to its maximum (300 steps) and said succeeded. A task that takes a localized pose now gets
+    # a seeded bin of 5 parts, and the run says so.
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(TASKS / "bin-picking-until-empty.yaml"), "--sim", "--journal", str(journal))
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr
+    assert result.stdout.splitlines()[0] == ("simulated bin: 5 parts at random poses (seed 0); "
+                                             "--bin-parts N for another")
+    records = journal_of(journal)
+    found = [r["params"] for r in records if r["kind"] == "event" and r["event"] == "PartLocalized"]
+    assert [f["outcome"] for f in found] == ["PartFound"] * 5 + ["BinEmpty"]
+    assert sorted(f["part_pose"] for f in found[:-1]) == sorted(p.pose for p in SimulatedBin(5, 0).parts)
+    assert records[-1]["kind"] == "end" and records[-1]["outcome"] == "succeeded"
+
+
+def test_a_task_that_takes_no_localized_pose_gets_no_default_bin() -> None:
+    assert service.default_bin_parts(TASKS / "bin-picking.yaml") is None  # its fixed pick pose: no bin
+    assert service.default_bin_parts(TASKS / "bin-picking-localized.yaml") == 5

@@ -207,3 +207,28 @@ def test_issue_15_ctrl_c_at_the_terminal_stops_serve_and_its_workers_quietly(che
     assert code == 0, err
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert "".join(out.rest()).strip().endswith("stopped")
+
+
+def test_serve_sim_gives_the_runs_of_a_localizing_task_a_default_bin_and_says_so() -> None:
+    proc, out, lines = _start("--sim")
+    try:
+        lines += [out.next().strip(), out.next().strip(), out.next().strip()]
+        assert lines[3] == ("simulated bin: 5 parts at random poses (seed 0) for the runs of tasks that take a "
+                            "localized pose; --bin-parts N for another")
+        url, token = lines[0].rsplit(" ", 1)[1], lines[2].removeprefix("token: ")
+        auth = {"Authorization": f"Bearer {token}"}
+        views = {}
+        for name in ("bin-picking-until-empty", "bin-picking"):  # the fixed-pose task runs on the charts' values
+            yaml = (service.builtin("tasks") / f"{name}.yaml").read_bytes()
+            task = httpx.post(url + "api/task/import", content=yaml, headers={"Content-Type": "application/yaml"},
+                              timeout=120).json()
+            res = httpx.post(url + "api/runs", json={"task": task}, headers=auth, timeout=120)
+            assert res.status_code == 202, res.text
+            views[name] = (res.json()["run"], _finished(url, res.json()["run"])["status"])
+        assert [status for _, status in views.values()] == ["succeeded", "succeeded"]
+        journal = httpx.get(f"{url}api/runs/{views['bin-picking-until-empty'][0]}/journal").json()
+        found = [r["params"] for r in journal if r["kind"] == "event" and r["event"] == "PartLocalized"]
+        assert [f["outcome"] for f in found] == ["PartFound"] * 5 + ["BinEmpty"]
+        assert sorted(f["part_pose"] for f in found[:-1]) == sorted(p.pose for p in SimulatedBin(5, 0).parts)
+    finally:
+        _stop(proc, out)

@@ -216,6 +216,8 @@ def repair_case(steps: tuple[str, ...], devices: tuple[str, ...], extra: str = "
     return WORLD + SECOND_GRIPPER + cell(*devices) + body + horizon(len(steps)) + costs + extra
 
 
+REFUSED = ('given("t",1,"force"). value_kind("t",1,"force","decimal"). value_num("t",1,"force",50000). '
+           'param_role("close","force","gripper"). value_refused("t",1,"force","g").')
 REPAIR_CASES = {
     "insert the missing open": (repair_case(("close", "close"), ("g",)), [{'edit(insert(2,1,"open"))'}]),
     "swap when inserting costs more": (
@@ -233,6 +235,18 @@ REPAIR_CASES = {
     "reset a value that does not fit": (
         repair_case(("close",), ("g",), 'given("t",1,"force"). value_kind("t",1,"force","string").'),
         [{'edit(reset(1,"force"))'}]),
+    "reset a value the bound device refuses by its own limits": (
+        repair_case(("close",), ("g",), REFUSED), [{'edit(reset(1,"force"))'}]),
+    "a device that refuses the default too is not bound at all": (
+        repair_case(("close",), ("g",), REFUSED + 'default_refused("close","force","g").'), [{"edit(remove(1))"}]),
+    "buy the dearer device that takes the value rather than reset it": (
+        repair_case(("close",), ("r",), REFUSED.replace('"g"', '"h"') + 'catalogue("g"). catalogue("h"). '
+                    'edit_cost("add","g",510). edit_cost("add","h",505).', COSTS.replace("400", "900")),
+        [{'edit(add("g"))'}]),
+    "an inserted command's defaults must fit its device": (
+        repair_case(("close", "close"), ("g", "h"), 'bind("t",1,"gripper","g"). bind("t",2,"gripper","g"). '
+                    'default_refused("open","width","g"). param_role("open","width","gripper").'),
+        [{'edit(rebind(2,"gripper","h"))'}, {'edit(rebind(1,"gripper","h"))'}]),
 }
 
 

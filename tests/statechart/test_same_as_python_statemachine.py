@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from statechart_support import run_to_end
 from statemachine.io.scxml.processor import SCXMLProcessor
@@ -12,6 +14,7 @@ from plugnproduce.statechart import parse_chart
 from plugnproduce.statechart.runtime.clock import ManualClock
 from plugnproduce.statechart.runtime.events import EVENT_CONSUMED, TRANSITION_TAKEN, MetaEvent
 from plugnproduce.statechart.runtime.interpreter import Interpreter
+from plugnproduce.verification import Budget
 
 CELL = service.builtin("cells", "bin-picking.yaml")
 
@@ -61,3 +64,23 @@ def test_same_final_configuration_and_order_of_device_commands(task: str) -> Non
     assert ours[0] == theirs[0] == {"done"}
     assert ours[1] == theirs[1]
     assert len(ours[1]) == sum(c.kind == "request" for _, _, c in generated.commands())
+
+
+COUNTING = Path(__file__).parents[1] / "data" / "libraries" / "counting-gripper"
+
+
+def test_a_library_chart_that_assigns_and_tests_its_variables_reaches_done_in_both_interpreters() -> None:
+    # The counting gripper's chart (a library outside the package) adds to its count with <assign>, computes
+    # one variable from two others, tests them in <if> and in a transition's cond (with In() on its own state)
+    # and reports the count in an event: in the closed world every one of those expressions must read the
+    # device's renamed variables and states, as verify and the simulated device do.
+    cell_file = COUNTING / "cells" / "bin-picking-counting.yaml"
+    k = service.knowledge_for_cell(cell_file)
+    cell = service.cell(cell_file, k)
+    generated = service.generate(COUNTING / "tasks" / "bin-picking-counting.yaml", cell, knowledge=k,
+                                 verify=Budget())
+    assert generated.verification is not None and generated.verification.proved
+    chart = closed_world_chart(generated.task, cell)
+    theirs, ours = in_python_statemachine(chart), in_our_runtime(chart)
+    assert ours[0] == theirs[0] == {"done"}
+    assert ours[1] == theirs[1] and ours[1].count("counting-gripper.xirp.request.Close") == 3

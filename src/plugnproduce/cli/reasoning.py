@@ -120,7 +120,8 @@ def repair(
     cell: Path = CELL_OPTION,
     catalogue: Path | None = typer.Option(None, "--catalogue", metavar="DIR",
                                           help="Devices a repair may add (a folder)."),
-    top: int = typer.Option(3, "--top", min=1, max=20, metavar="K", help="How many distinct repairs, cheapest first."),
+    top: int = typer.Option(3, "--top", min=1, max=20, metavar="K",
+                            help="How many distinct repairs: fewest side effects first, then cheapest."),
     live: bool = LIVE_OPTION,
     discovery_timeout: float | None = DISCOVERY_OPTION,
     verbose: bool = VERBOSE_OPTION,
@@ -128,6 +129,8 @@ def repair(
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
 
+    Ranked by their worst side effect (none first, a dropped part last), then by cost, cheapest first; each one
+    checked again, with the devices it buys and their own limits.
     A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists, 2 bad input.
     """

@@ -32,7 +32,8 @@ def run(
     faults: str = typer.Option("", "--faults", metavar="SPEC",
                                help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
-                                         help="With --sim: a simulated bin of N parts at random poses."),
+                                         help="With --sim: a simulated bin of N parts at random poses (default "
+                                              "5 for a task that takes a localized pose, else none)."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
     journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
                                         help="Journal file (default: a new file in PNP_RUNS)."),
@@ -55,6 +56,9 @@ def run(
         cell = service.builtin("cells", "bin-picking.yaml")
     if bin_parts is not None and not sim:
         raise typer.BadParameter("--bin-parts works on simulated devices: add --sim")
+    if sim and bin_parts is None and (bin_parts := service.default_bin_parts(task)) is not None:
+        typer.echo(f"simulated bin: {bin_parts} parts at random poses (seed {bin_seed}); --bin-parts N for another",
+                   err=json_out)
 
     phases = Phases(on_a_terminal(json_out))
 

@@ -25,12 +25,13 @@ from plugnproduce.statechart.model import (
     Final,
     History,
     Parallel,
-    Param,
     Send,
     State,
     Transition,
+    iter_states,
     walk,
 )
+from plugnproduce.statechart.rename import rename_in
 
 _TARGETS = {DONE: f"controller_{DONE}", FAILED: f"controller_{FAILED}"}
 
@@ -62,17 +63,23 @@ def closed_world_chart(generated: GeneratedTask, cell: Cell) -> bytes:
 def _device_region(device: DeviceDescription) -> tuple[State, list[Data]]:
     """A device's own chart as a region: ids and events prefixed with the device id.
 
-    The device's datamodel joins the chart's, its variables prefixed too; an event parameter that
-    reads one of them (``<param name="part_pose" expr="part_pose"/>``) reads the prefixed one.
+    The device's datamodel joins the chart's, its variables prefixed too, and every expression of the
+    device's chart reads and writes the prefixed ones: conditions, ``<assign>``, ``<param>``, ``<log>``,
+    ``<data>`` values that read other variables, and ``In()`` on the device's own states
+    (:func:`~plugnproduce.statechart.rename.rename_in`).
     """
     prefix = device.id.replace("-", "_")
     variables = {d.id: f"{prefix}__{d.id}" for d in device.chart.data}
+    states = {s.id: f"{prefix}__{s.id}" for s in iter_states(device.chart) if s.id}
     data = [dataclasses.replace(copy.deepcopy(d), id=variables[d.id]) for d in device.chart.data]
+    for d in data:
+        rename_in(d, variables, states)
     region = State(id=f"device_{prefix}", initial=[f"{prefix}__{device.initial}"])
     for state in device.chart.children:
         if not isinstance(state, State | Final):
             continue
         s = copy.deepcopy(state)
+        rename_in(s, variables, states)
         for node in walk(s, into_charts=False):
             if isinstance(node, State | Final | Parallel | History | Send) and node.id:
                 node.id = f"{prefix}__{node.id}"
@@ -84,7 +91,5 @@ def _device_region(device: DeviceDescription) -> tuple[State, list[Data]]:
                 node.type = node.target = node.delay = node.delayexpr = None
             elif isinstance(node, Cancel) and node.sendid:
                 node.sendid = f"{prefix}__{node.sendid}"
-            elif isinstance(node, Param) and node.expr in variables:
-                node.expr = variables[node.expr]
         region.children.append(s)
     return region, data

@@ -21,6 +21,7 @@ from plugnproduce.description.model import Cell, Task
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
 from plugnproduce.hmi.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
+from plugnproduce.hmi.simcell import SimulatedCellSource
 from plugnproduce.knowledge import Knowledge
 
 log = logging.getLogger(__name__)
@@ -37,6 +38,7 @@ class ExecutorRunner:
 
     def __init__(self, source: CellSource, runs_dir: Path, knowledge: Knowledge | None = None) -> None:
         self._dir = Path(runs_dir)
+        self._source = source
         self._knowledge = knowledge
         self._runs: dict[str, _Run] = {}
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -60,6 +62,8 @@ class ExecutorRunner:
         active = self.active()
         if active is not None:
             raise RunRefused(f"run {active} is still running; stop it first")
+        if isinstance(self._source, SimulatedCellSource):
+            self._source.prepare_run(task)  # its default bin, for a task that takes a localized pose
         try:  # planned from the state each device reports, not its chart's initial state
             reported = cell.reported(await service.reported_states(cell))
             generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from plugnproduce import service
-from plugnproduce.description.model import Cell, DeviceDescription
+from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import ProtocolTimeout
 from plugnproduce.hmi.interfaces import CellChangeRefused
 from plugnproduce.hmi.livecell import LiveCellSource
@@ -31,17 +31,29 @@ def _has(device_id: str) -> Callable[[Cell], bool]:
 
 class SimulatedCellSource(LiveCellSource):
     """The devices of ``cell`` simulated, and what discovery sees of them; ``faults`` as ``pnp run --faults``,
-    ``bin`` the simulated bin they work on as ``pnp run --bin-parts`` (none: their charts' fixed values)."""
+    ``bin`` the simulated bin they work on as ``pnp run --bin-parts`` (none: their charts' fixed values).
+
+    Without a ``bin``, a ``default_bin`` is the bin of the runs whose task takes a reported value (a localized
+    pose: :func:`plugnproduce.service.default_bin_parts`), as ``pnp run --sim`` gives one; other runs work on
+    the charts' fixed values. It is one bin for the session: what one run takes out of it is gone for the next.
+    """
 
     def __init__(self, cell: Cell, catalogue: list[DeviceDescription], faults: str = "",
                  wait: float = 10.0, knowledge: Knowledge | None = None,
-                 bin: SimulatedBin | None = None) -> None:  # noqa: A002
+                 bin: SimulatedBin | None = None, default_bin: SimulatedBin | None = None) -> None:  # noqa: A002
         """``wait``: seconds a plug, unplug or the start may take until discovery has seen it."""
         super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS, knowledge=knowledge)
         self._wanted = [d.id for d in cell.devices]
         self._wait = wait
+        self._default_bin = None if bin is not None else default_bin
         self.sim = SimulatedCell(Cell(cell.name, ()), catalogue=[*catalogue, *cell.devices], network=self.network,
                                  faults=parse_faults(faults, cell.devices), bin=bin)
+
+    def prepare_run(self, task: Task) -> None:
+        """Before a run of ``task``: the default bin for a task that takes a reported value, else none (a bin
+        given at the start stays)."""
+        if self._default_bin is not None:
+            self.sim.use_bin(self._default_bin if service.default_bin_parts(task) is not None else None)
 
     def catalogue(self) -> list[DeviceDescription]:
         """The devices that can be plugged in: the catalogue and the cell file's own devices."""

@@ -29,11 +29,13 @@ def _numeric(par: Parameter) -> bool:
     return DATATYPES.get(par.datatype, par.datatype) in NUMERIC
 
 
-def normalised(task: Task, processes: Sequence[ProcessDescription]) -> tuple[Task, list[Problem]]:
+def normalised(task: Task, processes: Sequence[ProcessDescription],
+               keep_unreadable: bool = False) -> tuple[Task, list[Problem]]:
     """The task with every quantity written with a unit in its parameter's unit, and the values that cannot be.
 
     A value that cannot be read is left out of the task returned (its parameter takes the default
-    there), so that one problem, not two, is told of it.
+    there), so that one problem, not two, is told of it; with ``keep_unreadable`` it stays as written
+    (the repair then sees a value that does not fit, and resets it).
     """
     declared = {p.id: {x.name: x for x in p.parameters} for p in processes}
     one_round = len(task.one_round())
@@ -49,7 +51,8 @@ def normalised(task: Task, processes: Sequence[ProcessDescription]) -> tuple[Tas
             if why is None:
                 params[name] = int(number) if par.datatype.endswith("integer") and number.is_integer() else number
                 continue
-            del params[name]
+            if not keep_unreadable:
+                del params[name]
             if step.index <= one_round:
                 text = f"step {step.index} ({step.command}): parameter {name} is {value!r}; {why}"
                 problems.append(Problem(step.index, step.command, "bad_unit", Reason("bad_unit", text, (par.quantity,),
@@ -106,8 +109,16 @@ def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
 
 def refuses(device: DeviceDescription, value: object, par: Parameter) -> bool:
     """Whether ``device`` refuses ``value`` of ``par`` by its own limits (what :func:`beyond_limits` tells of)."""
-    return not _beyond_own_range(value, par) and any(
-        _beyond(value, par, contract) is not None for contract in contracts_for(device, par.quantity))
+    return why_refused(device, value, par) is not None
+
+
+def why_refused(device: DeviceDescription, value: object, par: Parameter) -> str | None:
+    """Why ``device`` refuses ``value`` of ``par`` by its own limits ("takes at least 20 kPa; the value is 15 kPa"),
+    or None when it takes it (or when the value is beyond the process's own range: the range check tells of it)."""
+    if _beyond_own_range(value, par):
+        return None
+    return next((why for contract in contracts_for(device, par.quantity)
+                 if (why := _beyond(value, par, contract)) is not None), None)
 
 
 def _beyond_own_range(value: object, par: Parameter) -> bool:

@@ -152,7 +152,7 @@ def process_facts(process: ProcessDescription) -> list[Atom]:
             out.append(s.ParamMin(p, par.name, low))
         if par.maximum is not None and high is not None:
             out.append(s.ParamMax(p, par.name, high))
-    return out
+    return out + [s.ParamRole(p, par.name, par.role) for par in process.parameters]
 
 
 # ------------------------------------------------------------------ tasks and configurations

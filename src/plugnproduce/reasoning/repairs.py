@@ -19,9 +19,11 @@ from plugnproduce.errors import EncodingError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning import solver
+from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program
 from plugnproduce.reasoning.plausibility import TASK, check
+from plugnproduce.reasoning.refusals import Refusals, refusal_facts, reset_reason
 from plugnproduce.reasoning.results import Edit, Repair, RepairCosts
 from plugnproduce.reasoning.terms import Atom, Model, program
 
@@ -83,9 +85,19 @@ def outcome(model: Model, task: Task) -> Hashable:
     return commands, tuple(added)
 
 
+def task_program(task: Task, devices: Sequence[DeviceDescription], book: FactBook,
+                 known: Refusals | None = None) -> str:
+    """The facts of a task to repair: its values read in their parameters' units (``"40 %"`` is the number 40, as
+    the check reads it; a value that cannot be read stays as written, to be reset), and which of ``devices`` (the
+    cell's and the catalogue's) refuse which of them (:mod:`.refusals`; ``known``: the answers so far)."""
+    readable, _ = normalised(task, book.processes, keep_unreadable=True)
+    return program(task_facts(readable, TASK)
+                   + refusal_facts(readable, TASK, devices, book.processes, book.taxonomy, known))
+
+
 def _optimise(book: FactBook, task: Task, cell: Cell, extra: Sequence[DeviceDescription], top: int,
-              costs: RepairCosts, per_gap: int, max_inserts: int | None) -> list[Model]:
-    facts = (cell_program(book, cell, extra) + program(task_facts(task, TASK))
+              costs: RepairCosts, per_gap: int, max_inserts: int | None, known: Refusals) -> list[Model]:
+    facts = (cell_program(book, cell, extra) + task_program(task, [*cell.devices, *extra], book, known)
              + program(horizon(task, per_gap, max_inserts))
              + program(cost_facts(costs, book.processes, extra))
              + program(s.Catalogue(d.id) for d in extra))
@@ -110,10 +122,11 @@ def repair(
     book = fact_book(taxonomy, processes)
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
-    models = _optimise(book, task, cell, (), top, costs, per_gap, max_inserts)
+    known = Refusals(taxonomy)
+    models = _optimise(book, task, cell, (), top, costs, per_gap, max_inserts, known)
     cheapest_add = min((add_cost(costs, d) for d in extra), default=None)
     if cheapest_add is not None and (len(models) < top or models[-1].cost[0] > cheapest_add):
-        models = _optimise(book, task, cell, extra, top, costs, per_gap, max_inserts)
+        models = _optimise(book, task, cell, extra, top, costs, per_gap, max_inserts, known)
     devices = {d.id: d for d in [*extra, *cell.devices]}
     return [read_repair(m, rank, task, book, devices, costs) for rank, m in enumerate(models, start=1)]
 
@@ -164,18 +177,27 @@ def folded_repeat(steps: list[Step], most: int) -> int:
 def read_repair(model: Model, rank: int, task: Task, book: FactBook, devices: dict[str, DeviceDescription],
                 costs: RepairCosts) -> Repair:
     """A model of repair.lp as a :class:`Repair`."""
-    reader = _EditReader(task, book, devices, costs)
+    reader = _EditReader(task, book, devices, costs, lambda i: bound_at(model, i))
     edits = sorted((reader.read(e.e) for e in model[s.Edit]), key=lambda e: (e.step or 0, e.kind, e.text))
     added = tuple(sorted(e.device for e in edits if e.kind == "add" and e.device))
     return Repair(rank, model.cost[0] / 100 if model.cost else 0.0, tuple(edits),
                   repaired_task(model, task), added, tuple(i for i, _ in repaired_runs(model, task)))
 
 
-class _EditReader:
-    """Turns ``edit/1`` terms into :class:`Edit` objects with sentences and costs."""
+def bound_at(model: Model, i: int) -> dict[str, str]:
+    """The devices the repaired task binds to the roles of original step ``i`` (by role)."""
+    slots = {r.s for r in model[s.Runs] if r.i == i}
+    return {p.r: p.d for p in model[s.Plays] if p.s in slots}
 
-    def __init__(self, task: Task, book: FactBook, devices: dict[str, DeviceDescription], costs: RepairCosts):
+
+class _EditReader:
+    """Turns ``edit/1`` terms into :class:`Edit` objects with sentences and costs; ``bound`` tells the devices the
+    repaired task binds to an original step's roles (to say which device's limit a reset value broke)."""
+
+    def __init__(self, task: Task, book: FactBook, devices: dict[str, DeviceDescription], costs: RepairCosts,
+                 bound: Callable[[int], dict[str, str]] | None = None):
         self.task, self.book, self.devices, self.costs = task, book, devices, costs
+        self.bound = bound
 
     def read(self, term: clingo.Symbol) -> Edit:
         """The edit a term stands for."""
@@ -216,6 +238,11 @@ class _EditReader:
     def _reset(self, i: int, n: str) -> Edit:
         par = next((x for x in self.book.process(self.cmd(i)).parameters if x.name == n), None)
         what = f"reset parameter {n} to its default {par.default}" if par else f"drop parameter {n} (not declared)"
+        if par is not None and self.bound is not None:
+            readable, _ = normalised(self.task, self.book.processes)
+            device = self.devices.get(self.bound(i).get(par.role, ""))
+            why = reset_reason(device, readable.steps[i - 1].params.get(n), par, self.book.taxonomy)
+            what += f" ({why})" if why else ""
         return Edit("reset", f"step {i} ({self.cmd(i)}): {what}", self.costs.reset, i, self.cmd(i), parameter=n)
 
     def _add(self, a: str) -> Edit:

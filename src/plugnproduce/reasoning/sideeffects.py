@@ -57,7 +57,7 @@ class AssessedRepair:
     repair: Repair
     side_effects: tuple[SideEffect, ...]
     confirmed: bool
-    """Checking the repaired task again finds it plausible."""
+    """Checking the repaired task again finds it plausible (:func:`assess` proposes only such repairs)."""
 
     @property
     def severity(self) -> int:
@@ -108,10 +108,19 @@ def _sig(step: Step) -> tuple[object, ...]:
     return (step.command, tuple(sorted(step.bind.items())), tuple(sorted((k, str(v)) for k, v in step.params.items())))
 
 
-def new_steps(original: Task, repaired: Task) -> set[int]:
+def new_steps(original: Task, repaired: Task, origins: Sequence[int] = ()) -> set[int]:
     """The (1-based) steps of ``repaired`` that are not original steps kept in their order (inserted or moved):
-    a longest common subsequence, matched from the end so an inserted step is the one before the kept ones."""
-    a, b = [_sig(s) for s in original.steps], [_sig(s) for s in repaired.steps]
+    a longest common subsequence, matched from the end so an inserted step is the one before the kept ones.
+
+    With ``origins`` (the original position each repaired step keeps, 0 if inserted: :attr:`Repair.origins`) a
+    step is matched by where it came from, so a step rebound or with a value reset is still the original step."""
+    if len(origins) == len(repaired.steps) and origins:
+        return _unmatched(list(range(1, len(original.steps) + 1)), list(origins))
+    return _unmatched([_sig(s) for s in original.steps], [_sig(s) for s in repaired.steps])
+
+
+def _unmatched(a: Sequence[object], b: Sequence[object]) -> set[int]:
+    """The (1-based) positions of ``b`` outside a longest common subsequence with ``a``, matched from the end."""
     n, m = len(a), len(b)
     lcs = [[0] * (m + 1) for _ in range(n + 1)]
     for i in range(n):
@@ -176,7 +185,7 @@ def _drop_evidence(k: _Cell, result: CheckResult, cell: Cell, j: int, i: int, d:
 
 
 def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: Task,
-             original: Task) -> list[SideEffect]:
+             original: Task, origins: Sequence[int]) -> list[SideEffect]:
     out: list[SideEffect] = []
     held: dict[str, int] = {}
     for i, step in enumerate(result.steps, start=1):
@@ -194,8 +203,11 @@ def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: T
                                                   and k.is_a(after, "Closed")):
                 held[d] = i
         if i in fresh:
-            sig = _sig(task.steps[i - 1])
-            inserted = sum(_sig(s) == sig for s in task.steps) > sum(_sig(s) == sig for s in original.steps)
+            if len(origins) == len(task.steps) and origins:
+                inserted = origins[i - 1] == 0
+            else:
+                sig = _sig(task.steps[i - 1])
+                inserted = sum(_sig(s) == sig for s in task.steps) > sum(_sig(s) == sig for s in original.steps)
             out += _moves(k, result, i, task, inserted)
     return out
 
@@ -223,12 +235,14 @@ def _moves(k: _Cell, result: CheckResult, i: int, task: Task, inserted: bool) ->
 
 
 def side_effects(original: Task, repaired: Task, result: CheckResult, cell: Cell, taxonomy: Taxonomy,
-                 processes: Sequence[ProcessDescription], before: CheckResult) -> list[SideEffect]:
+                 processes: Sequence[ProcessDescription], before: CheckResult,
+                 origins: Sequence[int] = ()) -> list[SideEffect]:
     """What the repaired task changes besides being plausible: parts dropped, devices moved, a part still held
-    at the end that the original task released, default values of inserted steps."""
+    at the end that the original task released, default values of inserted steps (``origins``: see
+    :func:`new_steps`)."""
     k = _Cell(taxonomy, {p.id: p for p in processes})
-    fresh = new_steps(original, repaired)
-    out = _holding(k, result, cell, fresh, repaired, original)
+    fresh = new_steps(original, repaired, origins)
+    out = _holding(k, result, cell, fresh, repaired, original, origins)
     ends = [d for d, x in result.final_states.items() if k.is_a(_concept(cell, d, x), "Closed")
             and not k.is_a(_concept(cell, d, before.final_states.get(d)), "Closed")]
     if ends and any(k.process_is(s.command, "PickProcess") for s in repaired.steps):
@@ -241,15 +255,23 @@ def side_effects(original: Task, repaired: Task, result: CheckResult, cell: Cell
 def assess(repairs: Sequence[Repair], task: Task, cell: Cell, taxonomy: Taxonomy,
            processes: Sequence[ProcessDescription],
            catalogue: Sequence[DeviceDescription] = ()) -> list[AssessedRepair]:
-    """Each repair with its side effects, confirmed by checking it again (in the cell with the devices it adds
-    from ``catalogue``), ranked by its worst side effect, then by cost (the solver's order among equals)."""
+    """Each repair that checking it again (in the cell with the devices it adds from ``catalogue``, with their own
+    contracts and limits) confirms, with its side effects: ranked by its worst side effect, then by cost, then by
+    the solver's order. A repair the check does not confirm is no repair: it is left out."""
     before = check(task, cell, taxonomy, processes)
     out = []
     for r in repairs:
         added = tuple(d for d in catalogue if d.id in r.added_devices)
         the_cell = dataclasses.replace(cell, devices=cell.devices + added)
         result = check(r.task, the_cell, taxonomy, processes)
-        effects = side_effects(task, r.task, result, the_cell, taxonomy, processes, before)
-        out.append(AssessedRepair(0, r, tuple(effects), result.plausible))
-    ranked = sorted(out, key=lambda a: (not a.confirmed, a.severity, a.repair.cost, a.repair.rank))
-    return [dataclasses.replace(a, rank=n) for n, a in enumerate(ranked, start=1)]
+        if not result.plausible:
+            continue
+        effects = side_effects(task, r.task, result, the_cell, taxonomy, processes, before, r.origins)
+        out.append(AssessedRepair(0, r, tuple(effects), True))
+    return [dataclasses.replace(a, rank=n) for n, a in enumerate(sorted(out, key=ranking), start=1)]
+
+
+def ranking(repair: AssessedRepair) -> tuple[int, float, int]:
+    """The order repairs are proposed in: by their worst side effect (:data:`SEVERITY`: none or default values
+    first, a dropped part last), then by cost, cheapest first, then by the solver's order."""
+    return (repair.severity, repair.repair.cost, repair.repair.rank)

@@ -63,9 +63,11 @@ from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescr
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import lifting, repairs, solver
 from plugnproduce.reasoning import schema as s
+from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.offers import CELL, cell_program
 from plugnproduce.reasoning.plausibility import TASK
+from plugnproduce.reasoning.refusals import Refusals
 from plugnproduce.reasoning.results import Repair, RepairCosts
 from plugnproduce.reasoning.terms import Model, program
 
@@ -96,6 +98,9 @@ class _Part:
     left_in: tuple[tuple[str, str], ...]
     origins: tuple[int, ...] = ()
     """The original (whole-task) step position each of :attr:`steps` keeps, 0 if inserted."""
+    reset_bound: tuple[tuple[int, tuple[tuple[str, str], ...]], ...] = ()
+    """For each original step with a value reset: the devices the repair binds to its roles (to say which
+    device's limit the value broke)."""
 
 
 def shifted(term: clingo.Symbol, offset: int) -> clingo.Symbol:
@@ -226,7 +231,8 @@ def windowed_repair(
     changes no cost)."""
     costs = costs or RepairCosts()
     book = fact_book(taxonomy, processes)
-    facts = cell_program(book, cell) + program(task_facts(task, TASK)) + program([s.Check(CELL, TASK)])
+    readable, _ = normalised(task, processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
+    facts = cell_program(book, cell) + program(task_facts(readable, TASK)) + program([s.Check(CELL, TASK)])
     chain = _Chain(task, solver.symbols(solver.CHECK, facts))
     if top < 1 or chain.plausible:  # plausible to the encodings: whatever else check() finds, repair.lp cannot fix
         return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap) if top >= 1 else []
@@ -254,6 +260,7 @@ class _Solver:
                  memo: dict[Hashable, list[Model]]):
         self.book, self.chain, self.cell, self.costs, self.per_gap, self.top = book, chain, cell, costs, per_gap, top
         self.memo = memo
+        self.known = Refusals(book.taxonomy)
 
     def best(self, wins: list[Window], extra: list[DeviceDescription]) -> list[Repair] | None:
         """The top repairs (None when some window has no repair within its borders)."""
@@ -324,7 +331,8 @@ class _Solver:
         steps = self.chain.task.steps[w.first - 1:w.last]
         sub = Task(self.chain.task.name, tuple(replace(st, index=k) for k, st in enumerate(steps, start=1)),
                    self.chain.task.file)
-        facts = (cell_program(self.book, entering, bought) + program(task_facts(sub, TASK))
+        facts = (cell_program(self.book, entering, bought)
+                 + repairs.task_program(sub, [*cell.devices, *bought], self.book, self.known)
                  + program(repairs.horizon(sub, self.per_gap, None))
                  + program(repairs.cost_facts(costs or self.costs, self.book.processes, bought))
                  + program(s.Catalogue(d.id) for d in bought)
@@ -349,12 +357,18 @@ class _Solver:
         left = tuple(sorted((a.d, a.x) for a in model[s.LeftIn]))
         runs = repairs.repaired_runs(model, sub)
         origins = tuple(i + w.first - 1 if i else 0 for i, _ in runs)
-        return _Part(w, model.cost[0] if model.cost else 0, edits, tuple(st for _, st in runs), left, origins)
+        resets = sorted({e.e.arguments[0].number for e in model[s.Edit] if e.e.name == "reset"})
+        bound = tuple((i + w.first - 1, tuple(sorted(repairs.bound_at(model, i).items()))) for i in resets)
+        return _Part(w, model.cost[0] if model.cost else 0, edits, tuple(st for _, st in runs), left, origins,
+                     bound)
 
     def read(self, rank: int, combo: tuple[int, tuple[_Part, ...], tuple[str, ...]],
              reader: repairs._EditReader) -> Repair:
         """One combination as a :class:`Repair` of the whole task."""
         cost, parts, added = combo
+        bound = {i: dict(b) for p in parts for i, b in p.reset_bound}
+        reader = repairs._EditReader(reader.task, reader.book, reader.devices, reader.costs,
+                                     lambda i: bound.get(i, {}))
         terms = [t for p in parts for t in p.edits] + [clingo.Function("add", [clingo.String(a)]) for a in added]
         edits = sorted((reader.read(t) for t in terms), key=lambda e: (e.step or 0, e.kind, e.text))
         task = self.chain.task

@@ -70,6 +70,13 @@ class SimulatedCell:
         self.catalogue = {d.id: d for d in (*catalogue, *cell.devices)}
         self.devices: dict[str, SimulatedDevice] = {}
 
+    def use_bin(self, bin: SimulatedBin | None) -> None:  # noqa: A002
+        """Let the devices work on ``bin`` from their next request on (none: their charts' fixed values), and
+        the devices plugged in later too."""
+        self.bin = bin
+        for device in self.devices.values():
+            device.bin = bin
+
     async def __aenter__(self) -> SimulatedCell:
         await self.start()
         return self

@@ -15,6 +15,7 @@ from plugnproduce.reasoning.schema.inputs import (
     Check,
     Config,
     Cost,
+    DefaultRefused,
     Device,
     Edge,
     EditCost,
@@ -32,6 +33,7 @@ from plugnproduce.reasoning.schema.inputs import (
     Param,
     ParamMax,
     ParamMin,
+    ParamRole,
     Process,
     Recovers,
     RegionState,
@@ -44,6 +46,7 @@ from plugnproduce.reasoning.schema.inputs import (
     StepFact,
     ValueKind,
     ValueNum,
+    ValueRefused,
 )
 from plugnproduce.reasoning.schema.outputs import (
     Absent,
@@ -92,6 +95,7 @@ __all__ = [
     "Check",
     "Config",
     "Cost",
+    "DefaultRefused",
     "Device",
     "Edge",
     "Edit",
@@ -117,6 +121,7 @@ __all__ = [
     "Param",
     "ParamMax",
     "ParamMin",
+    "ParamRole",
     "Plausible",
     "Plays",
     "Process",
@@ -139,5 +144,6 @@ __all__ = [
     "Unreachable",
     "ValueKind",
     "ValueNum",
+    "ValueRefused",
     "WrongState",
 ]

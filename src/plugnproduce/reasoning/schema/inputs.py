@@ -177,6 +177,24 @@ class ParamMax(Atom):
     v: int
 
 
+@predicate("param_role")
+class ParamRole(Atom):
+    """Parameter ``n`` of ``p`` goes to the device bound to role ``r``."""
+
+    p: str
+    n: str
+    r: str
+
+
+@predicate("default_refused")
+class DefaultRefused(Atom):
+    """Device ``d`` refuses the default value of ``p``'s parameter ``n`` by its own limits."""
+
+    p: str
+    n: str
+    d: str
+
+
 # ------------------------------------------------------------------ input: configurations and tasks
 
 
@@ -248,6 +266,17 @@ class ValueNum(Atom):
     i: int
     n: str
     v: int
+
+
+@predicate("value_refused")
+class ValueRefused(Atom):
+    """Device ``d`` refuses the value step ``i`` of ``t`` sends for ``n`` (given or default): beyond the device's
+    limits, or a given value no request of its chart accepts."""
+
+    t: str
+    i: int
+    n: str
+    d: str
 
 
 @predicate("check")
