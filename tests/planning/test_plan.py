@@ -130,3 +130,10 @@ def test_a_bad_goal_is_one_line_at_its_line_and_exit_2(tmp_path: Path, text: str
     assert done.returncode == 2, done.stdout
     assert done.stderr.startswith(f"{goal}:{line}: ") and message in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_validate_reads_goal_files_and_names_an_unknown_command_at_its_line(tmp_path: Path) -> None:
+    assert pnp("validate", str(service.builtin("goals"))).returncode == 0
+    goal = goal_file(tmp_path, "goal: g\nachieve:\n  - command: plase\n")
+    done = pnp("validate", str(goal))
+    assert done.returncode == 1 and f"{goal}:3: unknown process command 'plase'; did you mean place?" in done.stdout

@@ -12,10 +12,12 @@ from pathlib import Path
 
 import yaml
 
-from plugnproduce.description.model import Link
+from plugnproduce.description.model import Link, ProcessDescription
 from plugnproduce.description.taskfile import _link, _mapping, _outcome, _plain, _str_map, _unknown_keys
 from plugnproduce.errors import DescriptionError, excerpt
-from plugnproduce.ontology.vocabulary import concept_iri
+from plugnproduce.ontology.names import did_you_mean
+from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.ontology.vocabulary import concept_iri, concept_value
 from plugnproduce.safeio import parse_yaml_bytes, read_bytes
 
 MAX_ITEMS = 50
@@ -94,3 +96,28 @@ def _item(node: yaml.Node, p: Path) -> GoalItem:
                                p, line)
     bind = {k: str(v) for k, v in _str_map(m.get("bind"), p, "bind").items()}
     return GoalItem(command, params, bind, line)
+
+
+def check_terms(goal: Goal, taxonomy: Taxonomy, processes: dict[str, ProcessDescription]) -> None:
+    """Refuse, at its line, a command, parameter or role the knowledge does not know, or an unknown concept."""
+    path = goal.file
+    for item in goal.achieve:
+        process = processes.get(item.command)
+        if process is None:
+            raise DescriptionError(f"unknown process command {item.command!r}"
+                                   f"{did_you_mean(item.command, sorted(processes))}", path, item.line)
+        names = [p.name for p in process.parameters]
+        for n in item.params:
+            if n not in names:
+                raise DescriptionError(f"{item.command} has no parameter {n!r}{did_you_mean(n, names)}",
+                                       path, item.line)
+        roles = [r.name for r in process.roles]
+        for r in item.bind:
+            if r not in roles:
+                raise DescriptionError(f"{item.command} has no role {r!r}{did_you_mean(r, roles)}", path, item.line)
+    for concept in goal.end.values():
+        if concept not in taxonomy.superclasses:
+            raise DescriptionError(f"end: unknown state concept {concept_value(concept)!r}", path,
+                                   goal.lines.get("end"))
+    if goal.until is not None and goal.until not in taxonomy.superclasses:
+        raise DescriptionError(f"until: unknown outcome {concept_value(goal.until)!r}", path, goal.lines.get("until"))

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import yaml
 
-from plugnproduce.description.goalfile import Goal
+from plugnproduce.description.goalfile import Goal, check_terms
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
 from plugnproduce.description.outcomes import falling_under
 from plugnproduce.description.taskfile import parse_task, task_to_yaml
@@ -85,30 +85,13 @@ def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Process
 
 
 def check_goal(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: dict[str, ProcessDescription]) -> None:
-    """Bad input in the goal file: unknown commands, parameters, roles, devices and concepts."""
-    path = goal.file
+    """Bad input in the goal file: unknown commands, parameters, roles, concepts, and devices not in the cell."""
+    check_terms(goal, taxonomy, processes)
     for item in goal.achieve:
-        process = processes.get(item.command)
-        if process is None:
-            raise DescriptionError(f"unknown process command {item.command!r}"
-                                   f"{did_you_mean(item.command, sorted(processes))}", path, item.line)
-        names = [p.name for p in process.parameters]
-        for n in item.params:
-            if n not in names:
-                raise DescriptionError(f"{item.command} has no parameter {n!r}{did_you_mean(n, names)}",
-                                       path, item.line)
-        roles = [r.name for r in process.roles]
-        for r, d in item.bind.items():
-            if r not in roles:
-                raise DescriptionError(f"{item.command} has no role {r!r}{did_you_mean(r, roles)}", path, item.line)
-            _device(d, cell, path, item.line)
-    for d, concept in goal.end.items():
-        _device(d, cell, path, goal.lines.get("end"))
-        if concept not in taxonomy.superclasses:
-            raise DescriptionError(f"end: unknown state concept {concept_value(concept)!r}", path,
-                                   goal.lines.get("end"))
-    if goal.until is not None and goal.until not in taxonomy.superclasses:
-        raise DescriptionError(f"until: unknown outcome {concept_value(goal.until)!r}", path, goal.lines.get("until"))
+        for d in item.bind.values():
+            _device(d, cell, goal.file, item.line)
+    for d in goal.end:
+        _device(d, cell, goal.file, goal.lines.get("end"))
 
 
 def _device(device: str, cell: Cell, path: str, line: int | None) -> None:

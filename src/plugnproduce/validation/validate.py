@@ -10,6 +10,7 @@ import rdflib
 from rdflib.namespace import OWL, RDF
 
 from plugnproduce.description.charts import device_chart
+from plugnproduce.description.goalfile import Goal, check_terms, load_goal
 from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.description.loader import (
     ContractError,
@@ -72,6 +73,7 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
     kg.add_tbox(knowledge.tbox(), taxonomy)
     processes: dict[str, ProcessDescription] = {}
     tasks = []
+    goals: list[Goal] = []
     described: dict[str, Where] = {}
     named: set[tuple[str, int]] = set()  # where a chart's unknown name is reported already
     for f in files:
@@ -92,11 +94,18 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
                 _turtle(loaded, taxonomy, kg, processes, report)
             elif _yaml_kind(f) == "task":
                 tasks.append(load_task(f))
+            elif _yaml_kind(f) == "goal":
+                goals.append(load_goal(f))
             else:
                 _cell(f, report, knowledge)
         except DescriptionError as exc:
             report.add(Problem.from_error(exc))
     _tasks(tasks, knowledge, processes, kg, report)
+    for goal in goals:  # after the loop: the processes the files define are known then
+        try:
+            check_terms(goal, taxonomy, {p.id: p for p in knowledge.processes} | processes)
+        except DescriptionError as exc:
+            report.add(Problem.from_error(exc))
     if not report.unreadable:
         say("checking the SHACL shapes")
         for p in shape_problems(kg):
@@ -231,6 +240,8 @@ def _yaml_kind(path: Path) -> str:
             return "task"
         if line.startswith("cell:"):
             return "cell"
+        if line.startswith("goal:"):
+            return "goal"
     return "task"
 
 
