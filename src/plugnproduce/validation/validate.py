@@ -15,11 +15,11 @@ from plugnproduce.description.loader import (
     Loaded,
     cell_device_files,
     cell_libraries,
-    not_a_description,
     device_from,
     device_subject,
     file_of,
     load_task,
+    not_a_description,
     process_from,
     read_description,
 )
