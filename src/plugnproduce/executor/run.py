@@ -37,7 +37,7 @@ from plugnproduce.codegen.task import STEP
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import values
-from plugnproduce.executor.journal import Journal
+from plugnproduce.executor.journal import Journal, JournalWriteError
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
@@ -62,7 +62,7 @@ class Fault:
     """What stopped a run.
 
     ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected``, ``chart`` (the task chart
-    broke down) or ``stopped``.
+    broke down), ``journal`` (the journal cannot be written) or ``stopped``.
     """
 
     kind: str
@@ -148,6 +148,7 @@ class TaskRun:
         self.interpreter.attach(self._on_meta)
         self._loop = ChartLoop(self.interpreter, self._on_step)
         self._journal: Journal | None = None
+        self._journal_failed = False
         self._links: dict[str, DeviceLink] = {}
         self._commands: set[asyncio.Task[None]] = set()
         self.fault: Fault | None = None
@@ -352,6 +353,12 @@ class TaskRun:
 
     def _record(self, kind: str, **data: Any) -> None:
         assert self._journal is not None
-        record = self._journal.write(kind, **data)
+        try:
+            record = self._journal.write(kind, **data)
+        except JournalWriteError as exc:  # the run must not go on unjournalled: a fault, and the safe stop
+            record = exc.record
+            if not self._journal_failed:
+                self._journal_failed = True
+                self._fail(Fault("journal", str(exc), self.step, self.command))
         if self._observer is not None:
             self._observer(record)
