@@ -29,3 +29,17 @@ async def test_a_refused_device_is_listed_by_the_api_with_its_url_and_reason_as_
     assert "4194304 bytes" in refused[0]["reason"]
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["refused"] == refused
+
+
+def test_the_page_lists_a_refused_device_with_its_url_and_reason(page, served) -> None:  # type: ignore[no-untyped-def]
+    from playwright.sync_api import expect
+
+    from tests.hmi.conftest import screenshot
+
+    with HostileDevice(served.hmi.source.network, "uuid:hostile-huge", "huge") as device:
+        item = page.locator(f"#refused-list li[data-udn='{device.udn}']")
+        expect(item).to_be_visible(timeout=60_000)
+        expect(item).to_contain_text(f"{device.udn} at {device.location}: ")
+        expect(item).to_contain_text("4194304 bytes")
+        expect(page.locator("#devices tbody tr")).to_have_count(4)  # the honest devices stay
+        screenshot(page, "cell-refused-device")
