@@ -47,3 +47,28 @@ def test_discover_expecting_more_devices_than_answer_exits_1(simulated_cell, env
 def test_discover_with_a_cell_file_that_is_not_there_is_bad_input(tmp_path: Path, env: dict[str, str]) -> None:  # noqa: F811
     found = pnp(env, "discover", "--cell", str(tmp_path / "nope.yaml"))
     assert found.returncode == 2 and len(found.stderr.splitlines()) == 1, found.stderr
+
+
+def test_discover_watch_prints_each_refusal_with_its_url_as_it_happens(env: dict[str, str]) -> None:  # noqa: F811
+    import subprocess
+    import sys
+
+    from plugnproduce.protocols.upnp import SsdpNetwork
+    from tests.discovery.hostile import HostileDevice
+    from tests.lines import Lines
+
+    watch = subprocess.Popen([sys.executable, "-m", "plugnproduce", "discover", "--json", "--watch", "--timeout",
+                              "1", "--settle", "0.5"], env=env, text=True, stdout=subprocess.PIPE)
+    lines = Lines(watch.stdout)
+    try:
+        assert json.loads(lines.next())["devices"] == []  # the private network is empty at first
+        with HostileDevice(SsdpNetwork(port=int(env["PNP_SSDP_PORT"])), "uuid:hostile-huge", "huge") as device:
+            change = json.loads(lines.next())
+        assert (change["change"], change["device"], change["url"]) == ("refused", device.udn, device.location)
+        assert "4194304 bytes" in change["reason"]
+    finally:
+        watch.terminate()
+        watch.wait(timeout=60)
+        lines.rest()
+        assert watch.stdout is not None
+        watch.stdout.close()
