@@ -72,6 +72,11 @@ class DescriptionError(PlugNProduceError):
         return f"{self.file}:{self.line}: {self.message}"
 
 
+class QuantityError(DescriptionError):
+    """A quantity a task writes that is no finite number, as written or once in its parameter's unit (``1e308 kN``
+    is 1e311 N): bad input, refused at its line, never turned into a figure."""
+
+
 class UnreadableError(DescriptionError):
     """Input that cannot be parsed at all: malformed XML, Turtle or YAML, or an unreadable file."""
 

@@ -319,12 +319,14 @@ def batch(
     progress: Callable[[int], None] | None = None,
     knowledge: Knowledge | None = None,
     top: int = 1,
-    cluster: str | None = None,
+    cluster: str | reasoning.ClusterAccess | None = None,
 ) -> Iterator[reasoning.BatchRow]:
     """Feasibility of many configurations (an iterable, or a JSONL/CSV file of device lists) of catalogue
     devices, streamed in order: per configuration the offered processes, the plausible tasks, and when
     some task is not, the ``top`` cheapest sets of catalogue devices to add (or why none suffices).
-    ``cluster``: a Dask scheduler address (``tcp://host:8786``) or ``local:N`` (N local worker processes)."""
+    ``cluster``: a Dask scheduler address (``tcp://host:8786``) or ``local:N`` (N local worker processes), or a
+    :class:`~plugnproduce.reasoning.ClusterAccess` with its connect timeout and TLS files; a cluster address is
+    trusted code execution (it runs what the batch sends, and what comes back is unpickled)."""
     k = _k(knowledge)
     devices = _devices(catalogue_or_folder, k)
     configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
@@ -343,7 +345,7 @@ def batch_report(
     progress: Callable[[int], None] | None = None,
     knowledge: Knowledge | None = None,
     top: int = 1,
-    cluster: str | None = None,
+    cluster: str | reasoning.ClusterAccess | None = None,
 ) -> Iterator[str]:
     """:func:`batch`'s answers as report text (JSONL, or CSV rows with ``form`` "csv"), a chunk at a time,
     made by the workers: what ``pnp batch`` writes."""

@@ -330,7 +330,7 @@ async def test_discover_json_shows_each_device_with_the_keys_and_values_of_the_h
     """One device view: ``pnp discover --json`` on the HMI's simulated cell and ``GET /api/cell`` agree."""
     over_http = {d["id"]: d for d in (await client.get("/api/cell")).json()["devices"]}
     env = {**os.environ, "PNP_SSDP_PORT": str(hmi.source.network.port)}
-    expect = [a for d in sorted(over_http) for a in ("--expect", d)]  # ends once they answered, not at a window
+    expect = ["--expect", str(len(over_http))]  # ends once they answered, not at a window
     command = [sys.executable, "-m", "plugnproduce", "discover", "--json", "--timeout", str(WAIT), *expect]
     done = await asyncio.to_thread(subprocess.run, command, env=env, capture_output=True, text=True,
                                    timeout=2 * WAIT)

@@ -128,7 +128,7 @@ async def test_unplug_reaches_the_event_stream(served: Served) -> None:
             assert "pick" in {o["command"] for o in first["commands"]["offered"]}  # type: ignore[index]
             assert (await client.delete("/api/cell/devices/gripper", headers=AUTH)).status_code == 200
             change = await asyncio.wait_for(_next(events, "cell"), 60)
-            assert change["change"] == {"kind": "unplug", "device": "gripper", "reason": ""}
+            assert change["change"] == {"kind": "unplug", "device": "gripper", "reason": "", "url": None}
             assert "pick" not in {o["command"] for o in change["commands"]["offered"]}  # type: ignore[index]
             assert "gripper" not in {d["id"] for d in change["cell"]["devices"]}  # type: ignore[index]
             await events.aclose()

@@ -232,3 +232,16 @@ def test_serve_sim_gives_the_runs_of_a_localizing_task_a_default_bin_and_says_so
         assert sorted(f["part_pose"] for f in found[:-1]) == sorted(p.pose for p in SimulatedBin(5, 0).parts)
     finally:
         _stop(proc, out)
+
+
+def test_issue_24_serve_takes_the_discovery_timeout_for_its_simulated_devices() -> None:
+    # hmi/simcell.py waited a fixed 10 s: pnp serve --sim failed to start at load 18-20
+    from plugnproduce.cli.serve import cell_source
+    from plugnproduce.hmi.simcell import SimulatedCellSource
+
+    default = cell_source(None, sim=True)
+    given = cell_source(None, sim=True, discovery_timeout=240.0)
+    assert isinstance(default, SimulatedCellSource) and isinstance(given, SimulatedCellSource)
+    assert (default._wait, given._wait) == (service.SIMULATED_DISCOVERY_SECONDS, 240.0)
+    help_text = CliRunner().invoke(app, ["serve", "--help"], terminal_width=200).stdout
+    assert "--discovery-timeout SECONDS" in help_text

@@ -124,3 +124,23 @@ def test_fault_specs_are_read_or_refused_with_the_reason() -> None:
                          ("sensor3d:disconnect", "speaks upnp"), ("gripper", "expected DEVICE:KIND")]:
         with pytest.raises(FaultSpecError, match=reason):
             parse_faults(spec, devices)
+
+
+@pytest.mark.parametrize("seconds", ["nan", "inf", "-1", "-0.5", "1e400", "3601", "", "٣"])
+def test_issue_24_fault_seconds_that_are_not_finite_or_negative_are_refused(seconds: str) -> None:
+    # robot:delay-event::nan was accepted
+    devices = service.cell(service.builtin("cells", "bin-picking.yaml")).devices
+    with pytest.raises(FaultSpecError, match=r"SECONDS must be a number from 0 to 3600; found"):
+        parse_faults(f"robot:delay-event::{seconds}", devices)
+
+
+def test_issue_24_a_run_with_nan_fault_seconds_is_bad_input_in_one_line() -> None:
+    from typer.testing import CliRunner
+
+    from plugnproduce.cli import app
+
+    task = str(service.builtin("tasks", "pick-and-place.yaml"))
+    result = CliRunner().invoke(app, ["run", task, "--sim", "--faults", "robot:delay-event::nan"])
+    assert result.exit_code == 2
+    assert result.stderr.splitlines() == [
+        "error: --faults 'robot:delay-event::nan': SECONDS must be a number from 0 to 3600; found 'nan'"]

@@ -7,6 +7,7 @@ instead of hanging, exhausting memory or raising past the interpreter.
 from __future__ import annotations
 
 import ast
+import re
 
 import pytest
 
@@ -75,3 +76,28 @@ def test_ordinary_expressions_keep_their_values(source: str, value: object) -> N
 def test_a_trusted_evaluator_is_not_budgeted() -> None:
     trusted = Evaluator(trusted=True)
     assert trusted.expr("len('a' * 2_000_000)").evaluate({"__builtins__": trusted.builtins()}) == 2_000_000
+
+
+@pytest.mark.parametrize(("source", "needle"), [
+    ("['a'*10**6 for _ in range(10)]", "build more than 4000000 items and characters in all"),
+    ("[s + s for _ in range(100)]", "joining sequences of 200000 and 200000 items would make"),
+    ("[s.replace('a', 'bb') for _ in range(100)]", "this replace would make"),
+    ("['-'.join([s, s]) for _ in range(100)]", "joining these strings would make"),
+    ("'%2000000000d' % 0", "a % format width or precision of 2000000000 would exceed"),
+    ("'%.*f' % (2000000000, 1.5)", "a % format width or precision of 2000000000 would exceed"),
+    ("'%*d' % ('x', 0)", "a % format width or precision of 'x' would exceed"),
+], ids=["rows", "concatenations", "replaces", "joins", "width", "star precision", "star not a number"])
+def test_what_an_evaluation_builds_in_all_is_bounded_before_it_is_built(source: str, needle: str) -> None:
+    with pytest.raises(EvaluationError, match=re.escape(needle)):
+        evaluate(source, s="ab" * 100_000)
+
+
+@pytest.mark.parametrize(("source", "value"), [
+    ("'%d %*d|%-3s|%.1f' % (1, 4, 2, 'a', 2.25)", "1    2|a  |2.2"),
+    ("'%(n)5d' % {'n': 7}", "    7"),
+    ("'100%%' % ()", "100%"),
+    ("len([s + 'x' for _ in range(10)])", 10),
+    ("3 % 2 + 4", 5),
+])
+def test_formatting_and_sums_within_the_budget_are_python_s(source: str, value: object) -> None:
+    assert evaluate(source, s="ab") == value

@@ -4,26 +4,27 @@ from __future__ import annotations
 
 import asyncio
 import json
+import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
 
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
-from plugnproduce.cli.helptext import PlainTyper
-from plugnproduce.errors import ProtocolConnectionError, ProtocolError
+from plugnproduce.errors import ProtocolError
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:  # the network stack is imported by the commands that use it
     from plugnproduce import service
     from plugnproduce.description.model import Cell
-    from plugnproduce.discovery import CellChange
+    from plugnproduce.discovery import CellChange, LiveCell
     from plugnproduce.sim import control
 else:
     control = lazy_module("plugnproduce.sim.control")
     service = lazy_module("plugnproduce.service")
 
-sim_app = PlainTyper(no_args_is_help=True, rich_markup_mode=None,
+sim_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
                       help="Run simulated devices: the paper's bin-picking cell and more.")
 app.add_typer(sim_app, name="sim")
 
@@ -39,7 +40,13 @@ def _offered(cell: Cell) -> list[str]:
 
 def _change_json(change: CellChange) -> dict[str, object]:
     return {"change": change.kind, "device": change.device, "reason": change.reason or None,
+            "url": change.location or None,
             "devices": [d.id for d in change.cell.devices], "offered": _offered(change.cell)}
+
+
+def _refused_json(live: LiveCell) -> list[dict[str, str]]:
+    return [{"udn": r.udn, "url": r.location, "reason": r.reason}
+            for r in sorted(live.refused.values(), key=lambda r: r.udn)]
 
 
 @app.command()
@@ -47,45 +54,117 @@ def _change_json(change: CellChange) -> dict[str, object]:
 def discover(
     json_out: bool = JSON_OPTION,
     watch: bool = typer.Option(False, "--watch", help="Keep watching: stream plug and unplug events."),
-    timeout: float = typer.Option(2.0, metavar="SECONDS", help="Seconds to search for devices."),
-    expect: list[str] = typer.Option([], "--expect", metavar="DEVICE",
-                                     help="A device id to wait for (repeatable): the search ends as soon as every "
-                                          "expected device has answered, at the latest after --timeout."),
+    timeout: float = typer.Option(10.0, metavar="SECONDS", min=0.1, max=3600,
+                                  help="Most seconds to search; the search ends earlier once the answers settle."),
+    settle: float = typer.Option(2.0, "--settle", metavar="SECONDS", min=0.1, max=600,
+                                 help="The answers have settled when no new device answered for this long."),
+    expect: int | None = typer.Option(None, "--expect", metavar="N", min=1, max=10_000,
+                                      help="Wait (up to --timeout) for N devices; exit 1 if fewer are found."),
+    cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
+                                     help="Wait (up to --timeout) for this cell's devices; exit 1 naming those "
+                                          "missing."),
 ) -> None:
-    """List the devices found on the network (SSDP on loopback), with class and skills."""
+    """List the devices found on the network (SSDP on loopback), with class and skills, and those refused.
+
+    The search ends when no new device answered for --settle seconds, at the latest after --timeout;
+    with --expect or --cell it waits for those devices instead. Exit 0 found, 1 some expected device
+    missing, 2 bad input.
+    """
+    wanted = [d.id for d in service.cell(cell, knowledge(cell)).devices] if cell is not None else []
     try:
-        asyncio.run(_discover(json_out, watch, timeout, tuple(expect)))
+        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted)))
     except KeyboardInterrupt:
-        pass
+        return
+    if missing:
+        raise typer.Exit(1)
 
 
-async def _discover(json_out: bool, watch: bool, timeout: float, expect: tuple[str, ...] = ()) -> None:
+@dataclass(frozen=True)
+class Search:
+    """How long ``pnp discover`` searches and what for."""
+
+    timeout: float
+    settle: float
+    expect: int | None
+    wanted: list[str]
+
+    @property
+    def waits(self) -> bool:
+        """Whether the search waits for devices rather than for the answers to settle."""
+        return self.expect is not None or bool(self.wanted)
+
+    def missing(self, cell: Cell) -> list[str]:
+        """What of the expected is not in ``cell``."""
+        present = [d.id for d in cell.devices]
+        named = [d for d in self.wanted if d not in present]
+        if self.expect is not None and len(present) < self.expect:
+            return [*named, f"{self.expect - len(present)} of {self.expect} device(s)"] if not named else named
+        return named
+
+    def summary(self, seconds: float, missing: list[str]) -> str:
+        """One line: how long it searched, why it stopped, and what may be missing."""
+        if missing:
+            return f"missing after {seconds:.1f} s of search (--timeout {self.timeout:g}): {', '.join(missing)}"
+        if self.waits:
+            return f"searched {seconds:.1f} s: every expected device answered"
+        why = (f"no new device for {self.settle:g} s" if seconds < self.timeout else f"--timeout {self.timeout:g} s")
+        return (f"searched {seconds:.1f} s (until {why}); devices that answer later may be missing "
+                f"(--expect N or --cell CELL waits for them)")
+
+
+async def _discover(json_out: bool, watch: bool, search: Search) -> list[str]:
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env
 
-    async with LiveCell(knowledge().taxonomy, network=network_from_env(), search_timeout=timeout,
-                        expected=expect) as live:
-        cell = live.cell
-        if json_out and watch:  # one JSON object per line from the first on
-            typer.echo(json.dumps({"devices": _device_json(cell), "offered": _offered(cell)}))
-        elif json_out:
-            emit_json({"devices": _device_json(cell), "offered": _offered(cell)})
+    began = time.monotonic()
+    async with LiveCell(knowledge().taxonomy, network=network_from_env(), search_timeout=search.timeout,
+                        expected=search.wanted, expected_count=search.expect,
+                        quiet=None if search.waits else search.settle) as live:
+        cell, seconds = live.cell, time.monotonic() - began
+        missing = search.missing(cell)
+        _show_found(live, cell, json_out, watch, {"searched_seconds": round(seconds, 1), "missing": missing,
+                                                  "summary": search.summary(seconds, missing)})
+        if missing and not json_out:
+            typer.echo(f"error: {search.summary(seconds, missing)}", err=True)
+        if watch:
+            await _watch(live, cell, json_out)
+    return missing
+
+
+def _show_found(live: LiveCell, cell: Cell, json_out: bool, watch: bool, search: dict[str, object]) -> None:
+    found = {"devices": _device_json(cell), "refused": _refused_json(live), "offered": _offered(cell), **search}
+    if json_out and watch:  # one JSON object per line from the first on
+        typer.echo(json.dumps(found))
+    elif json_out:
+        emit_json(found)
+    else:
+        for d in _device_json(cell):
+            typer.echo(f"{d['id']:16} {', '.join(d['classes']):22} {d['protocol']:5} {', '.join(d['skills'])}")
+        for r in _refused_json(live):
+            typer.echo(f"refused {r['udn']} at {r['url']}: {r['reason']}")
+        typer.echo(f"offered: {', '.join(_offered(cell)) or 'nothing'}")
+        if not search["missing"]:
+            typer.echo(str(search["summary"]))
+
+
+async def _watch(live: LiveCell, cell: Cell, json_out: bool) -> None:
+    shown = {d.id for d in cell.devices}
+    refusals_shown = {(r.udn, r.location, r.reason) for r in live.refused.values()}
+    while True:
+        change = await live.next_change()
+        if change.kind != "refused" and (change.device in shown) == (change.kind == "plug"):
+            continue  # already shown (the devices found at start are also queued as plugs)
+        if change.kind == "refused" and (change.device, change.location, change.reason) in refusals_shown:
+            refusals_shown.discard((change.device, change.location, change.reason))
+            continue
+        shown = {d.id for d in change.cell.devices}
+        line = _change_json(change)
+        if json_out:
+            typer.echo(json.dumps(line))
         else:
-            for d in _device_json(cell):
-                typer.echo(f"{d['id']:16} {', '.join(d['classes']):22} {d['protocol']:5} {', '.join(d['skills'])}")
-            typer.echo(f"offered: {', '.join(_offered(cell)) or 'nothing'}")
-        shown = {d.id for d in cell.devices}
-        while watch:
-            change = await live.next_change()
-            if change.kind != "refused" and (change.device in shown) == (change.kind == "plug"):
-                continue  # already shown (the devices found at start are also queued as plugs)
-            shown = {d.id for d in change.cell.devices}
-            line = _change_json(change)
-            if json_out:
-                typer.echo(json.dumps(line))
-            else:
-                typer.echo(f"{change.kind} {change.device}" + (f": {change.reason}" if change.reason else ""))
-                typer.echo(f"offered: {', '.join(line['offered']) or 'nothing'}")  # type: ignore[arg-type]
+            where = f" at {change.location}" if change.location else ""
+            typer.echo(f"{change.kind} {change.device}{where}" + (f": {change.reason}" if change.reason else ""))
+            typer.echo(f"offered: {', '.join(line['offered']) or 'nothing'}")  # type: ignore[arg-type]
 
 
 def _address(control_address: str | None) -> tuple[str, int]:
@@ -106,10 +185,7 @@ CONTROL = typer.Option(None, "--control", metavar="HOST:PORT",
 def sim_plug(device: str = typer.Argument(..., metavar="DEVICE",
                                           help="A catalogue device id or a device description file."),
              control_address: str | None = CONTROL) -> None:
-    """Plug a simulated device into the running cell.
-
-    Exit 0 plugged, 2 bad input (an unknown device, no running cell at the control address).
-    """
+    """Plug a simulated device into the running cell."""
     path = Path(device)
     if device.endswith(".ttl") or path.is_file():
         if not path.is_file():
@@ -122,20 +198,13 @@ def sim_plug(device: str = typer.Argument(..., metavar="DEVICE",
 @boundary
 def sim_unplug(device: str = typer.Argument(..., metavar="DEVICE", help="The id of a running device."),
                control_address: str | None = CONTROL) -> None:
-    """Unplug a simulated device from the running cell.
-
-    Exit 0 unplugged, 2 bad input (no such device, no running cell at the control address).
-    """
+    """Unplug a simulated device from the running cell."""
     _control("unplug", device, control_address)
 
 
 def _control(op: str, device: str, control_address: str | None) -> None:
-    address = _address(control_address)
     try:
-        devices = asyncio.run(control.request(address, op, device))
-    except ProtocolConnectionError as exc:  # the address the cell started last recorded: it may have stopped
-        hint = "" if control_address else "; start a cell with 'pnp sim up CELL', or name one with --control HOST:PORT"
-        fail(f"error: {exc}{hint}")
+        devices = asyncio.run(control.request(_address(control_address), op, device))
     except ProtocolError as exc:
         fail(f"error: {exc}")
     typer.echo(f"{op}ged {device}; running: {', '.join(devices)}")
@@ -157,8 +226,6 @@ def sim_up(
 
     Plug in more with 'pnp sim plug DEVICE' (a device of the libraries, or a device description file).
     PNP_SSDP_PORT chooses a private SSDP port.
-
-    Exit 0 stopped by Ctrl-C or SIGTERM, 2 bad input (a cell that cannot be read or started).
     """
     from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.bin import SimulatedBin

@@ -266,13 +266,26 @@ def batch(
                                        help="Report file: .jsonl or .csv (default: stdout, JSONL)."),
     workers: int = typer.Option(2, "--workers", min=1, metavar="N", help="Worker processes."),
     cluster: str | None = typer.Option(None, "--cluster", metavar="ADDRESS",
-                                       help="Run on a Dask cluster: tcp://HOST:8786, or local:N worker processes."),
+                                       help="Run on a Dask cluster: tcp://HOST:8786, tls://HOST:8786, or local:N "
+                                            "worker processes. The cluster runs what the batch sends it: give "
+                                            "only an address you trust as you trust your own machine."),
+    cluster_timeout: float = typer.Option(10.0, "--cluster-timeout", metavar="SECONDS", min=0.1, max=3600,
+                                          help="Most seconds connecting to the cluster may take."),
+    cluster_ca: Path | None = typer.Option(None, "--cluster-ca", metavar="FILE",
+                                           help="With tls://: the CA certificate the scheduler's is signed by."),
+    cluster_cert: Path | None = typer.Option(None, "--cluster-cert", metavar="FILE",
+                                             help="With tls://: this client's certificate."),
+    cluster_key: Path | None = typer.Option(None, "--cluster-key", metavar="FILE",
+                                            help="With tls://: this client's private key."),
 ) -> None:
     if (configs is None) == (generate is None):
         fail("give either CONFIGS (a JSONL or CSV file, or -) or --generate N")
+    access = None
     if cluster is not None:
+        access = reasoning.ClusterAccess(cluster, cluster_timeout, cluster_ca, cluster_cert, cluster_key)
         try:
             reasoning.check_cluster_address(cluster)
+            access.check()
         except ValueError as exc:
             fail(f"--cluster: {exc}")
     devices = service.catalogue(catalogue, knowledge())
@@ -293,7 +306,7 @@ def batch(
             csv.writer(out, lineterminator="\n").writerow(reasoning.BATCH_CSV_HEADER)
         written = _write(lambda progress: service.batch_report(
             configurations, devices, list(tasks), "csv" if as_csv else "jsonl", workers, progress,
-            knowledge=knowledge(), top=top, cluster=cluster), out, total)
+            knowledge=knowledge(), top=top, cluster=access), out, total)
     if output is not None:
         typer.echo(f"wrote {written} configurations to {output}", err=True)
 

@@ -89,6 +89,9 @@ def run(
         typer.echo(f"{report.outcome}; journal {report.journal}")
         if report.fault is not None:
             typer.echo(f"fault: {report.fault}")
+    if report.fault is not None and report.fault.kind == "journal":  # the journal cannot tell of it: say it here
+        typer.echo(f"error: {report.fault.message}; the run was stopped safely, its journal ends before the stop",
+                   err=True)
     if report.outcome != "succeeded":
         raise typer.Exit(1)
 

@@ -30,21 +30,23 @@ LOOPBACK_NAMES = ("127.0.0.1", "localhost")
 
 
 def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int | None = None,
-                bin_seed: int = 0) -> CellSource:
+                bin_seed: int = 0, discovery_timeout: float | None = None) -> CellSource:
     """The cell the HMI shows, as discovery sees it.
 
     With ``sim`` the devices of ``cell`` (default: the built-in bin-picking cell) are simulated
     on a private loopback SSDP network and can be plugged and unplugged from the page, working on
     a simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given (else, for the runs of tasks that take a
     localized pose, a bin of :data:`~plugnproduce.service.DEFAULT_BIN_PARTS` parts); without, the devices are
-    the ones on the network (``PNP_SSDP_PORT``) and plug in themselves.
+    the ones on the network (``PNP_SSDP_PORT``) and plug in themselves. ``discovery_timeout`` bounds the
+    wait for discovery to see the simulated devices start, plug or unplug (default
+    ``service.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s).
     """
     if not sim:
         from plugnproduce.hmi.livecell import LiveCellSource
         from plugnproduce.protocols.upnp import network_from_env
 
         return LiveCellSource(network_from_env(), name=service.cell(cell, knowledge()).name if cell else "live",
-                              knowledge=knowledge(cell))
+                              knowledge=knowledge(cell), search_timeout=discovery_timeout or 1.0)
     from plugnproduce.hmi.simcell import SimulatedCellSource
     from plugnproduce.sim.bin import SimulatedBin
 
@@ -52,7 +54,8 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int |
     k = knowledge(cell)
     parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
     return SimulatedCellSource(service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k,
-                               bin=parts, default_bin=SimulatedBin(service.DEFAULT_BIN_PARTS, bin_seed))
+                               bin=parts, default_bin=SimulatedBin(service.DEFAULT_BIN_PARTS, bin_seed),
+                               wait=discovery_timeout or service.SIMULATED_DISCOVERY_SECONDS)
 
 
 def runner_for(source: CellSource, cell: Path | None = None) -> Runner:
@@ -88,6 +91,10 @@ def serve(
                              help="Port to listen on (0: any free port)."),
     token_file: Path | None = typer.Option(None, "--token-file", metavar="FILE",
                                            help="Read the bearer token from this file (default: a new one)."),
+    discovery_timeout: float | None = typer.Option(
+        None, "--discovery-timeout", metavar="SECONDS", min=0.1, max=3600,
+        help="With --sim: most seconds discovery may take to see the simulated devices start, plug or unplug "
+             "(default 60: a busy machine answers late); without: the first search (default 1)."),
 ) -> None:
     """Serve the Generic HMI: the live cell, offered commands, task editor, check/repair, runs.
 
@@ -105,7 +112,7 @@ def serve(
         fail("--faults needs --sim: faults are injected into simulated devices")
     if bin_parts is not None and not sim:
         fail("--bin-parts works on simulated devices: add --sim")
-    source = cell_source(cell, sim, faults, bin_parts, bin_seed)
+    source = cell_source(cell, sim, faults, bin_parts, bin_seed, discovery_timeout)
     the_cell = cell or (service.builtin("cells", "bin-picking.yaml") if sim else None)
     allowed = list(LOOPBACK_NAMES) if host in LOOPBACK_NAMES else None
     application = create_app(source, runner_for(source, the_cell), token, allowed_hosts=allowed,

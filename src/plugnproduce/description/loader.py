@@ -408,6 +408,17 @@ def _device_path(cell: Path, node: yaml.ScalarNode) -> Path:
     return (cell.parent / value).resolve()
 
 
+def not_a_description(entry: Path) -> str | None:
+    """Why a file a cell lists is no device description (a device description is a Turtle ``.ttl`` file), or None.
+
+    Nothing of the file is read, so nothing of it (``/etc/passwd``) is ever quoted.
+    """
+    if entry.suffix.lower() == ".ttl" or not entry.is_file():
+        return None
+    return (f"device entry {excerpt(entry.name)!r} is a file that is no device description; expected a "
+            "Turtle file (.ttl) or the id of a device of a loaded library")
+
+
 def load_cell(path: str | Path, taxonomy: Taxonomy,
               by_id: Callable[[str], DeviceDescription | None] | None = None) -> Cell:
     """Read a cell (YAML) and all its device descriptions.
@@ -417,6 +428,8 @@ def load_cell(path: str | Path, taxonomy: Taxonomy,
     name, files = cell_device_files(path)
     devices = []
     for f, line in files:
+        if (why := not_a_description(f)) is not None:
+            raise DescriptionError(why, path, line)
         if f.is_file():
             devices.append(load_device(f, taxonomy))
             continue

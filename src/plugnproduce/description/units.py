@@ -21,7 +21,8 @@ MAX_TEXT = 64
 """Longest quantity text read; a longer string is no quantity."""
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d{1,3})?|[-+]?(?:nan|inf|infinity))\s*"
-                       r"([A-Za-z%°µΩ].*)?$", re.IGNORECASE)
+                       r"([A-Za-z%°µΩ].*)?$", re.IGNORECASE | re.ASCII)
+"""A number in ASCII digits only (``float`` would also read ``"١٢٠"`` and ``"𝟒𝟓"``), then its unit."""
 _FACTOR = r"[A-Za-z%°µΩ_]+(?:(?:\*\*|\^)-?\d{1,2})?"
 _UNIT = re.compile(rf"^{_FACTOR}(?:\s*[*/· ]\s*{_FACTOR})*$")
 """Units as factors with small whole exponents (``N m``, ``mm/s``, ``m/s^2``): nothing pint would compute long on."""

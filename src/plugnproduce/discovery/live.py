@@ -6,7 +6,14 @@ the address it was discovered at (see ``docs/upnp.md``). The live cell searches 
 at start, then follows ``alive`` and ``byebye`` announcements; each change yields a
 :class:`CellChange` with the new cell, so the offered process commands can be
 re-inferred at once. Entering the cell waits for the search window, or only until the
-``expected`` devices have answered; answers later in the window still plug in.
+``expected`` devices have answered, or until the answers settle (``quiet``); answers later in
+the window still plug in.
+
+Each device is read on its own, concurrently with the others, within its own time budget
+(``device_budget``: description and chart together) and the size limit of every file: a device
+that hangs, answers a byte at a time or serves 100 MB costs only itself. Every device refused is
+kept in :attr:`LiveCell.refused` with its URL and the reason, until it is plugged; one refused for
+a timeout is tried again on its next announcement.
 
 Anyone can announce a device's (predictable) UDN: each place a UDN is announced at is
 tried in turn, one at a time per UDN, until one's description reads; an impostor that
@@ -20,7 +27,7 @@ import contextlib
 import ipaddress
 import logging
 import re
-from collections.abc import AsyncIterator, Collection
+from collections.abc import AsyncIterator, Collection, Coroutine
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
@@ -57,6 +64,9 @@ on disk (a device's chart is only the chart it serves)."""
 CONFIRM_TIMEOUT = 1.0
 """Seconds a device's address is given to answer before its byebye is believed."""
 
+DEVICE_BUDGET = 15.0
+"""Seconds reading one discovered device (its UPnP description, Turtle description and chart) may take in all."""
+
 
 def _safe_name(name: str) -> str:
     """A file name that stays inside its folder, from anything a device sends."""
@@ -72,6 +82,17 @@ class CellChange:
     device: str
     cell: Cell
     reason: str = ""
+    location: str = ""
+    """For a refused device: the URL it was announced at."""
+
+
+@dataclass(frozen=True)
+class RefusedDevice:
+    """A device that announced itself but was not taken into the cell: its UDN, URL and why."""
+
+    udn: str
+    location: str
+    reason: str
 
 
 class LiveCell:
@@ -85,6 +106,9 @@ class LiveCell:
         name: str = "live",
         search_timeout: float = 1.0,
         expected: Collection[str] = (),
+        expected_count: int | None = None,
+        quiet: float | None = None,
+        device_budget: float = DEVICE_BUDGET,
     ) -> None:
         self.taxonomy = taxonomy
         self.network = network
@@ -92,8 +116,17 @@ class LiveCell:
         self.search_timeout = search_timeout
         self.expected = frozenset(expected)
         """Device ids whose answers end the wait at start (none: the whole search window is waited)."""
+        self.expected_count = expected_count
+        """As many devices as end the wait at start (None: not so)."""
+        self.quiet = quiet
+        """Seconds without news (no answer, no device read) that end the wait at start (None: not so)."""
+        self.device_budget = device_budget
+        self.refused: dict[str, RefusedDevice] = {}
+        """Devices refused and not plugged since, by UDN (the last place and reason of each)."""
         self._devices: dict[str, DeviceDescription] = {}
         self._found: dict[str, FoundDevice] = {}
+        self._readings: set[asyncio.Task[None]] = set()
+        self._news = 0.0  # loop time of the last answer, plug or refusal
         self._turns: dict[str, tuple[asyncio.Lock, int]] = {}  # UDN → its lock and how many wait for it
         self._plugged = asyncio.Event()
         self._search: asyncio.Task[None] | None = None
@@ -108,30 +141,65 @@ class LiveCell:
 
     async def __aenter__(self) -> LiveCell:
         await self._listener.start()
-        search = DeviceSearch(self.network, mx=max(1, min(5, int(self.search_timeout))))
+        mx = self.search_timeout if self.quiet is None else self.quiet  # answers must come within the quiet period
+        search = DeviceSearch(self.network, mx=max(1, min(5, int(mx))))
         try:
             await search.start()
         except BaseException:
             await self._listener.stop()
             raise
+        self._news = asyncio.get_running_loop().time()
         self._search = asyncio.create_task(self._follow_search(search))
-        while not self._search.done() and not self._expected_present():
-            self._plugged.clear()
-            plugged = asyncio.create_task(self._plugged.wait())
-            await asyncio.wait((self._search, plugged), return_when=asyncio.FIRST_COMPLETED)
-            plugged.cancel()
-        if self._search.done() and (error := self._search.exception()) is not None:
-            await self._listener.stop()
-            raise error
         self._task = asyncio.create_task(self._follow())
+        try:
+            await self._wait_at_start()
+        except BaseException:
+            await self.__aexit__(None, None, None)
+            raise
         return self
 
+    async def _wait_at_start(self) -> None:
+        """Until the window ends (and the devices answering in it are read), the expected devices are in, or
+        the answers settle."""
+        assert self._search is not None
+        while not self._search.done() and not self._expected_present() and not self._settled():
+            self._plugged.clear()
+            news = asyncio.create_task(self._plugged.wait())
+            await asyncio.wait((self._search, news), timeout=self._until_settled(),
+                               return_when=asyncio.FIRST_COMPLETED)
+            news.cancel()
+        if self._search.done() and (error := self._search.exception()) is not None:
+            raise error
+
     def _expected_present(self) -> bool:
-        """Whether every expected device is in the cell (never, when none is expected: the window decides)."""
+        """Whether every expected device is in the cell, or as many as expected (never, when none is expected:
+        the window decides)."""
+        if self.expected_count is not None and len(self._devices) >= self.expected_count:
+            return True
         return bool(self.expected) and self.expected <= {d.id for d in self._devices.values()}
 
+    def _settled(self) -> bool:
+        """Whether ``quiet`` seconds passed without news and no device is being read."""
+        return self._until_settled() == 0.0
+
+    def _until_settled(self) -> float | None:
+        if self.quiet is None:
+            return None
+        if self._readings:
+            return self.quiet
+        return max(0.0, self.quiet - (asyncio.get_running_loop().time() - self._news))
+
+    def _note_news(self) -> None:
+        self._news = asyncio.get_running_loop().time()
+        self._plugged.set()
+
+    @property
+    def reading(self) -> int:
+        """How many devices are being read now."""
+        return len(self._readings)
+
     async def __aexit__(self, *exc_info: object) -> None:
-        for task in (self._task, self._search):
+        for task in (self._task, self._search, *self._readings):
             if task is not None:
                 task.cancel()
                 with contextlib.suppress(asyncio.CancelledError):
@@ -150,10 +218,14 @@ class LiveCell:
     def _publish(self, change: CellChange) -> None:
         if change.reason:  # one line, whatever a device made the reason of
             change = replace(change, reason=" ".join(change.reason.split())[:500])
+        if change.kind == "refused":
+            self.refused[change.device] = RefusedDevice(change.device, change.location, change.reason)
         self._changes.put_nowait(change)
+        self._note_news()
 
     async def _follow_search(self, search: DeviceSearch) -> None:
-        """Plug each device that answers the search, in the order they answer, until the window ends."""
+        """Read each device that answers the search as it answers, until the window ends; then wait for those
+        readings (each within its budget)."""
         deadline = asyncio.get_running_loop().time() + self.search_timeout
         try:
             while (left := deadline - asyncio.get_running_loop().time()) > 0:
@@ -161,33 +233,60 @@ class LiveCell:
                     hit = await search.next_hit(left)
                 except ProtocolTimeout:
                     break
-                await self._plug_advertised(hit)
+                self._note_news()
+                self._read(hit)
         finally:
             search.stop()
+        for hit in search.pending():  # answered in the window, not yet taken
+            self._read(hit)
+        while self._readings and not self._expected_present():
+            await asyncio.wait(set(self._readings))
 
     async def _follow(self) -> None:
         while True:
             ad = await self._listener.next(None)
+            self._note_news()
+            if ad.alive:
+                self._read(ad)
+            elif ad.udn in self._devices:
+                self._start(self._unplug_confirmed(ad.udn), ad)
+
+    def _read(self, ad: Advertisement | SearchHit) -> None:
+        """Read a device that answered or announced itself, beside the others."""
+        self._start(self._plug_advertised(ad), ad)
+
+    def _start(self, work: Coroutine[None, None, None], ad: Advertisement | SearchHit) -> None:
+        async def guarded() -> None:
             try:
-                if ad.alive and ad.udn not in self._devices:
-                    await self._plug_advertised(ad)
-                elif not ad.alive and ad.udn in self._devices:
-                    await self._unplug_confirmed(ad.udn)
+                await work
             except Exception as exc:  # noqa: BLE001 - one device's defect must never stop following the others
                 _LOGGER.warning("device %s: %s: %s", ad.udn, type(exc).__name__, exc)
-                self._publish(CellChange("refused", ad.udn, self.cell, f"{type(exc).__name__}: {exc}"))
+                self._refuse(ad, f"{type(exc).__name__}: {exc}")
+
+        task = asyncio.create_task(guarded())
+        self._readings.add(task)
+        task.add_done_callback(self._readings.discard)
+
+    def _refuse(self, ad: Advertisement | SearchHit, reason: str, *, retry: bool = False) -> None:
+        """Publish the refusal of the device ``ad`` announced; with ``retry`` its next announcement is read again."""
+        if retry:
+            self._listener.forget(ad.udn, ad.location, ad.source_host)
+        self._publish(CellChange("refused", ad.udn, self.cell, reason, ad.location or ad.source_host))
 
     async def _unplug_confirmed(self, udn: str) -> None:
         """Unplug on a byebye only if the device's own address confirms it is gone (a byebye may be spoofed)."""
-        found = self._found[udn]
-        try:
-            await describe(Advertisement(udn, True, found.location, found.source_host), timeout=CONFIRM_TIMEOUT)
-        except ProtocolError:
-            device = self._devices.pop(udn)
-            del self._found[udn]
-            self._publish(CellChange("unplug", device.id, self.cell))
-            return
-        _LOGGER.warning("byebye for %s ignored: the device still answers at %s", udn, found.location)
+        async with self._turn(udn):
+            found = self._found.get(udn)
+            if found is None:  # unplugged meanwhile
+                return
+            try:
+                await describe(Advertisement(udn, True, found.location, found.source_host), timeout=CONFIRM_TIMEOUT)
+            except ProtocolError:
+                device = self._devices.pop(udn)
+                del self._found[udn]
+                self._publish(CellChange("unplug", device.id, self.cell))
+                return
+            _LOGGER.warning("byebye for %s ignored: the device still answers at %s", udn, found.location)
 
     @contextlib.asynccontextmanager
     async def _turn(self, udn: str) -> AsyncIterator[None]:
@@ -209,26 +308,26 @@ class LiveCell:
             if ad.udn in self._devices:  # a place announcing this UDN was plugged meanwhile
                 return
             try:
-                found = await describe(ad)
-            except ProtocolError as exc:
-                self._publish(CellChange("refused", ad.udn, self.cell, str(exc)))
+                async with asyncio.timeout(self.device_budget):
+                    found = await describe(ad)
+                    device = await self._fetch(found)
+            except TimeoutError:
+                self._refuse(ad, f"device {excerpt(ad.udn)} at {excerpt(ad.location or ad.source_host)} did not "
+                                 f"serve its description and chart within {self.device_budget:g} s", retry=True)
                 return
-            await self._plug(found)
-
-    async def _plug(self, found: FoundDevice) -> None:
-        try:
-            device = await self._fetch(found)
-        except (ProtocolError, DescriptionError) as exc:
-            self._publish(CellChange("refused", found.udn, self.cell, str(exc)))
-            return
-        except Exception as exc:  # noqa: BLE001 - whatever a device sends, it costs only that device
-            reason = f"its description cannot be read ({type(exc).__name__}: {exc})"
-            self._publish(CellChange("refused", found.udn, self.cell, reason))
-            return
-        self._devices[found.udn] = device
-        self._found[found.udn] = found
-        self._publish(CellChange("plug", device.id, self.cell))
-        self._plugged.set()
+            except ProtocolTimeout as exc:
+                self._refuse(ad, str(exc), retry=True)
+                return
+            except (ProtocolError, DescriptionError) as exc:
+                self._refuse(ad, str(exc))
+                return
+            except Exception as exc:  # noqa: BLE001 - whatever a device sends, it costs only that device
+                self._refuse(ad, f"its description cannot be read ({type(exc).__name__}: {exc})")
+                return
+            self._devices[found.udn] = device
+            self._found[found.udn] = found
+            self.refused.pop(found.udn, None)
+            self._publish(CellChange("plug", device.id, self.cell))
 
     async def _fetch(self, found: FoundDevice) -> DeviceDescription:
         """Fetch the device's own description files and read them as any description."""

@@ -28,8 +28,20 @@ class JournalInUse(PlugNProduceError):
     """A run was given a journal file that already exists."""
 
 
+class JournalWriteError(PlugNProduceError):
+    """A record could not be written (a full disk, a file size limit, an I/O error); ``record`` is the record."""
+
+    def __init__(self, message: str, record: dict[str, Any]) -> None:
+        super().__init__(message)
+        self.record = record
+
+
 class Journal:
-    """Appends records to a run's journal file, durably."""
+    """Appends records to a run's journal file, durably.
+
+    Once a write fails, nothing more is written (a torn line stays the last one, as after a crash):
+    each later :meth:`write` raises :class:`JournalWriteError` too, and the run stops safely.
+    """
 
     def __init__(self, path: str | Path, clock: Any = time.time):
         self.path = Path(path)
@@ -40,25 +52,36 @@ class Journal:
         except FileExistsError as exc:
             raise JournalInUse(f"journal {self.path} already exists (another run's); give each run its own") from exc
         self._seq = 0
+        self.failure: str | None = None
+        """Why the journal could not be written (None: every record so far was)."""
 
     def write(self, kind: str, **data: Any) -> dict[str, Any]:
-        """Append one record, make it durable, and return it."""
+        """Append one record, make it durable, and return it (:class:`JournalWriteError` if it cannot be)."""
         if kind not in KINDS:
             raise ValueError(f"unknown journal record kind {kind!r}")
         if self._file is None:
             raise ValueError(f"journal {self.path} is closed")
         self._seq += 1
         record = {"seq": self._seq, "t": round(self._clock(), 6), "kind": kind, **data}
-        self._file.write(json.dumps(record, sort_keys=True, default=str) + "\n")
-        self._file.flush()
-        os.fsync(self._file.fileno())
+        if self.failure is not None:
+            raise JournalWriteError(self.failure, record)
+        try:
+            self._file.write(json.dumps(record, sort_keys=True, default=str) + "\n")
+            self._file.flush()
+            os.fsync(self._file.fileno())
+        except OSError as exc:
+            self.failure = f"journal {self.path} cannot be written: {exc.strerror or exc}"
+            raise JournalWriteError(self.failure, record) from exc
         return record
 
     def close(self) -> None:
-        """Close the file (records already written stay)."""
+        """Close the file (records already written stay; what a failed write left unwritten is dropped)."""
         if self._file is not None:
-            self._file.close()
-            self._file = None
+            file, self._file = self._file, None
+            try:
+                file.close()
+            except OSError:  # the buffer of a failed write: it cannot be written now either
+                pass
 
     def __enter__(self) -> Journal:
         return self

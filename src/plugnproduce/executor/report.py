@@ -13,7 +13,7 @@ class Fault:
 
     ``kind``: ``timeout``, ``refused``, ``lost``, ``anomaly``, ``unexpected``, ``contract`` (an argument
     beyond the device's contract: the request was not sent), ``outcome`` (an outcome the process does not
-    declare), ``chart`` (the task chart broke down) or ``stopped``.
+    declare), ``chart`` (the task chart broke down), ``journal`` (the journal cannot be written) or ``stopped``.
     """
 
     kind: str

@@ -37,7 +37,7 @@ from plugnproduce.codegen.task import STEP
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import outcomes, values
-from plugnproduce.executor.journal import Journal
+from plugnproduce.executor.journal import Journal, JournalWriteError
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.executor.monitor import Breach, Monitor
 from plugnproduce.executor.report import Fault, RunReport
@@ -105,6 +105,7 @@ class TaskRun:
         self.interpreter.attach(self._on_meta)
         self._loop = ChartLoop(self.interpreter, self._on_step)
         self._journal: Journal | None = None
+        self._journal_failed = False
         self._links: dict[str, DeviceLink] = {}
         self._commands: set[asyncio.Task[None]] = set()
         self._monitor = Monitor(generated, cell)
@@ -397,6 +398,12 @@ class TaskRun:
 
     def _record(self, kind: str, **data: Any) -> None:
         assert self._journal is not None
-        record = self._journal.write(kind, **data)
+        try:
+            record = self._journal.write(kind, **data)
+        except JournalWriteError as exc:  # the run must not go on unjournalled: a fault, and the safe stop
+            record = exc.record
+            if not self._journal_failed:
+                self._journal_failed = True
+                self._fail(Fault("journal", str(exc), self.step, self.command))
         if self._observer is not None:
             self._observer(record)

@@ -14,7 +14,7 @@ from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
-from plugnproduce.errors import DescriptionError, PlugNProduceError, excerpt, tidy
+from plugnproduce.errors import DescriptionError, PlugNProduceError, QuantityError, excerpt, tidy
 from plugnproduce.hmi.interfaces import CellChangeRefused, RunRefused
 from plugnproduce.hmi.schemas import LOOP_TAG, STEP_TAG
 
@@ -61,6 +61,11 @@ async def _description(_: Request, exc: Exception) -> JSONResponse:
     return _one(status.HTTP_400_BAD_REQUEST, cast(DescriptionError, exc).location_message())
 
 
+async def _quantity(_: Request, exc: Exception) -> JSONResponse:
+    """A value of the request that is no finite quantity: the request's content is wrong, as a NaN number is."""
+    return _one(status.HTTP_422_UNPROCESSABLE_CONTENT, cast(QuantityError, exc).location_message())
+
+
 async def _unknown(_: Request, exc: Exception) -> JSONResponse:
     name = exc.args[0] if exc.args else "name"
     return _one(status.HTTP_404_NOT_FOUND, f"error: unknown {tidy(str(name))}")  # the name came in the request
@@ -78,6 +83,7 @@ def install(app: FastAPI) -> None:
     """Register the error boundary on ``app`` (the most specific class wins)."""
     app.add_exception_handler(RequestValidationError, _invalid_request)
     app.add_exception_handler(DescriptionError, _description)
+    app.add_exception_handler(QuantityError, _quantity)
     app.add_exception_handler(KeyError, _unknown)
     app.add_exception_handler(RunRefused, _conflict)
     app.add_exception_handler(CellChangeRefused, _conflict)

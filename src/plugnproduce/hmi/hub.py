@@ -94,7 +94,8 @@ class Hub:
     def cell_view(self, cell: Cell | None = None) -> dict[str, Any]:
         """The cell with its devices' states, and the process commands it offers."""
         cell = cell or self.cell
-        return {"cell": cell_json(cell, self.knowledge.taxonomy, self.states()), "commands": self.commands(cell)}
+        view = {**cell_json(cell, self.knowledge.taxonomy, self.states()), "refused": self.source.refused()}
+        return {"cell": view, "commands": self.commands(cell)}
 
     def _on_cell(self, update: CellUpdate) -> None:
         with self._lock:
@@ -109,7 +110,8 @@ class Hub:
         if update.kind == "state":
             self.publish("device-state", self._state_event(update.cell, update.device))
             return
-        change = {"kind": update.kind, "device": update.device, "reason": update.reason}
+        change = {"kind": update.kind, "device": update.device, "reason": update.reason,
+                  "url": update.location or None}
         self.publish("cell", {"change": change, **self.cell_view(update.cell)})
 
     def _state_event(self, cell: Cell, device_id: str) -> dict[str, Any]:

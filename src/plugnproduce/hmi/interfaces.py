@@ -35,6 +35,8 @@ class CellUpdate:
     cell: Cell
     reason: str = ""
     state: str | None = None
+    location: str = ""
+    """For a refused device: the URL it announced itself at."""
 
 
 CellListener = Callable[[CellUpdate], None]
@@ -52,6 +54,10 @@ class CellSource(Protocol):
 
     def subscribe(self, listener: CellListener) -> Callable[[], None]:
         """Call ``listener`` on every change from now on; the returned function unsubscribes."""
+        ...
+
+    def refused(self) -> list[dict[str, str]]:
+        """The devices refused and not plugged since: each one's ``udn``, ``url`` and ``reason``."""
         ...
 
     async def start(self) -> None:

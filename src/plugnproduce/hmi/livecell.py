@@ -55,6 +55,11 @@ class LiveCellSource:
 
         return unsubscribe
 
+    def refused(self) -> list[dict[str, str]]:
+        """The devices discovery refused and has not plugged since: UDN, URL and reason."""
+        return [{"udn": r.udn, "url": r.location, "reason": r.reason}
+                for r in sorted(self._live.refused.values(), key=lambda r: r.udn)]
+
     async def start(self) -> None:
         """Start following SSDP announcements."""
         await self._stack.enter_async_context(self._live)
@@ -80,7 +85,8 @@ class LiveCellSource:
     async def _follow(self) -> None:
         async for change in self._live.changes():
             self._cell = change.cell
-            self._notify(CellUpdate(change.kind, change.device, change.cell, change.reason))
+            self._notify(CellUpdate(change.kind, change.device, change.cell, change.reason,
+                                    location=change.location))
             async with self._changed:
                 self._changed.notify_all()
 

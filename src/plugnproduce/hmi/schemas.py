@@ -164,7 +164,7 @@ class TaskIn(BaseModel):
         doc = {"task": self.name, "description": self.description, "repeat": self.repeat,
                "steps": [s.model_dump(exclude_none=True, by_alias=True) for s in self.steps]}
         try:
-            task = service.task_from_text(json.dumps(doc), TASK_SOURCE)
+            task = service.task_from_text(json.dumps(doc, ensure_ascii=False), TASK_SOURCE)
         except DescriptionError as exc:
             raise ValueError(exc.message) from exc
         # the JSON's lines are no file's lines: problems name the steps instead

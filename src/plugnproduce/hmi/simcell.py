@@ -39,7 +39,7 @@ class SimulatedCellSource(LiveCellSource):
     """
 
     def __init__(self, cell: Cell, catalogue: list[DeviceDescription], faults: str = "",
-                 wait: float = 10.0, knowledge: Knowledge | None = None,
+                 wait: float = service.SIMULATED_DISCOVERY_SECONDS, knowledge: Knowledge | None = None,
                  bin: SimulatedBin | None = None, default_bin: SimulatedBin | None = None) -> None:  # noqa: A002
         """``wait``: seconds a plug, unplug or the start may take until discovery has seen it."""
         super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS, knowledge=knowledge)

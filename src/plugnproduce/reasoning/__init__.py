@@ -23,6 +23,7 @@ from plugnproduce.reasoning.batches import (
 )
 from plugnproduce.reasoning.cluster import check_address as check_cluster_address
 from plugnproduce.reasoning.cluster import cluster_mapper
+from plugnproduce.reasoning.clusterpeer import ClusterAccess, ClusterError
 from plugnproduce.reasoning.contracts import normalised
 from plugnproduce.reasoning.counterfactuals import Counterfactual
 from plugnproduce.reasoning.counterfactuals import from_repairs as counterfactuals_from_repairs
@@ -80,6 +81,8 @@ __all__ = [
     "capabilities",
     "check",
     "check_cluster_address",
+    "ClusterAccess",
+    "ClusterError",
     "bounded_lines",
     "cluster_mapper",
     "configurations_from",

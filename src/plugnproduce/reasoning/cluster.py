@@ -16,6 +16,7 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 from plugnproduce.reasoning.batches import Configuration, Engine, Mapper, Part, run_chunk
+from plugnproduce.reasoning.clusterpeer import ClusterAccess, ClusterError, probe
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -34,24 +35,36 @@ def check_address(address: str) -> str:
     raise ValueError(f"expected a scheduler address such as tcp://HOST:8786, or local:N; found {address!r}")
 
 
-def cluster_mapper(address: str) -> Mapper:
-    """A :data:`.batches.Mapper` that runs chunks on the cluster at ``address`` (see :func:`check_address`)."""
-    check_address(address)
+def cluster_mapper(cluster: str | ClusterAccess) -> Mapper:
+    """A :data:`.batches.Mapper` that runs chunks on the cluster at an address (see :func:`check_address`),
+    connecting within its timeout, with its TLS files for ``tls://``, to a peer checked first
+    (:func:`~.clusterpeer.probe`)."""
+    access = cluster if isinstance(cluster, ClusterAccess) else ClusterAccess(cluster)
+    check_address(access.address)
+    access.check()
 
     def run(engine: Engine, chunks: Iterator[list[Configuration]], form: str) -> Iterator[Part]:
-        with _client(address) as client:
+        with _client(access) as client:
             yield from _ordered(client, engine, chunks, form)
 
     return run
 
 
 @contextlib.contextmanager
-def _client(address: str) -> Iterator[Client]:
+def _client(access: ClusterAccess) -> Iterator[Client]:
+    import dask
     from distributed import Client, LocalCluster
 
-    local = LOCAL.fullmatch(address)
+    local = LOCAL.fullmatch(access.address)
     if local is None:
-        with Client(address) as client:  # type: ignore[no-untyped-call]
+        probe(access)
+        with dask.config.set({"distributed.comm.timeouts.connect": f"{access.timeout}s"}):
+            try:
+                client = Client(access.address, timeout=access.timeout,  # type: ignore[no-untyped-call]
+                                security=access.security())
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise ClusterError(f"--cluster {access.address}: cannot connect ({exc})") from exc
+        with client:
             yield client
         return
     workers = int(local.group(1))

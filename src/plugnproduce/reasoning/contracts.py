@@ -3,8 +3,9 @@
 Two steps of the plausibility check:
 
 - :func:`normalised` reads each quantity a task writes with a unit (``"0.12 kN"``) in the unit
-  its process parameter declares (``120`` N); a unit of another dimension, an unknown unit or a
-  number that is not finite is a problem at the value's line;
+  its process parameter declares (``120`` N); a unit of another dimension or an unknown unit is a
+  problem at the value's line, and a number that is not finite, as written or once converted
+  (``1e308 kN``), is bad input there (:class:`~plugnproduce.errors.QuantityError`);
 - :func:`beyond_limits` holds each value a device is sent (given, or the process's default) to
   that device's contract for the request that carries it (``pnp:RequestArgument``): its minimum
   and maximum, in the device's unit, and for a pose the device's reach.
@@ -17,8 +18,17 @@ import math
 from collections.abc import Iterator, Sequence
 
 from plugnproduce.description.contracts import breach
-from plugnproduce.description.model import Argument, Cell, DeviceDescription, Parameter, ProcessDescription, Task
+from plugnproduce.description.model import (
+    Argument,
+    Cell,
+    DeviceDescription,
+    Parameter,
+    ProcessDescription,
+    Task,
+    Where,
+)
 from plugnproduce.description.units import Amount, UnitError, convert, read_amount
+from plugnproduce.errors import QuantityError, excerpt
 from plugnproduce.reasoning.facts import DATATYPES
 from plugnproduce.reasoning.results import Problem, Reason, StepCheck
 
@@ -48,6 +58,9 @@ def normalised(task: Task, processes: Sequence[ProcessDescription],
             if par is None or amount is None or not _numeric(par):
                 continue  # not a quantity written as text: the type check tells of anything wrong with it
             number, why = _read(amount, par)
+            if not math.isfinite(number) and why is None or not math.isfinite(amount.number):
+                raise QuantityError(_not_finite(step.index, step.command, name, value, amount, par),
+                                    *_at(task.where(step, name)))
             if why is None:
                 params[name] = int(number) if par.datatype.endswith("integer") and number.is_integer() else number
                 continue
@@ -61,10 +74,19 @@ def normalised(task: Task, processes: Sequence[ProcessDescription],
     return dataclasses.replace(task, steps=tuple(steps)), problems
 
 
+def _not_finite(index: int, command: str, name: str, value: object, amount: Amount, par: Parameter) -> str:
+    what = f"step {index} ({command}): parameter {name} is {excerpt(str(value))!r}"
+    if not math.isfinite(amount.number):
+        return f"{what}; expected a finite number"
+    return f"{what}, which in {par.unit} is beyond any number a device can be given; expected a finite quantity"
+
+
+def _at(where: Where) -> tuple[str, int | None]:
+    return where.file, where.line
+
+
 def _read(amount: Amount, par: Parameter) -> tuple[float, str | None]:
     """An amount in the parameter's unit, or why it cannot be read so."""
-    if not math.isfinite(amount.number):
-        return math.nan, "expected a finite number"
     if amount.unit and not par.unit:
         return math.nan, f"parameter {par.name} takes a plain number (no unit)"
     try:

@@ -36,14 +36,24 @@ _LIMIT = 2_000_000_000
 
 
 def milli(value: object) -> int | None:
-    """A number in whole thousandths (clamped to ASP's range), or None if it is no number."""
+    """A finite number in whole thousandths (clamped to ASP's range), or None if it is no such number.
+
+    Only ASCII digits make a number (``Decimal`` would also read ``"١٢٠"``); an infinite or NaN value is none.
+    """
     if isinstance(value, bool):
         return None
+    text = str(value)
+    if not text.isascii():
+        return None
     try:
-        scaled = int((Decimal(str(value)) * SCALE).to_integral_value())
+        number = Decimal(text)
     except (InvalidOperation, ValueError):
         return None
-    return max(-_LIMIT, min(_LIMIT, scaled))
+    if not number.is_finite():
+        return None
+    if abs(number) >= _LIMIT:  # clamped before scaling: 1e308 is not turned into a 309-digit integer
+        return _LIMIT if number > 0 else -_LIMIT
+    return max(-_LIMIT, min(_LIMIT, int((number * SCALE).to_integral_value())))
 
 
 def value_kinds(value: object) -> tuple[str, ...]:

@@ -194,6 +194,21 @@ def _num(v: int) -> str:
     return format(v / SCALE, "g")
 
 
+def exact(value: float) -> str:
+    """A number to 15 significant digits, all a float holds for certain (``1.7e+308``, ``120``,
+    ``150.123456789``): never rounded to 6 digits, never clamped."""
+    return format(value, ".15g")
+
+
+def _given(ctx: Context, i: int, n: str, v: int) -> str:
+    """The value step ``i`` gives ``n``, exactly as the task holds it (ASP's thousandths are clamped)."""
+    if ctx.task is not None and 1 <= i <= len(ctx.task.steps):
+        value = ctx.task.steps[i - 1].params.get(n)
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return exact(value)
+    return _num(v)
+
+
 def parameter_problem(ctx: Context, a: s.BadType | s.TooLow | s.TooHigh | s.UnknownParam) -> Problem:
     """A parameter value that does not fit its process's declaration."""
     p = ctx.step_command(a.i)
@@ -201,12 +216,13 @@ def parameter_problem(ctx: Context, a: s.BadType | s.TooLow | s.TooHigh | s.Unkn
     par = next((x for x in proc.parameters if x.name == a.n), None) if proc else None
     unit = f" {par.unit}" if par and par.unit else ""
     head = f"step {a.i} ({p}): parameter {a.n}"
+    given = _given(ctx, a.i, a.n, a.v) if isinstance(a, s.TooLow | s.TooHigh) else ""
     if isinstance(a, s.BadType):
         kind, text = "bad_type", f"{head} is not a {a.ty} value"
     elif isinstance(a, s.TooLow):
-        kind, text = "too_low", f"{head} = {_num(a.v)}{unit} is below its minimum {_num(a.bound)}{unit}"
+        kind, text = "too_low", f"{head} = {given}{unit} is below its minimum {_num(a.bound)}{unit}"
     elif isinstance(a, s.TooHigh):
-        kind, text = "too_high", f"{head} = {_num(a.v)}{unit} is above its maximum {_num(a.bound)}{unit}"
+        kind, text = "too_high", f"{head} = {given}{unit} is above its maximum {_num(a.bound)}{unit}"
     else:
         names = ", ".join(x.name for x in proc.parameters) if proc else "-"
         kind, text = "unknown_param", f"{head} is not declared by {p} (its parameters: {names})"

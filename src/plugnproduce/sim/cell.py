@@ -7,6 +7,7 @@ Faults are injected per device with a spec such as ``gripper:drop-response:Close
 from __future__ import annotations
 
 import asyncio
+import re
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
@@ -46,12 +47,24 @@ def parse_faults(spec: str, devices: Iterable[DeviceDescription]) -> dict[str, x
             raise FaultSpecError(f"--faults {item!r}: unknown kind {kind!r}; expected one of "
                                  f"{', '.join(xirp.FaultKind)}")
         name = parts[2] if len(parts) > 2 and parts[2] else None
+        delay = _seconds(item, parts[3]) if len(parts) > 3 else 0.0
         try:
-            delay = float(parts[3]) if len(parts) > 3 else 0.0
             faults.setdefault(device, xirp.Faults()).add(kind, name, delay=delay)
         except (ValueError, xirp.MessageError) as exc:
             raise FaultSpecError(f"--faults {item!r}: {exc}") from None
     return faults
+
+
+MAX_FAULT_SECONDS = 3600.0
+"""Longest delay a fault may inject."""
+
+
+def _seconds(item: str, text: str) -> float:
+    """A fault's SECONDS: a plain decimal number from 0 to :data:`MAX_FAULT_SECONDS` (no ``nan``, ``inf``, ``-1``)."""
+    if not re.fullmatch(r"[0-9]+(?:\.[0-9]*)?|\.[0-9]+", text.strip()) or float(text) > MAX_FAULT_SECONDS:
+        raise FaultSpecError(f"--faults {item!r}: SECONDS must be a number from 0 to {MAX_FAULT_SECONDS:g}; "
+                             f"found {text!r}")
+    return float(text)
 
 
 class SimulatedCell:

@@ -21,6 +21,7 @@ from plugnproduce.description.loader import (
     device_subject,
     file_of,
     load_task,
+    not_a_description,
     process_from,
     read_description,
 )
@@ -249,5 +250,7 @@ def _cell(path: Path, report: Report, knowledge: Knowledge) -> None:
     _, files = cell_device_files(path)
     knowledge = knowledge.with_libraries(library_folders(cell_libraries(path)))
     for f, line in files:
-        if not f.is_file() and (f.suffix == ".ttl" or knowledge.device(f.name) is None):
+        if (why := not_a_description(f)) is not None:
+            report.add(Problem(str(path), line, why))
+        elif not f.is_file() and (f.suffix == ".ttl" or knowledge.device(f.name) is None):
             report.add(Problem(str(path), line, f"device description {excerpt(str(f), 120)} not found"))

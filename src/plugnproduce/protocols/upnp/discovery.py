@@ -208,6 +208,13 @@ class DeviceSearch:
         except TimeoutError as exc:
             raise ProtocolTimeout(f"SSDP search for {self.search_target}: no new answer within {timeout:g} s") from exc
 
+    def pending(self) -> list[SearchHit]:
+        """The candidates that answered and were not yet taken by :meth:`next_hit`, now taken."""
+        taken = []
+        while not self._queue.empty():
+            taken.append(self._queue.get_nowait())
+        return taken
+
     async def wait_for(self, udn: str, timeout: float) -> SearchHit:
         """The answer of the device ``udn``, as soon as it arrives."""
         return await self._changed.wait_for(lambda: self.hits.get(udn), timeout, f"SSDP search for {udn}")
@@ -400,6 +407,12 @@ class AdvertisementListener:
         self.seen.append(advertisement)
         self._queue.put_nowait(advertisement)
         self._changed.notify()
+
+    def forget(self, udn: str, location: str | None, source_host: str) -> None:
+        """Report the next ``alive`` of ``udn`` at this place again (its device is to be tried once more)."""
+        places = self._places.get(udn)
+        if places and (location, source_host) in places:
+            places.remove((location, source_host))
 
     async def next(self, timeout: float | None) -> Advertisement:
         """The next report; :class:`~plugnproduce.errors.ProtocolTimeout` if none comes in time (None: no limit)."""

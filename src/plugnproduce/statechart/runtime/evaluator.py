@@ -20,6 +20,7 @@ from __future__ import annotations
 import ast
 import builtins
 import functools
+import re
 import textwrap
 import warnings
 from collections.abc import Callable
@@ -53,6 +54,10 @@ MAX_INT_BITS = 65_536
 """Largest integer (in bits) an untrusted ``**`` or ``<<`` may produce."""
 MAX_STEPS = 1_000_000
 """Most comprehension iterations one untrusted evaluation may take."""
+MAX_ALLOCATED = 4_000_000
+"""Most items and characters one untrusted evaluation may build in all (repetitions, concatenations, ranges,
+joins, replaces, ``%`` widths), counted before each is built: ``[[1]*10**6 for _ in range(10**6)]`` is refused
+at its second row, not after gigabytes."""
 
 SAFE_METHODS = frozenset({
     "get", "keys", "values", "items", "copy", "count", "index", "append", "extend", "insert", "pop", "remove",
@@ -89,6 +94,7 @@ class Expr:
         if self.code is None:
             raise EvaluationError(f"cannot evaluate {self.source!r}: {self.problem}")
         _steps[0] = MAX_STEPS
+        _allocated[0] = MAX_ALLOCATED
         try:
             return eval(self.code, namespace)  # noqa: S307 - compiled from a checked AST (or trusted)
         except Exception as exc:
@@ -257,6 +263,15 @@ def _check_call(node: ast.Call) -> None:
 # per evaluation. The guard names start with ``__``, which no checked expression may name.
 
 _steps = [MAX_STEPS]
+_allocated = [MAX_ALLOCATED]
+
+
+def _charge(size: int, what: str) -> None:
+    """Count ``size`` items about to be built against the evaluation's allocation budget."""
+    _allocated[0] -= size
+    if _allocated[0] < 0:
+        raise EvaluationError(f"{what} would make the expression build more than {MAX_ALLOCATED} items and "
+                              "characters in all, the restricted evaluator's limit")
 
 
 def _too_large(what: str) -> EvaluationError:
@@ -284,11 +299,43 @@ def _binop(op: str, left: Any, right: Any) -> Any:
         if isinstance(right, int) and right > MAX_INT_BITS:
             raise _too_large(f"shifting left by {_shown(right)}")
         return left << right
+    if op == "Add":
+        if (size := _size(left)) is not None and (other := _size(right)) is not None:
+            _charge(size + other, f"joining sequences of {size} and {other} items")
+        return left + right
+    if op == "Mod":
+        if isinstance(left, str | bytes):
+            _charge(len(left) + _format_widths(left, right), "this % formatting")
+        return left % right
     for seq, times in ((left, right), (right, left)):  # Mult
         size = _size(seq)
-        if size is not None and isinstance(times, int) and size * times > MAX_ITEMS:
-            raise _too_large(f"a sequence of {size} items repeated {times} times")
+        if size is not None and isinstance(times, int):
+            if size * times > MAX_ITEMS:
+                raise _too_large(f"a sequence of {size} items repeated {times} times")
+            _charge(size * times, f"a sequence of {size} items repeated {times} times")
     return left * right
+
+
+_CONVERSION = re.compile(r"%(?:\([^)]*\))?[-#0 +]*(\*|\d+)?(?:\.(\*|\d+))?[hlL]?[a-zA-Z%]")
+
+
+def _format_widths(template: str | bytes, values: Any) -> int:
+    """The characters the widths and precisions of a ``%`` template ask for (a ``*`` takes its value from
+    ``values``); refused when one is beyond :data:`MAX_ITEMS`, before anything is formatted."""
+    text = template if isinstance(template, str) else template.decode("latin-1")
+    given = list(values) if isinstance(values, tuple) else [values]
+    total, taken = 0, 0
+    for m in _CONVERSION.finditer(text):
+        for part in (m.group(1), m.group(2)):
+            if part == "*":
+                width, taken = (given[taken] if taken < len(given) else 0), taken + 1
+            else:
+                width = int(part) if part else 0
+            if not isinstance(width, int) or abs(width) > MAX_ITEMS:
+                raise _too_large(f"a % format width or precision of {_shown(width)}")
+            total += abs(width)
+        taken += not m.group(0).endswith("%")
+    return total
 
 
 def _iterate(iterable: Any) -> Any:
@@ -302,12 +349,16 @@ def _iterate(iterable: Any) -> Any:
 def _method(target: Any, name: str, *args: Any, **kwargs: Any) -> Any:
     if isinstance(target, str | bytes) and name == "join" and args:  # bytes too: b''.join and b.replace multiply
         parts = list(_iterate(args[0]))
-        if sum(len(p) if isinstance(p, str | bytes) else 0 for p in parts) + len(target) * len(parts) > MAX_ITEMS:
+        size = sum(len(p) if isinstance(p, str | bytes) else 0 for p in parts) + len(target) * len(parts)
+        if size > MAX_ITEMS:
             raise _too_large("joining these strings")
+        _charge(size, "joining these strings")
         args = (parts, *args[1:])
     if isinstance(target, str | bytes) and name == "replace" and len(args) >= 2 and isinstance(args[1], str | bytes):
-        if len(target) + (len(target) + 1) * len(args[1]) > MAX_ITEMS:
+        size = len(target) + (len(target) + 1) * len(args[1])
+        if size > MAX_ITEMS:
             raise _too_large("this replace")
+        _charge(size, "this replace")
     return getattr(target, name)(*args, **kwargs)
 
 
@@ -315,6 +366,7 @@ def _range(*args: int) -> range:
     r = range(*args)
     try:
         if len(r) <= MAX_ITEMS:
+            _charge(len(r), f"range{args}")
             return r
     except OverflowError:
         pass
@@ -322,7 +374,7 @@ def _range(*args: int) -> range:
 
 
 _GUARDS: dict[str, Any] = {"__pnp_binop": _binop, "__pnp_iter": _iterate, "__pnp_method": _method, "range": _range}
-_GUARDED_OPS = (ast.Pow, ast.Mult, ast.LShift)
+_GUARDED_OPS = (ast.Pow, ast.Mult, ast.LShift, ast.Add, ast.Mod)
 _GUARDED_METHODS = frozenset({"join", "replace"})
 
 

@@ -68,6 +68,10 @@ export function renderCell() {
   fill($("#devices tbody"), devices.map(deviceRow));
   $("#devices").hidden = devices.length === 0;
   $("#devices-empty").hidden = devices.length > 0;
+  const refused = cell && cell.refused ? cell.refused : [];
+  fill($("#refused-list"), refused.map((r) => h("li", { dataset: { udn: r.udn } },
+    h("span", { class: "device-id" }, r.udn), " at ", h("code", {}, r.url), ": ", r.reason)));
+  $("#refused").hidden = refused.length === 0;
   const present = new Set(devices.map((d) => d.id));
   const pluggable = state.catalogue.filter((d) => !present.has(d.id));
   $("#plug-form").hidden = !state.pluggable || pluggable.length === 0;
