@@ -1,54 +1,46 @@
 """Modules loaded on first use, so that ``pnp --help`` does not pay for what a command needs.
 
 The command line names the heavy layers (the service, reasoning, drawing) at its top
-level but touches them only inside commands. :func:`lazy_module` gives such a module
-object whose code runs on the first attribute access; type checkers see the real
-module through an ``if TYPE_CHECKING`` import beside it.
+level but touches them only inside commands. :func:`lazy_module` gives a stand-in whose
+first attribute access imports the module; type checkers see the real module through an
+``if TYPE_CHECKING`` import beside it.
+
+The stand-in is not put in ``sys.modules``: the module is imported by the ordinary import
+system when it is first used, so a package runs before its submodules and each module runs
+once, whichever is imported first (a stand-in in ``sys.modules`` either left a submodule to
+run before its package, or ran it twice).
 """
 
 from __future__ import annotations
 
+import importlib
 import importlib.util
 import sys
 from types import ModuleType
 
-_WHERE = frozenset({"__name__", "__spec__", "__path__", "__loader__", "__package__", "__file__"})
-"""What the import system reads of a parent package to import a submodule."""
+_STAND_INS: dict[str, ModuleType] = {}
 
 
-class _LazyModule(importlib.util._LazyModule):  # type: ignore[name-defined,misc]
-    """A module whose code runs on first use; reading where it is (its ``__path__``) is no use.
+class _LazyModule(ModuleType):
+    """Stands for a module not imported yet; the first attribute it is asked for imports it."""
 
-    Importing a submodule of a package reads the package's ``__path__``. Were that to run the
-    package's code, which imports the same submodule, the import would then run the submodule a
-    second time, and two copies of it (of its registries, its classes) would exist.
-    """
-
-    def __getattribute__(self, attr: str) -> object:
-        if attr in _WHERE:
-            return ModuleType.__getattribute__(self, attr)
-        return super().__getattribute__(attr)
+    def __getattr__(self, attr: str) -> object:  # only for what the stand-in itself does not have
+        module = importlib.import_module(self.__name__)
+        self.__dict__.update(module.__dict__)
+        return getattr(module, attr)
 
 
 def lazy_module(name: str) -> ModuleType:
-    """Return the module *name*, executed on its first attribute access.
+    """Return the module *name*, imported on its first attribute access.
 
     A module that is already imported is returned as it is. A name that cannot be
     found raises :class:`ModuleNotFoundError` at once, not at first use.
     """
-    loaded = sys.modules.get(name)
+    loaded = sys.modules.get(name) or _STAND_INS.get(name)
     if loaded is not None:
         return loaded
     spec = importlib.util.find_spec(name)
-    if spec is None or spec.loader is None:
+    if spec is None:
         raise ModuleNotFoundError(f"no module named {name!r}", name=name)
-    loader = importlib.util.LazyLoader(spec.loader)
-    spec.loader = loader
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    loader.exec_module(module)
-    module.__class__ = _LazyModule
-    parent, _, child = name.rpartition(".")
-    if parent:
-        setattr(sys.modules[parent], child, module)
-    return module
+    stand_in = _STAND_INS[name] = _LazyModule(name)
+    return stand_in

@@ -12,7 +12,8 @@ from typing import TYPE_CHECKING
 import typer
 
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
-from plugnproduce.errors import ProtocolError
+from plugnproduce.cli.helptext import PlainTyper
+from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:  # the network stack is imported by the commands that use it
@@ -24,7 +25,7 @@ else:
     control = lazy_module("plugnproduce.sim.control")
     service = lazy_module("plugnproduce.service")
 
-sim_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
+sim_app = PlainTyper(no_args_is_help=True, rich_markup_mode=None,
                       help="Run simulated devices: the paper's bin-picking cell and more.")
 app.add_typer(sim_app, name="sim")
 
@@ -185,7 +186,10 @@ CONTROL = typer.Option(None, "--control", metavar="HOST:PORT",
 def sim_plug(device: str = typer.Argument(..., metavar="DEVICE",
                                           help="A catalogue device id or a device description file."),
              control_address: str | None = CONTROL) -> None:
-    """Plug a simulated device into the running cell."""
+    """Plug a simulated device into the running cell.
+
+    Exit 0 plugged, 2 bad input (an unknown device, no running cell at the control address).
+    """
     path = Path(device)
     if device.endswith(".ttl") or path.is_file():
         if not path.is_file():
@@ -198,13 +202,20 @@ def sim_plug(device: str = typer.Argument(..., metavar="DEVICE",
 @boundary
 def sim_unplug(device: str = typer.Argument(..., metavar="DEVICE", help="The id of a running device."),
                control_address: str | None = CONTROL) -> None:
-    """Unplug a simulated device from the running cell."""
+    """Unplug a simulated device from the running cell.
+
+    Exit 0 unplugged, 2 bad input (no such device, no running cell at the control address).
+    """
     _control("unplug", device, control_address)
 
 
 def _control(op: str, device: str, control_address: str | None) -> None:
+    address = _address(control_address)
     try:
-        devices = asyncio.run(control.request(_address(control_address), op, device))
+        devices = asyncio.run(control.request(address, op, device))
+    except ProtocolConnectionError as exc:  # the address the cell started last recorded: it may have stopped
+        hint = "" if control_address else "; start a cell with 'pnp sim up CELL', or name one with --control HOST:PORT"
+        fail(f"error: {exc}{hint}")
     except ProtocolError as exc:
         fail(f"error: {exc}")
     typer.echo(f"{op}ged {device}; running: {', '.join(devices)}")
@@ -226,6 +237,8 @@ def sim_up(
 
     Plug in more with 'pnp sim plug DEVICE' (a device of the libraries, or a device description file).
     PNP_SSDP_PORT chooses a private SSDP port.
+
+    Exit 0 stopped by Ctrl-C or SIGTERM, 2 bad input (a cell that cannot be read or started).
     """
     from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.bin import SimulatedBin

@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
+from plugnproduce.lazy import lazy_module
+
+if TYPE_CHECKING:
+    from plugnproduce import service
+else:
+    service = lazy_module("plugnproduce.service")  # `pnp --help` imports none of it
 
 ontology_app = typer.Typer(no_args_is_help=True, rich_markup_mode=None,
                            help="The ontology of the loaded knowledge, for an ontology editor such as Protégé.")

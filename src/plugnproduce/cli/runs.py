@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import typer
 
-from plugnproduce import service
 from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.lazy import lazy_module
+
+if TYPE_CHECKING:
+    from plugnproduce import service
+else:
+    service = lazy_module("plugnproduce.service")  # `pnp --help` imports none of it
 
 HEADER = ("ID", "TASK", "CELL", "START", "STATUS", "DURATION")
 
