@@ -69,7 +69,7 @@ EXPECTED: dict[str, list[str]] = {
     ],
     "planner": [
         r"planned: 3 steps, repeated until BinEmpty",
-        r"pick_pose: \{from: localize_part, output: part_pose\}",
+        r"pick_pose:\s+from: localize_part\s+output: part_pose",
         r"plausible: True",
         r"verified: proved",
         r"buy: screwdriver 1400",

@@ -499,13 +499,14 @@ value gets when no bin is asked for (``--bin-parts``)."""
 
 def default_bin_parts(task_or_path: TaskArg) -> int | None:
     """How many parts a simulated bin needs for a run of this task when none was asked for:
-    :data:`DEFAULT_BIN_PARTS` when a step takes a value another step reports (a data link, such as the pose
-    where a localisation found a part), so that the parts it finds are taken out and the bin empties; None for
-    a task that takes no reported value (the simulated devices report their charts' fixed values, and a bin
-    would refuse a move to a fixed pose where no part lies)."""
+    :data:`DEFAULT_BIN_PARTS` when the task loops until (or while) an outcome and a step takes a value another
+    step reports (a data link, such as the pose where a localisation found a part), so that the parts it finds
+    are taken out and the loop ends when the bin is empty; None for any other task (the simulated devices report
+    their charts' values, and a bin would refuse a move to a fixed pose where no part lies)."""
     the_task = _as_task(task_or_path)
     takes = any(isinstance(v, Link) for step in the_task.steps for v in step.params.values())
-    return DEFAULT_BIN_PARTS if takes else None
+    waits = any(loop.until or loop.while_outcome for loop in the_task.loops)
+    return DEFAULT_BIN_PARTS if takes and waits else None
 
 
 async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cell:

@@ -67,7 +67,7 @@ def test_a_bin_needs_simulated_devices() -> None:
 
 def test_with_sim_alone_the_task_empties_a_default_bin_of_five_parts_and_says_so(tmp_path: Path) -> None:
     # Without --bin-parts the simulated devices used to report their charts' fixed pose: the loop picked the
-    # same pose up to its maximum (300 steps) and said succeeded. A task that takes a localized pose now gets
+    # same pose up to its maximum (300 steps) and said succeeded. A task that loops on a localized pose now gets
     # a seeded bin of 5 parts, and the run says so.
     journal = tmp_path / "run.jsonl"
     result = pnp("run", str(TASKS / "bin-picking-until-empty.yaml"), "--sim", "--journal", str(journal))
@@ -81,6 +81,7 @@ def test_with_sim_alone_the_task_empties_a_default_bin_of_five_parts_and_says_so
     assert records[-1]["kind"] == "end" and records[-1]["outcome"] == "succeeded"
 
 
-def test_a_task_that_takes_no_localized_pose_gets_no_default_bin() -> None:
+def test_only_a_task_that_loops_on_an_outcome_and_takes_a_localized_pose_gets_a_default_bin() -> None:
     assert service.default_bin_parts(TASKS / "bin-picking.yaml") is None  # its fixed pick pose: no bin
-    assert service.default_bin_parts(TASKS / "bin-picking-localized.yaml") == 5
+    assert service.default_bin_parts(TASKS / "bin-picking-localized.yaml") is None  # three rounds: the charts' poses
+    assert service.default_bin_parts(TASKS / "bin-picking-until-empty.yaml") == 5

@@ -213,7 +213,7 @@ def test_serve_sim_gives_the_runs_of_a_localizing_task_a_default_bin_and_says_so
     proc, out, lines = _start("--sim")
     try:
         lines += [out.next().strip(), out.next().strip(), out.next().strip()]
-        assert lines[3] == ("simulated bin: 5 parts at random poses (seed 0) for the runs of tasks that take a "
+        assert lines[3] == ("simulated bin: 5 parts at random poses (seed 0) for the runs of tasks that loop on a "
                             "localized pose; --bin-parts N for another")
         url, token = lines[0].rsplit(" ", 1)[1], lines[2].removeprefix("token: ")
         auth = {"Authorization": f"Bearer {token}"}

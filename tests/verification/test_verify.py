@@ -201,6 +201,9 @@ EXPECTED = {
     ("glue", "glue-cell"): (True, "proved", set()),
     ("iri-then-home", "iri-outcomes"): (True, "proved", set()),
     ("iri-until-empty", "iri-outcomes"): (True, "proved", set()),
+    ("bin-picking-counting", "bin-picking-counting"): (True, "proved", set()),
+    ("gentle-tending", "tending-without-gripper"): (False, None, {"absent", "no_device"}),
+    ("tending-door-shut", "tending-without-gripper"): (False, None, {"wrong_state", "no_device"}),
 }
 """What the check and verification answer for every pair: a change in either is a failing row, never a skip."""
 

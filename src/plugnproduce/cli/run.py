@@ -33,7 +33,7 @@ def run(
                                help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
                                          help="With --sim: a simulated bin of N parts at random poses (default "
-                                              "5 for a task that takes a localized pose, else none)."),
+                                              "5 for a task that loops on a localized pose, else none)."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
     journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
                                         help="Journal file (default: a new file in PNP_RUNS)."),

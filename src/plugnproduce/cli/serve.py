@@ -35,8 +35,8 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int |
 
     With ``sim`` the devices of ``cell`` (default: the built-in bin-picking cell) are simulated
     on a private loopback SSDP network and can be plugged and unplugged from the page, working on
-    a simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given (else, for the runs of tasks that take a
-    localized pose, a bin of :data:`~plugnproduce.service.DEFAULT_BIN_PARTS` parts); without, the devices are
+    a simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given (else, for the runs of tasks that loop
+    on a localized pose, a bin of :data:`~plugnproduce.service.DEFAULT_BIN_PARTS` parts); without, the devices are
     the ones on the network (``PNP_SSDP_PORT``) and plug in themselves. ``discovery_timeout`` bounds the
     wait for discovery to see the simulated devices start, plug or unplug (default
     ``service.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s).
@@ -84,7 +84,7 @@ def serve(
     faults: str = typer.Option("", "--faults", metavar="SPEC", help="With --sim: faults to inject, as for pnp run."),
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
                                          help="With --sim: a simulated bin of N parts at random poses (as pnp run; "
-                                              "default 5 for the runs of tasks that take a localized pose)."),
+                                              "default 5 for the runs of tasks that loop on a localized pose)."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
     host: str = typer.Option("127.0.0.1", "--host", metavar="ADDRESS", help="Address to listen on."),
     port: int = typer.Option(0, "--port", min=0, max=65535, metavar="PORT",
@@ -129,7 +129,7 @@ def serve(
         typer.echo(f"token: {token}")
     if sim and bin_parts is None:
         typer.echo(f"simulated bin: {service.DEFAULT_BIN_PARTS} parts at random poses (seed {bin_seed}) for the runs "
-                   "of tasks that take a localized pose; --bin-parts N for another")
+                   "of tasks that loop on a localized pose; --bin-parts N for another")
     config = uvicorn.Config(application, log_level="warning", timeout_graceful_shutdown=2, lifespan="on", ws="none")
     previous = signal.signal(signal.SIGTERM, _interrupt)  # uvicorn re-raises the signal it stopped on: as Ctrl-C
     try:

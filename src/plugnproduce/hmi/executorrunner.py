@@ -63,7 +63,7 @@ class ExecutorRunner:
         if active is not None:
             raise RunRefused(f"run {active} is still running; stop it first")
         if isinstance(self._source, SimulatedCellSource):
-            self._source.prepare_run(task)  # its default bin, for a task that takes a localized pose
+            self._source.prepare_run(task)  # its default bin, for a task that loops on a localized pose
         try:  # planned from the state each device reports, not its chart's initial state
             reported = cell.reported(await service.reported_states(cell))
             generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)
