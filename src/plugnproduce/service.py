@@ -299,16 +299,18 @@ def batch_report(
     knowledge: Knowledge | None = None,
     top: int = 1,
     cluster: str | None = None,
+    tally: dict[str, int] | None = None,
 ) -> Iterator[str]:
     """:func:`batch`'s answers as report text (JSONL, or CSV rows with ``form`` "csv"), a chunk at a time,
-    made by the workers: what ``pnp batch`` writes."""
+    made by the workers: what ``pnp batch`` writes. ``tally`` counts the configurations written by outcome
+    (all plausible, a purchase, a role to bind, nothing helps)."""
     k = _k(knowledge)
     devices = _devices(catalogue_or_folder, k)
     configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
     mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
     return reasoning.report(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
-                            form=form, workers=workers, progress=progress, top=top, mapper=mapper)
+                            form=form, workers=workers, progress=progress, top=top, mapper=mapper, tally=tally)
 
 
 def generate_configurations(

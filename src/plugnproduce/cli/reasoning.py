@@ -225,8 +225,10 @@ Output (stdout or -o FILE): one JSON line per configuration, in input order:
 {"config", "devices", "offered", "plausible", "purchase"}. "purchase" is null when every --task
 is plausible; otherwise {"options": [{"add": [DEVICE, ...], "cost": N}, ...]}, the --top cheapest
 sets of catalogue devices (pnp:cost; ties: fewer devices) whose addition makes every task
-plausible, or {"options": [], "impossible": "why"} when no set from the catalogue does.
-A .csv output file gets the same columns as CSV.
+plausible; {"options": [], "ambiguous": "..."} when several devices of the configuration can
+play a step's role (bind it in the task: no purchase cures that); {"options": [], "impossible":
+"why"} when no set from the catalogue helps. A .csv output file gets the same columns as CSV.
+With -o, or on a terminal, a last line on stderr counts the configurations of each kind.
 """
 
 
@@ -275,11 +277,20 @@ def batch(
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
         if as_csv:
             csv.writer(out, lineterminator="\n").writerow(reasoning.BATCH_CSV_HEADER)
+        tally: dict[str, int] = {}
         written = _write(lambda progress: service.batch_report(
             configurations, devices, list(tasks), "csv" if as_csv else "jsonl", workers, progress,
-            knowledge=knowledge(), top=top, cluster=cluster), out, total)
-    if output is not None:
-        typer.echo(f"wrote {written} configurations to {output}", err=True)
+            knowledge=knowledge(), top=top, cluster=cluster, tally=tally), out, total)
+    if output is not None or on_a_terminal():
+        where = f" to {output}" if output is not None else ""
+        typer.echo(f"wrote {written} configurations{where}: {_tally(tally)}", err=True)
+
+
+def _tally(tally: dict[str, int]) -> str:
+    """``3 all tasks plausible, 5 with a purchase, 2 ambiguous (bind a role), 1 impossible``."""
+    words = {"plausible": "all tasks plausible", "buy": "with a purchase", "ambiguous": "ambiguous (bind a role)",
+             "impossible": "impossible"}
+    return ", ".join(f"{tally.get(k, 0)} {w}" for k, w in words.items())
 
 
 def _write(report: Callable[[Callable[[int], None]], Iterator[str]], out: TextIO, total: int | None) -> int:

@@ -59,6 +59,11 @@ class BatchRow:
     purchase: Purchase | None = None
     """The cheapest sets of devices to add so every task is plausible; None when they all are."""
 
+    @property
+    def outcome(self) -> str:
+        """One of :data:`OUTCOMES`: every task plausible, a purchase helps, a role to bind, or nothing helps."""
+        return "plausible" if self.purchase is None else self.purchase.outcome
+
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         return {"config": self.config, "devices": list(self.devices), "offered": list(self.offered),
@@ -72,6 +77,9 @@ class BatchRow:
 
 
 CSV_HEADER = ["config", "devices", "offered", "plausible", "purchase"]
+OUTCOMES = ("plausible", "buy", "ambiguous", "impossible")
+"""What a configuration's answer comes to (:attr:`BatchRow.outcome`), in the order a batch's tally tells them."""
+Tally = dict[str, int]
 
 
 # ------------------------------------------------------------------ configurations in
@@ -191,7 +199,10 @@ class Engine:
 
     def line(self, config: Configuration) -> str:
         """The JSONL line of one configuration: ``json.dumps(row.to_json())``, answers' JSON remembered."""
-        offered, plausible, bought = self._answer(self.mask(config))
+        return self._line(config, *self._answer(self.mask(config)))
+
+    def _line(self, config: Configuration, offered: tuple[str, ...], plausible: tuple[str, ...],
+              bought: Purchase | None) -> str:
         return (f'{{"config": {json.dumps(config.name)}, "devices": {json.dumps(list(config.devices))}, '
                 f'"offered": {self._dumped(offered)}, "plausible": {self._dumped(plausible)}, '
                 f'"purchase": {self._dumped(bought)}}}\n')
@@ -205,13 +216,23 @@ class Engine:
             text = self._json[value] = json.dumps(data)
         return text
 
-    def text(self, configs: list[Configuration], form: str) -> str:
-        """The report of some configurations: JSONL lines, or CSV rows (``form`` "csv")."""
+    def text(self, configs: list[Configuration], form: str) -> tuple[str, Tally]:
+        """The report of some configurations: JSONL lines, or CSV rows (``form`` "csv"), and how many of them
+        come to each of :data:`OUTCOMES`."""
+        tally = dict.fromkeys(OUTCOMES, 0)
         if form != "csv":
-            return "".join(self.line(c) for c in configs)
+            lines = []
+            for c in configs:
+                offered, plausible, bought = self._answer(self.mask(c))
+                lines.append(self._line(c, offered, plausible, bought))
+                tally["plausible" if bought is None else bought.outcome] += 1
+            return "".join(lines), tally
         buf = io.StringIO()
-        csv.writer(buf, lineterminator="\n").writerows(self.row(c).to_csv() for c in configs)
-        return buf.getvalue()
+        rows = [self.row(c) for c in configs]
+        for r in rows:
+            tally[r.outcome] += 1
+        csv.writer(buf, lineterminator="\n").writerows(r.to_csv() for r in rows)
+        return buf.getvalue(), tally
 
 
 _ENGINE: Engine | None = None
@@ -222,9 +243,10 @@ def _start(engine: Engine) -> None:
     _ENGINE = engine
 
 
-def run_chunk(chunk: list[Configuration], form: str = "rows", engine: Engine | None = None) -> list[BatchRow] | str:
-    """Rows for a chunk of configurations, or their report text (``form`` "jsonl" or "csv"); in a worker,
-    with the engine its start-up was given."""
+def run_chunk(chunk: list[Configuration], form: str = "rows",
+              engine: Engine | None = None) -> list[BatchRow] | tuple[str, Tally]:
+    """Rows for a chunk of configurations, or their report text (``form`` "jsonl" or "csv") with its tally; in
+    a worker, with the engine its start-up was given."""
     e = engine or _ENGINE
     if e is None:
         raise RuntimeError("run_chunk needs an engine")
@@ -250,7 +272,7 @@ def engine(catalogue: Sequence[DeviceDescription], tasks: Sequence[Task], taxono
     return Engine(abilities(catalogue, task_names(tasks), taxonomy, processes), top)
 
 
-Part = list[BatchRow] | str
+Part = list[BatchRow] | tuple[str, Tally]
 Mapper = Callable[[Engine, Iterator[list[Configuration]], str], Iterator[Part]]
 """Runs chunks somewhere (here, a process pool, a Dask cluster) in a form ("rows", "jsonl", "csv") and
 yields their answers in chunk order."""
@@ -288,12 +310,18 @@ def report(
     progress: Callable[[int], None] | None = None,
     top: int = 1,
     mapper: Mapper | None = None,
+    tally: Tally | None = None,
 ) -> Iterator[str]:
     """The report of :func:`batch` as text, a chunk at a time: JSONL lines (``BatchRow.to_json``) or CSV rows
-    (``form`` "csv", without the header). The text is made where the chunk is answered (in the workers)."""
+    (``form`` "csv", without the header). The text is made where the chunk is answered (in the workers);
+    ``tally`` counts the configurations by :data:`OUTCOMES` as their text comes."""
     e = engine(catalogue, tasks, taxonomy, processes, top)
     for part, n in _run(e, configurations, form, workers, chunk, mapper):
-        yield cast(str, part)
+        text, counted = cast(tuple[str, Tally], part)
+        yield text
+        if tally is not None:
+            for k, v in counted.items():
+                tally[k] = tally.get(k, 0) + v
         if progress is not None:
             progress(n)
 

@@ -83,6 +83,16 @@ class Feasibility:
             found = memo[key] = _findings(self.abilities, self.abilities.tasks[task], mask)
         return found
 
+    def limit(self, task: int, finding: Finding, mask: int) -> str:
+        """Why the device of a ``device_limit`` finding refuses a value: the parameter, its value and the
+        request's limit (for a task with loops, branches or links, as the full check says it)."""
+        _, index, role, device = finding
+        spec = self.abilities.tasks[task]
+        if spec.flow is not None:
+            return self.abilities.full.limit(spec.flow, mask, finding)
+        d = self.abilities.devices.index(device)
+        return "; ".join(why for r, k, why in spec.steps[index - 1].limits if r == role and k == d)
+
     def plausible(self, mask: int) -> tuple[str, ...]:
         """The tasks plausible in a configuration, in task order."""
         return tuple(t.name for n, t in enumerate(self.abilities.tasks) if not self.findings(n, mask))
