@@ -313,6 +313,47 @@ def batch_report(
                             form=form, workers=workers, progress=progress, top=top, mapper=mapper, tally=tally)
 
 
+def batch_engine(
+    catalogue_folder: str | Path | None,
+    tasks: list[str | Path],
+    top: int = 1,
+    libraries: tuple[str | Path, ...] = (),
+    builtin: bool = True,
+) -> reasoning.Engine:
+    """What a batch over files reasons once (the catalogue devices and tasks against the libraries' processes),
+    kept in the user's cache folder: a later batch over the same files, unchanged, reads it back instead of
+    reading and reasoning over every description again (:mod:`.reasoning.enginecache`)."""
+    from plugnproduce.reasoning import enginecache
+
+    folder = Path(catalogue_folder) if catalogue_folder is not None else None
+    libs = ((builtin_library(),) if builtin else ()) + library_folders(libraries)
+
+    def build() -> reasoning.Engine:
+        k = knowledge(libraries, builtin)
+        return reasoning.engine(catalogue(folder, k), [task(p) for p in tasks], k.taxonomy, k.processes, top)
+
+    key = enginecache.digest(libs, folder, [Path(p) for p in tasks], top)
+    found = enginecache.cached(key, build)
+    return found if isinstance(found, reasoning.Engine) else build()
+
+
+def batch_report_from(
+    engine: reasoning.Engine,
+    configurations: Iterable[reasoning.Configuration] | str | Path,
+    form: str = "jsonl",
+    workers: int = 2,
+    progress: Callable[[int], None] | None = None,
+    cluster: str | None = None,
+    tally: dict[str, int] | None = None,
+) -> Iterator[str]:
+    """:func:`batch_report` by an engine already built (:func:`batch_engine`)."""
+    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+               else configurations)
+    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
+    return reasoning.report_from(engine, configs, form=form, workers=workers, progress=progress, mapper=mapper,
+                                 tally=tally)
+
+
 def generate_configurations(
     count: int,
     sizes: tuple[int, int],

@@ -12,7 +12,7 @@ import pytest
 from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
-from plugnproduce.reasoning import Configuration, engine, generate, read_configurations
+from plugnproduce.reasoning import Configuration, batches, engine, generate, read_configurations
 from tests.reasoning.conftest import DESCRIPTIONS, task, write
 
 PAPER = ("binpicking-pc", "gripper", "robot", "sensor3d")
@@ -250,7 +250,29 @@ def test_purchases_are_the_cheapest_sets_an_exhaustive_search_finds() -> None:
 
 def test_two_workers_give_the_same_rows_as_one() -> None:
     configs = list(generate(service.catalogue(), 5000, (2, 5), seed=3))
-    assert list(service.batch(configs, None, tasks(), workers=2)) == rows(configs, workers=1)
+    k = service.knowledge()
+    by_workers = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+                                    chunk=500, solo=1000))
+    assert by_workers == rows(configs, workers=1)
+
+
+def test_workers_start_only_for_work_large_enough_to_repay_them(monkeypatch: pytest.MonkeyPatch) -> None:
+    started: list[int] = []
+
+    class Counted(batches.ProcessPoolExecutor):
+        def __init__(self, workers: int, **kwargs: object) -> None:
+            started.append(workers)
+            super().__init__(workers, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(batches, "ProcessPoolExecutor", Counted)
+    k = service.knowledge()
+    configs = list(generate(service.catalogue(), 3000, (2, 5), seed=4))
+    small = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+                               chunk=500, solo=3000))
+    assert started == [] and len(small) == 3000
+    large = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+                               chunk=500, solo=2000))
+    assert started == [2] and large == small
 
 
 def test_generation_is_deterministic_and_sized() -> None:

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, TextIO
 
 import typer
 
-from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, fail, knowledge
+from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, LIBRARIES, app, boundary, emit_json, fail, knowledge
 from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.lazy import lazy_module
 
@@ -250,7 +250,8 @@ def batch(
                             help="Cheapest purchases to list per configuration."),
     output: Path | None = typer.Option(None, "-o", "--output", metavar="FILE",
                                        help="Report file: .jsonl or .csv (default: stdout, JSONL)."),
-    workers: int = typer.Option(2, "--workers", min=1, metavar="N", help="Worker processes."),
+    workers: int = typer.Option(2, "--workers", min=1, metavar="N",
+                                help="Worker processes, for the configurations beyond the first 100,000."),
     cluster: str | None = typer.Option(None, "--cluster", metavar="ADDRESS",
                                        help="Run on a Dask cluster: tcp://HOST:8786, or local:N worker processes."),
 ) -> None:
@@ -261,11 +262,11 @@ def batch(
             reasoning.check_cluster_address(cluster)
         except ValueError as exc:
             fail(f"--cluster: {exc}")
-    devices = service.catalogue(catalogue, knowledge())
+    engine = service.batch_engine(catalogue, list(tasks), top, tuple(LIBRARIES["folders"]), LIBRARIES["builtin"])
     total: int | None = generate
     if generate is not None:
         try:
-            configurations = service.generate_configurations(generate, _sizes(sizes), seed, devices)
+            configurations = reasoning.generate(engine.devices, generate, _sizes(sizes), seed)
         except ValueError as exc:
             fail(f"--sizes: {exc}")
     elif configs == "-":
@@ -278,9 +279,9 @@ def batch(
         if as_csv:
             csv.writer(out, lineterminator="\n").writerow(reasoning.BATCH_CSV_HEADER)
         tally: dict[str, int] = {}
-        written = _write(lambda progress: service.batch_report(
-            configurations, devices, list(tasks), "csv" if as_csv else "jsonl", workers, progress,
-            knowledge=knowledge(), top=top, cluster=cluster, tally=tally), out, total)
+        written = _write(lambda progress: service.batch_report_from(
+            engine, configurations, "csv" if as_csv else "jsonl", workers, progress, cluster=cluster, tally=tally),
+            out, total)
     if output is not None or on_a_terminal():
         where = f" to {output}" if output is not None else ""
         typer.echo(f"wrote {written} configurations{where}: {_tally(tally)}", err=True)
@@ -295,12 +296,22 @@ def _tally(tally: dict[str, int]) -> str:
 
 def _write(report: Callable[[Callable[[int], None]], Iterator[str]], out: TextIO, total: int | None) -> int:
     """Write the report as it comes, with a progress bar on a terminal; the number of configurations written."""
+    if not on_a_terminal():  # no bar to show: rich is not even imported
+        written = 0
+
+        def count(n: int) -> None:
+            nonlocal written
+            written += n
+
+        for text in report(count):
+            out.write(text)
+        return written
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     written = 0
-    with Progress(*columns, console=Console(stderr=True), transient=True, disable=not on_a_terminal()) as bar:
+    with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
         job = bar.add_task("batch", total=total)
 
         def advance(n: int) -> None:
