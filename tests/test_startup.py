@@ -80,3 +80,29 @@ def test_a_lazy_module_loads_on_first_use() -> None:
 def test_a_missing_module_is_an_error_at_once() -> None:
     with pytest.raises(ModuleNotFoundError, match="plugnproduce.nowhere"):
         lazy_module("plugnproduce.nowhere")
+
+
+def _help(home: Path, columns: str) -> tuple[str, set[str]]:
+    code = ("import sys\nsys.argv = ['pnp', '--help']\nfrom plugnproduce.__main__ import run\n"
+            "try:\n    run()\nexcept SystemExit:\n    pass\n"
+            "import json\nprint(json.dumps(sorted(n for n, m in sys.modules.items() "
+            "if type(m).__name__ != '_LazyModule')))")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (SRC, os.environ.get("PYTHONPATH")))),
+           "HOME": str(home), "COLUMNS": columns}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120,
+                         check=True, cwd=ROOT).stdout
+    text, _, modules = out.rpartition("\n[")
+    return text, set(json.loads("[" + modules))
+
+
+def test_help_is_printed_from_the_cache_folder_the_second_time(tmp_path: Path) -> None:
+    """The first ``pnp --help`` runs the command line and keeps its text; the next prints that text without
+    importing typer or click (a bare interpreter's start, about)."""
+    first, loaded = _help(tmp_path, "100")
+    assert "typer" in loaded and "Usage:" in first and "batch" in first
+    again, loaded_again = _help(tmp_path, "100")
+    assert again == first
+    assert sorted(m for m in ("typer", "click", "plugnproduce.cli", *HEAVY) if m in loaded_again) == []
+    narrow, loaded_narrow = _help(tmp_path, "60")  # another width: laid out again, by the command line
+    assert "typer" in loaded_narrow and narrow != first
+    assert max(map(len, narrow.splitlines())) <= 60 < max(map(len, first.splitlines()))
