@@ -10,7 +10,7 @@ process, dropped where the robot stands otherwise. The repair solver is not chan
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task, Where
@@ -112,21 +112,38 @@ def new_steps(original: Task, repaired: Task) -> set[int]:
     """The (1-based) steps of ``repaired`` that are not original steps kept in their order (inserted or moved):
     a longest common subsequence, matched from the end so an inserted step is the one before the kept ones."""
     a, b = [_sig(s) for s in original.steps], [_sig(s) for s in repaired.steps]
-    n, m = len(a), len(b)
-    lcs = [[0] * (m + 1) for _ in range(n + 1)]
-    for i in range(n):
-        for j in range(m):
-            lcs[i + 1][j + 1] = lcs[i][j] + 1 if a[i] == b[j] else max(lcs[i][j + 1], lcs[i + 1][j])
-    fresh, i, j = set(), n, m
+    lcs = _lcs_rows(a, b)
+    fresh, i, j = set(), len(a), len(b)
     while j > 0:
-        if i > 0 and a[i - 1] == b[j - 1] and lcs[i][j] == lcs[i - 1][j - 1] + 1:
+        if i > 0 and a[i - 1] == b[j - 1] and lcs(i, j) == lcs(i - 1, j - 1) + 1:
             i, j = i - 1, j - 1
-        elif i > 0 and lcs[i - 1][j] == lcs[i][j]:
+        elif i > 0 and lcs(i - 1, j) == lcs(i, j):
             i -= 1
         else:
             fresh.add(j)
             j -= 1
     return fresh
+
+
+def _lcs_rows(a: list[tuple[object, ...]], b: list[tuple[object, ...]]) -> Callable[[int, int], int]:
+    """The length of the longest common subsequence of ``a[:i]`` and ``b[:j]``, for any ``i`` and ``j``.
+
+    Bit-parallel (Hyyrö's row recurrence): row ``i`` is one integer whose zero bits below ``j`` count that
+    length, so the table of a 10,000-step task is 10,000 integer operations rather than 10^8 cells."""
+    full = (1 << len(b)) - 1
+    matches: dict[tuple[object, ...], int] = {}
+    for j, x in enumerate(b):
+        matches[x] = matches.get(x, 0) | 1 << j
+    rows = [full]
+    for x in a:
+        v = rows[-1]
+        u = v & matches.get(x, 0)
+        rows.append(((v + u) | (v - u)) & full)
+
+    def lcs(i: int, j: int) -> int:
+        return j - (rows[i] & ((1 << j) - 1)).bit_count()
+
+    return lcs
 
 
 def _concept(cell: Cell, d: str, x: str | None) -> str | None:
