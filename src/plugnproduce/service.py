@@ -256,14 +256,16 @@ def assessed_repairs(
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     top: int = 3,
     knowledge: Knowledge | None = None,
+    checked: reasoning.CheckResult | None = None,
 ) -> list[reasoning.AssessedRepair]:
     """The repairs of :func:`repair`, each confirmed by checking it again and with its side effects; those that
-    lose a held part or move a device a later step relies on rank below those that do not."""
+    lose a held part or move a device a later step relies on rank below those that do not. ``checked``: the
+    task's :func:`check` in that cell, when the caller has it (it is not checked again)."""
     the_cell, k = _context(cell_or_path, knowledge)
     the_task = _as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
     repairs = repair(the_task, the_cell, devices, top, knowledge=k)
-    return reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
+    return reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or (), checked)
 
 
 def batch(

@@ -127,8 +127,10 @@ def repair(
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists.
     """
     the_cell = _cell(cell, live, discovery_timeout)
-    result = service.check(task, the_cell, knowledge(cell))
-    repairs = [] if result.plausible else service.assessed_repairs(task, the_cell, catalogue, top, knowledge(cell))
+    the_task = service.task(task)  # read once, checked once: the repairs' assessment starts from this check
+    result = service.check(the_task, the_cell, knowledge(cell))
+    repairs = [] if result.plausible else service.assessed_repairs(the_task, the_cell, catalogue, top,
+                                                                   knowledge(cell), checked=result)
     players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,

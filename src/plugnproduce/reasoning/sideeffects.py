@@ -257,10 +257,11 @@ def side_effects(original: Task, repaired: Task, result: CheckResult, cell: Cell
 
 def assess(repairs: Sequence[Repair], task: Task, cell: Cell, taxonomy: Taxonomy,
            processes: Sequence[ProcessDescription],
-           catalogue: Sequence[DeviceDescription] = ()) -> list[AssessedRepair]:
+           catalogue: Sequence[DeviceDescription] = (), before: CheckResult | None = None) -> list[AssessedRepair]:
     """Each repair with its side effects, confirmed by checking it again (in the cell with the devices it adds
-    from ``catalogue``), ranked by its worst side effect, then by cost (the solver's order among equals)."""
-    before = check(task, cell, taxonomy, processes)
+    from ``catalogue``), ranked by its worst side effect, then by cost (the solver's order among equals).
+    ``before``: the check of ``task`` in ``cell``, when the caller has it already."""
+    before = before if before is not None else check(task, cell, taxonomy, processes)
     out = []
     for r in repairs:
         added = tuple(d for d in catalogue if d.id in r.added_devices)
