@@ -1,6 +1,7 @@
 """Benchmark of ``pnp batch``: throughput on distinct device sets, agreement and speed against a naive reference.
 
-    python bench/bench_batch.py [--agree 5000] [--distinct 100000] [--sample 2000] [--end-to-end 10000,100000,1000000]
+    python bench/bench_batch.py [--agree 5000] [--distinct 100000] [--sample 2000] [--end-to-end 1000,10000,100000]
+                                [--only end-to-end]
 
 1. agreement: on ``--agree`` random configurations of the built-in catalogue (0-7 devices, so many
    miss two devices or more), the batch and the naive reference (``naive_batch.py``) give the same
@@ -9,9 +10,11 @@
    over, ids suffixed): offered commands only (target >= 20,000 sets/s), then with the three
    built-in tasks and their cheapest purchases (target >= 5,000 sets/s); each figure is a ratio
    against the naive reference timed on a sample of the same sets, whose answers are checked equal;
-3. end to end: ``pnp batch`` as a process on 10^4, 10^5 and 10^6 distinct configurations of that
-   catalogue, JSONL in and out, with the three tasks: time (target 10^6 < 2 min) and the peak RSS
-   of its largest process, which must stay flat in the number of configurations;
+3. end to end: ``pnp batch`` as a process against the brute-force script (``naive_batch.py``, a
+   straightforward per-configuration script) as a process, on the same 10^3, 10^4 and 10^5 distinct
+   configurations of that catalogue, JSONL in and out, with the three tasks: CPU time (user+sys of
+   each process and the workers it started) and wall time, their ratios, the load, and the answers
+   (offered, plausible) checked equal on every line; the batch also computes purchases;
 4. tasks with loops, branches and links (the three shipped ones), which the batch answers with the full
    check once per way their roles are bound: on ``--flow`` random configurations around the paper's
    cell, against the plain way (``pnp check``'s check of every task in every configuration), answers
@@ -22,9 +25,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import random
 import re
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -187,32 +192,67 @@ def flow(count: int, seed: int) -> None:
 
 RUN = ("import resource, subprocess, sys; code = subprocess.run(sys.argv[1:]).returncode; "
        "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss); sys.exit(code)")
+NAIVE = Path(__file__).resolve().parent / "naive_batch.py"
 
 
-def end_to_end(folder: Path, counts: list[int], seed: int, work: Path) -> None:
+def _process(args: list[str]) -> tuple[float, float, float]:
+    """Wall and CPU seconds (user+sys, with every process it started) and peak RSS (MB) of a command."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu, t = usage.ru_utime + usage.ru_stime, time.perf_counter()
+    done = subprocess.run([sys.executable, "-c", RUN, *args], capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - t
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, usage.ru_utime + usage.ru_stime - cpu, int(done.stdout.split()[-1]) / 1024
+
+
+def _ensure_kept(folder: Path, work: Path) -> None:
+    """One batch over the catalogue and tasks, so the reasoned catalogue is in the cache folder."""
+    configs = work / "one.jsonl"
+    configs.write_text(json.dumps({"config": "one", "devices": []}) + "\n", encoding="utf-8")
+    task_args = [a for n in TASKS for a in ("--task", str(service.builtin("tasks", f"{n}.yaml")))]
+    _process([sys.executable, "-m", "plugnproduce", "batch", "--catalogue", str(folder), str(configs),
+              "-o", str(work / "one-out.jsonl"), *task_args])
+
+
+def _answers(path: Path) -> list[tuple[str, list[str], list[str]]]:
+    with path.open(encoding="utf-8") as f:
+        return [(d["config"], d["offered"], d["plausible"]) for d in map(json.loads, f)]
+
+
+def end_to_end(folder: Path, counts: list[int], seed: int, work: Path, rounds: int = 3) -> None:
+    """``pnp batch`` as a process against the brute-force script as a process, on the same file; the batch's
+    first run (not counted) reasons over the catalogue and keeps the result, as any first batch over new files
+    does, so the rounds measure a batch over files it has seen."""
+    _ensure_kept(folder, work)
     ids = sorted(d.id for d in service.catalogue(folder))
     task_args = [a for n in TASKS for a in ("--task", str(service.builtin("tasks", f"{n}.yaml")))]
-    base = None
     for count in counts:
         configs = work / f"configs-{count}.jsonl"
         with configs.open("w", encoding="utf-8") as f:
             for c in distinct(ids, count, (2, 8), seed):
                 f.write(json.dumps({"config": c.name, "devices": list(c.devices)}) + "\n")
-        out = work / f"out-{count}.jsonl"
-        t = time.perf_counter()
-        done = subprocess.run([sys.executable, "-c", RUN, sys.executable, "-m", "plugnproduce", "batch",
-                               "--catalogue", str(folder), str(configs), "-o", str(out), *task_args],
-                              capture_output=True, text=True, check=True)
-        seconds = time.perf_counter() - t
-        rss = int(done.stdout.split()[-1]) / 1024
-        base = base or rss
-        with out.open(encoding="utf-8") as f:
-            lines = sum(1 for _ in f)
-        print(f"end to end: pnp batch on {count:,} distinct configurations ({lines:,} rows) in {seconds:.1f} s "
-              f"= {count / seconds:,.0f}/s; peak RSS {rss:.0f} MB ({rss / base:.2f}x the first run)"
-              + (" (target < 120 s)" if count >= 1_000_000 else ""))
-        configs.unlink()
-        out.unlink()
+        ours, theirs = work / f"out-{count}.jsonl", work / f"naive-{count}.jsonl"
+        load = [os.getloadavg()[0]]
+        runs: dict[str, list[tuple[float, float, float]]] = {"script": [], "batch": []}
+        for _ in range(rounds):  # interleaved, so a burst of load hits both alike; the medians are compared
+            runs["script"].append(_process([sys.executable, str(NAIVE), str(configs), "--catalogue", str(folder),
+                                            *task_args, "-o", str(theirs)]))
+            runs["batch"].append(_process([sys.executable, "-m", "plugnproduce", "batch", "--catalogue",
+                                           str(folder), str(configs), "-o", str(ours), *task_args]))
+            load.append(os.getloadavg()[0])
+        script = tuple(statistics.median(r[i] for r in runs["script"]) for i in range(3))
+        batch_ = tuple(statistics.median(r[i] for r in runs["batch"]) for i in range(3))
+        wrong = sum(a != b for a, b in zip(_answers(ours), _answers(theirs), strict=True))
+        print(f"end to end, {count:,} distinct configurations (3 tasks; median of {rounds}; load "
+              f"{min(load):.1f}-{max(load):.1f} on {os.cpu_count()} cores): "
+              f"pnp batch {batch_[1]:.2f} s CPU, {batch_[0]:.2f} s wall, peak RSS {batch_[2]:.0f} MB "
+              f"(with purchases); brute-force script {script[1]:.2f} s CPU, {script[0]:.2f} s wall "
+              f"(offered + plausible); script/batch: CPU {script[1] / batch_[1]:.2f}x, wall "
+              f"{script[0] / batch_[0]:.2f}x; {wrong} disagreements")
+        if wrong:
+            raise SystemExit("the batch disagrees with the brute-force script")
+        for p in (configs, ours, theirs):
+            p.unlink()
 
 
 def main() -> None:
@@ -220,21 +260,27 @@ def main() -> None:
     parser.add_argument("--agree", type=int, default=5000)
     parser.add_argument("--distinct", type=int, default=100_000)
     parser.add_argument("--sample", type=int, default=2000)
-    parser.add_argument("--end-to-end", default="10000,100000,1000000")
+    parser.add_argument("--end-to-end", default="1000,10000,100000")
     parser.add_argument("--flow", type=int, default=300)
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--rounds", type=int, default=3, help="end-to-end runs of each, interleaved")
+    parser.add_argument("--only", choices=["agreement", "throughput", "end-to-end", "flow"])
     args = parser.parse_args()
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     engine(service.catalogue(), [], service.knowledge().taxonomy, service.knowledge().processes)
-    agreement(args.agree, args.seed)
+    if args.only in (None, "agreement"):
+        agreement(args.agree, args.seed)
     with tempfile.TemporaryDirectory(prefix="pnp-bench-batch-") as tmp:
         (Path(tmp) / "catalogue").mkdir()
         folder = copies(Path(tmp) / "catalogue")
-        throughput(folder, args.distinct, args.sample, args.seed)
-        counts = [int(c) for c in args.end_to_end.split(",") if c]
-        end_to_end(folder, counts, args.seed, Path(tmp))
-    flow(args.flow, args.seed)
-    print(f"(this process's own peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB)")
-
+        if args.only in (None, "throughput"):
+            throughput(folder, args.distinct, args.sample, args.seed)
+        if args.only in (None, "end-to-end"):
+            end_to_end(folder, [int(c) for c in args.end_to_end.split(",") if c], args.seed, Path(tmp), args.rounds)
+    if args.only in (None, "flow"):
+        flow(args.flow, args.seed)
+    print(f"(this process's own peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB; "
+          f"load average now {os.getloadavg()[0]:.2f})")
 
 if __name__ == "__main__":
     main()

@@ -21,7 +21,9 @@ Each time is the best of ``--repeat`` measurements.
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
+import os
 import tempfile
 import time
 from collections import defaultdict
@@ -121,4 +123,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
+    atexit.register(lambda: print(f"load average {os.getloadavg()[0]:.2f} at the end"))
     main()

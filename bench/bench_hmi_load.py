@@ -14,6 +14,7 @@ took. Not a test: figures only.
 from __future__ import annotations
 
 import argparse
+import atexit
 import os
 import statistics
 import subprocess
@@ -111,6 +112,8 @@ def main(rounds: int) -> None:
 
 
 if __name__ == "__main__":
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
+    atexit.register(lambda: print(f"load average {os.getloadavg()[0]:.2f} at the end"))
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--rounds", type=int, default=7)
     main(parser.parse_args().rounds)

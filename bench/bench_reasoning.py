@@ -13,7 +13,9 @@
 from __future__ import annotations
 
 import argparse
+import atexit
 import io
+import os
 import random
 import statistics
 import tempfile
@@ -184,4 +186,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
+    atexit.register(lambda: print(f"load average {os.getloadavg()[0]:.2f} at the end"))
     main()

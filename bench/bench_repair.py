@@ -1,6 +1,6 @@
 """Benchmark of repair window by window against the whole-task optimum (prints figures; not a test).
 
-    python bench/bench_repair.py [--seed 1] [--whole-up-to 1000]
+    python bench/bench_repair.py [--seed 1] [--whole-up-to 1000] [--processes [--rounds 3]]
 
 Long bin-picking tasks with faults injected (``tests/reasoning/faulty_tasks.py``, seeded): 100,
 1,000, 2,000 and 10,000 steps with one fault per 100 steps, every place with its own speed so that
@@ -15,7 +15,11 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
+import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -53,13 +57,51 @@ def compare(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None, w
     return dt
 
 
+def _process(args: list[str]) -> tuple[float, float]:
+    """Wall and CPU seconds (user+sys) of a command run as a process."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu, t = usage.ru_utime + usage.ru_stime, time.perf_counter()
+    subprocess.run([sys.executable, *args], capture_output=True, check=False)
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.perf_counter() - t, usage.ru_utime + usage.ru_stime - cpu
+
+
+def processes(seed: int, rounds: int) -> None:
+    """``pnp repair`` against ``pnp check`` of the same task, both as processes (targets: 1,000 steps with 10
+    faults within a check + 2 s of CPU; 10,000 steps with 100 faults at most 2x a check)."""
+    cell = str(service.builtin("cells", "bin-picking.yaml"))
+    with tempfile.TemporaryDirectory(prefix="pnp-bench-repair-") as tmp:
+        for steps, target in ((1000, "check + 2 s"), (10000, "2x check")):
+            path = Path(tmp) / f"faulty-{steps}.yaml"
+            path.write_text(service.task_text(faulty_task(steps // 2, steps // 100, seed, varied=True), block=True),
+                            encoding="utf-8")
+            runs: dict[str, list[tuple[float, float]]] = {"check": [], "repair": []}
+            load = [os.getloadavg()[0]]
+            for _ in range(rounds):
+                for name in runs:
+                    runs[name].append(_process(["-m", "plugnproduce", name, str(path), "--cell", cell]))
+                load.append(os.getloadavg()[0])
+            check = [statistics.median(r[i] for r in runs["check"]) for i in (0, 1)]
+            repair = [statistics.median(r[i] for r in runs["repair"]) for i in (0, 1)]
+            print(f"as processes, {steps:,} steps, {steps // 100} faults (median of {rounds}, load "
+                  f"{min(load):.1f}-{max(load):.1f}): pnp check {check[1]:.2f} s CPU ({check[0]:.2f} s wall), "
+                  f"pnp repair {repair[1]:.2f} s CPU ({repair[0]:.2f} s wall): repair - check = "
+                  f"{repair[1] - check[1]:+.2f} s CPU, repair / check = {repair[1] / check[1]:.2f}x "
+                  f"(target {target})", flush=True)
+
+
 def main() -> None:
     """Run the benchmark and print its figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--whole-up-to", type=int, default=1000, help="largest task the whole-task solver repairs")
+    parser.add_argument("--processes", action="store_true", help="only pnp repair against pnp check, as processes")
+    parser.add_argument("--rounds", type=int, default=3)
     args = parser.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    if args.processes:
+        processes(args.seed, args.rounds)
+        return
     cell = service.cell(service.builtin("cells", "bin-picking.yaml"))
     catalogue = service.catalogue()
     windows.windowed_repair(faulty_task(30, 2, args.seed), cell, K.taxonomy, K.processes, catalogue)  # warm up

@@ -12,6 +12,8 @@ CPU time, best of the rounds; both must give the same problems.
 from __future__ import annotations
 
 import argparse
+import atexit
+import os
 import tempfile
 import time
 from collections.abc import Callable
@@ -94,6 +96,8 @@ def main(rounds: int) -> None:
 
 
 if __name__ == "__main__":
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
+    atexit.register(lambda: print(f"load average {os.getloadavg()[0]:.2f} at the end"))
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0] if __doc__ else None)
     parser.add_argument("--rounds", type=int, default=5)
     main(parser.parse_args().rounds)

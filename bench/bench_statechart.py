@@ -21,6 +21,8 @@ python-statemachine on every chart.
 from __future__ import annotations
 
 import argparse
+import atexit
+import os
 import tempfile
 import time
 from collections.abc import Callable
@@ -146,6 +148,8 @@ def main(events: int, sizes: list[int], repeat: int) -> None:
 
 
 if __name__ == "__main__":
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
+    atexit.register(lambda: print(f"load average {os.getloadavg()[0]:.2f} at the end"))
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--events", type=int, default=20000, help="toggle events per measurement")
     parser.add_argument("--sizes", default="10,100,1000", help="closed-world chart sizes, in task steps")

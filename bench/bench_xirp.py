@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import atexit
+import os
 import statistics
 import time
 from collections.abc import Awaitable, Callable, Mapping
@@ -208,6 +210,8 @@ async def main(iterations: int, rounds: int) -> float:
 
 
 if __name__ == "__main__":
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
+    atexit.register(lambda: print(f"load average {os.getloadavg()[0]:.2f} at the end"))
     parser = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     parser.add_argument("--iterations", type=int, default=2000, help="round trips of each kind (default 2000)")
     parser.add_argument("--rounds", type=int, default=10, help="alternating blocks (default 10)")

@@ -10,6 +10,8 @@ from libyaml's C parser against the pure-Python parser, and the pure-Python
 from __future__ import annotations
 
 import argparse
+import atexit
+import os
 import tempfile
 import time
 from collections.abc import Callable
@@ -53,6 +55,8 @@ def main(steps: int, rounds: int) -> None:
 
 
 if __name__ == "__main__":
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
+    atexit.register(lambda: print(f"load average {os.getloadavg()[0]:.2f} at the end"))
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=1000)
     parser.add_argument("--rounds", type=int, default=5)

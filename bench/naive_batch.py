@@ -1,19 +1,30 @@
-"""The naive reference for the batch benchmark: the reasoner's rules applied by plain brute force.
+"""The brute-force reference of the batch benchmark: a straightforward per-configuration script.
 
-It reads the same facts the encodings read (``facts.py``: devices, processes, tasks) and applies
-``roles.lp``, ``offered.lp``, ``resolve.lp``, ``chain.lp``, ``params.lp``, the acceptance check
-and the devices' own limits (``contracts.refuses``) literally, per configuration, with Python
-sets; nothing is shared between configurations. The cheapest purchase tries every set of up to
-``MAX_BUY`` catalogue devices, keeps those that make every task plausible and of which no
-smaller such set is a part, and sorts them by cost, then size, then the devices' order by
-(cost, id).
+    python bench/naive_batch.py CONFIGS.jsonl --catalogue DIR --task TASK... -o OUT.jsonl
+
+It reads the same facts the encodings read (``facts.py``: devices, processes, tasks), indexes them
+once in plain dicts, and then answers each configuration on its own with Python sets, nothing
+shared between configurations: which roles each device can play (its skills, by subsumption, and
+the ordered states of the role's region reachable in its chart), the offered processes, each
+task's role binding, its parameter values against the bound devices' argument contracts (the
+quantity accepted, the device's own limits), and the chain of states through the task. As a
+script it writes one JSON line per configuration: ``config``, ``devices``, ``offered``,
+``plausible`` (no purchases: the batch computes those on top).
+
+:meth:`Naive.purchases` (for the benchmark's agreement check, not timed) tries every set of up to
+``MAX_BUY`` catalogue devices, keeps those that make every task plausible and of which no smaller
+such set is a part, and sorts them by cost, then size, then the devices' order by (cost, id).
 """
 
 from __future__ import annotations
 
+import argparse
 import itertools
+import json
+import sys
 from collections import defaultdict
 from collections.abc import Sequence
+from pathlib import Path
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -25,9 +36,12 @@ from plugnproduce.reasoning.facts import device_facts, process_facts, task_facts
 MAX_BUY = 4
 """Largest purchase the reference tries."""
 
+Step = tuple[int, str, list[str], dict[str, str], dict[str, object]]
+"""A task's step: index, process, the process's roles in order, the devices bound by name, the values given."""
+
 
 class Naive:
-    """The facts of a catalogue, its processes and tasks; answers one configuration at a time."""
+    """The facts of a catalogue, its processes and tasks, indexed; answers one configuration at a time."""
 
     def __init__(self, catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]],
                  taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> None:
@@ -35,23 +49,50 @@ class Naive:
         atoms = [a for p in processes for a in process_facts(p)]
         atoms += [a for d in catalogue for a in device_facts(d, taxonomy, processes)]
         atoms += [a for name, t in tasks for a in task_facts(t, name)]
-        self.by: dict[type, list] = defaultdict(list)
+        by: dict[type, list] = defaultdict(list)
         for a in atoms:
-            self.by[type(a)].append(a)
+            by[type(a)].append(a)
+        self.by = by
         self.catalogue = {d.id: d for d in catalogue}
         self.taxonomy = taxonomy
-        self.params = {(p.id, par.name): par for p in processes for par in p.parameters}
         self.tasks = [name for name, _ in tasks]
-        self.given = {(name, st.index): dict(st.params) for name, t in tasks for st in t.steps}
+        self.params = {(p.id, par.name): par for p in processes for par in p.parameters}
         self.declared = {p.id: p.parameters for p in processes}
+        self.processes = sorted({a.p for a in by[s.Process]})
+        order = sorted((a.p, a.k, a.r) for a in by[s.RoleOrder])
+        self.roles: dict[str, list[str]] = defaultdict(list)
+        for p, _, r in order:
+            self.roles[p].append(r)
+        self.is_ = {(a.d, a.x, a.c) for a in by[s.StateIs]}
+        self.first = {(a.p, a.r): a.c for a in by[s.RegionState] if a.i == 1}
+        self.initial: dict[str, set[str]] = defaultdict(set)
+        for a in by[s.Initial]:
+            self.initial[a.d].add(a.x)
+        self.leaves: dict[tuple[str, str, str], dict[str, set[str]]] = defaultdict(lambda: defaultdict(set))
+        for a in by[s.Leaves]:
+            self.leaves[(a.p, a.r, a.d)][a.x].add(a.y)
+        self.recovers: dict[tuple[str, str, str], set[str]] = defaultdict(set)
+        for a in by[s.Recovers]:
+            self.recovers[(a.p, a.r, a.d)].add(a.y)
         self.can_play = self._can_play()
         self.bad_value = self._bad_values()
+        self.steps = {name: self._steps(name, t) for name, t in tasks}
+
+    def _steps(self, name: str, task: Task) -> list[Step]:
+        process = {(a.t, a.i): a.p for a in self.by[s.StepFact]}
+        binds: dict[int, dict[str, str]] = defaultdict(dict)
+        for a in self.by[s.Bind]:
+            if a.t == name:
+                binds[a.i][a.r] = a.d
+        return [(st.index, process[(name, st.index)], self.roles.get(process[(name, st.index)], []),
+                 binds[st.index], dict(st.params)) for st in task.steps]
 
     def _can_play(self) -> set[tuple[str, str, str]]:
+        """(process, role, device): the device has the role's skill (by subsumption) and its chart reaches the
+        role's region states in order."""
         edges = defaultdict(set)
         for e in self.by[s.Edge]:
             edges[(e.d, e.x)].add(e.y)
-        is_ = {(a.d, a.x, a.c) for a in self.by[s.StateIs]}
         states = defaultdict(set)
         for a in self.by[s.ChartState]:
             states[a.d].add(a.x)
@@ -66,9 +107,9 @@ class Naive:
                 if (d, q.s) not in skills:
                     continue
                 concepts = [region[(q.p, q.r)][i] for i in sorted(region[(q.p, q.r)])]
-                here = {x for x in states[d] if (d, x, concepts[0]) in is_}
+                here = {x for x in states[d] if (d, x, concepts[0]) in self.is_}
                 for c in concepts[1:]:
-                    here = {y for x in here for y in _reach(edges, d, x) if (d, y, c) in is_}
+                    here = {y for x in here for y in _reach(edges, d, x) if (d, y, c) in self.is_}
                 if here and (q.p, q.r, d) not in lacking:
                     out.add((q.p, q.r, d))
         return out
@@ -98,32 +139,22 @@ class Naive:
 
     def offered(self, members: set[str]) -> list[str]:
         """The processes a configuration offers, sorted."""
-        roles = defaultdict(list)
-        for r in self.by[s.Role]:
-            roles[r.p].append(r.r)
-        return sorted(p.p for p in self.by[s.Process]
-                      if all(any((p.p, r, d) in self.can_play for d in members) for r in roles[p.p]))
+        return [p for p in self.processes
+                if all(any((p, r, d) in self.can_play for d in members) for r in self.roles[p])]
 
     def plausible(self, members: set[str]) -> list[str]:
         """The tasks plausible in a configuration, in task order."""
         return [t for t in self.tasks if self._plausible(t, members)]
 
     def _plausible(self, t: str, members: set[str]) -> bool:
-        steps = sorted((a.i, a.p) for a in self.by[s.StepFact] if a.t == t)
-        procs = {a.p for a in self.by[s.Process]}
-        order = sorted((a.p, a.k, a.r) for a in self.by[s.RoleOrder])
-        binds = {(a.i, a.r): a.d for a in self.by[s.Bind] if a.t == t}
         bound: list[list[tuple[str, str]]] = []
-        for i, p in steps:
-            if p not in procs or (t, i) in self.bad_value:
-                return False
-            roles = [r for q, _, r in order if q == p]
-            if any(r not in roles for j, r in binds if j == i):
+        for i, p, roles, binds, given in self.steps[t]:
+            if p not in self.declared or (t, i) in self.bad_value or any(r not in roles for r in binds):
                 return False
             here = []
             for r in roles:
-                if (i, r) in binds:
-                    d = binds[(i, r)]
+                if r in binds:
+                    d = binds[r]
                     if d not in members or (p, r, d) not in self.can_play:
                         return False
                     here.append((r, d))
@@ -132,35 +163,40 @@ class Naive:
                     if len(cands) != 1:
                         return False
                     here.append((r, cands[0]))
-            for name in self.given.get((t, i), {}):
-                par = self.params.get((p, name))
-                player = dict(here).get(par.role) if par else None
-                if player is not None and not accepts(self.catalogue[player], par.quantity, self.taxonomy):
-                    return False
-            for par in self.declared[p]:
-                value = self.given.get((t, i), {}).get(par.name, par.default)
-                player = dict(here).get(par.role)
-                if player is not None and value is not None and refuses(self.catalogue[player], value, par):
-                    return False
+            if not self._values_fit(p, dict(here), given):
+                return False
             bound.append(here)
-        return self._chain(steps, bound, members)
+        return self._chain(t, bound)
 
-    def _chain(self, steps: list[tuple[int, str]], bound: list[list[tuple[str, str]]], members: set[str]) -> bool:
-        at = {d: {a.x for a in self.by[s.Initial] if a.d == d} for d in members}
-        first = {(a.p, a.r): a.c for a in self.by[s.RegionState] if a.i == 1}
-        is_ = {(a.d, a.x, a.c) for a in self.by[s.StateIs]}
-        for (_, p), here in zip(steps, bound, strict=True):
-            for d in {d for _, d in here}:
-                states = at[d]
+    def _values_fit(self, p: str, players: dict[str, str], given: dict[str, object]) -> bool:
+        """Each value given goes to a device that accepts its quantity; each value sent (given or the default)
+        keeps the bound device's own limits."""
+        for name in given:
+            par = self.params.get((p, name))
+            player = players.get(par.role) if par else None
+            if player is not None and not accepts(self.catalogue[player], par.quantity, self.taxonomy):
+                return False
+        for par in self.declared[p]:
+            value = given.get(par.name, par.default)
+            player = players.get(par.role)
+            if player is not None and value is not None and refuses(self.catalogue[player], value, par):
+                return False
+        return True
+
+    def _chain(self, t: str, bound: list[list[tuple[str, str]]]) -> bool:
+        at: dict[str, set[str]] = {}
+        for (_, p, _, _, _), here in zip(self.steps[t], bound, strict=True):
+            for d in dict.fromkeys(d for _, d in here):
+                states = at.get(d, self.initial[d])
                 for r in [r for r, e in here if e == d]:
-                    leaves = {(a.x, a.y) for a in self.by[s.Leaves] if (a.p, a.r, a.d) == (p, r, d)}
-                    after = set()
+                    leaves = self.leaves.get((p, r, d), {})
+                    k = self.first.get((p, r))
+                    after: set[str] = set()
                     for x in states:
-                        k = first.get((p, r))
-                        starts = {y for x2, y in leaves if x2 == x}
-                        if k is not None and ((d, x, k) not in is_ or not starts):
+                        starts = leaves.get(x, set())
+                        if k is not None and ((d, x, k) not in self.is_ or not starts):
                             return False
-                        after |= starts or {a.y for a in self.by[s.Recovers] if (a.p, a.r, a.d) == (p, r, d)}
+                        after |= starts or self.recovers.get((p, r, d), set())
                     states = after
                 at[d] = states
         return True
@@ -191,3 +227,30 @@ def _reach(edges: dict[tuple[str, str], set[str]], d: str, x: str) -> set[str]:
                 seen.add(y)
                 todo.append(y)
     return seen
+
+
+def main() -> None:
+    """Answer a JSONL file of configurations as a script: offered processes and plausible tasks per line."""
+    from plugnproduce import service
+    from plugnproduce.reasoning.batches import task_names
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("configs", type=Path)
+    parser.add_argument("--catalogue", type=Path)
+    parser.add_argument("--task", type=Path, action="append", default=[])
+    parser.add_argument("-o", "--output", type=Path)
+    args = parser.parse_args()
+    k = service.knowledge()
+    catalogue = service.catalogue(args.catalogue, k)
+    ref = Naive(catalogue, task_names([service.task(t) for t in args.task]), k.taxonomy, k.processes)
+    out = args.output.open("w", encoding="utf-8") if args.output else sys.stdout
+    with args.configs.open(encoding="utf-8") as f, out:
+        for line in f:
+            doc = json.loads(line)
+            members = set(doc["devices"])
+            out.write(json.dumps({"config": doc["config"], "devices": doc["devices"], "offered": ref.offered(members),
+                                  "plausible": ref.plausible(members)}) + "\n")
+
+
+if __name__ == "__main__":
+    main()

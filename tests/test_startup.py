@@ -15,21 +15,35 @@ from plugnproduce.lazy import lazy_module
 
 SRC = str(Path(plugnproduce.__file__).resolve().parents[1])
 HEAVY = ("rdflib", "pyshacl", "owlready2", "xmlschema", "networkx", "clingo", "lxml", "rich", "aiohttp", "fastapi",
-         "uvicorn", "async_upnp_client", "graphviz", "yaml", "plugnproduce.service", "plugnproduce.reasoning")
+         "uvicorn", "async_upnp_client", "graphviz", "yaml", "pint", "numpy", "pydantic", "distributed",
+         "plugnproduce.service", "plugnproduce.reasoning")
+NOT_FOR_VALIDATE = ("owlready2", "networkx", "clingo", "aiohttp", "fastapi", "uvicorn", "async_upnp_client", "graphviz",
+                    "pint", "numpy", "distributed", "plugnproduce.reasoning", "plugnproduce.codegen",
+                    "plugnproduce.hmi", "plugnproduce.verification")
+"""What validating a device, a task and a cell has no use for (the SHACL shapes need rdflib and pySHACL; units
+come from the cached table, not pint)."""
+ROOT = Path(__file__).resolve().parents[1]
 
 
-def _run(code: str) -> str:
-    """What ``code`` prints in a fresh interpreter running this checkout."""
+def _run(code: str, home: Path | None = None) -> str:
+    """What ``code`` prints in a fresh interpreter running this checkout (with ``home`` as its user's home)."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (SRC, os.environ.get("PYTHONPATH"))))}
-    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120,
-                          check=True).stdout
+    if home is not None:
+        env["HOME"] = str(home)
+    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300,
+                          check=True, cwd=ROOT).stdout
 
 
-def _loaded_after(code: str) -> set[str]:
+def _loaded_after(code: str, home: Path | None = None) -> set[str]:
     """The modules whose code has run in a fresh interpreter after ``code`` (lazy ones not yet used excluded)."""
     report = ("\nimport json, sys\n"
               "print(json.dumps(sorted(n for n, m in sys.modules.items() if type(m).__name__ != '_LazyModule')))")
-    return set(json.loads(_run(code + report).splitlines()[-1]))
+    return set(json.loads(_run(code + report, home).splitlines()[-1]))
+
+
+def _command(*args: str) -> str:
+    return (f"import sys\nfrom plugnproduce.cli import app\nsys.argv = ['pnp', *{list(args)!r}]\n"
+            "try:\n    app()\nexcept SystemExit:\n    pass")
 
 
 def test_importing_the_command_line_loads_nothing_heavy() -> None:
@@ -38,10 +52,20 @@ def test_importing_the_command_line_loads_nothing_heavy() -> None:
 
 
 def test_help_loads_nothing_heavy() -> None:
-    code = ("import sys\nfrom plugnproduce.cli import app\nsys.argv = ['pnp', '--help']\n"
-            "try:\n    app()\nexcept SystemExit:\n    pass")
-    loaded = _loaded_after(code)
+    loaded = _loaded_after(_command("--help"))
     assert sorted(h for h in HEAVY if h in loaded) == []
+
+
+def test_validate_loads_neither_the_reasoner_nor_pint_once_the_units_are_cached(tmp_path: Path) -> None:
+    """The first process to read a unit asks pint and keeps the answer in the user's cache folder; the next
+    validation of the same files reads units from there and loads nothing it has no use for."""
+    files = ("descriptions/devices/gripper.ttl", "descriptions/devices/robot.ttl", "descriptions/tasks/bin-picking.yaml",
+             "descriptions/cells/bin-picking.yaml")
+    first = _loaded_after(_command("validate", *files), tmp_path)
+    assert "pint" in first and list((tmp_path / ".cache" / "plugnproduce").glob("units-*.json"))
+    again = _loaded_after(_command("validate", *files), tmp_path)
+    assert "rdflib" in again and "pyshacl" in again  # it did validate
+    assert sorted(h for h in NOT_FOR_VALIDATE if h in again) == []
 
 
 def test_a_lazy_module_loads_on_first_use() -> None:
@@ -68,3 +92,29 @@ def test_a_submodule_imported_before_its_lazy_package_is_used_runs_once_after_it
             "import plugnproduce.reasoning.linksafety\n"  # a package runs before its submodules: no partial import
             "print(solver.decode.__globals__['_REGISTRY'] is _REGISTRY)")
     assert _run(code).split() == ["True"]
+
+
+def _help(home: Path, columns: str) -> tuple[str, set[str]]:
+    code = ("import sys\nsys.argv = ['pnp', '--help']\nfrom plugnproduce.__main__ import run\n"
+            "try:\n    run()\nexcept SystemExit:\n    pass\n"
+            "import json\nprint(json.dumps(sorted(n for n, m in sys.modules.items() "
+            "if type(m).__name__ != '_LazyModule')))")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (SRC, os.environ.get("PYTHONPATH")))),
+           "HOME": str(home), "COLUMNS": columns}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120,
+                         check=True, cwd=ROOT).stdout
+    text, _, modules = out.rpartition("\n[")
+    return text, set(json.loads("[" + modules))
+
+
+def test_help_is_printed_from_the_cache_folder_the_second_time(tmp_path: Path) -> None:
+    """The first ``pnp --help`` runs the command line and keeps its text; the next prints that text without
+    importing typer or click (a bare interpreter's start, about)."""
+    first, loaded = _help(tmp_path, "100")
+    assert "typer" in loaded and "Usage:" in first and "batch" in first
+    again, loaded_again = _help(tmp_path, "100")
+    assert again == first
+    assert sorted(m for m in ("typer", "click", "plugnproduce.cli", *HEAVY) if m in loaded_again) == []
+    narrow, loaded_narrow = _help(tmp_path, "60")  # another width: laid out again, by the command line
+    assert "typer" in loaded_narrow and narrow != first
+    assert max(map(len, narrow.splitlines())) <= 60 < max(map(len, first.splitlines()))

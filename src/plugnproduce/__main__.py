@@ -1,5 +1,18 @@
-"""``python -m plugnproduce``: the same as the ``pnp`` command."""
+"""``python -m plugnproduce`` and the ``pnp`` command: the command line, and ``--help`` from where it was kept."""
 
-from plugnproduce.cli import main
+import sys
 
-main()
+from plugnproduce.helpcache import keeping, print_kept
+
+
+def run() -> None:
+    """Entry point of the ``pnp`` console script."""
+    if print_kept(sys.argv[1:]):
+        return
+    from plugnproduce.cli import main
+
+    keeping(sys.argv[1:], main)
+
+
+if __name__ == "__main__":
+    run()

@@ -294,17 +294,19 @@ def assessed_repairs(
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     top: int = 3,
     knowledge: Knowledge | None = None,
+    checked: reasoning.CheckResult | None = None,
 ) -> list[reasoning.AssessedRepair]:
     """The repairs of :func:`repair` that checking them again confirms, with their side effects, ranked by their
     worst side effect, then by cost (:func:`plugnproduce.reasoning.sideeffects.ranking`). When the check refuses
-    some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds."""
+    some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds. ``checked``: the
+    task's :func:`check` in that cell, when the caller has it (it is not checked again)."""
     the_cell, k = _context(cell_or_path, knowledge)
     the_task = _as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
     asked = top
     for _ in range(MORE_REPAIRS):
         repairs = repair(the_task, the_cell, devices, asked, knowledge=k)
-        assessed = reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or ())
+        assessed = reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or (), checked)
         if len(assessed) >= top or len(repairs) < asked:
             break
         asked += top
@@ -346,16 +348,59 @@ def batch_report(
     knowledge: Knowledge | None = None,
     top: int = 1,
     cluster: str | reasoning.ClusterAccess | None = None,
+    tally: dict[str, int] | None = None,
 ) -> Iterator[str]:
     """:func:`batch`'s answers as report text (JSONL, or CSV rows with ``form`` "csv"), a chunk at a time,
-    made by the workers: what ``pnp batch`` writes."""
+    made by the workers: what ``pnp batch`` writes. ``tally`` counts the configurations written by outcome
+    (all plausible, a purchase, a role to bind, nothing helps)."""
     k = _k(knowledge)
     devices = _devices(catalogue_or_folder, k)
     configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
     mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
     return reasoning.report(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
-                            form=form, workers=workers, progress=progress, top=top, mapper=mapper)
+                            form=form, workers=workers, progress=progress, top=top, mapper=mapper, tally=tally)
+
+
+def batch_engine(
+    catalogue_folder: str | Path | None,
+    tasks: list[str | Path],
+    top: int = 1,
+    libraries: tuple[str | Path, ...] = (),
+    builtin: bool = True,
+) -> reasoning.Engine:
+    """What a batch over files reasons once (the catalogue devices and tasks against the libraries' processes),
+    kept in the user's cache folder: a later batch over the same files, unchanged, reads it back instead of
+    reading and reasoning over every description again (:mod:`.reasoning.enginecache`)."""
+    from plugnproduce.reasoning import enginecache
+
+    folder = Path(catalogue_folder) if catalogue_folder is not None else None
+    libs = ((builtin_library(),) if builtin else ()) + library_folders(libraries)
+
+    def build() -> reasoning.Engine:
+        k = knowledge(libraries, builtin)
+        return reasoning.engine(catalogue(folder, k), [task(p) for p in tasks], k.taxonomy, k.processes, top)
+
+    key = enginecache.digest(libs, folder, [Path(p) for p in tasks], top)
+    found = enginecache.cached(key, build)
+    return found if isinstance(found, reasoning.Engine) else build()
+
+
+def batch_report_from(
+    engine: reasoning.Engine,
+    configurations: Iterable[reasoning.Configuration] | str | Path,
+    form: str = "jsonl",
+    workers: int = 2,
+    progress: Callable[[int], None] | None = None,
+    cluster: str | reasoning.ClusterAccess | None = None,
+    tally: dict[str, int] | None = None,
+) -> Iterator[str]:
+    """:func:`batch_report` by an engine already built (:func:`batch_engine`)."""
+    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+               else configurations)
+    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
+    return reasoning.report_from(engine, configs, form=form, workers=workers, progress=progress, mapper=mapper,
+                                 tally=tally)
 
 
 def generate_configurations(

@@ -12,7 +12,7 @@ import pytest
 from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
-from plugnproduce.reasoning import Configuration, engine, generate, read_configurations
+from plugnproduce.reasoning import Configuration, batches, engine, generate, read_configurations
 from tests.reasoning.conftest import DESCRIPTIONS, task, write
 
 PAPER = ("binpicking-pc", "gripper", "robot", "sensor3d")
@@ -80,10 +80,70 @@ def test_no_purchase_when_the_catalogue_lacks_a_skill_and_the_reason_names_it() 
     assert "no device can play role gripper" in row.purchase.impossible and "CanGrip" in row.purchase.impossible
 
 
-def test_an_ambiguous_binding_cannot_be_bought_away() -> None:
+def test_an_ambiguous_binding_is_not_impossible_and_says_which_role_to_bind() -> None:
     (row,) = rows([Configuration("two-grippers", ("gripper", "magnetic-gripper", "robot"))])
-    assert row.purchase is not None and row.purchase.options == ()
-    assert "several devices can play role gripper" in (row.purchase.impossible or "")
+    assert row.outcome == "ambiguous" and row.purchase is not None
+    assert row.purchase.options == () and row.purchase.impossible is None
+    assert row.purchase.ambiguous == ("step 2 of bin-picking: several devices can play role gripper; "
+                                      "bind step 2's role gripper to one of them")
+    assert row.to_json()["purchase"] == {"options": [], "ambiguous": row.purchase.ambiguous}
+
+
+def test_no_purchase_is_offered_for_a_configuration_whose_role_is_ambiguous() -> None:
+    """Buying the missing robot would leave the gripper role ambiguous: binding comes first, not a purchase."""
+    (row,) = service.batch([Configuration("grippers-only", ("gripper", "magnetic-gripper"))], None,
+                           [task("pick-and-place")], workers=1)
+    assert row.outcome == "ambiguous" and row.purchase is not None and row.purchase.options == ()
+    assert "bind step 1's role gripper" in (row.purchase.ambiguous or "")
+
+
+def test_an_ambiguous_role_of_a_task_with_loops_and_branches_is_not_impossible() -> None:
+    """The check picks one binding and then finds a branch leaving the gripper differently: a consequence of the
+    role left open, which binding it may cure."""
+    (row,) = service.batch([Configuration("two-grippers", ("gripper", "magnetic-gripper", "robot"))], None,
+                           [task("bin-picking-then-home")], workers=1)
+    assert row.outcome == "ambiguous" and row.purchase is not None and row.purchase.impossible is None
+    assert "role gripper; bind step 3's role gripper" in (row.purchase.ambiguous or "")
+
+
+def test_a_limit_no_binding_cures_stays_impossible_beside_an_ambiguous_role() -> None:
+    (row,) = service.batch([Configuration("slow-cobot", ("cobot", "gripper", "magnetic-gripper"))], None,
+                           [task("pick-and-place")], workers=1)
+    assert row.outcome == "impossible" and row.purchase is not None and row.purchase.ambiguous is None
+    assert row.purchase.impossible == (
+        "step 2 of pick-and-place: device cobot (role robot) refuses a value sent to it by its own limits: "
+        "parameter speed = 100 % goes with request MoveTo, which takes at most 60 %; the value is 100 %; "
+        "adding devices cannot cure it")
+
+
+def test_a_value_refused_by_a_devices_limits_is_named_with_its_parameter() -> None:
+    (row,) = service.batch([Configuration("scara", ("gripper", "scara"))], None, [task("pick-and-place")], workers=1)
+    assert row.purchase is not None and row.purchase.impossible is not None
+    assert ("device scara (role robot) refuses a value sent to it by its own limits: parameter place_pose = "
+            "[0.55, -0.25, 0.08, 0, 180, 0] goes with request MoveTo, which reaches at most 0.6 m from its base; "
+            "the pose is 0.609 m away; parameter retract_pose (its default) = '0.60 -0.20 0.30 0 180 0'"
+            ) in row.purchase.impossible
+
+
+def test_a_value_refused_in_a_task_with_loops_and_branches_is_named_as_the_check_names_it() -> None:
+    (row,) = service.batch([Configuration("scara", ("gripper", "scara"))], None, [task("bin-picking-then-home")],
+                           workers=1)
+    assert row.purchase is not None and row.purchase.impossible is not None
+    assert row.purchase.impossible.startswith(
+        "step 3 of bin-picking-then-home: device scara (role robot) refuses a value sent to it by its own limits: "
+        "parameter place_pose = [0.6, -0.2, 0.1, 0, 180, 0] goes to device 'scara' with request MoveTo, which "
+        "reaches at most 0.6 m from its base; the pose is 0.64 m away")
+
+
+def test_the_report_tallies_each_outcome() -> None:
+    configs = [Configuration("paper", PAPER), Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d")),
+               Configuration("two-grippers", ("gripper", "magnetic-gripper", "robot")),
+               Configuration("scara", ("binpicking-pc", "gripper", "scara", "sensor3d"))]
+    tally: dict[str, int] = {}
+    text = "".join(service.batch_report(configs, None, tasks(), workers=1, tally=tally))
+    assert [json.loads(line)["config"] for line in text.splitlines()] == [c.name for c in configs]
+    assert [r.outcome for r in rows(configs)] == ["plausible", "buy", "ambiguous", "impossible"]
+    assert tally == {"plausible": 1, "buy": 1, "ambiguous": 1, "impossible": 1}
 
 
 def _reasoner(configs: list[Configuration], the_tasks: list[Task],
@@ -190,7 +250,29 @@ def test_purchases_are_the_cheapest_sets_an_exhaustive_search_finds() -> None:
 
 def test_two_workers_give_the_same_rows_as_one() -> None:
     configs = list(generate(service.catalogue(), 5000, (2, 5), seed=3))
-    assert list(service.batch(configs, None, tasks(), workers=2)) == rows(configs, workers=1)
+    k = service.knowledge()
+    by_workers = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+                                    chunk=500, solo=1000))
+    assert by_workers == rows(configs, workers=1)
+
+
+def test_workers_start_only_for_work_large_enough_to_repay_them(monkeypatch: pytest.MonkeyPatch) -> None:
+    started: list[int] = []
+
+    class Counted(batches.ProcessPoolExecutor):
+        def __init__(self, workers: int, **kwargs: object) -> None:
+            started.append(workers)
+            super().__init__(workers, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(batches, "ProcessPoolExecutor", Counted)
+    k = service.knowledge()
+    configs = list(generate(service.catalogue(), 3000, (2, 5), seed=4))
+    small = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+                               chunk=500, solo=3000))
+    assert started == [] and len(small) == 3000
+    large = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+                               chunk=500, solo=2000))
+    assert started == [2] and large == small
 
 
 def test_generation_is_deterministic_and_sized() -> None:

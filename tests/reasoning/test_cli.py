@@ -168,6 +168,20 @@ def test_batch_generates_and_writes_jsonl_and_csv(tmp_path: Path) -> None:
     assert table.read_text().splitlines()[1].startswith("paper,robot gripper,close-gripper")
 
 
+def test_batch_counts_ambiguous_apart_from_impossible(tmp_path: Path) -> None:
+    configs = write(tmp_path, "c.jsonl", "".join(json.dumps({"config": n, "devices": d}) + "\n" for n, d in (
+        ("paper", ["binpicking-pc", "gripper", "robot", "sensor3d"]), ("two-grippers", ["gripper", "magnetic-gripper",
+         "robot"]), ("cobot", ["cobot", "gripper"]), ("no-robot", ["gripper"]))))
+    out = tmp_path / "out.jsonl"
+    result = pnp("batch", str(configs), "--task", str(TASKS / "pick-and-place.yaml"), "-o", str(out), "--workers", "1")
+    assert result.exit_code == 0, result.output
+    assert result.stderr == (f"wrote 4 configurations to {out}: 1 all tasks plausible, 1 with a purchase, "
+                             "1 ambiguous (bind a role), 1 impossible\n")
+    purchases = [json.loads(line)["purchase"] for line in out.read_text().splitlines()]
+    assert purchases[0] is None and set(purchases[1]) == {"options", "ambiguous"}
+    assert set(purchases[2]) == {"options", "impossible"} and purchases[3]["options"][0]["add"] == ["robot"]
+
+
 def test_batch_reads_configurations_from_standard_input() -> None:
     lines = json.dumps({"config": "no-gripper", "devices": ["binpicking-pc", "robot", "sensor3d"]}) + "\n"
     result = runner.invoke(app, ["batch", "-", "--task", VALID, "--workers", "1", "--top", "2"], input=lines)

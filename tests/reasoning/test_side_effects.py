@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import random
 from pathlib import Path
 
 from plugnproduce import service
@@ -59,3 +61,51 @@ def test_a_dropped_part_rests_on_the_pick_process_and_the_gripper_states(cell: C
     lines = [Path(n.where.file).read_text(encoding="utf-8").splitlines()[(n.where.line or 0) - 1]
              for n in drop.children if n.where]
     assert "proc:bin-pick a pnp:PickProcess" in lines[0] and 'id="closed"' in lines[1] and 'id="open"' in lines[2]
+
+
+def _new_steps_by_table(original: Task, repaired: Task) -> set[int]:
+    """The steps new in ``repaired`` as the whole longest-common-subsequence table finds them (the reference)."""
+    sig = [(s.command, tuple(sorted(s.bind.items())), tuple(sorted((k, str(v)) for k, v in s.params.items())))
+           for s in original.steps]
+    new = [(s.command, tuple(sorted(s.bind.items())), tuple(sorted((k, str(v)) for k, v in s.params.items())))
+           for s in repaired.steps]
+    n, m = len(sig), len(new)
+    lcs = [[0] * (m + 1) for _ in range(n + 1)]
+    for i in range(n):
+        for j in range(m):
+            lcs[i + 1][j + 1] = lcs[i][j] + 1 if sig[i] == new[j] else max(lcs[i][j + 1], lcs[i + 1][j])
+    fresh, i, j = set(), n, m
+    while j > 0:
+        if i > 0 and sig[i - 1] == new[j - 1] and lcs[i][j] == lcs[i - 1][j - 1] + 1:
+            i, j = i - 1, j - 1
+        elif i > 0 and lcs[i - 1][j] == lcs[i][j]:
+            i -= 1
+        else:
+            fresh.add(j)
+            j -= 1
+    return fresh
+
+
+def test_new_steps_of_long_repaired_tasks_are_those_the_whole_table_finds() -> None:
+    """Repeated steps (bin-pick, place, ...) with steps inserted, moved, dropped and changed at random: the
+    steps called new are the reference's, step for step."""
+    rng = random.Random(28)
+    kinds = [Step(0, "bin-pick"), Step(0, "place"), Step(0, "open-gripper"), Step(0, "place", params={"speed": 20}),
+             Step(0, "move-to", bind={"robot": "robot"})]
+    for _ in range(60):
+        steps = [kinds[n % 2] for n in range(rng.randint(0, 120))]
+        edited = list(steps)
+        for _ in range(rng.randint(0, 8)):
+            at = rng.randint(0, len(edited))
+            what = rng.choice(["insert", "drop", "move", "change"])
+            if what == "insert" or not edited:
+                edited.insert(at, rng.choice(kinds))
+            elif what == "drop":
+                edited.pop(min(at, len(edited) - 1))
+            elif what == "move":
+                edited.insert(rng.randint(0, len(edited) - 1), edited.pop(min(at, len(edited) - 1)))
+            else:
+                edited[min(at, len(edited) - 1)] = rng.choice(kinds)
+        original = Task("t", tuple(dataclasses.replace(s, index=n + 1) for n, s in enumerate(steps)), "t.yaml")
+        repaired = Task("t", tuple(dataclasses.replace(s, index=n + 1) for n, s in enumerate(edited)), "t.yaml")
+        assert new_steps(original, repaired) == _new_steps_by_table(original, repaired)

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, TextIO
 
 import typer
 
-from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, fail, knowledge
+from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, LIBRARIES, app, boundary, emit_json, fail, knowledge
 from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.lazy import lazy_module
 
@@ -135,8 +135,10 @@ def repair(
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists, 2 bad input.
     """
     the_cell = _cell(cell, live, discovery_timeout)
-    result = service.check(task, the_cell, knowledge(cell))
-    repairs = [] if result.plausible else service.assessed_repairs(task, the_cell, catalogue, top, knowledge(cell))
+    the_task = service.task(task)  # read once, checked once: the repairs' assessment starts from this check
+    result = service.check(the_task, the_cell, knowledge(cell))
+    repairs = [] if result.plausible else service.assessed_repairs(the_task, the_cell, catalogue, top,
+                                                                   knowledge(cell), checked=result)
     players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
@@ -239,8 +241,10 @@ Output (stdout or -o FILE): one JSON line per configuration, in input order:
 {"config", "devices", "offered", "plausible", "purchase"}. "purchase" is null when every --task
 is plausible; otherwise {"options": [{"add": [DEVICE, ...], "cost": N}, ...]}, the --top cheapest
 sets of catalogue devices (pnp:cost; ties: fewer devices) whose addition makes every task
-plausible, or {"options": [], "impossible": "why"} when no set from the catalogue does.
-A .csv output file gets the same columns as CSV.
+plausible; {"options": [], "ambiguous": "..."} when several devices of the configuration can
+play a step's role (bind it in the task: no purchase cures that); {"options": [], "impossible":
+"why"} when no set from the catalogue helps. A .csv output file gets the same columns as CSV.
+With -o, or on a terminal, a last line on stderr counts the configurations of each kind.
 
 Exit 0 answered (whatever is feasible), 2 bad input.
 """
@@ -264,7 +268,8 @@ def batch(
                             help="Cheapest purchases to list per configuration."),
     output: Path | None = typer.Option(None, "-o", "--output", metavar="FILE",
                                        help="Report file: .jsonl or .csv (default: stdout, JSONL)."),
-    workers: int = typer.Option(2, "--workers", min=1, metavar="N", help="Worker processes."),
+    workers: int = typer.Option(2, "--workers", min=1, metavar="N",
+                                help="Worker processes, for the configurations beyond the first 100,000."),
     cluster: str | None = typer.Option(None, "--cluster", metavar="ADDRESS",
                                        help="Run on a Dask cluster: tcp://HOST:8786, tls://HOST:8786, or local:N "
                                             "worker processes. The cluster runs what the batch sends it: give "
@@ -288,11 +293,11 @@ def batch(
             access.check()
         except ValueError as exc:
             fail(f"--cluster: {exc}")
-    devices = service.catalogue(catalogue, knowledge())
+    engine = service.batch_engine(catalogue, list(tasks), top, tuple(LIBRARIES["folders"]), LIBRARIES["builtin"])
     total: int | None = generate
     if generate is not None:
         try:
-            configurations = service.generate_configurations(generate, _sizes(sizes), seed, devices)
+            configurations = reasoning.generate(engine.devices, generate, _sizes(sizes), seed)
         except ValueError as exc:
             fail(f"--sizes: {exc}")
     elif configs == "-":
@@ -304,21 +309,40 @@ def batch(
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
         if as_csv:
             csv.writer(out, lineterminator="\n").writerow(reasoning.BATCH_CSV_HEADER)
-        written = _write(lambda progress: service.batch_report(
-            configurations, devices, list(tasks), "csv" if as_csv else "jsonl", workers, progress,
-            knowledge=knowledge(), top=top, cluster=access), out, total)
-    if output is not None:
-        typer.echo(f"wrote {written} configurations to {output}", err=True)
+        tally: dict[str, int] = {}
+        written = _write(lambda progress: service.batch_report_from(
+            engine, configurations, "csv" if as_csv else "jsonl", workers, progress, cluster=access, tally=tally),
+            out, total)
+    if output is not None or on_a_terminal():
+        where = f" to {output}" if output is not None else ""
+        typer.echo(f"wrote {written} configurations{where}: {_tally(tally)}", err=True)
+
+
+def _tally(tally: dict[str, int]) -> str:
+    """``3 all tasks plausible, 5 with a purchase, 2 ambiguous (bind a role), 1 impossible``."""
+    words = {"plausible": "all tasks plausible", "buy": "with a purchase", "ambiguous": "ambiguous (bind a role)",
+             "impossible": "impossible"}
+    return ", ".join(f"{tally.get(k, 0)} {w}" for k, w in words.items())
 
 
 def _write(report: Callable[[Callable[[int], None]], Iterator[str]], out: TextIO, total: int | None) -> int:
     """Write the report as it comes, with a progress bar on a terminal; the number of configurations written."""
+    if not on_a_terminal():  # no bar to show: rich is not even imported
+        written = 0
+
+        def count(n: int) -> None:
+            nonlocal written
+            written += n
+
+        for text in report(count):
+            out.write(text)
+        return written
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     columns = (TextColumn("batch"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     written = 0
-    with Progress(*columns, console=Console(stderr=True), transient=True, disable=not on_a_terminal()) as bar:
+    with Progress(*columns, console=Console(stderr=True), transient=True) as bar:
         job = bar.add_task("batch", total=total)
 
         def advance(n: int) -> None:

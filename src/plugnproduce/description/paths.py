@@ -1,9 +1,9 @@
 """Path search in a Device State Chart (paper section 6.1).
 
 A General Process State Chart says which state concept a device must reach next; the
-Device State Chart says how. The chart becomes a networkx multigraph whose edges are
-its transitions; a path to any state whose concept is subsumed by the wanted one is
-searched, shortest by number of device commands; among equally short paths the one
+Device State Chart says how. The chart is a graph whose edges are its transitions; a
+path to any state whose concept is subsumed by the wanted one is searched, shortest by
+number of device commands (Dijkstra's, all shortest paths); among equally short paths the one
 whose requests accept more of the parameters the step hands over wins (a lift with a
 pose moves to it rather than homing), then the one first by state ids, so the result
 never depends on dict or set order.
@@ -11,16 +11,11 @@ never depends on dict or set order.
 
 from __future__ import annotations
 
+import heapq
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.taxonomy import Taxonomy
-
-if TYPE_CHECKING:  # networkx is imported on first use: a command that searches no path never pays for it
-    import networkx as nx
-
-_GOAL = "\0goal"
 
 
 class NoPath(Exception):
@@ -46,15 +41,17 @@ def commands(t: ChartTransition) -> int:
     return (1 if t.request else 0) + len(t.sends)
 
 
-def chart_graph(device: DeviceDescription) -> nx.MultiDiGraph:
-    """The Device State Chart as a graph: one edge per transition, weighted by its commands."""
-    import networkx as nx
+Edges = dict[str, dict[str, list[ChartTransition]]]
+"""A chart's transitions by source state, then target state."""
 
-    g = nx.MultiDiGraph()
-    g.add_nodes_from(s.id for s in device.states)
-    for i, t in enumerate(device.transitions):
-        g.add_edge(t.source, t.target, key=i, transition=t, weight=commands(t))
-    return g
+
+def chart_edges(device: DeviceDescription) -> Edges:
+    """The Device State Chart as a graph: the transitions from each state to each other, in chart order."""
+    out: Edges = {s.id: {} for s in device.states}
+    for t in device.transitions:
+        out.setdefault(t.source, {}).setdefault(t.target, []).append(t)
+        out.setdefault(t.target, {})
+    return out
 
 
 def matching_states(device: DeviceDescription, concept: str, taxonomy: Taxonomy) -> list[str]:
@@ -78,26 +75,61 @@ def find_path(
         return Path(source, source, ())
     if not goals:
         raise NoPath(device.id, source, concept)
-    import networkx as nx
-
-    g = chart_graph(device)
-    for s in goals:
-        g.add_edge(s, _GOAL, key=-1, weight=0)
-    try:
-        candidates = list(nx.all_shortest_paths(g, source, _GOAL, weight="weight"))
-    except nx.NetworkXNoPath as exc:
-        raise NoPath(device.id, source, concept) from exc
+    edges = chart_edges(device)
+    if source not in edges:
+        raise NoPath(device.id, source, concept)
+    candidates = _shortest(edges, source, set(goals))
+    if not candidates:
+        raise NoPath(device.id, source, concept)
     ranked = []
     for nodes in candidates:
-        steps = tuple(_best_edge(g, a, b, wanted) for a, b in zip(nodes[:-2], nodes[1:-1], strict=True))
+        steps = tuple(_best_edge(edges, a, b, wanted) for a, b in zip(nodes[:-1], nodes[1:], strict=True))
         accepted = sum(len(wanted.intersection(t.accepts)) for t in steps)
-        ranked.append((-accepted, tuple(nodes[:-1]), tuple(t.line or 0 for t in steps), steps))
-    _, nodes, _, steps = min(ranked)
-    return Path(source, nodes[-1], steps)
+        ranked.append((-accepted, tuple(nodes), tuple(t.line or 0 for t in steps), steps))
+    _, best, _, steps = min(ranked)
+    return Path(source, best[-1], steps)
 
 
-def _best_edge(g: nx.MultiDiGraph, a: str, b: str, wanted: frozenset[str]) -> ChartTransition:
-    edges = g.get_edge_data(a, b).values()
-    best = min(edges, key=lambda e: (e["weight"], -len(wanted.intersection(e["transition"].accepts)),
-                                     e["transition"].line or 0))
-    return best["transition"]  # type: ignore[no-any-return]
+def _shortest(edges: Edges, source: str, goals: set[str]) -> list[list[str]]:
+    """Every path from ``source`` to a goal state that carries the fewest commands, without a state twice.
+
+    Dijkstra's distances (an edge weighs the fewest commands of the transitions it stands for), then every
+    simple path back through the predecessors that keep a distance shortest: the paths networkx's
+    ``all_shortest_paths`` gives, without importing networkx (most of a command's start-up)."""
+    dist = {source: 0}
+    heap = [(0, source)]
+    while heap:
+        d, a = heapq.heappop(heap)
+        if d > dist[a]:
+            continue
+        for b, ts in edges[a].items():
+            nd = d + min(commands(t) for t in ts)
+            if nd < dist.get(b, nd + 1):
+                dist[b] = nd
+                heapq.heappush(heap, (nd, b))
+    reached = [g for g in goals if g in dist]
+    if not reached:
+        return []
+    best = min(dist[g] for g in reached)
+    pred: dict[str, list[str]] = {}
+    for a, targets in edges.items():
+        for b, ts in targets.items():
+            if a in dist and b in dist and dist[a] + min(commands(t) for t in ts) == dist[b]:
+                pred.setdefault(b, []).append(a)
+    out: list[list[str]] = []
+    for goal in (g for g in reached if dist[g] == best):
+        out += _back(pred, source, [goal])
+    return out
+
+
+def _back(pred: dict[str, list[str]], source: str, path: list[str]) -> list[list[str]]:
+    """The simple paths from ``source`` that end with ``path`` (reversed), through ``pred``."""
+    out = [path[::-1]] if path[-1] == source else []
+    for a in pred.get(path[-1], ()):
+        if a not in path:
+            out += _back(pred, source, [*path, a])
+    return out
+
+
+def _best_edge(edges: Edges, a: str, b: str, wanted: frozenset[str]) -> ChartTransition:
+    return min(edges[a][b], key=lambda t: (commands(t), -len(wanted.intersection(t.accepts)), t.line or 0))

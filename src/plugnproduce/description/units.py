@@ -14,8 +14,13 @@ from dataclasses import dataclass
 from functools import cache
 from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:  # pint is imported on first use: a command that reads no unit never pays for it
+from plugnproduce.description.unitcache import Incompatible, UnitTable, table_file
+from plugnproduce.lazy import lazy_module
+
+if TYPE_CHECKING:
     import pint
+else:  # pint is imported only when a unit is new to the cached table (unitcache.py), or for its error classes
+    pint = lazy_module("pint")
 
 MAX_TEXT = 64
 """Longest quantity text read; a longer string is no quantity."""
@@ -41,11 +46,10 @@ class Amount:
 
 
 @cache
-def registry() -> pint.UnitRegistry[float]:
-    """The one unit registry (built once, on first use)."""
-    import pint
-
-    return pint.UnitRegistry()
+def registry() -> UnitTable:
+    """The one unit registry: pint's answers kept in the user's cache folder (:mod:`.unitcache`), read on first
+    use; pint itself is built only for a unit no earlier process has asked of."""
+    return UnitTable(table_file())
 
 
 def read_amount(value: object) -> Amount | None:
@@ -68,8 +72,6 @@ def unit_known(unit: str) -> bool:
         return True
     if len(unit) > MAX_TEXT or not _UNIT.match(unit):
         return False
-    import pint
-
     try:
         registry().Unit(_spelling(unit))
     except (pint.PintError, AttributeError, ValueError, TypeError, SyntaxError, ArithmeticError):  # pint on bad text
@@ -84,14 +86,14 @@ def convert(number: float, unit: str, to: str) -> float:
     """
     if not unit or not to or unit == to or not math.isfinite(number):
         return number
-    import pint
-
     for u in (unit, to):
         if not unit_known(u):
             raise UnitError(f"unknown unit {u!r}")
     ureg = registry()
     try:
         return float(ureg.Quantity(number, _spelling(unit)).to(_spelling(to)).magnitude)
+    except Incompatible as exc:  # remembered by the table: no need to load pint for its error classes
+        raise UnitError(f"{unit} cannot be converted to {to}") from exc
     except (pint.PintError, AttributeError, ValueError, TypeError, ArithmeticError) as exc:  # pint's own and offsets
         raise UnitError(f"{unit} cannot be converted to {to}") from exc
 

@@ -13,6 +13,7 @@ from plugnproduce.reasoning.batches import CSV_HEADER as BATCH_CSV_HEADER
 from plugnproduce.reasoning.batches import (
     BatchRow,
     Configuration,
+    Engine,
     batch,
     bounded_lines,
     configurations_from,
@@ -20,6 +21,7 @@ from plugnproduce.reasoning.batches import (
     generate,
     read_configurations,
     report,
+    report_from,
 )
 from plugnproduce.reasoning.cluster import check_address as check_cluster_address
 from plugnproduce.reasoning.cluster import cluster_mapper
@@ -50,6 +52,7 @@ from plugnproduce.reasoning.why import Explanation, explain_offered, explain_pla
 from plugnproduce.reasoning.windows import repair
 
 __all__ = [
+    "Engine",
     "AssessedRepair",
     "Counterfactual",
     "Explanation",
@@ -93,4 +96,5 @@ __all__ = [
     "read_configurations",
     "repair",
     "report",
+    "report_from",
 ]

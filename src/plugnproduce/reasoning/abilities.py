@@ -11,19 +11,23 @@ on the combination of devices.
 
 from __future__ import annotations
 
+import re
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.description.model import Cell, DeviceDescription, Parameter, ProcessDescription, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning import solver
 from plugnproduce.reasoning.accepts import accepts
-from plugnproduce.reasoning.contracts import normalised, refuses
+from plugnproduce.reasoning.contracts import normalised, refusal
 from plugnproduce.reasoning.facts import device_facts, process_facts, task_facts
 from plugnproduce.reasoning.plausibility import check
 from plugnproduce.reasoning.terms import Atom, program
+
+_STEP = re.compile(r"step \d+ \([^)]*\): ")
+"""Where a check's problem text names its step, before it says what is wrong."""
 
 PR = tuple[str, str]
 """A role of a process: (process, role)."""
@@ -46,6 +50,8 @@ class StepSpec:
     beyond: tuple[tuple[str, int], ...] = ()
     """Per parameter value sent (given or default): the role it goes to, and the devices (bit mask) whose own
     limits refuse it (:mod:`plugnproduce.reasoning.contracts`)."""
+    limits: tuple[tuple[str, int, str], ...] = ()
+    """Per value and device of :attr:`beyond`: the role, the device's index, and why it refuses the value."""
 
 
 @dataclass(frozen=True)
@@ -74,6 +80,13 @@ class FullCheck:
         result = check(task, Cell("configuration", devices), self.taxonomy, self.processes)
         return tuple(sorted({(p.kind, p.step, p.role or "", p.device or "") for p in result.problems},
                             key=lambda f: (f[1], f)))
+
+    def limit(self, task: Task, mask: int, finding: tuple[str, int, str, str]) -> str:
+        """The check's words for one ``device_limit`` finding of ``task`` in the configuration ``mask``."""
+        devices = tuple(d for n, d in enumerate(self.catalogue) if mask >> n & 1)
+        result = check(task, Cell("configuration", devices), self.taxonomy, self.processes)
+        return "; ".join(_STEP.split(p.text, 1)[-1] for p in result.problems
+                         if (p.kind, p.step, p.role or "", p.device or "") == finding)
 
 
 @dataclass(frozen=True)
@@ -195,10 +208,27 @@ def _task(name: str, written: Task, processes: Sequence[ProcessDescription], bad
         declared = {par.name: par for par in p.parameters} if p is not None else {}
         refusals = tuple((declared[n].role, refusing[(step.command, n)]) for n in sorted(step.params)
                          if n in declared)
-        sent = {n: step.params.get(n, par.default) for n, par in declared.items()}
-        beyond = tuple((declared[n].role, sum(1 << k for k, d in enumerate(devices) if refuses(d, v, declared[n])))
-                       for n, v in sorted(sent.items()) if v is not None)
+        limits = _limits(step.params, declared, devices)
+        beyond: dict[str, int] = defaultdict(int)
+        for role, k, _ in limits:
+            beyond[role] |= 1 << k
         steps.append(StepSpec(step.index, p.id if p is not None else None, roles, unknown,
-                              (name, step.index) in bad, refusals, tuple(b for b in beyond if b[1])))
+                              (name, step.index) in bad, refusals, tuple(sorted(beyond.items())), limits))
     flow = task.loops or task.branches or any(step.links() for step in task.steps)
     return TaskSpec(name, tuple(steps), written if flow else None)
+
+
+def _limits(params: Mapping[str, object], declared: dict[str, Parameter],
+            devices: Sequence[DeviceDescription]) -> tuple[tuple[str, int, str], ...]:
+    """Per value sent (given or the default) and catalogue device whose own limits refuse it: the role it goes to,
+    the device's index and why (:func:`.contracts.refusal`)."""
+    out = []
+    for n, par in sorted(declared.items()):
+        value = params.get(n, par.default)
+        if value is None:
+            continue
+        for k, d in enumerate(devices):
+            why = refusal(d, value, par, n in params)
+            if why is not None:
+                out.append((par.role, k, why))
+    return tuple(out)

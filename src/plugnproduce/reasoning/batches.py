@@ -30,6 +30,10 @@ from plugnproduce.reasoning.purchases import Purchase, purchase
 
 CHUNK = 2_000
 """Configurations sent to a worker at a time."""
+SOLO = 100_000
+"""Configurations answered in the batch's own process before worker processes start: about two seconds of
+work, below which starting workers and sending them the reasoned catalogue and the chunks costs more CPU (and on
+a busy machine more time) than they save."""
 MAX_LINE = 1 << 20
 """Longest configuration line read (bytes)."""
 
@@ -59,6 +63,11 @@ class BatchRow:
     purchase: Purchase | None = None
     """The cheapest sets of devices to add so every task is plausible; None when they all are."""
 
+    @property
+    def outcome(self) -> str:
+        """One of :data:`OUTCOMES`: every task plausible, a purchase helps, a role to bind, or nothing helps."""
+        return "plausible" if self.purchase is None else self.purchase.outcome
+
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         return {"config": self.config, "devices": list(self.devices), "offered": list(self.offered),
@@ -72,15 +81,23 @@ class BatchRow:
 
 
 CSV_HEADER = ["config", "devices", "offered", "plausible", "purchase"]
+OUTCOMES = ("plausible", "buy", "ambiguous", "impossible")
+"""What a configuration's answer comes to (:attr:`BatchRow.outcome`), in the order a batch's tally tells them."""
+Tally = dict[str, int]
+Known = tuple[tuple[str, ...], Purchase | None, str, str]
+"""A configuration's plausible tasks, its purchase, the end of its JSON line from "plausible" on, its outcome."""
+_json_text: Callable[[str], str] = json.encoder.encode_basestring_ascii
+"""``json.dumps`` of a string (the C function it calls)."""
 
 
 # ------------------------------------------------------------------ configurations in
 
 
-def generate(catalogue: Sequence[DeviceDescription], count: int, sizes: tuple[int, int],
+def generate(catalogue: Sequence[DeviceDescription] | Sequence[str], count: int, sizes: tuple[int, int],
              seed: int) -> Iterator[Configuration]:
-    """``count`` random configurations of ``sizes[0]`` to ``sizes[1]`` distinct catalogue devices, lazily."""
-    ids = sorted(d.id for d in catalogue)
+    """``count`` random configurations of ``sizes[0]`` to ``sizes[1]`` distinct catalogue devices (descriptions
+    or ids), lazily."""
+    ids = sorted(d if isinstance(d, str) else d.id for d in catalogue)
     low, high = max(0, sizes[0]), min(len(ids), sizes[1])
     if low > high:
         raise ValueError(f"sizes {sizes[0]}-{sizes[1]} do not fit a catalogue of {len(ids)} devices")
@@ -157,9 +174,14 @@ class Engine:
         self.top = top
         self._bits = abilities.bits
         self._tasks = range(len(abilities.tasks))
-        self._bought: dict[tuple[Key, ...], Purchase | None] = {}
         self._names = tuple(t.name for t in abilities.tasks)
-        self._json: dict[object, str] = {}
+        self._known: dict[Key, Known] = {}
+        self._offered: dict[int, tuple[tuple[str, ...], str]] = {}
+
+    @property
+    def devices(self) -> tuple[str, ...]:
+        """The catalogue's device ids, sorted."""
+        return self.feasibility.abilities.devices
 
     def mask(self, config: Configuration) -> int:
         """The configuration as a bit mask; an unknown device is bad input."""
@@ -174,44 +196,65 @@ class Engine:
 
     def row(self, config: Configuration) -> BatchRow:
         """The answer for one configuration."""
-        return BatchRow(config.name, config.devices, *self._answer(self.mask(config)))
+        mask = self.mask(config)
+        plausible, bought, _, _ = self._answer(mask)
+        return BatchRow(config.name, config.devices, self._offer(mask)[0], plausible, bought)
 
-    def _answer(self, mask: int) -> tuple[tuple[str, ...], tuple[str, ...], Purchase | None]:
-        f = self.feasibility
-        keys = tuple(f.key(t, mask) for t in self._tasks)
-        plausible = tuple(self._names[t] for t in self._tasks if not f.findings(t, mask, keys[t]))
-        if len(plausible) == len(keys):
-            return f.offered(mask), plausible, None
-        # a purchase depends on the configuration only through its tasks' keys (see purchases.py)
-        if keys not in self._bought:
-            if len(self._bought) >= MEMORY:
-                self._bought.clear()
-            self._bought[keys] = purchase(f, mask, self.top)
-        return f.offered(mask), plausible, self._bought[keys]
+    def _answer(self, mask: int) -> Known:
+        """The plausible tasks and the purchase of a configuration, remembered by what they depend on (every
+        task's key: see feasibility.py and purchases.py), with their JSON and outcome."""
+        key = self.feasibility.key_all(mask)
+        known = self._known.get(key)
+        if known is None:
+            if len(self._known) >= MEMORY:
+                self._known.clear()
+            f = self.feasibility
+            plausible = tuple(self._names[t] for t in self._tasks if not f.findings(t, mask))
+            bought = None if len(plausible) == len(self._names) else purchase(f, mask, self.top)
+            tail = (f'"plausible": {json.dumps(list(plausible))}, '
+                    f'"purchase": {json.dumps(bought.to_json() if bought is not None else None)}}}\n')
+            known = self._known[key] = (plausible, bought, tail, "plausible" if bought is None else bought.outcome)
+        return known
+
+    def _offer(self, mask: int) -> tuple[tuple[str, ...], str]:
+        """The processes a configuration offers and their JSON, remembered by the roles its devices fill."""
+        fill = self.feasibility.fill(mask)
+        found = self._offered.get(fill)
+        if found is None:
+            if len(self._offered) >= MEMORY:
+                self._offered.clear()
+            offered = self.feasibility.offered(mask, fill)
+            found = self._offered[fill] = (offered, json.dumps(list(offered)))
+        return found
 
     def line(self, config: Configuration) -> str:
         """The JSONL line of one configuration: ``json.dumps(row.to_json())``, answers' JSON remembered."""
-        offered, plausible, bought = self._answer(self.mask(config))
-        return (f'{{"config": {json.dumps(config.name)}, "devices": {json.dumps(list(config.devices))}, '
-                f'"offered": {self._dumped(offered)}, "plausible": {self._dumped(plausible)}, '
-                f'"purchase": {self._dumped(bought)}}}\n')
+        return self._line(config, self.mask(config))[0]
 
-    def _dumped(self, value: tuple[str, ...] | Purchase | None) -> str:
-        text = self._json.get(value)
-        if text is None:
-            if len(self._json) >= MEMORY:
-                self._json.clear()
-            data = value.to_json() if isinstance(value, Purchase) else list(value) if value is not None else None
-            text = self._json[value] = json.dumps(data)
-        return text
+    def _line(self, config: Configuration, mask: int) -> tuple[str, str]:
+        """The JSONL line and the outcome of one configuration."""
+        _, _, tail, outcome = self._answer(mask)
+        devices = ", ".join(map(_json_text, config.devices))
+        return (f'{{"config": {_json_text(config.name)}, "devices": [{devices}], '
+                f'"offered": {self._offer(mask)[1]}, {tail}'), outcome
 
-    def text(self, configs: list[Configuration], form: str) -> str:
-        """The report of some configurations: JSONL lines, or CSV rows (``form`` "csv")."""
+    def text(self, configs: list[Configuration], form: str) -> tuple[str, Tally]:
+        """The report of some configurations: JSONL lines, or CSV rows (``form`` "csv"), and how many of them
+        come to each of :data:`OUTCOMES`."""
+        tally = dict.fromkeys(OUTCOMES, 0)
         if form != "csv":
-            return "".join(self.line(c) for c in configs)
+            lines = []
+            for c in configs:
+                line, outcome = self._line(c, self.mask(c))
+                lines.append(line)
+                tally[outcome] += 1
+            return "".join(lines), tally
         buf = io.StringIO()
-        csv.writer(buf, lineterminator="\n").writerows(self.row(c).to_csv() for c in configs)
-        return buf.getvalue()
+        rows = [self.row(c) for c in configs]
+        for r in rows:
+            tally[r.outcome] += 1
+        csv.writer(buf, lineterminator="\n").writerows(r.to_csv() for r in rows)
+        return buf.getvalue(), tally
 
 
 _ENGINE: Engine | None = None
@@ -222,9 +265,10 @@ def _start(engine: Engine) -> None:
     _ENGINE = engine
 
 
-def run_chunk(chunk: list[Configuration], form: str = "rows", engine: Engine | None = None) -> list[BatchRow] | str:
-    """Rows for a chunk of configurations, or their report text (``form`` "jsonl" or "csv"); in a worker,
-    with the engine its start-up was given."""
+def run_chunk(chunk: list[Configuration], form: str = "rows",
+              engine: Engine | None = None) -> list[BatchRow] | tuple[str, Tally]:
+    """Rows for a chunk of configurations, or their report text (``form`` "jsonl" or "csv") with its tally; in
+    a worker, with the engine its start-up was given."""
     e = engine or _ENGINE
     if e is None:
         raise RuntimeError("run_chunk needs an engine")
@@ -250,7 +294,7 @@ def engine(catalogue: Sequence[DeviceDescription], tasks: Sequence[Task], taxono
     return Engine(abilities(catalogue, task_names(tasks), taxonomy, processes), top)
 
 
-Part = list[BatchRow] | str
+Part = list[BatchRow] | tuple[str, Tally]
 Mapper = Callable[[Engine, Iterator[list[Configuration]], str], Iterator[Part]]
 """Runs chunks somewhere (here, a process pool, a Dask cluster) in a form ("rows", "jsonl", "csv") and
 yields their answers in chunk order."""
@@ -267,10 +311,12 @@ def batch(
     progress: Callable[[int], None] | None = None,
     top: int = 1,
     mapper: Mapper | None = None,
+    solo: int = SOLO,
 ) -> Iterator[BatchRow]:
-    """One :class:`BatchRow` per configuration, in order; ``progress(n)`` is told as configurations finish."""
+    """One :class:`BatchRow` per configuration, in order; ``progress(n)`` is told as configurations finish.
+    The first ``solo`` configurations are answered in this process; ``workers`` processes answer the rest."""
     e = engine(catalogue, tasks, taxonomy, processes, top)
-    for part, n in _run(e, configurations, "rows", workers, chunk, mapper):
+    for part, n in _run(e, configurations, "rows", workers, chunk, mapper, solo):
         yield from cast(list[BatchRow], part)
         if progress is not None:
             progress(n)
@@ -288,18 +334,32 @@ def report(
     progress: Callable[[int], None] | None = None,
     top: int = 1,
     mapper: Mapper | None = None,
+    tally: Tally | None = None,
+    solo: int = SOLO,
 ) -> Iterator[str]:
     """The report of :func:`batch` as text, a chunk at a time: JSONL lines (``BatchRow.to_json``) or CSV rows
-    (``form`` "csv", without the header). The text is made where the chunk is answered (in the workers)."""
+    (``form`` "csv", without the header). The text is made where the chunk is answered (in the workers);
+    ``tally`` counts the configurations by :data:`OUTCOMES` as their text comes."""
     e = engine(catalogue, tasks, taxonomy, processes, top)
-    for part, n in _run(e, configurations, form, workers, chunk, mapper):
-        yield cast(str, part)
+    return report_from(e, configurations, form, workers, chunk, progress, mapper, tally, solo)
+
+
+def report_from(e: Engine, configurations: Iterable[Configuration], form: str = "jsonl", workers: int = 2,
+                chunk: int = CHUNK, progress: Callable[[int], None] | None = None, mapper: Mapper | None = None,
+                tally: Tally | None = None, solo: int = SOLO) -> Iterator[str]:
+    """:func:`report` by an engine already built (:func:`engine`, or one kept from an earlier batch)."""
+    for part, n in _run(e, configurations, form, workers, chunk, mapper, solo):
+        text, counted = cast(tuple[str, Tally], part)
+        yield text
+        if tally is not None:
+            for k, v in counted.items():
+                tally[k] = tally.get(k, 0) + v
         if progress is not None:
             progress(n)
 
 
 def _run(e: Engine, configurations: Iterable[Configuration], form: str, workers: int, chunk: int,
-         mapper: Mapper | None) -> Iterator[tuple[Part, int]]:
+         mapper: Mapper | None, solo: int = SOLO) -> Iterator[tuple[Part, int]]:
     sizes: deque[int] = deque()
 
     def chunks() -> Iterator[list[Configuration]]:
@@ -308,20 +368,27 @@ def _run(e: Engine, configurations: Iterable[Configuration], form: str, workers:
             sizes.append(len(part))
             yield part
 
-    run = mapper or (lambda eng, cs, f: _pool(eng, cs, f, workers))
+    run = mapper or (lambda eng, cs, f: _pool(eng, cs, f, workers, solo))
     for part in run(e, chunks(), form):
         yield part, sizes.popleft()
 
 
-def _pool(e: Engine, chunks: Iterator[list[Configuration]], form: str, workers: int) -> Iterator[Part]:
+def _pool(e: Engine, chunks: Iterator[list[Configuration]], form: str, workers: int, solo: int) -> Iterator[Part]:
+    """The chunks' answers in order: the first ``solo`` configurations here, the rest (if any) in ``workers``
+    worker processes."""
+    done = 0
+    while workers <= 1 or done < solo:
+        c = next(chunks, None)
+        if c is None:
+            return
+        done += len(c)
+        yield run_chunk(c, form, e)
     first = list(itertools.islice(chunks, 1))
-    if workers <= 1 or not (second := list(itertools.islice(chunks, 1))):  # one chunk: no pool to start
-        yield from (run_chunk(c, form, e) for c in itertools.chain(first, chunks))
+    if not first:  # the work ended with what was answered here: no pool to start
         return
-    chunks = itertools.chain(first, second, chunks)
     with ProcessPoolExecutor(workers, initializer=_start, initargs=(e,)) as pool:
         pending: deque[Future[Part]] = deque()
-        for c in chunks:
+        for c in itertools.chain(first, chunks):
             pending.append(pool.submit(run_chunk, c, form))
             if len(pending) >= 2 * workers:
                 yield pending.popleft().result()

@@ -120,9 +120,8 @@ def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
                 why = _beyond(value, par, contract)
                 if why is None:
                     continue
-                given = "" if par.name in step.params else " (its default)"
-                text = (f"step {step.index} ({step.command}): parameter {par.name}{given} goes to device "
-                        f"'{device.id}' with request {contract.request}, which {why}")
+                text = (f"step {step.index} ({step.command}): {sent(par, value, par.name in step.params)} goes to "
+                        f"device '{device.id}' with request {contract.request}, which {why}")
                 rests = tuple(w for w in (contract.where, par.where) if w is not None) or (device.where,)
                 reason = Reason("device_limit", text, (par.quantity, device.iri), rests)
                 yield Problem(step.index, step.command, "device_limit", reason, task.where(step, par.name),
@@ -141,6 +140,28 @@ def why_refused(device: DeviceDescription, value: object, par: Parameter) -> str
         return None
     return next((why for contract in contracts_for(device, par.quantity)
                  if (why := _beyond(value, par, contract)) is not None), None)
+
+
+def refusal(device: DeviceDescription, value: object, par: Parameter, given: bool) -> str | None:
+    """Why ``device`` refuses ``value`` of ``par`` (``given`` by the step, else its default) by its own limits,
+    naming the value and the request (None when it takes it): ``parameter grip_force = 150 goes with request
+    Close, which takes at most 140 N; the value is 150 N``."""
+    if _beyond_own_range(value, par):
+        return None
+    for contract in contracts_for(device, par.quantity):
+        why = _beyond(value, par, contract)
+        if why is not None:
+            return f"{sent(par, value, given)} goes with request {contract.request}, which {why}"
+    return None
+
+
+def sent(par: Parameter, value: object, given: bool) -> str:
+    """A parameter and its value as sent: ``parameter place_pose (its default) = [0.9, 0.5, 0.1, 0, 180, 0]``."""
+    shown = repr(value) if isinstance(value, str) else str(list(value)) if isinstance(value, tuple) else str(value)
+    if len(shown) > 60:
+        shown = shown[:57] + "..."
+    unit = f" {par.unit}" if par.unit and isinstance(value, int | float) and not isinstance(value, bool) else ""
+    return f"parameter {par.name}{'' if given else ' (its default)'} = {shown}{unit}"
 
 
 def _beyond_own_range(value: object, par: Parameter) -> bool:

@@ -51,21 +51,32 @@ class Feasibility:
                             for p, roles in abilities.processes if all((p, r) in index for r in roles))
         self._offered: dict[int, tuple[str, ...]] = {}
         self._keys = tuple(_key_masks(abilities, t) for t in abilities.tasks)
+        self._all = tuple(sorted(set().union(*self._keys)))
         self._memo: list[dict[Key, tuple[Finding, ...]]] = [{} for _ in abilities.tasks]
 
-    def offered(self, mask: int) -> tuple[str, ...]:
-        """The processes a configuration offers, sorted."""
+    def fill(self, mask: int) -> int:
+        """The roles (a bit each) the devices of a configuration can fill: what :meth:`offered` depends on."""
         fill = 0
         while mask:
             low = mask & -mask
             fill |= self._fills[low.bit_length() - 1]
             mask ^= low
+        return fill
+
+    def offered(self, mask: int, fill: int | None = None) -> tuple[str, ...]:
+        """The processes a configuration offers, sorted; ``fill``: its :meth:`fill` if already known."""
+        fill = self.fill(mask) if fill is None else fill
         found = self._offered.get(fill)
         if found is None:
             if len(self._offered) >= MEMORY:
                 self._offered.clear()
             found = self._offered[fill] = tuple(p for p, need in self._needs if fill & need == need)
         return found
+
+    def key_all(self, mask: int) -> Key:
+        """What every task's answer depends on (the :meth:`key` of each, at once): per role any task leaves to
+        the configuration, the one present player, 0 or -1 (several); per device a task names, its bit or 0."""
+        return tuple(x if not x & (x - 1) else -1 for x in (mask & m for m in self._all))
 
     def key(self, task: int, mask: int) -> Key:
         """What task number ``task``'s answer depends on: per role the one present player, 0 or -1 (several)."""
@@ -82,6 +93,16 @@ class Feasibility:
                 memo.clear()
             found = memo[key] = _findings(self.abilities, self.abilities.tasks[task], mask)
         return found
+
+    def limit(self, task: int, finding: Finding, mask: int) -> str:
+        """Why the device of a ``device_limit`` finding refuses a value: the parameter, its value and the
+        request's limit (for a task with loops, branches or links, as the full check says it)."""
+        _, index, role, device = finding
+        spec = self.abilities.tasks[task]
+        if spec.flow is not None:
+            return self.abilities.full.limit(spec.flow, mask, finding)
+        d = self.abilities.devices.index(device)
+        return "; ".join(why for r, k, why in spec.steps[index - 1].limits if r == role and k == d)
 
     def plausible(self, mask: int) -> tuple[str, ...]:
         """The tasks plausible in a configuration, in task order."""

@@ -8,6 +8,11 @@ of those roles is never needed (it is either unused or makes a binding ambiguous
 enumerated cheapest first (cost, then fewest devices, then catalogue order) and checked with
 :mod:`.feasibility`; the first ``top`` that make every task plausible are the answer. When the
 enumeration is exhausted, no set from the catalogue suffices, and the answer says why.
+
+A role several devices of the configuration can play (``ambiguous``) is no impossibility, and no
+purchase cures it (a device added can only make it more ambiguous): the answer says which step's
+role to bind, and to which devices, instead of offering purchases. A finding no binding or purchase
+can cure (a bad value, a device's limits, a role no catalogue device plays) still makes it impossible.
 """
 
 from __future__ import annotations
@@ -41,6 +46,11 @@ KINDS = {
 ``pnp check`` explains (:func:`describe` names their kind)."""
 
 
+ON_THE_BINDING = frozenset({"wrong_state", "stuck", "loop_fixpoint", "branch_join"})
+"""Findings of the states a task leaves its devices in: of a task with an ambiguous role, they are those of one
+binding the check picked, and the answer is to bind the role (which may cure them)."""
+
+
 @dataclass(frozen=True)
 class Purchase:
     """The cheapest sets of devices to add, cheapest first, or why there is none."""
@@ -48,27 +58,50 @@ class Purchase:
     options: tuple[tuple[tuple[str, ...], int], ...]
     """Each option: the devices to add (sorted) and their total cost."""
     impossible: str | None = None
+    ambiguous: str | None = None
+    """Which step's role several devices of the configuration can play, and to bind it (no purchase cures it)."""
+
+    @property
+    def outcome(self) -> str:
+        """``buy`` (options to buy), ``ambiguous`` (bind a role first) or ``impossible``."""
+        return "ambiguous" if self.ambiguous is not None else "impossible" if self.impossible is not None else "buy"
 
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict."""
         out: dict[str, object] = {"options": [{"add": list(a), "cost": k} for a, k in self.options]}
         if self.impossible is not None:
             out["impossible"] = self.impossible
+        if self.ambiguous is not None:
+            out["ambiguous"] = self.ambiguous
         return out
 
     def text(self) -> str:
-        """One line: ``a+b=cost`` per option, or ``impossible: why``."""
+        """One line: ``a+b=cost`` per option, ``ambiguous: what to bind`` or ``impossible: why``."""
+        if self.ambiguous is not None:
+            return f"ambiguous: {self.ambiguous}"
         if self.impossible is not None:
             return f"impossible: {self.impossible}"
         return " | ".join(f"{'+'.join(a)}={k}" for a, k in self.options)
 
 
-def describe(feasibility: Feasibility, task: int, finding: Finding) -> str:
-    """A finding in words: ``step 2 of pick-and-place: no device can play role gripper``."""
+def describe(feasibility: Feasibility, task: int, finding: Finding, mask: int | None = None) -> str:
+    """A finding in words: ``step 2 of pick-and-place: no device can play role gripper``; with the
+    configuration's ``mask``, a value a device's limits refuse is named with its parameter and the limit."""
     kind, step, role, device = finding
     name = feasibility.abilities.tasks[task].name
     text = KINDS.get(kind, f"a finding of kind {kind} (pnp check says why)").format(role=role, device=device)
+    if kind == "device_limit" and mask is not None:
+        text += f": {feasibility.limit(task, finding, mask)}"
     return f"step {step} of {name}: {text}"
+
+
+def _ambiguity(feasibility: Feasibility, task: int, finding: Finding) -> str:
+    """``step 2 of t: several devices can play role gripper; bind step 2's role gripper to one of them``.
+
+    The devices are not named: the answer is shared by every configuration whose devices bind the task's roles
+    alike (:meth:`.Feasibility.key`), and the configuration's own devices are beside it in the report."""
+    _, step, role, _ = finding
+    return f"{describe(feasibility, task, finding)}; bind step {step}'s role {role} to one of them"
 
 
 def purchase(feasibility: Feasibility, mask: int, top: int = 1) -> Purchase | None:
@@ -79,7 +112,10 @@ def purchase(feasibility: Feasibility, mask: int, top: int = 1) -> Purchase | No
         return None
     groups: set[int] = set()
     forced = 0
+    ambiguous = ""
     for t, findings in enumerate(found):
+        if any(f[0] == "ambiguous" for f in findings):  # where it goes on from depends on the binding chosen
+            findings = tuple(f for f in findings if f[0] not in ON_THE_BINDING)
         for f in findings:
             kind, step, role, device = f
             process = ab.tasks[t].steps[step - 1].process or ""
@@ -91,9 +127,13 @@ def purchase(feasibility: Feasibility, mask: int, top: int = 1) -> Purchase | No
                 groups.add(players)
             elif kind == "absent" and ab.bit(device):
                 forced |= ab.bit(device)
+            elif kind == "ambiguous":
+                ambiguous = ambiguous or _ambiguity(feasibility, t, f)
             else:
-                return Purchase((), describe(feasibility, t, f) + ("; it is not in the catalogue" if kind == "absent"
-                                                                   else "; adding devices cannot cure it"))
+                return Purchase((), describe(feasibility, t, f, mask) + (
+                    "; it is not in the catalogue" if kind == "absent" else "; adding devices cannot cure it"))
+    if ambiguous:
+        return Purchase((), ambiguous=ambiguous)
     return _search(feasibility, mask, sorted(groups), forced, top)
 
 
@@ -145,7 +185,7 @@ def _failure(feasibility: Feasibility, mask: int) -> str | None:
     for t in range(len(feasibility.abilities.tasks)):
         findings = feasibility.findings(t, mask)
         if findings:
-            return describe(feasibility, t, findings[0])
+            return describe(feasibility, t, findings[0], mask)
     return None
 
 

@@ -10,7 +10,7 @@ process, dropped where the robot stands otherwise. The repair solver is not chan
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task, Where
@@ -119,23 +119,40 @@ def new_steps(original: Task, repaired: Task, origins: Sequence[int] = ()) -> se
     return _unmatched([_sig(s) for s in original.steps], [_sig(s) for s in repaired.steps])
 
 
-def _unmatched(a: Sequence[object], b: Sequence[object]) -> set[int]:
+def _unmatched(a: Sequence[Hashable], b: Sequence[Hashable]) -> set[int]:
     """The (1-based) positions of ``b`` outside a longest common subsequence with ``a``, matched from the end."""
-    n, m = len(a), len(b)
-    lcs = [[0] * (m + 1) for _ in range(n + 1)]
-    for i in range(n):
-        for j in range(m):
-            lcs[i + 1][j + 1] = lcs[i][j] + 1 if a[i] == b[j] else max(lcs[i][j + 1], lcs[i + 1][j])
-    fresh, i, j = set(), n, m
+    lcs = _lcs_rows(a, b)
+    fresh, i, j = set(), len(a), len(b)
     while j > 0:
-        if i > 0 and a[i - 1] == b[j - 1] and lcs[i][j] == lcs[i - 1][j - 1] + 1:
+        if i > 0 and a[i - 1] == b[j - 1] and lcs(i, j) == lcs(i - 1, j - 1) + 1:
             i, j = i - 1, j - 1
-        elif i > 0 and lcs[i - 1][j] == lcs[i][j]:
+        elif i > 0 and lcs(i - 1, j) == lcs(i, j):
             i -= 1
         else:
             fresh.add(j)
             j -= 1
     return fresh
+
+
+def _lcs_rows(a: Sequence[Hashable], b: Sequence[Hashable]) -> Callable[[int, int], int]:
+    """The length of the longest common subsequence of ``a[:i]`` and ``b[:j]``, for any ``i`` and ``j``.
+
+    Bit-parallel (Hyyrö's row recurrence): row ``i`` is one integer whose zero bits below ``j`` count that
+    length, so the table of a 10,000-step task is 10,000 integer operations rather than 10^8 cells."""
+    full = (1 << len(b)) - 1
+    matches: dict[Hashable, int] = {}
+    for j, x in enumerate(b):
+        matches[x] = matches.get(x, 0) | 1 << j
+    rows = [full]
+    for x in a:
+        v = rows[-1]
+        u = v & matches.get(x, 0)
+        rows.append(((v + u) | (v - u)) & full)
+
+    def lcs(i: int, j: int) -> int:
+        return j - (rows[i] & ((1 << j) - 1)).bit_count()
+
+    return lcs
 
 
 def _concept(cell: Cell, d: str, x: str | None) -> str | None:
@@ -254,11 +271,12 @@ def side_effects(original: Task, repaired: Task, result: CheckResult, cell: Cell
 
 def assess(repairs: Sequence[Repair], task: Task, cell: Cell, taxonomy: Taxonomy,
            processes: Sequence[ProcessDescription],
-           catalogue: Sequence[DeviceDescription] = ()) -> list[AssessedRepair]:
+           catalogue: Sequence[DeviceDescription] = (), before: CheckResult | None = None) -> list[AssessedRepair]:
     """Each repair that checking it again (in the cell with the devices it adds from ``catalogue``, with their own
     contracts and limits) confirms, with its side effects: ranked by its worst side effect, then by cost, then by
-    the solver's order. A repair the check does not confirm is no repair: it is left out."""
-    before = check(task, cell, taxonomy, processes)
+    the solver's order. A repair the check does not confirm is no repair: it is left out. ``before``: the check
+    of ``task`` in ``cell``, when the caller has it already."""
+    before = before if before is not None else check(task, cell, taxonomy, processes)
     out = []
     for r in repairs:
         added = tuple(d for d in catalogue if d.id in r.added_devices)
