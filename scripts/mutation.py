@@ -1,7 +1,8 @@
-"""Mutation testing of the guard modules: does a test fail when a guard is broken?
+"""Mutation testing of the guard and core modules: does a test fail when the code is changed?
 
-    python scripts/mutation.py                    # every guard module
+    python scripts/mutation.py                    # every module and encoding
     python scripts/mutation.py evaluator tokens   # some of them (names below, or --list)
+    python scripts/mutation.py rules-chain        # one ASP encoding (rules/chain.lp; see mutation_asp.py)
     python scripts/mutation.py --jobs 2 --work build/mutation
     python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
                                                   # (a whole run again if the module's test files changed)
@@ -16,6 +17,10 @@ survived, timeouts, equivalent, and each survivor at its ``file:line`` with the 
 A survivor that cannot change any behaviour (an equivalent mutant) is listed with the
 reason in ``scripts/mutation_equivalent.txt``; it is printed as such and does not count as
 a survivor. Exit 0 when no mutant survives, 1 otherwise, 2 when the run itself fails.
+
+The ASP encodings (``rules-NAME`` for ``rules/NAME.lp``) are changed by scripts/mutation_asp.py
+instead (delete a rule, drop a body literal, flip a comparison), and reported the same way, with
+the mutants clingo refuses counted apart. Their equivalents are listed under the encoding's file.
 
 Each module runs in its own work folder (``--work``, default ``build/mutation/NAME``) that
 holds a copy of the checkout, so the checkout is never changed. mutmut only changes code
@@ -39,6 +44,9 @@ import tomllib
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
+
+import mutation_asp
+from mutation_asp import Target
 
 ROOT = Path(__file__).resolve().parents[1]
 EQUIVALENT_FILE = ROOT / "scripts" / "mutation_equivalent.txt"
@@ -84,6 +92,30 @@ GUARDS = (
            "xǁTaskRunǁ_on_anomaly", "xǁTaskRunǁ_on_step", "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail",
            "xǁTaskRunǁ_outcome")),
 )
+
+_ENC, _CAP, _PLA, _WHY = ("tests/reasoning/test_encodings.py", "tests/reasoning/test_capabilities.py",
+                          "tests/reasoning/test_plausibility.py", "tests/reasoning/test_why.py")
+_REP, _WIN = "tests/reasoning/test_repair.py", "tests/reasoning/test_windows.py"
+ENCODINGS = tuple(Target(f"rules-{name}", f"rules/{name}.lp", tests) for name, tests in (
+    ("roles", (_ENC, _CAP, _PLA)),
+    ("offered", (_ENC, _CAP)),
+    ("bindings", (_ENC, _CAP)),
+    ("explain", (_ENC, _CAP, _WHY)),
+    ("resolve", (_ENC, _PLA, _WHY)),
+    ("chain", (_ENC, _PLA, _REP, _WHY)),
+    ("params", (_ENC, _PLA, _REP)),
+    ("provenance", (_ENC, _WHY)),
+    ("repair", (_ENC, _REP, "tests/reasoning/test_repair_lifting.py")),
+    ("window", (_ENC, _WIN)),
+    ("show_abilities", (_ENC, "tests/reasoning/test_batch.py")),
+    ("show_capabilities", (_CAP, _WHY)),
+    ("show_check", (_PLA, _WHY)),
+    ("show_derivation", (_WHY,)),
+    ("show_repair", (_REP,)),
+    ("show_window", (_WIN,)),
+))
+"""Each encoding with the reasoning tests that cover it, the fast table-driven ones first (``-x`` stops at the
+first failure)."""
 
 PLUGIN = "mutation_fresh_caches"
 PLUGIN_TEXT = '''"""Empties the caches of the guard modules before each test (mutation runs only)."""
@@ -291,33 +323,51 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
     return dict(counts)
 
 
+def run_encoding(target: Target, work: Path, jobs: int, known: dict[tuple[str, str, str], str],
+                 again: bool = False) -> dict[str, int]:
+    """Mutate one ASP encoding (``again``: test only the last run's survivors), print its figures and survivors."""
+    started = time.monotonic()
+    results = mutation_asp.run_target(target, ROOT, work, jobs, again)
+    counts = mutation_asp.report(target, results, known, time.monotonic() - started)
+    counts["seconds"] = round(time.monotonic() - started)
+    return dict(counts)
+
+
+def _list() -> None:
+    for g in GUARDS:
+        print(f"{g.name}: {', '.join(g.files)}")
+        print(f"  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
+    for t in ENCODINGS:
+        print(f"{t.name}: {t.file}\n  tests: {', '.join(t.tests)}")
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the guard modules named (all by default) and print the figures; exit 1 if a mutant survived."""
+    """Run the modules and encodings named (all by default) and print the figures; exit 1 if a mutant survived."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0] if __doc__ else None)
-    parser.add_argument("modules", nargs="*", help="guard modules to run (default: all; see --list)")
-    parser.add_argument("--list", action="store_true", help="list the guard modules with their files and tests")
+    parser.add_argument("modules", nargs="*", help="modules and encodings to run (default: all; see --list)")
+    parser.add_argument("--list", action="store_true", help="list the modules and encodings with their files and tests")
     parser.add_argument("--jobs", type=int, default=2, help="mutants tested at once (default 2)")
     parser.add_argument("--again", action="store_true",
                         help="test only the survivors of the last run again, with the tests as they are now")
     parser.add_argument("--work", type=Path, default=ROOT / "build" / "mutation",
                         help="folder for the per-module copies (default build/mutation)")
     args = parser.parse_args(argv)
-    by_name = {g.name: g for g in GUARDS}
+    by_name: dict[str, Guard | Target] = {g.name: g for g in (*GUARDS, *ENCODINGS)}
     if args.list:
-        for g in GUARDS:
-            print(f"{g.name}: {', '.join(g.files)}")
-            print(f"  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
+        _list()
         return 0
     unknown = [m for m in args.modules if m not in by_name]
     if unknown:
-        print(f"scripts/mutation.py: unknown guard module {unknown[0]!r}; expected one of {', '.join(by_name)}",
+        print(f"scripts/mutation.py: unknown module {unknown[0]!r}; expected one of {', '.join(by_name)}",
               file=sys.stderr)
         return 2
     known = equivalents()
     total: Counter[str] = Counter()
     try:
         for name in args.modules or list(by_name):
-            total.update(run_guard(by_name[name], args.work.resolve() / name, args.jobs, known, args.again))
+            unit = by_name[name]
+            run = run_guard if isinstance(unit, Guard) else run_encoding
+            total.update(run(unit, args.work.resolve() / name, args.jobs, known, args.again))  # type: ignore[arg-type]
     except RuntimeError as exc:
         print(f"scripts/mutation.py: {exc}", file=sys.stderr)
         return 2

@@ -276,3 +276,80 @@ def test_abilities_are_of_each_device_alone_and_bad_values_of_the_task_alone() -
 def test_every_encoding_file_belongs_to_a_program_and_every_program_names_files_that_exist() -> None:
     named = {name for program in solver.PROGRAMS for name in solver.rules(program)}
     assert named == {f.name for f in rules_path().glob("*.lp")}
+
+
+HANDOVER = """
+process("handover"). role("handover","holder"). role("handover","robot"). role("handover","gripper").
+nroles("handover",3). role_order("handover",1,"holder"). role_order("handover",2,"robot").
+role_order("handover",3,"gripper").
+requires("handover","holder","Grip"). requires("handover","robot","Move"). requires("handover","gripper","Release").
+region_state("handover","holder",1,"Open"). region_state("handover","holder",2,"Closed").
+region_state("handover","robot",1,"Idle"). region_state("handover","robot",2,"Moving").
+region_state("handover","robot",3,"AtPose").
+region_state("handover","gripper",1,"Closed"). region_state("handover","gripper",2,"Open").
+leaves("handover","holder",D,"o","c") :- device(D), state_is(D,"o","Open").
+leaves("handover","gripper",D,"c","o") :- device(D), state_is(D,"c","Closed").
+leaves("handover","robot","r","h","h").
+"""
+
+
+def test_a_device_in_the_first_and_last_of_three_roles_keeps_one_state_through_the_step() -> None:
+    # the gripper holds (o -> c) while the robot moves, then releases (c -> o): it plays role 1 and role 3,
+    # and between them it waits in c while role 2 (not its own) runs; other processes order "gripper" first
+    (model,) = answer_sets(CHECK, WORLD + HANDOVER + cell("g", "r") + task("handover", "close"), PROBLEMS + ["at/5"])
+    assert model == {'at("c","t",1,"g","o")', 'at("c","t",2,"g","o")', 'at("c","t",3,"g","c")',
+                     'at("c","t",1,"r","h")', 'at("c","t",2,"r","h")', 'at("c","t",3,"r","h")', 'plausible("c","t")'}
+
+
+WIDE = """
+device("k"). has_skill("k","Grip"). initial("k","w").
+chart_state("k","o"). chart_state("k","c"). chart_state("k","w"). chart_state("k","x").
+state_is("k","o","Open"). state_is("k","c","Closed"). state_is("k","w","Open"). state_is("k","x","Closed").
+edge("k","o","c"). edge("k","c","o"). edge("k","w","x"). edge("k","x","w").
+leaves("close","gripper","k","w","x").
+"""
+
+
+def test_a_role_leaves_the_device_where_its_own_start_leads_not_where_another_start_would() -> None:
+    # "k" opens narrow (o) or wide (w) and closes from each to its own closed state (c, x); it starts wide
+    (model,) = answer_sets(CHECK, WORLD + WIDE + cell("k") + task("close"), PROBLEMS + ["at/5"])
+    assert model == {'at("c","t",1,"k","w")', 'at("c","t",2,"k","x")', 'plausible("c","t")'}
+
+
+SQUEEZE = """
+process("squeeze"). role("squeeze","gripper"). nroles("squeeze",1). role_order("squeeze",1,"gripper").
+requires("squeeze","gripper","Grip").
+region_state("squeeze","gripper",1,"Open"). region_state("squeeze","gripper",2,"Closed").
+param("squeeze","force","integer"). param_min("squeeze","force",50000). param_max("squeeze","force",60000).
+param("squeeze","speed","decimal"). param("squeeze","label","decimal").
+"""
+
+
+def value(kind: str, name: str, number: int | None = None, step: int = 1) -> str:
+    """A value the task gives step ``step`` for parameter ``name``, of ``kind`` (and its number in thousandths)."""
+    num = f'value_num("t",{step},"{name}",{number}).' if number is not None else ""
+    return f'given("t",{step},"{name}"). value_kind("t",{step},"{name}","{kind}"). {num}'
+
+
+# Two processes declare a parameter of one name with other types and ranges: each step is checked against
+# its own process only. A value of the wrong type is that finding alone, not also one of range.
+PARAMETER_CASES = {
+    "within close's range, below squeeze's": (task("close") + value("integer", "force", 40000), {'plausible("c","t")'}),
+    "within close's range, above squeeze's": (task("close") + value("integer", "force", 100000), {'plausible("c","t")'}),
+    "a decimal for move's integer speed, though squeeze's speed is a decimal": (
+        task("move") + value("decimal", "speed", 2500), {'bad_type("t",1,"speed","integer")'}),
+    "an integer for close's text label, though squeeze's label is a decimal": (
+        task("close") + 'param("close","label","string").' + value("integer", "label", 3000),
+        {'bad_type("t",1,"label","string")'}),
+    "a decimal below move's minimum speed is a wrong type only": (
+        task("move") + 'param_min("move","speed",1000).' + value("decimal", "speed", 500),
+        {'bad_type("t",1,"speed","integer")'}),
+    "a decimal above move's maximum speed is a wrong type only": (
+        task("move") + 'param_max("move","speed",100000).' + value("decimal", "speed", 900000),
+        {'bad_type("t",1,"speed","integer")'}),
+}
+
+
+@pytest.mark.parametrize("facts, expected", PARAMETER_CASES.values(), ids=PARAMETER_CASES.keys())
+def test_parameters_are_checked_against_the_steps_own_process(facts: str, expected: set[str]) -> None:
+    assert answer_sets(CHECK, WORLD + SQUEEZE + cell("g", "r") + facts, PROBLEMS) == [expected]
