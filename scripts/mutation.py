@@ -93,6 +93,40 @@ GUARDS = (
            "xǁTaskRunǁ_outcome")),
 )
 
+_S = "src/plugnproduce/"
+CORE = (
+    Guard("codegen-flow", (_S + "codegen/flow.py",),
+          ("tests/codegen/test_loops_and_links.py", "tests/codegen/test_branch_charts.py",
+           "tests/codegen/test_nested_loop_charts.py")),
+    Guard("description-outcomes", (_S + "description/outcomes.py",),
+          ("tests/description/test_task_branches.py", "tests/validation/test_branch_findings.py",
+           "tests/codegen/test_branch_charts.py", "tests/codegen/test_loops_and_links.py")),
+    Guard("reasoning-plausibility", (_S + "reasoning/plausibility.py",),
+          ("tests/reasoning/test_plausibility.py", "tests/reasoning/test_branch_check.py",
+           "tests/reasoning/test_flow_check.py", "tests/reasoning/test_why.py")),
+    Guard("codegen-specific", (_S + "codegen/specific.py",),
+          ("tests/codegen/test_task_chart.py", "tests/codegen/test_closed_world.py")),
+    Guard("description-flow", (_S + "description/flow.py",),
+          ("tests/description/test_nested_loops.py", "tests/description/test_task_branches.py")),
+    Guard("reasoning-branches", (_S + "reasoning/branches.py",),
+          ("tests/reasoning/test_branch_check.py", "tests/reasoning/test_nested_loop_check.py")),
+    Guard("reasoning-dataflow", (_S + "reasoning/dataflow.py",),
+          ("tests/reasoning/test_flow_check.py", "tests/reasoning/test_plausibility.py")),
+    Guard("reasoning-feasibility", (_S + "reasoning/feasibility.py",), ("tests/reasoning/test_batch.py",)),
+    Guard("reasoning-purchases", (_S + "reasoning/purchases.py",), ("tests/reasoning/test_batch.py",)),
+    Guard("reasoning-windows", (_S + "reasoning/windows.py",), ("tests/reasoning/test_windows.py",)),
+    Guard("reasoning-lifting", (_S + "reasoning/lifting.py",), ("tests/reasoning/test_repair_lifting.py",)),
+    Guard("executor-links", (_S + "executor/links.py",),
+          ("tests/executor/test_run.py", "tests/executor/test_faults.py")),
+    Guard("executor-values", (_S + "executor/values.py",),
+          ("tests/executor/test_journal.py",)),
+    Guard("verification", tuple(_S + f"verification/{n}.py" for n in ("arguments", "results", "search", "trace",
+                                                                         "world")),
+          ("tests/verification/test_verify.py", "tests/verification/test_branch_verify.py",
+           "tests/verification/test_nested_verify.py")),
+)
+"""The core modules (the answers users rely on), each with the smallest set of test files that covers it."""
+
 _ENC, _CAP, _PLA, _WHY = ("tests/reasoning/test_encodings.py", "tests/reasoning/test_capabilities.py",
                           "tests/reasoning/test_plausibility.py", "tests/reasoning/test_why.py")
 _REP, _WIN = "tests/reasoning/test_repair.py", "tests/reasoning/test_windows.py"
@@ -334,7 +368,7 @@ def run_encoding(target: Target, work: Path, jobs: int, known: dict[tuple[str, s
 
 
 def _list() -> None:
-    for g in GUARDS:
+    for g in (*GUARDS, *CORE):
         print(f"{g.name}: {', '.join(g.files)}")
         print(f"  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
     for t in ENCODINGS:
@@ -352,7 +386,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--work", type=Path, default=ROOT / "build" / "mutation",
                         help="folder for the per-module copies (default build/mutation)")
     args = parser.parse_args(argv)
-    by_name: dict[str, Guard | Target] = {g.name: g for g in (*GUARDS, *ENCODINGS)}
+    by_name: dict[str, Guard | Target] = {g.name: g for g in (*GUARDS, *CORE, *ENCODINGS)}
     if args.list:
         _list()
         return 0

@@ -353,3 +353,36 @@ PARAMETER_CASES = {
 @pytest.mark.parametrize("facts, expected", PARAMETER_CASES.values(), ids=PARAMETER_CASES.keys())
 def test_parameters_are_checked_against_the_steps_own_process(facts: str, expected: set[str]) -> None:
     assert answer_sets(CHECK, WORLD + SQUEEZE + cell("g", "r") + facts, PROBLEMS) == [expected]
+
+
+GRIP_ONLY = SECOND_GRIPPER.replace('has_skill("h","Release").', "")
+"""A second gripper, ``h``, that can close but not open (no Release skill)."""
+
+# What a step's bindings are when the task names devices: the check lists a device bound to a role only when
+# the cell has it and it can play that role of the step's own process; each wrong binding is one finding.
+BINDING_CASES = {
+    "a device not in the cell is not bound": (
+        WORLD + cell("r") + task("close", binds='bind("t",1,"gripper","g").'),
+        {'absent("c","t",1,"gripper","g")', 'at("c","t",1,"r","h")', 'at("c","t",2,"r","h")'}),
+    "a device not in the cell that could not play the role either is only absent": (
+        WORLD + cell("g") + task("close", binds='bind("t",1,"gripper","r").'),
+        {'absent("c","t",1,"gripper","r")', 'at("c","t",1,"g","o")', 'at("c","t",2,"g","o")'}),
+    "a device bound to its role in another process only is not bound here": (
+        WORLD + GRIP_ONLY + cell("h") + task("open", binds='bind("t",1,"gripper","h").'),
+        {'cannot_play("c","t",1,"gripper","h")', 'at("c","t",1,"h","o")', 'at("c","t",2,"h","o")'}),
+    "a device that plays the step's role is bound, whatever other processes it cannot play": (
+        WORLD + GRIP_ONLY + cell("h") + task("close", binds='bind("t",1,"gripper","h").'),
+        {'bound("c","t",1,"gripper","h")', 'at("c","t",1,"h","o")', 'at("c","t",2,"h","c")', 'plausible("c","t")'}),
+    "a binding of an unknown role to a device not in the cell is an unknown role only": (
+        WORLD + cell("g") + task("close", binds='bind("t",1,"hand","z").'),
+        {'unknown_role("c","t",1,"hand")', 'bound("c","t",1,"gripper","g")', 'at("c","t",1,"g","o")',
+         'at("c","t",2,"g","c")'}),
+    "a binding in a step of an unknown command is an unknown command only": (
+        WORLD + cell("g") + task("fly", binds='bind("t",1,"hand","g").'),
+        {'unknown_command("c","t",1,"fly")', 'at("c","t",1,"g","o")', 'at("c","t",2,"g","o")'}),
+}
+
+
+@pytest.mark.parametrize("facts, expected", BINDING_CASES.values(), ids=BINDING_CASES.keys())
+def test_bindings_the_task_names(facts: str, expected: set[str]) -> None:
+    assert answer_sets(CHECK, facts, PROBLEMS + ["bound/5", "at/5"]) == [expected]
