@@ -88,6 +88,11 @@ OFFERED_CASES = {
         ["binding/3"],
         {'binding("c","pick",("g",("g",nil)))', 'binding("c","move",("g",nil))', 'binding("c","close",("g",nil))',
          'binding("c","open",("g",nil))'}),
+    "a device with the states a region visits but not the skill plays no role": (
+        WORLD + SECOND_GRIPPER.replace('has_skill("h","Release").', "") + cell("h"), ["can_play/3", "offered/2"],
+        {'can_play("close","gripper","g")', 'can_play("open","gripper","g")', 'can_play("pick","gripper","g")',
+         'can_play("close","gripper","h")', 'can_play("pick","gripper","h")',
+         'can_play("pick","robot","r")', 'can_play("move","robot","r")', 'offered("c","close")'}),
     "every valid binding, not just one": (
         WORLD + SECOND_GRIPPER + cell("g", "h", "r"), ["binding/3"],
         {'binding("c","pick",("r",("g",nil)))', 'binding("c","pick",("r",("h",nil)))',
