@@ -277,7 +277,7 @@ def run_target(target: Target, root: Path, work: Path, jobs: int, again: bool = 
         for done, (mutant, outcome) in enumerate(pool.map(test, pending), start=1):
             results[_key(mutant)] = (mutant, outcome)
             print(f"{target.name}: {done} of {len(pending)} mutants tested", file=sys.stderr, flush=True)
-    record.write_text(json.dumps({k: v[1] for k, v in results.items()}, indent=1), encoding="utf-8")
+            record.write_text(json.dumps({k: v[1] for k, v in results.items()}, indent=1), encoding="utf-8")
     return results
 
 
