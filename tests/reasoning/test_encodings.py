@@ -391,3 +391,41 @@ BINDING_CASES = {
 @pytest.mark.parametrize("facts, expected", BINDING_CASES.values(), ids=BINDING_CASES.keys())
 def test_bindings_the_task_names(facts: str, expected: set[str]) -> None:
     assert answer_sets(CHECK, facts, PROBLEMS + ["bound/5", "at/5"]) == [expected]
+
+
+def _gripper(name: str) -> str:
+    return GRIPPER.replace('"g"', f'"{name}"')
+
+
+NO_CLOSED = (_gripper("h").replace('chart_state("h","c"). ', "").replace('state_is("h","c","Closed").', "")
+             .replace('edge("h","o","c"). edge("h","c","o").', ""))
+"""A gripper ``h`` without a closed state."""
+ONE_WAY = _gripper("u").replace('edge("u","o","c").', "")
+"""A gripper ``u`` that can open but not close."""
+NO_FORCE = _gripper("a") + 'missing_arg("close","gripper","a","grip","force").'
+"""A gripper ``a`` whose grip request needs a force that close does not supply."""
+REASONS = ["no_skill/4", "lacks_state/6", "unreachable/7", "no_argument/6"]
+
+# Why a process is not offered: each reason is about a role no device of the cell fills, and names only devices of
+# the cell that walk as far as the reason says.
+REASON_CASES = {
+    "no reasons for roles another device of the cell fills": (
+        WORLD + NO_CLOSED + ONE_WAY + NO_FORCE + cell("g", "h", "u", "a", "r"), set()),
+    "reasons name only devices of the cell": (
+        WORLD + NO_CLOSED + ONE_WAY + NO_FORCE + cell("r"),
+        {'no_skill("c","pick","gripper","Grip")', 'no_skill("c","close","gripper","Grip")',
+         'no_skill("c","open","gripper","Release")'}),
+    "a request's missing argument is a reason only for a device that walks the region": (
+        WORLD + NO_CLOSED + 'missing_arg("close","gripper","h","grip","force").' + cell("h", "r"),
+        {'lacks_state("c","pick","gripper","h",2,"Closed")', 'lacks_state("c","close","gripper","h",2,"Closed")',
+         'lacks_state("c","open","gripper","h",1,"Closed")'}),
+    "each reason for its own device, for the one process no device fills (a plays pick and open)": (
+        WORLD + NO_CLOSED + ONE_WAY + NO_FORCE + cell("h", "u", "a", "r"),
+        {'lacks_state("c","close","gripper","h",2,"Closed")', 'unreachable("c","close","gripper","u",1,"o","Closed")',
+         'no_argument("c","close","gripper","a","grip","force")'}),
+}
+
+
+@pytest.mark.parametrize("facts, expected", REASON_CASES.values(), ids=REASON_CASES.keys())
+def test_reasons_a_process_is_not_offered(facts: str, expected: set[str]) -> None:
+    assert answer_sets(OFFERED, facts, REASONS) == [expected]
