@@ -42,6 +42,7 @@ import sys
 import time
 import tomllib
 from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -318,6 +319,31 @@ def _survivor(key: str, file: str, work: Path, functions: dict[str, str]) -> Sur
     return Survivor(key, f"{file}:{line}", " ".join(before), " ".join(after))
 
 
+def _confirmed(guard: Guard, work: Path, jobs: int, codes: dict[str, int]) -> dict[str, int]:
+    """The codes with each survivor tested again against the whole of the module's test files.
+
+    mutmut runs a mutant only against the tests it saw call the function, and it does not see a call made while
+    a module- or session-scoped fixture is set up: a function only such a fixture reaches would survive untested.
+    """
+    survivors = [k for k, code in codes.items() if code in _SURVIVED]
+    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
+    command = [sys.executable, "-m", "pytest", "-x", "-q", "-n", "0", "-p", "no:cacheprovider", "-p", PLUGIN,
+               *guard.tests]
+
+    def run(key: str) -> int:
+        try:
+            done = subprocess.run(command, cwd=work / "mutants", env={**env, "MUTANT_UNDER_TEST": key},
+                                  capture_output=True, text=True, timeout=900)
+        except subprocess.TimeoutExpired:
+            return -24
+        return 1 if done.returncode in (1, 2, 3) else codes[key]
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        for key, code in zip(survivors, pool.map(run, survivors), strict=True):
+            codes[key] = code
+    return codes
+
+
 def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, str], str],
               again: bool = False) -> dict[str, int]:
     """Mutate one guard module (``again``: test only the last run's survivors), print its figures and survivors."""
@@ -330,7 +356,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
     else:
         _prepare(guard, work)
         _run_mutmut(guard, work, jobs)
-    codes = _results(guard, work)
+    codes = _confirmed(guard, work, jobs, _results(guard, work))
     functions = {f: _functions((work / "mutants" / f).read_text(encoding="utf-8")) for f in guard.files}
     counts: Counter[str] = Counter()
     lines: list[str] = []
