@@ -238,6 +238,19 @@ REPAIR_CASES = {
     "reset a value that does not fit": (
         repair_case(("close",), ("g",), 'given("t",1,"force"). value_kind("t",1,"force","string").'),
         [{'edit(reset(1,"force"))'}]),
+    "a step of an unknown command is removed": (
+        repair_case(("close", "fly", "open"), ("g",)), [{"edit(remove(2))"}]),
+    "a binding of an unknown role is dropped": (
+        repair_case(("close",), ("g",), 'bind("t",1,"hand","g").'), [{'edit(unbind(1,"hand"))'}]),
+    "dropping a binding is priced: removing its step can be cheaper": (
+        repair_case(("close",), ("g",), 'bind("t",1,"hand","g").', COSTS.replace('"rebind","",200', '"rebind","",900')),
+        [{"edit(remove(1))"}]),
+    "at most max_inserts commands are inserted": (
+        repair_case(("close", "close"), ("g",), "max_inserts(1)."), [{'edit(insert(2,1,"open"))'}]),
+    "beyond max_inserts, steps are removed instead": (
+        repair_case(("close", "close", "close"), ("g",), "max_inserts(1)."),
+        [{'edit(insert(3,1,"open"))', "edit(remove(1))"}, {'edit(insert(2,1,"open"))', "edit(remove(3))"},
+         {'edit(insert(3,1,"open"))', "edit(remove(2))"}, {'edit(insert(2,1,"open"))', "edit(remove(2))"}]),
 }
 
 
