@@ -245,6 +245,12 @@ REPAIR_CASES = {
     "dropping a binding is priced: removing its step can be cheaper": (
         repair_case(("close",), ("g",), 'bind("t",1,"hand","g").', COSTS.replace('"rebind","",200', '"rebind","",900')),
         [{"edit(remove(1))"}]),
+    "resetting a value is priced: removing its step can be cheaper": (
+        repair_case(("close",), ("g",), 'given("t",1,"force"). value_kind("t",1,"force","string").',
+                    COSTS.replace('"reset","",100', '"reset","",900')), [{"edit(remove(1))"}]),
+    "naming one of two fitting devices is priced: removing the step can be cheaper": (
+        repair_case(("close",), ("g", "h"), costs=COSTS.replace('"rebind","",200', '"rebind","",900')),
+        [{"edit(remove(1))"}]),
     "at most max_inserts commands are inserted": (
         repair_case(("close", "close"), ("g",), "max_inserts(1)."), [{'edit(insert(2,1,"open"))'}]),
     "beyond max_inserts, steps are removed instead": (
