@@ -137,3 +137,13 @@ def test_a_gripper_lacking_a_state_is_derived_from_the_missing_state(cell: Cell,
     (rule,) = [n for n in nodes(tree, "asp") if n.detail.startswith("lacks_state(")]
     assert '"gripper",2,' in rule.detail and "Closed" in rule.detail
     assert line_at(rule.where).startswith("lacks_state(")
+
+
+def test_a_gripper_that_cannot_close_is_derived_from_the_unreachable_state(cell: Cell, device) -> None:
+    gripper = device("gripper")
+    one_way = DeviceDescription(**{**gripper.__dict__, "transitions": tuple(
+        t for t in gripper.transitions if t.target not in ("closing", "closed"))})
+    tree = service.explain_offered(cell.without("gripper").with_device(one_way), "pick").derivation
+    (rule,) = [n for n in nodes(tree, "asp") if n.detail.startswith("unreachable(")]
+    assert '"gripper",1,"open",' in rule.detail and "Closed" in rule.detail
+    assert line_at(rule.where).startswith("unreachable(")
