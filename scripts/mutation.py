@@ -1,7 +1,8 @@
-"""Mutation testing of the guard modules: does a test fail when a guard is broken?
+"""Mutation testing of the guard and core modules: does a test fail when the code is changed?
 
-    python scripts/mutation.py                    # every guard module
+    python scripts/mutation.py                    # every module and encoding
     python scripts/mutation.py evaluator tokens   # some of them (names below, or --list)
+    python scripts/mutation.py rules-chain        # one ASP encoding (rules/chain.lp; see mutation_asp.py)
     python scripts/mutation.py --jobs 2 --work build/mutation
     python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
                                                   # (a whole run again if the module's test files changed)
@@ -16,6 +17,10 @@ survived, timeouts, equivalent, and each survivor at its ``file:line`` with the 
 A survivor that cannot change any behaviour (an equivalent mutant) is listed with the
 reason in ``scripts/mutation_equivalent.txt``; it is printed as such and does not count as
 a survivor. Exit 0 when no mutant survives, 1 otherwise, 2 when the run itself fails.
+
+The ASP encodings (``rules-NAME`` for ``rules/NAME.lp``) are changed by scripts/mutation_asp.py
+instead (delete a rule, drop a body literal, flip a comparison), and reported the same way, with
+the mutants clingo refuses counted apart. Their equivalents are listed under the encoding's file.
 
 Each module runs in its own work folder (``--work``, default ``build/mutation/NAME``) that
 holds a copy of the checkout, so the checkout is never changed. mutmut only changes code
@@ -37,8 +42,12 @@ import sys
 import time
 import tomllib
 from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
+
+import mutation_asp
+from mutation_asp import Target
 
 ROOT = Path(__file__).resolve().parents[1]
 EQUIVALENT_FILE = ROOT / "scripts" / "mutation_equivalent.txt"
@@ -89,6 +98,66 @@ GUARDS = (
           ("tests/executor/test_monitor.py", "tests/executor/test_outcome_names.py",
            "tests/executor/test_unanswered.py")),
 )
+
+_S = "src/plugnproduce/"
+CORE = (
+    Guard("codegen-flow", (_S + "codegen/flow.py",),
+          ("tests/codegen/test_loops_and_links.py", "tests/codegen/test_branch_charts.py",
+           "tests/codegen/test_nested_loop_charts.py")),
+    Guard("description-outcomes", (_S + "description/outcomes.py",),
+          ("tests/description/test_task_branches.py", "tests/validation/test_branch_findings.py",
+           "tests/codegen/test_branch_charts.py", "tests/codegen/test_loops_and_links.py"),
+          ("x_branch_of", "x_falling_under", "x_taken_by", "x__written", "x_flow_findings", "x_loop_ending",
+           "x_ending_loop", "x_body_outcomes", "x__ends_on")),
+    Guard("reasoning-plausibility", (_S + "reasoning/plausibility.py",),
+          ("tests/reasoning/test_plausibility.py", "tests/reasoning/test_branch_check.py",
+           "tests/reasoning/test_flow_check.py", "tests/reasoning/test_why.py")),
+    Guard("codegen-specific", (_S + "codegen/specific.py",),
+          ("tests/codegen/test_task_chart.py", "tests/codegen/test_closed_world.py")),
+    Guard("description-flow", (_S + "description/flow.py",),
+          ("tests/description/test_nested_loops.py", "tests/description/test_task_branches.py")),
+    Guard("reasoning-branches", (_S + "reasoning/branches.py",),
+          ("tests/reasoning/test_branch_check.py", "tests/reasoning/test_nested_loop_check.py")),
+    Guard("reasoning-dataflow", (_S + "reasoning/dataflow.py",),
+          ("tests/reasoning/test_flow_check.py", "tests/reasoning/test_plausibility.py")),
+    Guard("reasoning-feasibility", (_S + "reasoning/feasibility.py",), ("tests/reasoning/test_batch.py",)),
+    Guard("reasoning-purchases", (_S + "reasoning/purchases.py",), ("tests/reasoning/test_batch.py",)),
+    Guard("reasoning-windows", (_S + "reasoning/windows.py",), ("tests/reasoning/test_windows.py",)),
+    Guard("reasoning-lifting", (_S + "reasoning/lifting.py",), ("tests/reasoning/test_repair_lifting.py",)),
+    Guard("executor-links", (_S + "executor/links.py",),
+          ("tests/executor/test_run.py", "tests/executor/test_faults.py")),
+    Guard("executor-values", (_S + "executor/values.py",),
+          ("tests/executor/test_journal.py",)),
+    Guard("verification", tuple(_S + f"verification/{n}.py" for n in ("arguments", "results", "search", "trace",
+                                                                         "world")),
+          ("tests/verification/test_verify.py", "tests/verification/test_branch_verify.py",
+           "tests/verification/test_nested_verify.py")),
+)
+"""The core modules (the answers users rely on), each with the smallest set of test files that covers it."""
+
+_ENC, _CAP, _PLA, _WHY = ("tests/reasoning/test_encodings.py", "tests/reasoning/test_capabilities.py",
+                          "tests/reasoning/test_plausibility.py", "tests/reasoning/test_why.py")
+_REP, _WIN = "tests/reasoning/test_repair.py", "tests/reasoning/test_windows.py"
+ENCODINGS = tuple(Target(f"rules-{name}", f"rules/{name}.lp", tests) for name, tests in (
+    ("roles", (_ENC, _CAP, _PLA)),
+    ("offered", (_ENC, _CAP)),
+    ("bindings", (_ENC, _CAP)),
+    ("explain", (_ENC, _CAP, _WHY)),
+    ("resolve", (_ENC, _PLA, _WHY)),
+    ("chain", (_ENC, _PLA, _REP, _WHY)),
+    ("params", (_ENC, _PLA, _REP)),
+    ("provenance", (_ENC, _WHY)),
+    ("repair", (_ENC, _REP, "tests/reasoning/test_repair_lifting.py")),
+    ("window", (_ENC, _WIN)),
+    ("show_abilities", (_ENC, "tests/reasoning/test_batch.py")),
+    ("show_capabilities", (_CAP, _WHY)),
+    ("show_check", (_PLA, _WHY)),
+    ("show_derivation", (_WHY,)),
+    ("show_repair", (_REP,)),
+    ("show_window", (_WIN,)),
+))
+"""Each encoding with the reasoning tests that cover it, the fast table-driven ones first (``-x`` stops at the
+first failure)."""
 
 PLUGIN = "mutation_fresh_caches"
 PLUGIN_TEXT = '''"""Empties the caches of the guard modules before each test (mutation runs only)."""
@@ -255,6 +324,31 @@ def _survivor(key: str, file: str, work: Path, functions: dict[str, str]) -> Sur
     return Survivor(key, f"{file}:{line}", " ".join(before), " ".join(after))
 
 
+def _confirmed(guard: Guard, work: Path, jobs: int, codes: dict[str, int]) -> dict[str, int]:
+    """The codes with each survivor tested again against the whole of the module's test files.
+
+    mutmut runs a mutant only against the tests it saw call the function, and it does not see a call made while
+    a module- or session-scoped fixture is set up: a function only such a fixture reaches would survive untested.
+    """
+    survivors = [k for k, code in codes.items() if code in _SURVIVED]
+    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
+    command = [sys.executable, "-m", "pytest", "-x", "-q", "-n", "0", "-p", "no:cacheprovider", "-p", PLUGIN,
+               *guard.tests]
+
+    def run(key: str) -> int:
+        try:
+            done = subprocess.run(command, cwd=work / "mutants", env={**env, "MUTANT_UNDER_TEST": key},
+                                  capture_output=True, text=True, timeout=900)
+        except subprocess.TimeoutExpired:
+            return -24
+        return 1 if done.returncode in (1, 2, 3) else codes[key]
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        for key, code in zip(survivors, pool.map(run, survivors), strict=True):
+            codes[key] = code
+    return codes
+
+
 def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, str], str],
               again: bool = False) -> dict[str, int]:
     """Mutate one guard module (``again``: test only the last run's survivors), print its figures and survivors."""
@@ -267,7 +361,7 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
     else:
         _prepare(guard, work)
         _run_mutmut(guard, work, jobs)
-    codes = _results(guard, work)
+    codes = _confirmed(guard, work, jobs, _results(guard, work))
     functions = {f: _functions((work / "mutants" / f).read_text(encoding="utf-8")) for f in guard.files}
     counts: Counter[str] = Counter()
     lines: list[str] = []
@@ -296,33 +390,51 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
     return dict(counts)
 
 
+def run_encoding(target: Target, work: Path, jobs: int, known: dict[tuple[str, str, str], str],
+                 again: bool = False) -> dict[str, int]:
+    """Mutate one ASP encoding (``again``: test only the last run's survivors), print its figures and survivors."""
+    started = time.monotonic()
+    results = mutation_asp.run_target(target, ROOT, work, jobs, again)
+    counts = mutation_asp.report(target, results, known, time.monotonic() - started)
+    counts["seconds"] = round(time.monotonic() - started)
+    return dict(counts)
+
+
+def _list() -> None:
+    for g in (*GUARDS, *CORE):
+        print(f"{g.name}: {', '.join(g.files)}")
+        print(f"  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
+    for t in ENCODINGS:
+        print(f"{t.name}: {t.file}\n  tests: {', '.join(t.tests)}")
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the guard modules named (all by default) and print the figures; exit 1 if a mutant survived."""
+    """Run the modules and encodings named (all by default) and print the figures; exit 1 if a mutant survived."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0] if __doc__ else None)
-    parser.add_argument("modules", nargs="*", help="guard modules to run (default: all; see --list)")
-    parser.add_argument("--list", action="store_true", help="list the guard modules with their files and tests")
+    parser.add_argument("modules", nargs="*", help="modules and encodings to run (default: all; see --list)")
+    parser.add_argument("--list", action="store_true", help="list the modules and encodings with their files and tests")
     parser.add_argument("--jobs", type=int, default=2, help="mutants tested at once (default 2)")
     parser.add_argument("--again", action="store_true",
                         help="test only the survivors of the last run again, with the tests as they are now")
     parser.add_argument("--work", type=Path, default=ROOT / "build" / "mutation",
                         help="folder for the per-module copies (default build/mutation)")
     args = parser.parse_args(argv)
-    by_name = {g.name: g for g in GUARDS}
+    by_name: dict[str, Guard | Target] = {g.name: g for g in (*GUARDS, *CORE, *ENCODINGS)}
     if args.list:
-        for g in GUARDS:
-            print(f"{g.name}: {', '.join(g.files)}")
-            print(f"  functions: {', '.join(g.functions)}\n  tests: {', '.join(g.tests)}")
+        _list()
         return 0
     unknown = [m for m in args.modules if m not in by_name]
     if unknown:
-        print(f"scripts/mutation.py: unknown guard module {unknown[0]!r}; expected one of {', '.join(by_name)}",
+        print(f"scripts/mutation.py: unknown module {unknown[0]!r}; expected one of {', '.join(by_name)}",
               file=sys.stderr)
         return 2
     known = equivalents()
     total: Counter[str] = Counter()
     try:
         for name in args.modules or list(by_name):
-            total.update(run_guard(by_name[name], args.work.resolve() / name, args.jobs, known, args.again))
+            unit = by_name[name]
+            run = run_guard if isinstance(unit, Guard) else run_encoding
+            total.update(run(unit, args.work.resolve() / name, args.jobs, known, args.again))  # type: ignore[arg-type]
     except RuntimeError as exc:
         print(f"scripts/mutation.py: {exc}", file=sys.stderr)
         return 2

@@ -5,6 +5,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import pytest
 from statemachine.io.scxml.processor import SCXMLProcessor
 
 from plugnproduce import service
@@ -14,7 +15,8 @@ from plugnproduce.description.loader import load_device, parse_task
 from plugnproduce.description.model import Cell, ProcessDescription
 from plugnproduce.resources import descriptions_path
 from plugnproduce.statechart import parse_chart, schema_problems
-from plugnproduce.statechart.model import Assign, Param, walk
+from plugnproduce.statechart.model import Assign, Param, Transition, walk
+from plugnproduce.statechart.runtime.evaluator import Evaluator
 from tests.codegen.conftest import bind_by_skill
 from tests.conftest import edit
 
@@ -69,3 +71,33 @@ def test_the_loop_ends_on_the_outcome_the_device_reports(tmp_path: Path, bin_pic
     generated = generate_task(task, empty, bind_by_skill(task, empty, processes), processes,
                               service.knowledge().taxonomy)
     assert run(closed_world_chart(generated, empty)) == {"done"}
+
+
+def rule_taken(chart: bytes, datamodel: dict[str, object]) -> list[tuple[str, str]]:
+    """What the first loop or branch rule of the task chart's step picker that holds in ``datamodel`` assigns,
+    its condition evaluated as the chart's interpreter does ([] when none holds)."""
+    evaluator = Evaluator()
+    for t in walk(parse_chart(chart, "task.scxml")):
+        if isinstance(t, Transition) and any(v in (t.cond or "") for v in ("pnp_outcome", "pnp_rounds_", "pnp_branch_")):
+            if evaluator.expr(t.cond or "").evaluate({"__builtins__": evaluator.builtins(), **datamodel}):
+                return [(a.location, a.expr) for a in t.actions if isinstance(a, Assign)]
+    return []
+
+
+@pytest.mark.parametrize("until", ["BinEmpty", "NoPartFound"])
+def test_an_outcome_under_the_loops_until_ends_it(until: str, bin_picking_cell, processes) -> None:
+    # BinEmpty ⊑ NoPartFound; the body is localize, pick, place (positions 3-5 in its later iterations' copy)
+    chart = chart_of(UNTIL_EMPTY.replace("until: BinEmpty", f"until: {until}"), bin_picking_cell, processes)
+    localized = {"pnp_step": 4, "pnp_rounds_1": 1}
+    assert rule_taken(chart, {**localized, "pnp_outcome": "BinEmpty"}) == [
+        ("pnp_step", "6"), ("pnp_outcome", "None"), ("pnp_rounds_1", "-1")]
+    assert rule_taken(chart, {**localized, "pnp_outcome": "PartFound"}) == []
+
+
+def test_a_loop_goes_on_while_an_outcome_under_its_while_is_reported(bin_picking_cell, processes) -> None:
+    # scan again while no part is found (BinEmpty ⊑ NoPartFound); the body's later iterations' copy is 3-5
+    chart = chart_of(UNTIL_EMPTY.replace("until: BinEmpty", "while: NoPartFound"), bin_picking_cell, processes)
+    iterated = {"pnp_step": 6, "pnp_rounds_1": 1}
+    assert rule_taken(chart, {**iterated, "pnp_outcome": "BinEmpty"}) == [
+        ("pnp_rounds_1", "pnp_rounds_1 + 1"), ("pnp_step", "3")]
+    assert rule_taken(chart, {**iterated, "pnp_outcome": "PartFound"}) == [("pnp_outcome", "None"), ("pnp_rounds_1", "-1")]

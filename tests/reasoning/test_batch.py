@@ -308,3 +308,18 @@ def test_the_report_text_is_each_row_as_json() -> None:
     configs = list(generate(service.catalogue(), 400, (0, 7), seed=8))
     text = "".join(service.batch_report(configs, None, tasks(), workers=1, top=2))
     assert text == "".join(json.dumps(r.to_json()) + "\n" for r in rows(configs, top=2))
+
+
+
+@pytest.mark.parametrize("speed, kind", [("0.5", "too_low"), ("101", "too_high")])
+def test_a_value_outside_the_process_range_is_implausible_in_the_batch_as_in_check(tmp_path: Path, speed: str,
+                                                                                    kind: str) -> None:
+    the_task = service.task(write(
+        tmp_path, "pick-and-place.yaml",
+        "task: pick-and-place\nsteps:\n  - command: pick-and-place\n    params:\n"
+        "      pick_pose: [0.35, 0.15, 0.04, 0, 180, 0]\n      place_pose: [0.45, -0.25, 0.08, 0, 180, 0]\n"
+        f"      retract_pose: [0.30, 0.00, 0.30, 0, 180, 0]\n      grip_force: 30\n      speed: {speed}\n"))
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    checked = service.check(the_task, service.cell(DESCRIPTIONS / "cells" / "bin-picking.yaml"))
+    assert [p.kind for p in checked.problems] == [kind]
+    assert row.plausible == () and not checked.plausible

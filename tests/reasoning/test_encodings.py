@@ -88,6 +88,11 @@ OFFERED_CASES = {
         ["binding/3"],
         {'binding("c","pick",("g",("g",nil)))', 'binding("c","move",("g",nil))', 'binding("c","close",("g",nil))',
          'binding("c","open",("g",nil))'}),
+    "a device with the states a region visits but not the skill plays no role": (
+        WORLD + SECOND_GRIPPER.replace('has_skill("h","Release").', "") + cell("h"), ["can_play/3", "offered/2"],
+        {'can_play("close","gripper","g")', 'can_play("open","gripper","g")', 'can_play("pick","gripper","g")',
+         'can_play("close","gripper","h")', 'can_play("pick","gripper","h")',
+         'can_play("pick","robot","r")', 'can_play("move","robot","r")', 'offered("c","close")'}),
     "every valid binding, not just one": (
         WORLD + SECOND_GRIPPER + cell("g", "h", "r"), ["binding/3"],
         {'binding("c","pick",("r",("g",nil)))', 'binding("c","pick",("r",("h",nil)))',
@@ -247,6 +252,25 @@ REPAIR_CASES = {
         repair_case(("close", "close"), ("g", "h"), 'bind("t",1,"gripper","g"). bind("t",2,"gripper","g"). '
                     'default_refused("open","width","g"). param_role("open","width","gripper").'),
         [{'edit(rebind(2,"gripper","h"))'}, {'edit(rebind(1,"gripper","h"))'}]),
+    "a step of an unknown command is removed": (
+        repair_case(("close", "fly", "open"), ("g",)), [{"edit(remove(2))"}]),
+    "a binding of an unknown role is dropped": (
+        repair_case(("close",), ("g",), 'bind("t",1,"hand","g").'), [{'edit(unbind(1,"hand"))'}]),
+    "dropping a binding is priced: removing its step can be cheaper": (
+        repair_case(("close",), ("g",), 'bind("t",1,"hand","g").', COSTS.replace('"rebind","",200', '"rebind","",900')),
+        [{"edit(remove(1))"}]),
+    "resetting a value is priced: removing its step can be cheaper": (
+        repair_case(("close",), ("g",), 'given("t",1,"force"). value_kind("t",1,"force","string").',
+                    COSTS.replace('"reset","",100', '"reset","",900')), [{"edit(remove(1))"}]),
+    "naming one of two fitting devices is priced: removing the step can be cheaper": (
+        repair_case(("close",), ("g", "h"), costs=COSTS.replace('"rebind","",200', '"rebind","",900')),
+        [{"edit(remove(1))"}]),
+    "at most max_inserts commands are inserted": (
+        repair_case(("close", "close"), ("g",), "max_inserts(1)."), [{'edit(insert(2,1,"open"))'}]),
+    "beyond max_inserts, steps are removed instead": (
+        repair_case(("close", "close", "close"), ("g",), "max_inserts(1)."),
+        [{'edit(insert(3,1,"open"))', "edit(remove(1))"}, {'edit(insert(2,1,"open"))', "edit(remove(3))"},
+         {'edit(insert(3,1,"open"))', "edit(remove(2))"}, {'edit(insert(2,1,"open"))', "edit(remove(2))"}]),
 }
 
 
@@ -290,3 +314,151 @@ def test_abilities_are_of_each_device_alone_and_bad_values_of_the_task_alone() -
 def test_every_encoding_file_belongs_to_a_program_and_every_program_names_files_that_exist() -> None:
     named = {name for program in solver.PROGRAMS for name in solver.rules(program)}
     assert named == {f.name for f in rules_path().glob("*.lp")}
+
+
+HANDOVER = """
+process("handover"). role("handover","holder"). role("handover","robot"). role("handover","gripper").
+nroles("handover",3). role_order("handover",1,"holder"). role_order("handover",2,"robot").
+role_order("handover",3,"gripper").
+requires("handover","holder","Grip"). requires("handover","robot","Move"). requires("handover","gripper","Release").
+region_state("handover","holder",1,"Open"). region_state("handover","holder",2,"Closed").
+region_state("handover","robot",1,"Idle"). region_state("handover","robot",2,"Moving").
+region_state("handover","robot",3,"AtPose").
+region_state("handover","gripper",1,"Closed"). region_state("handover","gripper",2,"Open").
+leaves("handover","holder",D,"o","c") :- device(D), state_is(D,"o","Open").
+leaves("handover","gripper",D,"c","o") :- device(D), state_is(D,"c","Closed").
+leaves("handover","robot","r","h","h").
+"""
+
+
+def test_a_device_in_the_first_and_last_of_three_roles_keeps_one_state_through_the_step() -> None:
+    # the gripper holds (o -> c) while the robot moves, then releases (c -> o): it plays role 1 and role 3,
+    # and between them it waits in c while role 2 (not its own) runs; other processes order "gripper" first
+    (model,) = answer_sets(CHECK, WORLD + HANDOVER + cell("g", "r") + task("handover", "close"), PROBLEMS + ["at/5"])
+    assert model == {'at("c","t",1,"g","o")', 'at("c","t",2,"g","o")', 'at("c","t",3,"g","c")',
+                     'at("c","t",1,"r","h")', 'at("c","t",2,"r","h")', 'at("c","t",3,"r","h")', 'plausible("c","t")'}
+
+
+WIDE = """
+device("k"). has_skill("k","Grip"). initial("k","w").
+chart_state("k","o"). chart_state("k","c"). chart_state("k","w"). chart_state("k","x").
+state_is("k","o","Open"). state_is("k","c","Closed"). state_is("k","w","Open"). state_is("k","x","Closed").
+edge("k","o","c"). edge("k","c","o"). edge("k","w","x"). edge("k","x","w").
+leaves("close","gripper","k","w","x").
+"""
+
+
+def test_a_role_leaves_the_device_where_its_own_start_leads_not_where_another_start_would() -> None:
+    # "k" opens narrow (o) or wide (w) and closes from each to its own closed state (c, x); it starts wide
+    (model,) = answer_sets(CHECK, WORLD + WIDE + cell("k") + task("close"), PROBLEMS + ["at/5"])
+    assert model == {'at("c","t",1,"k","w")', 'at("c","t",2,"k","x")', 'plausible("c","t")'}
+
+
+SQUEEZE = """
+process("squeeze"). role("squeeze","gripper"). nroles("squeeze",1). role_order("squeeze",1,"gripper").
+requires("squeeze","gripper","Grip").
+region_state("squeeze","gripper",1,"Open"). region_state("squeeze","gripper",2,"Closed").
+param("squeeze","force","integer"). param_min("squeeze","force",50000). param_max("squeeze","force",60000).
+param("squeeze","speed","decimal"). param("squeeze","label","decimal").
+"""
+
+
+def value(kind: str, name: str, number: int | None = None, step: int = 1) -> str:
+    """A value the task gives step ``step`` for parameter ``name``, of ``kind`` (and its number in thousandths)."""
+    num = f'value_num("t",{step},"{name}",{number}).' if number is not None else ""
+    return f'given("t",{step},"{name}"). value_kind("t",{step},"{name}","{kind}"). {num}'
+
+
+# Two processes declare a parameter of one name with other types and ranges: each step is checked against
+# its own process only. A value of the wrong type is that finding alone, not also one of range.
+PARAMETER_CASES = {
+    "within close's range, below squeeze's": (task("close") + value("integer", "force", 40000), {'plausible("c","t")'}),
+    "within close's range, above squeeze's": (task("close") + value("integer", "force", 100000), {'plausible("c","t")'}),
+    "a decimal for move's integer speed, though squeeze's speed is a decimal": (
+        task("move") + value("decimal", "speed", 2500), {'bad_type("t",1,"speed","integer")'}),
+    "an integer for close's text label, though squeeze's label is a decimal": (
+        task("close") + 'param("close","label","string").' + value("integer", "label", 3000),
+        {'bad_type("t",1,"label","string")'}),
+    "a decimal below move's minimum speed is a wrong type only": (
+        task("move") + 'param_min("move","speed",1000).' + value("decimal", "speed", 500),
+        {'bad_type("t",1,"speed","integer")'}),
+    "a decimal above move's maximum speed is a wrong type only": (
+        task("move") + 'param_max("move","speed",100000).' + value("decimal", "speed", 900000),
+        {'bad_type("t",1,"speed","integer")'}),
+}
+
+
+@pytest.mark.parametrize("facts, expected", PARAMETER_CASES.values(), ids=PARAMETER_CASES.keys())
+def test_parameters_are_checked_against_the_steps_own_process(facts: str, expected: set[str]) -> None:
+    assert answer_sets(CHECK, WORLD + SQUEEZE + cell("g", "r") + facts, PROBLEMS) == [expected]
+
+
+GRIP_ONLY = SECOND_GRIPPER.replace('has_skill("h","Release").', "")
+"""A second gripper, ``h``, that can close but not open (no Release skill)."""
+
+# What a step's bindings are when the task names devices: the check lists a device bound to a role only when
+# the cell has it and it can play that role of the step's own process; each wrong binding is one finding.
+BINDING_CASES = {
+    "a device not in the cell is not bound": (
+        WORLD + cell("r") + task("close", binds='bind("t",1,"gripper","g").'),
+        {'absent("c","t",1,"gripper","g")', 'at("c","t",1,"r","h")', 'at("c","t",2,"r","h")'}),
+    "a device not in the cell that could not play the role either is only absent": (
+        WORLD + cell("g") + task("close", binds='bind("t",1,"gripper","r").'),
+        {'absent("c","t",1,"gripper","r")', 'at("c","t",1,"g","o")', 'at("c","t",2,"g","o")'}),
+    "a device bound to its role in another process only is not bound here": (
+        WORLD + GRIP_ONLY + cell("h") + task("open", binds='bind("t",1,"gripper","h").'),
+        {'cannot_play("c","t",1,"gripper","h")', 'at("c","t",1,"h","o")', 'at("c","t",2,"h","o")'}),
+    "a device that plays the step's role is bound, whatever other processes it cannot play": (
+        WORLD + GRIP_ONLY + cell("h") + task("close", binds='bind("t",1,"gripper","h").'),
+        {'bound("c","t",1,"gripper","h")', 'at("c","t",1,"h","o")', 'at("c","t",2,"h","c")', 'plausible("c","t")'}),
+    "a binding of an unknown role to a device not in the cell is an unknown role only": (
+        WORLD + cell("g") + task("close", binds='bind("t",1,"hand","z").'),
+        {'unknown_role("c","t",1,"hand")', 'bound("c","t",1,"gripper","g")', 'at("c","t",1,"g","o")',
+         'at("c","t",2,"g","c")'}),
+    "a binding in a step of an unknown command is an unknown command only": (
+        WORLD + cell("g") + task("fly", binds='bind("t",1,"hand","g").'),
+        {'unknown_command("c","t",1,"fly")', 'at("c","t",1,"g","o")', 'at("c","t",2,"g","o")'}),
+}
+
+
+@pytest.mark.parametrize("facts, expected", BINDING_CASES.values(), ids=BINDING_CASES.keys())
+def test_bindings_the_task_names(facts: str, expected: set[str]) -> None:
+    assert answer_sets(CHECK, facts, PROBLEMS + ["bound/5", "at/5"]) == [expected]
+
+
+def _gripper(name: str) -> str:
+    return GRIPPER.replace('"g"', f'"{name}"')
+
+
+NO_CLOSED = (_gripper("h").replace('chart_state("h","c"). ', "").replace('state_is("h","c","Closed").', "")
+             .replace('edge("h","o","c"). edge("h","c","o").', ""))
+"""A gripper ``h`` without a closed state."""
+ONE_WAY = _gripper("u").replace('edge("u","o","c").', "")
+"""A gripper ``u`` that can open but not close."""
+NO_FORCE = _gripper("a") + 'missing_arg("close","gripper","a","grip","force").'
+"""A gripper ``a`` whose grip request needs a force that close does not supply."""
+REASONS = ["no_skill/4", "lacks_state/6", "unreachable/7", "no_argument/6"]
+
+# Why a process is not offered: each reason is about a role no device of the cell fills, and names only devices of
+# the cell that walk as far as the reason says.
+REASON_CASES = {
+    "no reasons for roles another device of the cell fills": (
+        WORLD + NO_CLOSED + ONE_WAY + NO_FORCE + cell("g", "h", "u", "a", "r"), set()),
+    "reasons name only devices of the cell": (
+        WORLD + NO_CLOSED + ONE_WAY + NO_FORCE + cell("r"),
+        {'no_skill("c","pick","gripper","Grip")', 'no_skill("c","close","gripper","Grip")',
+         'no_skill("c","open","gripper","Release")'}),
+    "a request's missing argument is a reason only for a device that walks the region": (
+        WORLD + NO_CLOSED + 'missing_arg("close","gripper","h","grip","force").' + cell("h", "r"),
+        {'lacks_state("c","pick","gripper","h",2,"Closed")', 'lacks_state("c","close","gripper","h",2,"Closed")',
+         'lacks_state("c","open","gripper","h",1,"Closed")'}),
+    "each reason for its own device, for the one process no device fills (a plays pick and open)": (
+        WORLD + NO_CLOSED + ONE_WAY + NO_FORCE + cell("h", "u", "a", "r"),
+        {'lacks_state("c","close","gripper","h",2,"Closed")', 'unreachable("c","close","gripper","u",1,"o","Closed")',
+         'no_argument("c","close","gripper","a","grip","force")'}),
+}
+
+
+@pytest.mark.parametrize("facts, expected", REASON_CASES.values(), ids=REASON_CASES.keys())
+def test_reasons_a_process_is_not_offered(facts: str, expected: set[str]) -> None:
+    assert answer_sets(OFFERED, facts, REASONS) == [expected]

@@ -92,3 +92,31 @@ def test_explain_step_gives_every_device_its_state_and_need(cell: Cell) -> None:
 def test_explain_step_of_a_plausible_step(cell: Cell) -> None:
     ex = service.explain_step(task("bin-picking"), cell, 3)
     assert ex.plausible and len(ex.states) == 4
+
+
+def test_each_wrong_binding_the_task_names_is_one_problem_of_its_kind(cell: Cell) -> None:
+    t = task("pick-and-place")
+    for bind, kind, role, device in (({"gripper": "cobot"}, "absent", "gripper", "cobot"),
+                                     ({"gripper": "robot"}, "cannot_play", "gripper", "robot"),
+                                     ({"hand": "gripper"}, "unknown_role", "hand", None)):
+        bad = replace(t, steps=(replace(t.steps[0], bind=bind), t.steps[1]))
+        (p,) = service.check(bad, cell).problems
+        assert (p.step, p.kind, p.role, p.device) == (1, kind, role, device)
+        assert f"role '{role}'" in p.text
+
+
+def test_a_role_no_device_of_the_cell_can_play_says_why_each_candidate_cannot(cell: Cell, device) -> None:
+    t = task("pick-and-place")
+    (p,) = service.check(t, cell.without("gripper")).problems
+    assert (p.step, p.kind, p.role) == (1, "no_device", "gripper")
+    (p,) = service.check(t, cell.without("gripper").with_device(device("vacuum-gripper"))).problems
+    assert (p.step, p.kind, p.role) == (1, "no_device", "gripper")
+    assert "its request SuctionOn needs the argument vacuum (pnp:Vacuum)" in p.text
+
+
+def test_a_value_below_the_process_minimum(cell: Cell) -> None:
+    t = task("pick-and-place")
+    bad = replace(t, steps=(replace(t.steps[0], params={**t.steps[0].params, "grip_force": 5}), t.steps[1]))
+    (p,) = service.check(bad, cell).problems
+    assert (p.step, p.kind, p.parameter) == (1, "too_low", "grip_force")
+    assert "grip_force = 5 N is below its minimum 10 N" in p.text

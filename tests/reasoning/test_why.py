@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from plugnproduce import service
-from plugnproduce.description.model import Cell, Where
+from plugnproduce.description.model import Cell, DeviceDescription, Where
 from plugnproduce.reasoning import Node
 from tests.reasoning.conftest import TASKS
 
@@ -121,3 +121,29 @@ def test_a_reason_in_plain_words_drops_the_terms(cell: Cell) -> None:
     (problem,) = service.check(INVALID, cell).problems
     assert "(pnp:Closed)" in problem.reason.text and "pnp:" not in problem.reason.plain
     assert "is in state 'closed' [closed], left there by step 1 (bin-pick)" in problem.reason.plain
+
+
+def test_a_process_no_device_has_the_skill_for_is_derived_from_the_missing_skill(cell: Cell) -> None:
+    tree = service.explain_offered(cell, "screw").derivation
+    (rule,) = [n for n in nodes(tree, "asp") if n.detail.startswith("no_skill(")]
+    assert '"screwdriver"' in rule.detail and "CanScrew" in rule.detail
+    assert line_at(rule.where).startswith("no_skill(")
+
+
+def test_a_gripper_lacking_a_state_is_derived_from_the_missing_state(cell: Cell, device) -> None:
+    gripper = device("gripper")
+    broken = DeviceDescription(**{**gripper.__dict__, "states": tuple(s for s in gripper.states if s.id != "closed")})
+    tree = service.explain_offered(cell.without("gripper").with_device(broken), "pick").derivation
+    (rule,) = [n for n in nodes(tree, "asp") if n.detail.startswith("lacks_state(")]
+    assert '"gripper",2,' in rule.detail and "Closed" in rule.detail
+    assert line_at(rule.where).startswith("lacks_state(")
+
+
+def test_a_gripper_that_cannot_close_is_derived_from_the_unreachable_state(cell: Cell, device) -> None:
+    gripper = device("gripper")
+    one_way = DeviceDescription(**{**gripper.__dict__, "transitions": tuple(
+        t for t in gripper.transitions if t.target not in ("closing", "closed"))})
+    tree = service.explain_offered(cell.without("gripper").with_device(one_way), "pick").derivation
+    (rule,) = [n for n in nodes(tree, "asp") if n.detail.startswith("unreachable(")]
+    assert '"gripper",1,"open",' in rule.detail and "Closed" in rule.detail
+    assert line_at(rule.where).startswith("unreachable(")

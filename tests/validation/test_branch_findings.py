@@ -82,3 +82,57 @@ def test_a_loop_that_goes_on_on_every_outcome_has_no_exit(tmp_path: Path) -> Non
     messages = [(p.line, p.message) for p in validate_paths([path]).problems]
     assert (4, "loop while Outcome has no exit: every outcome its steps can end with (BinEmpty, PartFound) lets "
                "it go on, and it has no max") in messages
+
+
+NESTED = """task: t
+steps:
+  - loop:
+      until: BinEmpty
+      max: 3
+      steps:
+        - loop:
+            until: BinEmpty
+            max: 3
+            steps:
+              - command: localize-part
+        - command: scan-bin
+"""
+INNER_ENDS_FIRST = ("loop until BinEmpty: every step of its body that can end with that outcome lies in an inner loop "
+                    "that ends on it first, so the loop never ends on it")
+
+
+@pytest.mark.parametrize(("text", "found"), [
+    (NESTED, [(4, INNER_ENDS_FIRST)]),
+    # the outer loop's own first step can end it, at the start of the task or after another step
+    (NESTED.replace("        - loop:\n", "        - command: localize-part\n        - loop:\n", 1), []),
+    (NESTED.replace("steps:\n  - loop:", "steps:\n  - command: scan-bin\n  - loop:", 1)
+     .replace("        - loop:\n", "        - command: localize-part\n        - loop:\n", 1), []),
+], ids=["only-inner", "own-first-step", "own-first-step-after-another"])
+def test_an_outcome_only_an_inner_loop_ends_on_never_ends_the_outer_loop(tmp_path: Path, text: str,
+                                                                          found: list[tuple[int, str]]) -> None:
+    path = tmp_path / "t.yaml"
+    path.write_text(text, encoding="utf-8")
+    assert [(p.line, p.message) for p in validate_paths([path]).problems if p.message.startswith("loop")] == found
+
+
+def test_a_finding_inside_a_loop_is_reported_once_not_again_for_its_later_iterations(
+        report: tuple[Path, Report]) -> None:
+    path, found = report
+    assert [p.line for p in found.problems].count(21) == 1
+
+
+def test_a_step_after_the_loop_is_not_part_of_its_body(tmp_path: Path) -> None:
+    path = tmp_path / "t.yaml"
+    path.write_text("task: t\nsteps:\n  - loop:\n      until: BinEmpty\n      max: 3\n      steps:\n"
+                    "        - command: scan-bin\n  - command: localize-part\n", encoding="utf-8")
+    assert [(p.line, p.message) for p in validate_paths([path]).problems] == [
+        (4, "loop until BinEmpty: no step of its body can end with that outcome, so the loop never ends on it; "
+            "its steps' outcomes: none")]
+
+
+def test_a_branch_on_an_outcome_the_loop_does_not_end_on_is_no_finding(tmp_path: Path) -> None:
+    path = tmp_path / "t.yaml"
+    path.write_text("task: t\nsteps:\n  - loop:\n      until: BinEmpty\n      max: 3\n      steps:\n"
+                    "        - command: localize-part\n          on:\n            PartFound: [{command: scan-bin}]\n",
+                    encoding="utf-8")
+    assert [(p.line, p.message) for p in validate_paths([path]).problems] == []

@@ -1,0 +1,71 @@
+"""The ASP mutator of ``scripts/mutation_asp.py``: the changes it makes to an encoding, and where it says they are."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+from plugnproduce.resources import rules_path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def asp():
+    spec = importlib.util.spec_from_file_location("mutation_asp", ROOT / "scripts" / "mutation_asp.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["mutation_asp"] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+PARAMS = (rules_path() / "params.lp").read_text(encoding="utf-8")
+TOO_LOW = "too_low(T,I,N,V,M) :- step(T,I,P), fits_type(T,I,N), param_min(P,N,M), value_num(T,I,N,V), V < M."
+
+
+def test_statements_are_found_at_their_lines_past_comments_and_strings(asp):
+    found = {s.line: " ".join(s.text.split()) for s in asp.statements(PARAMS)}
+    assert found[11] == TOO_LOW
+    assert found[8] == 'fits_type(T,I,N) :- step(T,I,P), param(P,N,"decimal"), value_kind(T,I,N,"integer").'
+    assert not any("thousandths" in text for text in found.values())  # '0.001' in a comment ends nothing
+    assert len(found) == 10
+
+
+def test_each_statement_is_deleted_each_literal_dropped_and_each_comparison_flipped(asp):
+    changed = {(m.kind, m.after) for m, _ in asp.mutants("rules/params.lp", PARAMS) if m.before == TOO_LOW}
+    assert ("delete rule", "(deleted)") in changed
+    assert ("flip comparison", TOO_LOW.replace("V < M", "V <= M")) in changed
+    assert ("drop literal", TOO_LOW.replace(" fits_type(T,I,N),", "")) in changed
+    assert ("drop literal", TOO_LOW.replace(", V < M", "")) in changed
+    assert len(changed) == 1 + 5 + 1
+
+
+def test_comparisons_flip_both_ways(asp):
+    rule = asp.Statement(1, 0, 0, "a(X) :- b(X,Y), X <= Y, X != Y, Y >= 2, #count{ Z : c(Z) } = 3.")
+    flipped = {after for kind, after in asp.changes(rule) if kind == "flip comparison"}
+    assert flipped == {
+        "a(X) :- b(X,Y), X < Y, X != Y, Y >= 2, #count{ Z : c(Z) } = 3.",
+        "a(X) :- b(X,Y), X <= Y, X = Y, Y >= 2, #count{ Z : c(Z) } = 3.",
+        "a(X) :- b(X,Y), X <= Y, X != Y, Y > 2, #count{ Z : c(Z) } = 3.",
+        "a(X) :- b(X,Y), X <= Y, X != Y, Y >= 2, #count{ Z : c(Z) } != 3.",
+    }
+
+
+def test_a_mutant_keeps_every_other_rule_at_its_line(asp):
+    chain = (rules_path() / "chain.lp").read_text(encoding="utf-8")
+    lines = [(s.line, " ".join(s.text.split())) for s in asp.statements(chain)]
+    for mutant, text in asp.mutants("rules/chain.lp", chain):
+        kept = [(s.line, " ".join(s.text.split())) for s in asp.statements(text)]
+        assert [entry for entry in lines if entry[0] != mutant.line] == [k for k in kept if k[0] != mutant.line]
+        assert mutant.where == f"rules/chain.lp:{mutant.line}"
+
+
+def test_clingo_refuses_a_mutant_that_leaves_a_variable_unsafe(asp):
+    by_change = {m.after: text for m, text in asp.mutants("rules/params.lp", PARAMS) if m.before == TOO_LOW}
+    assert asp.refused(by_change[TOO_LOW.replace(" value_num(T,I,N,V),", "")])  # V is bound nowhere else
+    assert not asp.refused(by_change[TOO_LOW.replace("V < M", "V <= M")])
+    assert not asp.refused(PARAMS)
