@@ -15,20 +15,15 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
+from plugnproduce.description.contracts import KINDS
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
 from plugnproduce.description.paths import NoPath, find_path
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP_IRI
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.terms import Atom, program
 
-XSD = "http://www.w3.org/2001/XMLSchema#"
-DATATYPES = {
-    XSD + "decimal": "decimal", XSD + "double": "decimal", XSD + "float": "decimal",
-    XSD + "integer": "integer", XSD + "int": "integer", XSD + "long": "integer",
-    XSD + "boolean": "boolean", XSD + "string": "string", PNP_IRI + "Pose": "pose",
-}
-"""Declared parameter datatypes → the short names the encodings compare."""
+DATATYPES = KINDS
+"""Declared parameter datatypes → the short names the encodings compare (the contracts' kinds of value)."""
 
 SCALE = 1000
 """Numbers reach ASP as whole thousandths."""
