@@ -18,7 +18,6 @@ from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, TypedDict
 
-from plugnproduce import reasoning
 from plugnproduce.description.loader import (
     cell_libraries,
     load_cell,
@@ -30,9 +29,11 @@ from plugnproduce.description.loader import (
 from plugnproduce.description.model import Cell, DeviceDescription, Link, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
+from plugnproduce.lazy import lazy_module
 from plugnproduce.resources import descriptions_path
 
 if TYPE_CHECKING:  # validation, code generation and execution are imported by the use cases that need them
+    from plugnproduce import reasoning
     from plugnproduce.codegen import GeneratedTask
     from plugnproduce.codegen.outputs import GeneratedChart
     from plugnproduce.description.goalfile import Goal
@@ -46,6 +47,8 @@ if TYPE_CHECKING:  # validation, code generation and execution are imported by t
     from plugnproduce.reasoning.impact import Impact
     from plugnproduce.validation import Report
     from plugnproduce.verification import Budget, Verification
+else:
+    reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
 
 
 @lru_cache(maxsize=8)
