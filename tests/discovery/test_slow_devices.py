@@ -120,3 +120,22 @@ def test_discover_lists_the_honest_devices_and_every_refused_one_with_its_url_an
     for device in hostile:
         line = next(x for x in as_text.stdout.splitlines() if x.startswith(f"refused {device.udn} "))
         assert line.startswith(f"refused {device.udn} at {device.location}: ")
+
+
+async def test_the_refused_devices_kept_are_the_latest_hundred_whatever_is_announced(taxonomy) -> None:
+    from plugnproduce.discovery.live import MAX_REFUSED
+    from tests.discovery.test_live_cell import squatter_alive
+
+    network = SsdpNetwork(port=free_udp_port())
+    nobody = f"http://127.0.0.1:{free_udp_port()}/description.xml"  # refused at once: nothing listens there
+    async with LiveCell(taxonomy, network=network, search_timeout=0.1) as live:
+        udns = [f"uuid:flood-{i}" for i in range(MAX_REFUSED + 50)]
+        for udn in udns:
+            squatter_alive(network, udn, nobody)
+        seen = set()
+        async with asyncio.timeout(WAIT):
+            while len(seen) < len(udns):
+                change = await live.next_change()
+                seen.add(change.device)
+        assert len(live.refused) == MAX_REFUSED
+        assert all(r.location == nobody for r in live.refused.values())

@@ -62,3 +62,11 @@ def test_issue_24_only_ascii_digits_make_a_number(tmp_path: Path, value: str) ->
 def test_milli_takes_only_finite_ascii_numbers_and_clamps_without_building_huge_integers(
         value: object, expected: int | None) -> None:
     assert milli(value) == expected
+
+
+def test_validate_tells_of_a_quantity_beyond_any_number_as_no_number(tmp_path: Path) -> None:
+    # it said "is Infinity N; expected a value from 10 to 140 N"
+    task = _pick(tmp_path, "'1e308 kN'")
+    result = CliRunner().invoke(app, ["validate", str(task)])
+    assert result.exit_code == 1
+    assert result.stdout.splitlines() == [f"{task}:4: step 1: parameter 'grip_force' takes a number; found 1e308 kN"]

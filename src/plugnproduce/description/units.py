@@ -100,14 +100,15 @@ def convert(number: float, unit: str, to: str) -> float:
 
 def number_in(value: str, unit: str) -> float | None:
     """A quantity written as text (``"0.12 kN"``) as a number in ``unit``; None if it is none, is not
-    finite, or cannot be converted (the check says which)."""
+    finite (as written or in ``unit``), or cannot be converted (the check says which)."""
     amount = read_amount(value)
     if amount is None or not math.isfinite(amount.number) or (amount.unit and not unit):
         return None
     try:
-        return convert(amount.number, amount.unit, unit)
+        number = convert(amount.number, amount.unit, unit)
     except UnitError:
         return None
+    return number if math.isfinite(number) else None  # 1e308 kN is no number in N
 
 
 def _spelling(unit: str) -> str:

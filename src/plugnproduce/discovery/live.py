@@ -64,6 +64,9 @@ on disk (a device's chart is only the chart it serves)."""
 CONFIRM_TIMEOUT = 1.0
 """Seconds a device's address is given to answer before its byebye is believed."""
 
+MAX_REFUSED = 100
+"""Refused devices kept for :attr:`LiveCell.refused` (the latest)."""
+
 DEVICE_BUDGET = 15.0
 """Seconds reading one discovered device (its UPnP description, Turtle description and chart) may take in all."""
 
@@ -219,7 +222,10 @@ class LiveCell:
         if change.reason:  # one line, whatever a device made the reason of
             change = replace(change, reason=" ".join(change.reason.split())[:500])
         if change.kind == "refused":
+            self.refused.pop(change.device, None)  # the latest refusal last
             self.refused[change.device] = RefusedDevice(change.device, change.location, change.reason)
+            while len(self.refused) > MAX_REFUSED:  # any number of UDNs may be announced: the oldest go
+                del self.refused[next(iter(self.refused))]
         self._changes.put_nowait(change)
         self._note_news()
 
