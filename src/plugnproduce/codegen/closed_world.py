@@ -15,7 +15,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 
-from plugnproduce.codegen.task import DONE, FAILED, GeneratedTask
+from plugnproduce.chartnames import DONE, FAILED
+from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import copy
 
-from plugnproduce.codegen.task import NEXT, PLAN, STEP, GeneratedTask
+from plugnproduce.chartnames import NEXT, PLAN, STEP
+from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.vocabulary import concept_value
 from plugnproduce.statechart.io.writer import write_chart

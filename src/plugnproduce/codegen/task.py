@@ -12,17 +12,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from plugnproduce.codegen.flow import OUTCOME, Outcomes, branch_variable, flow_data, flow_transitions, outcome_names
+from plugnproduce.chartnames import DONE, FAILED, NEXT, OUTCOME, PLAN, STEP, VALUES, branch_variable, output_variable
+from plugnproduce.codegen.flow import Outcomes, flow_data, flow_transitions, outcome_names
 from plugnproduce.codegen.specific import (
-    PLAN,
-    STEP,
-    VALUES,
     Flow,
     RegionResult,
     Varying,
     controller_ids,
     literal,
-    output_variable,
     specific_region,
 )
 from plugnproduce.description.model import Cell, ChartTransition, Command, Link, ProcessDescription, Step, Task
@@ -46,10 +43,7 @@ from plugnproduce.statechart.model import (
     pnp,
 )
 
-DONE, FAILED = "done", "failed"
-NEXT = "next_step"
-"""The state that picks the next step's chart from the plan."""
-__all__ = ["DONE", "FAILED", "NEXT", "PLAN", "STEP", "VALUES", "GeneratedTask", "ImplausibleStep", "StepChart",
+__all__ = ["GeneratedTask", "ImplausibleStep", "StepChart",
            "StuckStep", "generate_task", "specific_name", "step_values", "values_data"]
 
 

@@ -25,7 +25,8 @@ from collections.abc import Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from plugnproduce.codegen.task import DONE, STEP, GeneratedTask
+from plugnproduce.chartnames import DONE, STEP
+from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import Cell, ChartTransition, DeviceDescription
 from plugnproduce.errors import ExecutionError
 from plugnproduce.ontology.vocabulary import local_name
