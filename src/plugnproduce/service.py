@@ -27,7 +27,7 @@ from plugnproduce.description.loader import (
     task_to_yaml,
 )
 from plugnproduce.description.model import Cell, DeviceDescription, Link, Task
-from plugnproduce.errors import PlugNProduceError
+from plugnproduce.errors import PlugNProduceError, UnknownName
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
 from plugnproduce.lazy import lazy_module
 from plugnproduce.resources import descriptions_path
@@ -718,6 +718,8 @@ def report(run: str | Path | None = None) -> RunRecord:
     path = Path(run)
     if not path.exists() and not path.suffix:
         path = runs_folder() / f"{run}.jsonl"
+        if not path.exists():
+            raise UnknownName("run", str(run), (r.id for r in runs()))
     return read_journal(path)
 
 

@@ -15,6 +15,7 @@ from typing import Literal
 from plugnproduce.description.flow import Branch as Branch
 from plugnproduce.description.flow import Loop as Loop
 from plugnproduce.description.flow import enclosing, outermost_first, path_name
+from plugnproduce.errors import UnknownName
 from plugnproduce.statechart.model import Chart
 
 Protocol = Literal["xirp", "upnp"]
@@ -165,7 +166,7 @@ class DeviceDescription:
         for s in self.states:
             if s.id == state_id:
                 return s
-        raise KeyError(f"device {self.id} has no state {state_id!r}")
+        raise UnknownName("state", state_id, (s.id for s in self.states), owner=f"device {self.id}")
 
 
 @dataclass(frozen=True)
@@ -257,14 +258,14 @@ class ProcessDescription:
         for r in self.roles:
             if r.name == name:
                 return r
-        raise KeyError(f"process {self.id} has no role {name!r}")
+        raise UnknownName("role", name, (r.name for r in self.roles), owner=f"process {self.id}")
 
     def parameter(self, name: str) -> Parameter:
         """The parameter called ``name``."""
         for p in self.parameters:
             if p.name == name:
                 return p
-        raise KeyError(f"process {self.id} has no parameter {name!r}")
+        raise UnknownName("parameter", name, (p.name for p in self.parameters), owner=f"process {self.id}")
 
     @property
     def outcomes(self) -> tuple[str, ...]:
@@ -280,7 +281,7 @@ class ProcessDescription:
         for o in self.outputs:
             if o.name == name:
                 return o
-        raise KeyError(f"process {self.id} has no output {name!r}")
+        raise UnknownName("output", name, (o.name for o in self.outputs), owner=f"process {self.id}")
 
 
 @dataclass(frozen=True)
@@ -407,7 +408,7 @@ class Cell:
         for d in self.devices:
             if d.id == device_id:
                 return d
-        raise KeyError(f"cell {self.name} has no device {device_id!r}")
+        raise UnknownName("device", device_id, (d.id for d in self.devices), owner=f"cell {self.name}")
 
     def without(self, device_id: str) -> Cell:
         """The same cell with one device unplugged."""

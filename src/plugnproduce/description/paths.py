@@ -15,10 +15,11 @@ import heapq
 from dataclasses import dataclass
 
 from plugnproduce.description.model import ChartTransition, DeviceDescription
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
 
 
-class NoPath(Exception):
+class NoPath(PlugNProduceError):
     """No path in a device's chart from a state to the wanted concept."""
 
     def __init__(self, device: str, source: str, concept: str):

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from plugnproduce import service
 from plugnproduce.description.model import Cell, Task
+from plugnproduce.errors import UnknownName
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
 from plugnproduce.hmi.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
@@ -107,7 +108,7 @@ class ExecutorRunner:
 
     def _run(self, run_id: str) -> _Run:
         if run_id not in self._runs:
-            raise KeyError(f"run {run_id!r}")
+            raise UnknownName("run", run_id, self._runs)
         return self._runs[run_id]
 
     def _finished(self, task: asyncio.Task[object]) -> None:

@@ -18,6 +18,7 @@ from decimal import Decimal, InvalidOperation
 from plugnproduce.description.contracts import KINDS
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
 from plugnproduce.description.paths import NoPath, find_path
+from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning import schema as s
 from plugnproduce.reasoning.terms import Atom, program
@@ -220,7 +221,7 @@ class FactBook:
         for p in self.processes:
             if p.id == command:
                 return p
-        raise KeyError(f"process command {command!r}")
+        raise UnknownName("process command", command, (p.id for p in self.processes))
 
 
 _BOOKS: dict[tuple[str, int], FactBook] = {}

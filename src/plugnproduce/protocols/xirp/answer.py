@@ -18,6 +18,7 @@ import logging
 from collections.abc import Awaitable, Callable, Coroutine, Mapping
 from typing import Any
 
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.codec import encode_frame, frame
 from plugnproduce.protocols.xirp.decoding import decode
@@ -54,7 +55,7 @@ Finish = Coroutine[Any, Any, None]
 """The rest of a reaction, when it has to wait for an asynchronous handler."""
 
 
-class RequestFailed(Exception):
+class RequestFailed(PlugNProduceError):
     """Raised by a request handler: the response is a failure with this ``code`` and the message as text."""
 
     def __init__(self, text: str, code: str = FAILED) -> None:
