@@ -29,7 +29,7 @@ class NoPath(PlugNProduceError):
 
 
 @dataclass(frozen=True)
-class Path:
+class ChartPath:
     """The transitions taken from ``source`` to ``target`` (empty when already there)."""
 
     source: str
@@ -66,14 +66,14 @@ def find_path(
     concept: str,
     taxonomy: Taxonomy,
     wanted: frozenset[str] = frozenset(),
-) -> Path:
+) -> ChartPath:
     """The shortest path from state ``source`` to a state of ``concept`` (empty if ``source`` is one).
 
     ``wanted`` are the quantities of the parameters handed over on the way.
     """
     goals = matching_states(device, concept, taxonomy)
     if source in goals:
-        return Path(source, source, ())
+        return ChartPath(source, source, ())
     if not goals:
         raise NoPath(device.id, source, concept)
     edges = chart_edges(device)
@@ -88,7 +88,7 @@ def find_path(
         accepted = sum(len(wanted.intersection(t.accepts)) for t in steps)
         ranked.append((-accepted, tuple(nodes), tuple(t.line or 0 for t in steps), steps))
     _, best, _, steps = min(ranked)
-    return Path(source, best[-1], steps)
+    return ChartPath(source, best[-1], steps)
 
 
 def _shortest(edges: Edges, source: str, goals: set[str]) -> list[list[str]]:

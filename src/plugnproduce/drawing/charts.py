@@ -16,7 +16,7 @@ from itertools import pairwise
 
 import graphviz
 
-from plugnproduce.drawing.steps import Plan, Step, find_plan, pnp
+from plugnproduce.drawing.steps import Plan, PlanStep, find_plan, pnp
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.model import Chart, Final, Parallel, Raise, Send, State, StateNode, Transition, walk
 
@@ -91,7 +91,7 @@ def _state_label(node: StateNode) -> str:
     return f"{node.id}\\n«{local_name(concept)}»" if concept else str(node.id)
 
 
-def _step_label(step: Step) -> str:
+def _step_label(step: PlanStep) -> str:
     lines = [step.title, *step.binding_text()]
     if step.chart:
         lines.append(step.chart)
@@ -127,7 +127,7 @@ class _Drawing:
         self.ids = {node.id: node for node in chart.states() if node.id}
         self.edges: list[_Edge] = []
         self.hidden: set[str] = set()
-        self.expanded: Step | None = None
+        self.expanded: PlanStep | None = None
         self._segment_of = self._segment_states(plan) if plan and not plan.is_task else {}
         self._folded = False
         if plan and plan.is_task:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from plugnproduce.codegen.outputs import GeneratedChart
 from plugnproduce.description.model import DeviceDescription
-from plugnproduce.drawing import Step, find_plan, render_chart
+from plugnproduce.drawing import PlanStep, find_plan, render_chart
 from plugnproduce.errors import UnknownName
 from plugnproduce.statechart import parse_chart, write_chart
 
@@ -66,7 +66,7 @@ class Pictures:
 
 
 
-def steps_of(chart: GeneratedChart) -> tuple[Step, ...]:
+def steps_of(chart: GeneratedChart) -> tuple[PlanStep, ...]:
     """The steps a generated task chart runs, in order (none for a chart without a plan of processes)."""
     plan = find_plan(parse_chart(chart.data, chart.name))
     return plan.steps if plan and plan.is_task else ()

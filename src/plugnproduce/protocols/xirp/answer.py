@@ -2,7 +2,7 @@
 
 :class:`Responder` decodes a frame and reacts: a request is answered by the
 device's handler (``describe`` by the device's files), a ``bye`` ends the
-connection, anything malformed or unexpected gets an ``error``. Fault rules
+connection, anything malformed or unexpected gets an ``error``. FaultRule rules
 (:mod:`~plugnproduce.protocols.xirp.faults`) are applied on the way.
 
 A reaction is synchronous whenever it can be: a plain-function handler is answered
@@ -22,7 +22,7 @@ from plugnproduce.errors import PlugNProduceError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.codec import encode_frame, frame
 from plugnproduce.protocols.xirp.decoding import decode
-from plugnproduce.protocols.xirp.faults import REQUEST_FAULTS, Fault, FaultKind, Faults
+from plugnproduce.protocols.xirp.faults import REQUEST_FAULTS, FaultKind, FaultRule, Faults
 from plugnproduce.protocols.xirp.messages import (
     BAD_PARAMETER,
     DESCRIBE,
@@ -121,7 +121,7 @@ class Responder:
         return None
 
     async def _finish(
-        self, link: FrameLink, request: Request, pending: Awaitable[Results], fault: Fault | None
+        self, link: FrameLink, request: Request, pending: Awaitable[Results], fault: FaultRule | None
     ) -> None:
         try:
             results = await pending
@@ -146,7 +146,7 @@ class Responder:
             return _failed(request, BAD_PARAMETER, f"describe takes no parameters; got {', '.join(request.params)}")
         return Response(request.id, documents=documents_of(self.files))
 
-    def _send(self, link: FrameLink, response: Response, fault: Fault | None) -> None:
+    def _send(self, link: FrameLink, response: Response, fault: FaultRule | None) -> None:
         """Send the response, unless a fault drops it or sends garbage instead."""
         if fault is not None and fault.kind is FaultKind.DROP_RESPONSE:
             return
