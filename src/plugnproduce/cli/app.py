@@ -91,8 +91,9 @@ def fail(message: str, code: int = 2) -> NoReturn:
     raise typer.Exit(code)
 
 
-BUG = 3
-"""Exit code of a command that failed on a bug of its own (2 is bad input, 1 a finding)."""
+BUG = 4
+"""Exit code of a command that failed on a bug of its own: 1 is a finding, 2 bad input, 3 no answer within a
+budget (`pnp verify` inconclusive), so a bug takes the next."""
 
 log = logging.getLogger("plugnproduce.cli")
 
@@ -123,7 +124,7 @@ def report_bug(exc: Exception, command: str) -> NoReturn:
 
 def boundary(func: F) -> F:
     """Turn the project's errors into one line and exit code 2, never a traceback; anything else is a bug:
-    one line saying so, the traceback in :func:`bug_log`, exit code 3."""
+    one line saying so, the traceback in :func:`bug_log`, exit code :data:`BUG`."""
 
     @wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
