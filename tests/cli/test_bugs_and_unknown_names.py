@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import typer.main
 from typer.testing import CliRunner
 
 from plugnproduce import service
@@ -67,3 +68,16 @@ def test_an_unknown_run_is_bad_input_with_the_nearest_run_ids(home: Path) -> Non
     assert result.exit_code == 2
     assert result.stderr.strip().startswith("error: unknown run 'bin-picking-20261127-10150'; did you mean "
                                             "bin-picking-20261127-101500")
+
+
+def test_every_command_answers_through_the_boundary() -> None:
+    """A command without it would show a user's typo as a traceback, and a bug as exit 1."""
+    def commands(group: object, path: tuple[str, ...] = ()) -> list[tuple[str, ...]]:
+        found = []
+        for name, command in getattr(group, "commands", {}).items():
+            if command.callback is not None and not getattr(command.callback, "under_boundary", False):
+                found.append((*path, name))
+            found += commands(command, (*path, name))
+        return found
+
+    assert commands(typer.main.get_command(app)) == []  # type: ignore[arg-type]

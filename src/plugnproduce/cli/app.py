@@ -141,6 +141,7 @@ def boundary(func: F) -> F:
         except Exception as exc:  # noqa: BLE001 - the boundary: whatever is left is a bug
             report_bug(exc, func.__name__)
 
+    wrapper.under_boundary = True  # type: ignore[attr-defined]  # kept by typer's own wrapper (functools.wraps)
     return wrapper  # type: ignore[return-value]
 
 
