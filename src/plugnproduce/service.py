@@ -6,13 +6,11 @@ generation, execution) and return typed results; they never print.
 
 from __future__ import annotations
 
-import asyncio
-import contextlib
 import dataclasses
 import os
 import secrets
 import time
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -26,7 +24,7 @@ from plugnproduce.description.loader import (
     parse_task,
     task_to_yaml,
 )
-from plugnproduce.description.model import Cell, DeviceDescription, Link, Task
+from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
 from plugnproduce.lazy import lazy_module
@@ -37,11 +35,8 @@ if TYPE_CHECKING:  # validation, code generation and execution are imported by t
     from plugnproduce.codegen import GeneratedTask
     from plugnproduce.codegen.outputs import GeneratedChart
     from plugnproduce.description.goalfile import Goal
-    from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.history import RunSummary
     from plugnproduce.executor.journal import RunRecord
-    from plugnproduce.executor.report import RunReport
-    from plugnproduce.executor.run import RecordObserver, TaskRun
     from plugnproduce.ontology.taxonomy import Taxonomy
     from plugnproduce.planning import Plan, Unreachable
     from plugnproduce.reasoning.impact import Impact
@@ -149,7 +144,7 @@ CellArg = Cell | str | Path
 TaskArg = Task | str | Path
 
 
-def _context(cell_or_path: CellArg, knowledge: Knowledge | None) -> tuple[Cell, Knowledge]:
+def cell_and_knowledge(cell_or_path: CellArg, knowledge: Knowledge | None) -> tuple[Cell, Knowledge]:
     """The cell and the knowledge to reason with: ``knowledge`` plus the cell file's libraries."""
     if isinstance(cell_or_path, Cell):
         if cell_or_path.file and Path(cell_or_path.file).is_file():
@@ -159,7 +154,7 @@ def _context(cell_or_path: CellArg, knowledge: Knowledge | None) -> tuple[Cell, 
     return load_cell(cell_or_path, k.taxonomy, k.device), k
 
 
-def _as_task(task_or_path: TaskArg) -> Task:
+def as_task(task_or_path: TaskArg) -> Task:
     return task_or_path if isinstance(task_or_path, Task) else task(task_or_path)
 
 
@@ -173,7 +168,7 @@ def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None,
                  all_bindings: bool = False) -> reasoning.Capabilities:
     """The process commands a cell offers, each with one valid role binding, how many there are and the
     devices that can fill each role (every binding listed if ``all_bindings``); the others with reasons."""
-    the_cell, k = _context(cell_or_path, knowledge)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     return reasoning.capabilities(the_cell, k.taxonomy, k.processes, all_bindings)
 
 
@@ -181,8 +176,8 @@ def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | N
     """Whether a task is plausible in a cell: per step its bindings, device states and problems."""
     from plugnproduce.reasoning.linksafety import link_safety
 
-    the_cell, k = _context(cell_or_path, knowledge)
-    task = _as_task(task_or_path)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
+    task = as_task(task_or_path)
     result = reasoning.check(task, the_cell, k.taxonomy, k.processes)
     return dataclasses.replace(result, links=link_safety(task, the_cell, result, k.processes))
 
@@ -199,9 +194,9 @@ def repair(
 
     With a catalogue (device descriptions, or a folder of them) a repair may add a device.
     """
-    the_cell, k = _context(cell_or_path, knowledge)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
-    return reasoning.repair(_as_task(task_or_path), the_cell, k.taxonomy, k.processes,
+    return reasoning.repair(as_task(task_or_path), the_cell, k.taxonomy, k.processes,
                             catalogue=devices, top=top, costs=costs)
 
 
@@ -214,7 +209,7 @@ def plan(goal_or_path: Goal | str | Path, cell_or_path: CellArg, knowledge: Know
     from plugnproduce.description.goalfile import Goal, load_goal
     from plugnproduce.planning import plan as make_plan
 
-    the_cell, k = _context(cell_or_path, knowledge)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     goal = goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path)
     devices = list(k.devices) if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
     return make_plan(goal, the_cell, k.taxonomy, k.processes, devices, source=source)
@@ -226,7 +221,7 @@ def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,
     from plugnproduce.description.goalfile import Goal, load_goal
     from plugnproduce.planning.pddl import export
 
-    the_cell, k = _context(cell_or_path, knowledge)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     return export(goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path), the_cell, k.taxonomy,
                   k.processes)
 
@@ -247,15 +242,15 @@ def catalogue_players(result: reasoning.CheckResult,
 def explain_process(cell_or_path: CellArg, command: str,
                     knowledge: Knowledge | None = None) -> reasoning.ProcessExplanation:
     """Why a process command is (not) offered in a cell."""
-    the_cell, k = _context(cell_or_path, knowledge)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     return reasoning.explain_process(the_cell, command, k.taxonomy, k.processes)
 
 
 def explain_step(task_or_path: TaskArg, cell_or_path: CellArg, n: int,
                  knowledge: Knowledge | None = None) -> reasoning.StepExplanation:
     """Why step ``n`` (1-based) of a task is (not) plausible in a cell."""
-    the_cell, k = _context(cell_or_path, knowledge)
-    return reasoning.explain_step(_as_task(task_or_path), the_cell, n, k.taxonomy, k.processes)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
+    return reasoning.explain_step(as_task(task_or_path), the_cell, n, k.taxonomy, k.processes)
 
 
 def explain_offered(cell_or_path: CellArg, command: str, knowledge: Knowledge | None = None,
@@ -264,7 +259,7 @@ def explain_offered(cell_or_path: CellArg, command: str, knowledge: Knowledge | 
     """Why a process command is (not) offered: the derivation tree (rules, ontology axioms, chart states) and
     the counterfactuals the reasoner confirms (devices of the catalogue to add or swap in; for a "yes", the
     devices it rests on)."""
-    the_cell, k = _context(cell_or_path, knowledge)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
     return reasoning.explain_offered(command, the_cell, k.taxonomy, ontology, k.processes,
                                      _devices(catalogue_or_folder, k), language)
@@ -275,8 +270,8 @@ def explain_plausible(task_or_path: TaskArg, cell_or_path: CellArg, n: int, know
     """Why step ``n`` (1-based) of a task is (not) plausible: the derivation tree and, for a "no", the states its
     devices would have to be in and the repairs (steps to insert, remove or reorder, with their side effects),
     each confirmed by the reasoner."""
-    the_cell, k = _context(cell_or_path, knowledge)
-    the_task = _as_task(task_or_path)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
+    the_task = as_task(task_or_path)
     ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
     ex = reasoning.explain_plausible(the_task, n, the_cell, k.taxonomy, ontology, k.processes, language)
     if ex.answer:
@@ -303,8 +298,8 @@ def assessed_repairs(
     worst side effect, then by cost (:func:`plugnproduce.reasoning.sideeffects.ranking`). When the check refuses
     some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds. ``checked``: the
     task's :func:`check` in that cell, when the caller has it (it is not checked again)."""
-    the_cell, k = _context(cell_or_path, knowledge)
-    the_task = _as_task(task_or_path)
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
+    the_task = as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
     asked = top
     for _ in range(MORE_REPAIRS):
@@ -337,7 +332,7 @@ def batch(
     configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
     mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
-    return reasoning.batch(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+    return reasoning.batch(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
                            workers=workers, progress=progress, top=top, mapper=mapper)
 
 
@@ -361,7 +356,7 @@ def batch_report(
     configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
     mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
-    return reasoning.report(configs, devices, [_as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+    return reasoning.report(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
                             form=form, workers=workers, progress=progress, top=top, mapper=mapper, tally=tally)
 
 
@@ -470,7 +465,7 @@ def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = 
     and charts are made only for a proved program. An implausible or unproved task is a result
     here (``generated`` is None), not an error.
     """
-    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
     result = check(the_task, the_cell, k)
     if not result.plausible:
         return Generation(result, None)
@@ -508,7 +503,7 @@ def verify(task_or_path: TaskArg, cell_or_path: CellArg, budget: Budget | None =
     """Check and generate a task, then explore every interleaving of its program with the cell's device
     charts within ``budget``: proved, refuted (with the shortest counterexample) or inconclusive.
     Raises :class:`ImplausibleTask` for an implausible task."""
-    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
     return _verify(plan_run(the_task, the_cell, k), the_cell, budget)
 
 
@@ -521,10 +516,6 @@ def _verify(generated: GeneratedTask, the_cell: Cell, budget: Budget | None) -> 
 # ------------------------------------------------------------------ execution
 
 
-class DevicesMissing(PlugNProduceError):
-    """Devices of the cell that discovery did not find."""
-
-
 def runs_folder() -> Path:
     """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``~/.local/state/plugnproduce/runs``."""
     return Path(os.environ.get("PNP_RUNS") or Path.home() / ".local" / "state" / "plugnproduce" / "runs")
@@ -535,175 +526,16 @@ def new_run_id(task_name: str) -> str:
     return f"{time.strftime('%Y%m%d-%H%M%S')}-{task_name}-{secrets.token_hex(2)}"
 
 
-DISCOVERY_SECONDS = 10.0
-"""How long a run or a live check waits for the cell's devices on the network, unless told."""
-SIMULATED_DISCOVERY_SECONDS = 60.0
-"""The same for the devices a run simulates itself: they are up, so only a busy machine delays their answers."""
-
-DEFAULT_BIN_PARTS = 5
-"""Parts in the simulated bin (placed by seed 0 unless told) that a simulated run of a task taking a reported
-value gets when no bin is asked for (``--bin-parts``)."""
-
-
-def default_bin_parts(task_or_path: TaskArg) -> int | None:
-    """How many parts a simulated bin needs for a run of this task when none was asked for:
-    :data:`DEFAULT_BIN_PARTS` when the task loops until (or while) an outcome and a step takes a value another
-    step reports (a data link, such as the pose where a localisation found a part), so that the parts it finds
-    are taken out and the loop ends when the bin is empty; None for any other task (the simulated devices report
-    their charts' values, and a bin would refuse a move to a fixed pose where no part lies)."""
-    the_task = _as_task(task_or_path)
-    takes = any(isinstance(v, Link) for step in the_task.steps for v in step.params.values())
-    waits = any(loop.until or loop.while_outcome for loop in the_task.loops)
-    return DEFAULT_BIN_PARTS if takes and waits else None
-
-
-async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cell:
-    """Wait until discovery has found every wanted device; the live cell's devices with their real endpoints."""
-    deadline = asyncio.get_running_loop().time() + timeout
-    while missing := [d for d in wanted if d not in {x.id for x in live.cell.devices}]:
-        left = deadline - asyncio.get_running_loop().time()
-        if left <= 0:
-            raise DevicesMissing(f"device(s) {', '.join(missing)} of the cell not found on the network "
-                                 f"within {timeout:g} s")
-        with contextlib.suppress(TimeoutError):
-            await live.next_change(left)
-    return Cell(live.cell.name, tuple(live.cell.device(d) for d in wanted))
-
-
-async def run_task(
-    task_or_path: Task | str | Path,
-    cell_or_path: Cell | str | Path,
-    *,
-    simulate: bool = False,
-    faults: str = "",
-    journal: Path | None = None,
-    observer: RecordObserver | None = None,
-    started: Callable[[TaskRun], None] | None = None,
-    discovery_timeout: float | None = None,
-    progress: Callable[[str], None] | None = None,
-    knowledge: Knowledge | None = None,
-    bin_parts: int | None = None,
-    bin_seed: int = 0,
-    assume_initial: bool = False,
-) -> RunReport:
-    """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
-
-    With ``simulate`` the cell's devices are simulated for the run, on a private SSDP network,
-    with ``faults`` injected (see :func:`plugnproduce.sim.cell.parse_faults`), working on a
-    simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given. ``started`` is
-    given the run once it exists (to stop it); ``discovery_timeout`` bounds the wait for the devices
-    (default :data:`DISCOVERY_SECONDS`, simulated: :data:`SIMULATED_DISCOVERY_SECONDS`); ``progress`` is told
-    each phase as it begins (checking, generating, starting devices, discovering, running). The task is
-    checked and generated from the state each device reports once discovered (:func:`reported_states`), or, with
-    ``assume_initial``, from the charts' initial states before discovery. Raises :class:`ImplausibleTask`
-    before any command goes out.
-    """
-    from plugnproduce.discovery import LiveCell
-    from plugnproduce.protocols.upnp import network_from_env, private_network
-    from plugnproduce.sim.bin import SimulatedBin
-    from plugnproduce.sim.cell import SimulatedCell, parse_faults
-
-    say = progress or (lambda _: None)
-    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
-    generated: GeneratedTask | None = None
-    if assume_initial:
-        say("checking the task in the cell")
-        generated = plan_run(the_task, the_cell, k, progress=say)
-    journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
-    network = private_network() if simulate else network_from_env()
-    async with contextlib.AsyncExitStack() as stack:
-        if simulate:
-            say(f"starting {len(the_cell.devices)} simulated device(s) on loopback")
-            parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
-            sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices), bin=parts)
-            await stack.enter_async_context(sim)
-        say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
-        wanted = [d.id for d in the_cell.devices]
-        live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
-                                                        expected=wanted))
-        devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
-                                                                         else DISCOVERY_SECONDS))
-        if generated is None:
-            say("asking each device its state; checking the task from there")
-            generated = plan_run(the_task, the_cell.reported(await reported_states(devices)), k, progress=say)
-        say("running")
-        run = start_run(generated, devices, journal, observer, prefixes=k.prefixes)
-        if started is not None:
-            started(run)
-        follow = asyncio.create_task(_follow_unplugs(live, run))
-        try:
-            return await run.run()
-        finally:
-            follow.cancel()
-
-
-class StateNotReported(PlugNProduceError):
-    """A device of a live cell did not report its state."""
-
-
-async def reported_states(devices: Cell, timeout: float | None = None) -> dict[str, str]:
-    """Ask every device of a live cell (``devices``: their real endpoints) its current state over its protocol,
-    all at once; each answer bounded by ``timeout`` (default: the device's command timeout)."""
-    from plugnproduce.executor.links import query_state
-
-    async def one(device: DeviceDescription) -> str:
-        try:
-            state = await query_state(device, timeout or device.command_timeout)
-        except PlugNProduceError as exc:
-            raise StateNotReported(f"device {device.id} did not report its state ({exc}); to plan from its chart's "
-                                   "initial state instead, give --assume-initial") from None
-        if state not in {s.id for s in device.states}:
-            raise StateNotReported(f"device {device.id} reports state {state!r}, which its device state chart "
-                                   f"{Path(device.chart_file).name} does not have")
-        return state
-
-    states = await asyncio.gather(*(one(d) for d in devices.devices))
-    return {d.id: x for d, x in zip(devices.devices, states, strict=True)}
-
-
-async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
-                    discovery_timeout: float = DISCOVERY_SECONDS) -> Cell:
-    """The cell with each device in the state it reports: its devices found by discovery (on the network
-    ``PNP_SSDP_PORT`` names) and asked their states. For ``check``, ``repair`` and ``explain`` on a live cell."""
-    from plugnproduce.discovery import LiveCell
-    from plugnproduce.protocols.upnp import network_from_env
-
-    the_cell, k = _context(cell_or_path, knowledge)
-    wanted = [d.id for d in the_cell.devices]
-    async with LiveCell(k.taxonomy, network=network_from_env(), name=the_cell.name, expected=wanted) as live:
-        devices = await find_devices(live, wanted, discovery_timeout)
-        return the_cell.reported(await reported_states(devices))
-
-
 def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None,
              progress: Callable[[str], None] | None = None) -> GeneratedTask:
     """Check a task and generate only what a run needs: the task chart (no closed-world chart, no device
     programs, no chart written). Raises :class:`ImplausibleTask` for an implausible task."""
-    the_task, (the_cell, k) = _as_task(task_or_path), _context(cell_or_path, knowledge)
+    the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
     if not (result := check(the_task, the_cell, k)).plausible:
         raise ImplausibleTask(result)
     if progress is not None:
         progress(f"generating the charts of {len(the_task.steps)} step(s)")
     return _generate_task(the_task, the_cell, result, k)
-
-
-def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
-              observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> TaskRun:
-    """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
-    real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
-
-    Both faces start runs this way: ``pnp run`` after discovering the cell's devices
-    (:func:`run_task`), the HMI with the devices its cell source follows.
-    """
-    from plugnproduce.executor.run import TaskRun
-
-    return TaskRun(generated, devices, journal, observer, prefixes)
-
-
-async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:
-    async for change in live.changes():
-        if change.kind == "unplug":
-            run.device_lost(change.device, "the device left the network (SSDP byebye)")
 
 
 def report(run: str | Path | None = None) -> RunRecord:
