@@ -30,8 +30,8 @@ from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.facts import device_facts, process_facts, task_facts
-from plugnproduce.reasoning.check.accepts import accepts
-from plugnproduce.reasoning.check.contracts import normalised, refuses
+from plugnproduce.reasoning.checks.accepts import accepts
+from plugnproduce.reasoning.checks.contracts import normalised, refuses
 
 MAX_BUY = 4
 """Largest purchase the reference tries."""

@@ -27,7 +27,7 @@ LAYERS = {
 }
 """Rank of each subpackage or top-level module: a module imports only from lower ranks or its own part."""
 
-REASONING_PARTS = ("asp", "check", "repair", "explanation")
+REASONING_PARTS = ("asp", "checks", "repairs", "explanation")
 """The parts of ``reasoning/`` in order: each imports only from itself and the parts before it."""
 
 SCXML_NAMESPACE = "http://www.w3.org/2005/07/scxml"

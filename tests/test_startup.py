@@ -89,7 +89,7 @@ def test_a_submodule_imported_before_its_lazy_package_is_used_runs_once_after_it
             "lazy_module('plugnproduce.reasoning')\n"
             "from plugnproduce.reasoning.asp.terms import _REGISTRY\n"
             "from plugnproduce.reasoning.asp import solver\n"
-            "import plugnproduce.reasoning.check.linksafety\n"  # a package runs before its submodules: no partial import
+            "import plugnproduce.reasoning.checks.linksafety\n"  # a package runs before its submodules: no partial import
             "print(solver.decode.__globals__['_REGISTRY'] is _REGISTRY)")
     assert _run(code).split() == ["True"]
 

@@ -45,7 +45,7 @@ if TYPE_CHECKING:  # validation, code generation and execution are imported by t
     from plugnproduce.executor.run import RecordObserver, TaskRun
     from plugnproduce.ontology.taxonomy import Taxonomy
     from plugnproduce.planning import Plan, Unreachable
-    from plugnproduce.reasoning.repair.impact import Impact
+    from plugnproduce.reasoning.repairs.impact import Impact
     from plugnproduce.validation import Report
     from plugnproduce.verification import Budget, Verification
 else:
@@ -181,7 +181,7 @@ def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None,
 
 def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.CheckResult:
     """Whether a task is plausible in a cell: per step its bindings, device states and problems."""
-    from plugnproduce.reasoning.check.linksafety import link_safety
+    from plugnproduce.reasoning.checks.linksafety import link_safety
 
     the_cell, k = _context(cell_or_path, knowledge)
     task = _as_task(task_or_path)
@@ -302,7 +302,7 @@ def assessed_repairs(
     checked: reasoning.CheckResult | None = None,
 ) -> list[reasoning.AssessedRepair]:
     """The repairs of :func:`repair` that checking them again confirms, with their side effects, ranked by their
-    worst side effect, then by cost (:func:`plugnproduce.reasoning.repair.sideeffects.ranking`). When the check refuses
+    worst side effect, then by cost (:func:`plugnproduce.reasoning.repairs.sideeffects.ranking`). When the check refuses
     some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds. ``checked``: the
     task's :func:`check` in that cell, when the caller has it (it is not checked again)."""
     the_cell, k = _context(cell_or_path, knowledge)
@@ -735,7 +735,7 @@ def impact(extensions: list[Path], cell_files: list[Path] | None = None,
     """What adding the TBox files ``extensions`` to ``knowledge`` changes: offered commands per cell
     (default: every cell of the loaded libraries), catalogue roles, the libraries' tasks, and the
     validation findings (shapes, structure) of every catalogue device and cell, before and after."""
-    from plugnproduce.reasoning.repair.impact import impact as compute
+    from plugnproduce.reasoning.repairs.impact import impact as compute
 
     return compute(_k(knowledge), extensions, cell_files, _findings)
 

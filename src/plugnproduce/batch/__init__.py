@@ -1,6 +1,6 @@
 """The batch: every task of a product family checked in many cell configurations drawn from a catalogue.
 
-Each catalogue device is reasoned once (:mod:`plugnproduce.reasoning.check.abilities`); a configuration is then a
+Each catalogue device is reasoned once (:mod:`plugnproduce.reasoning.checks.abilities`); a configuration is then a
 bit mask (:mod:`.feasibility`), the cheapest purchases are searched over masks (:mod:`.purchases`), rows are
 written by :mod:`.batches`, spread over a process pool or a Dask cluster (:mod:`.cluster`, :mod:`.clusterpeer`),
 and the reasoned catalogue is kept between runs (:mod:`.enginecache`). It uses the reasoning layer and is not

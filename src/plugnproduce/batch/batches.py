@@ -1,6 +1,6 @@
 """Feasibility of many cell configurations: offered processes, plausible tasks, cheapest purchases.
 
-What depends on one device is reasoned once (:mod:`plugnproduce.reasoning.check.abilities`); each configuration only
+What depends on one device is reasoned once (:mod:`plugnproduce.reasoning.checks.abilities`); each configuration only
 combines those answers (:mod:`.feasibility`, :mod:`.purchases`). Configurations stream in and
 rows stream out in input order: chunks of configurations go to worker processes (or a Dask
 cluster, :mod:`.cluster`) with a bounded number in flight, so memory does not grow with the
@@ -26,7 +26,7 @@ from plugnproduce.batch.purchases import Purchase, purchase
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.reasoning.check.abilities import Abilities, abilities
+from plugnproduce.reasoning.checks.abilities import Abilities, abilities
 
 CHUNK = 2_000
 """Configurations sent to a worker at a time."""

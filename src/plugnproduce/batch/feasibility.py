@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 
-from plugnproduce.reasoning.check.abilities import Abilities, TaskSpec
+from plugnproduce.reasoning.checks.abilities import Abilities, TaskSpec
 
 Finding = tuple[str, int, str, str]
 """Why a task is not plausible: (kind, step, role, device); role and device are "" where they do not apply."""

@@ -28,7 +28,7 @@ from plugnproduce.planning import schema as ps
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import fact_book
 from plugnproduce.reasoning.asp.terms import Atom, Model, program
-from plugnproduce.reasoning.check.offers import capabilities, cell_program
+from plugnproduce.reasoning.checks.offers import capabilities, cell_program
 from plugnproduce.safeio import PlainDumper
 
 MAX_STEPS = 12

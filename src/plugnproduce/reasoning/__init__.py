@@ -8,8 +8,8 @@ Infeasible and implausible are results, never exceptions.
 The layer is split by concern, each part using only those before it:
 
 - :mod:`.asp`: the ASP layer (the solver, the fact schema, facts in, answers and reasons out);
-- :mod:`.check`: what a cell offers and whether a task is plausible on it;
-- :mod:`.repair`: the cheapest repairs of an implausible task and their side effects;
+- :mod:`.checks`: what a cell offers and whether a task is plausible on it;
+- :mod:`.repairs`: the cheapest repairs of an implausible task and their side effects;
 - :mod:`.explanation`: why and why not, down to the axioms and rules, and counterfactuals.
 
 The batch over many cells (:mod:`plugnproduce.batch`) uses this layer and is not part of it.
@@ -32,15 +32,15 @@ from plugnproduce.reasoning.asp.results import (
     StepCheck,
     StepExplanation,
 )
-from plugnproduce.reasoning.check.contracts import normalised
-from plugnproduce.reasoning.check.offers import capabilities, explain_process
-from plugnproduce.reasoning.check.plausibility import check, explain_step
+from plugnproduce.reasoning.checks.contracts import normalised
+from plugnproduce.reasoning.checks.offers import capabilities, explain_process
+from plugnproduce.reasoning.checks.plausibility import check, explain_step
 from plugnproduce.reasoning.explanation.axioms import ontology_of
 from plugnproduce.reasoning.explanation.counterfactuals import Counterfactual
 from plugnproduce.reasoning.explanation.counterfactuals import from_repairs as counterfactuals_from_repairs
 from plugnproduce.reasoning.explanation.why import Explanation, explain_offered, explain_plausible
-from plugnproduce.reasoning.repair.sideeffects import AssessedRepair, SideEffect, assess
-from plugnproduce.reasoning.repair.windows import repair
+from plugnproduce.reasoning.repairs.sideeffects import AssessedRepair, SideEffect, assess
+from plugnproduce.reasoning.repairs.windows import repair
 
 __all__ = [
     "AssessedRepair",

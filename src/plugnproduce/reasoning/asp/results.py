@@ -183,7 +183,7 @@ class CheckResult:
     final_states: dict[str, str] = field(default_factory=dict)
     links: tuple[LinkSafety, ...] = ()
     """Per value taken from an earlier step's output: proven within its device's contract, or checked at run
-    time (:class:`plugnproduce.reasoning.check.linksafety.LinkSafety`)."""
+    time (:class:`plugnproduce.reasoning.checks.linksafety.LinkSafety`)."""
 
     def bindings(self) -> list[dict[str, str]]:
         """Role bindings per step (for code generation; complete only when plausible)."""
@@ -281,7 +281,7 @@ class Repair:
     added_devices: tuple[str, ...] = ()
     origins: tuple[int, ...] = field(default=(), compare=False, repr=False)
     """For each step of the flat repaired task, the original step position it keeps (0 if inserted); empty once
-    the repair is lifted onto the written task (:mod:`plugnproduce.reasoning.repair.lifting`)."""
+    the repair is lifted onto the written task (:mod:`plugnproduce.reasoning.repairs.lifting`)."""
     unrolls: str | None = None
     """Why the resulting task writes the original's loops and branches out step by step (None: it keeps them)."""
 

@@ -15,9 +15,9 @@ from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book
 from plugnproduce.reasoning.asp.results import CheckResult
-from plugnproduce.reasoning.check.offers import CELL, cell_program
-from plugnproduce.reasoning.check.plausibility import check
-from plugnproduce.reasoning.repair.sideeffects import AssessedRepair
+from plugnproduce.reasoning.checks.offers import CELL, cell_program
+from plugnproduce.reasoning.checks.plausibility import check
+from plugnproduce.reasoning.repairs.sideeffects import AssessedRepair
 
 MAX_PAIRS = 400
 """At most this many pairs of catalogue devices are tried when no single device makes a process offered."""

@@ -18,9 +18,9 @@ from plugnproduce.reasoning.asp.facts import fact_book
 from plugnproduce.reasoning.asp.results import CheckResult
 from plugnproduce.reasoning.asp.schema.derivations import Walk
 from plugnproduce.reasoning.asp.terms import Model
-from plugnproduce.reasoning.check.branches import on_a_path, renumbered_text
-from plugnproduce.reasoning.check.offers import CELL, cell_program
-from plugnproduce.reasoning.check.plausibility import TASK, check
+from plugnproduce.reasoning.checks.branches import on_a_path, renumbered_text
+from plugnproduce.reasoning.checks.offers import CELL, cell_program
+from plugnproduce.reasoning.checks.plausibility import TASK, check
 from plugnproduce.reasoning.explanation import counterfactuals
 from plugnproduce.reasoning.explanation.axioms import Axiom, Ontology
 from plugnproduce.reasoning.explanation.counterfactuals import Counterfactual

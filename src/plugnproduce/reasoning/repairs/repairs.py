@@ -22,10 +22,10 @@ from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.asp.results import Edit, Repair, RepairCosts
 from plugnproduce.reasoning.asp.terms import Atom, Model, program
-from plugnproduce.reasoning.check.contracts import normalised
-from plugnproduce.reasoning.check.offers import CELL, cell_program
-from plugnproduce.reasoning.check.plausibility import TASK, check
-from plugnproduce.reasoning.check.refusals import Refusals, refusal_facts, reset_reason
+from plugnproduce.reasoning.checks.contracts import normalised
+from plugnproduce.reasoning.checks.offers import CELL, cell_program
+from plugnproduce.reasoning.checks.plausibility import TASK, check
+from plugnproduce.reasoning.checks.refusals import Refusals, refusal_facts, reset_reason
 
 PER_GAP = 2
 """Default number of commands that may be inserted before each step."""
@@ -89,7 +89,7 @@ def task_program(task: Task, devices: Sequence[DeviceDescription], book: FactBoo
                  known: Refusals | None = None) -> str:
     """The facts of a task to repair: its values read in their parameters' units (``"40 %"`` is the number 40, as
     the check reads it; a value that cannot be read stays as written, to be reset), and which of ``devices`` (the
-    cell's and the catalogue's) refuse which of them (:mod:`..check.refusals`; ``known``: the answers so far)."""
+    cell's and the catalogue's) refuse which of them (:mod:`..checks.refusals`; ``known``: the answers so far)."""
     readable, _ = normalised(task, book.processes, keep_unreadable=True)
     return program(task_facts(readable, TASK)
                    + refusal_facts(readable, TASK, devices, book.processes, book.taxonomy, known))
@@ -156,7 +156,7 @@ def repaired_runs(model: Model, task: Task) -> list[tuple[int, Step]]:
 
 def repaired_task(model: Model, task: Task) -> Task:
     """The task the model's edits produce, flat; ``repeat`` kept when every round was repaired alike (loops and
-    branches are lifted onto the written task afterwards, :mod:`plugnproduce.reasoning.repair.lifting`)."""
+    branches are lifted onto the written task afterwards, :mod:`plugnproduce.reasoning.repairs.lifting`)."""
     steps = [st for _, st in repaired_runs(model, task)]
     kept = len(steps) == len(task.steps)  # a loop's or branch's steps kept in place: still the loop, the branch
     return Task(task.name, tuple(steps), task.file, task.description, folded_repeat(steps, task.repeat),

@@ -22,7 +22,7 @@ from plugnproduce.description.flow import Branch, Loop
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp.results import Repair
-from plugnproduce.reasoning.check.plausibility import check
+from plugnproduce.reasoning.checks.plausibility import check
 
 Key = tuple[object, ...]
 """A written item (``("step", pos)``, ``("loop", entry)``, ``("new", n)``) or a container of items

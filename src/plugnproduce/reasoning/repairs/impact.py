@@ -16,7 +16,7 @@ from plugnproduce.description.loader import cell_libraries, load_cell, load_task
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.errors import DescriptionError
 from plugnproduce.knowledge.libraries import Knowledge, library_folders, load_knowledge
-from plugnproduce.reasoning.check import offers, plausibility
+from plugnproduce.reasoning.checks import offers, plausibility
 
 Bindings = dict[str, set[str]]
 """Offered command → its role bindings, each written ``role=device ...``."""

@@ -18,8 +18,8 @@ from plugnproduce.description.model import DeviceDescription, Parameter, Process
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.terms import Atom
-from plugnproduce.reasoning.check.accepts import accepts
-from plugnproduce.reasoning.check.contracts import refuses, why_refused
+from plugnproduce.reasoning.checks.accepts import accepts
+from plugnproduce.reasoning.checks.contracts import refuses, why_refused
 
 
 class Refusals:

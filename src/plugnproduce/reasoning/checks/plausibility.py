@@ -14,8 +14,8 @@ from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.facts import fact_book, task_facts
 from plugnproduce.reasoning.asp.results import CheckResult, Problem, Reason, StepCheck, StepExplanation
 from plugnproduce.reasoning.asp.terms import Model, program
-from plugnproduce.reasoning.check.accepts import not_accepted
-from plugnproduce.reasoning.check.branches import (
+from plugnproduce.reasoning.checks.accepts import not_accepted
+from plugnproduce.reasoning.checks.branches import (
     MAX_PATH_STEPS,
     MAX_PATHS,
     check_paths,
@@ -25,10 +25,10 @@ from plugnproduce.reasoning.check.branches import (
     renumbered_text,
     task_paths,
 )
-from plugnproduce.reasoning.check.contracts import beyond_limits, normalised
-from plugnproduce.reasoning.check.controlflow import loop_problems, on_path
-from plugnproduce.reasoning.check.dataflow import link_problems, unreported
-from plugnproduce.reasoning.check.offers import CELL, cell_program, context
+from plugnproduce.reasoning.checks.contracts import beyond_limits, normalised
+from plugnproduce.reasoning.checks.controlflow import loop_problems, on_path
+from plugnproduce.reasoning.checks.dataflow import link_problems, unreported
+from plugnproduce.reasoning.checks.offers import CELL, cell_program, context
 
 TASK = "task"
 """The name a single task gets in ASP."""
@@ -77,9 +77,9 @@ def run_check(task: Task, cell: Cell, taxonomy: Taxonomy,
 def check(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> CheckResult:
     """Whether ``task`` is plausible in ``cell``; per step its bindings, device states and problems.
 
-    A task with loops is checked on every path: see :mod:`plugnproduce.reasoning.check.controlflow`.
+    A task with loops is checked on every path: see :mod:`plugnproduce.reasoning.checks.controlflow`.
     Quantities written with a unit are read in their parameters' units first; every value a device
-    is sent must keep that device's contract (:mod:`plugnproduce.reasoning.check.contracts`).
+    is sent must keep that device's contract (:mod:`plugnproduce.reasoning.checks.contracts`).
     """
     if task.branches:
         return _branched(task, cell, taxonomy, processes)
@@ -111,7 +111,7 @@ def flow_problems(task: Task, processes: Sequence[ProcessDescription], taxonomy:
 
 
 def _branched(task: Task, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> CheckResult:
-    """The check of a task with branches: each of its paths (:mod:`plugnproduce.reasoning.check.branches`)."""
+    """The check of a task with branches: each of its paths (:mod:`plugnproduce.reasoning.checks.branches`)."""
     by_id = {p.id: p for p in processes}
     paths = task_paths(task, by_id, taxonomy)
     if len(paths) > MAX_PATHS or sum(len(p.positions) for p in paths) > MAX_PATH_STEPS:

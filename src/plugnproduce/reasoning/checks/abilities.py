@@ -22,9 +22,9 @@ from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import device_facts, process_facts, task_facts
 from plugnproduce.reasoning.asp.terms import Atom, program
-from plugnproduce.reasoning.check.accepts import accepts
-from plugnproduce.reasoning.check.contracts import normalised, refusal
-from plugnproduce.reasoning.check.plausibility import check
+from plugnproduce.reasoning.checks.accepts import accepts
+from plugnproduce.reasoning.checks.contracts import normalised, refusal
+from plugnproduce.reasoning.checks.plausibility import check
 
 _STEP = re.compile(r"step \d+ \([^)]*\): ")
 """Where a check's problem text names its step, before it says what is wrong."""
@@ -49,7 +49,7 @@ class StepSpec:
     """Per parameter value given: the role it goes to, and the devices (bit mask) that accept no such quantity."""
     beyond: tuple[tuple[str, int], ...] = ()
     """Per parameter value sent (given or default): the role it goes to, and the devices (bit mask) whose own
-    limits refuse it (:mod:`plugnproduce.reasoning.check.contracts`)."""
+    limits refuse it (:mod:`plugnproduce.reasoning.checks.contracts`)."""
     limits: tuple[tuple[str, int, str], ...] = ()
     """Per value and device of :attr:`beyond`: the role, the device's index, and why it refuses the value."""
 
@@ -67,7 +67,7 @@ class TaskSpec:
 
 @dataclass(frozen=True)
 class FullCheck:
-    """The full plausibility check (:mod:`plugnproduce.reasoning.check.plausibility`) of a task in a configuration."""
+    """The full plausibility check (:mod:`plugnproduce.reasoning.checks.plausibility`) of a task in a configuration."""
 
     catalogue: tuple[DeviceDescription, ...]
     """The catalogue devices, in bit order."""

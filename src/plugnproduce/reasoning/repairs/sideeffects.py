@@ -18,8 +18,8 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP_IRI
 from plugnproduce.reasoning.asp.derivation import Node, asp
 from plugnproduce.reasoning.asp.results import CheckResult, Repair
-from plugnproduce.reasoning.check.offers import CELL
-from plugnproduce.reasoning.check.plausibility import TASK, check
+from plugnproduce.reasoning.checks.offers import CELL
+from plugnproduce.reasoning.checks.plausibility import TASK, check
 
 SEVERITY = {"drops_part": 2, "moves_device": 1, "ends_holding": 1, "default_values": 0}
 """How much each kind of side effect weighs when repairs are ranked (0: worth knowing, harmless)."""

@@ -66,11 +66,11 @@ from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.asp.results import Repair, RepairCosts
 from plugnproduce.reasoning.asp.terms import Model, program
-from plugnproduce.reasoning.check.contracts import normalised
-from plugnproduce.reasoning.check.offers import CELL, cell_program
-from plugnproduce.reasoning.check.plausibility import TASK
-from plugnproduce.reasoning.check.refusals import Refusals
-from plugnproduce.reasoning.repair import lifting, repairs
+from plugnproduce.reasoning.checks.contracts import normalised
+from plugnproduce.reasoning.checks.offers import CELL, cell_program
+from plugnproduce.reasoning.checks.plausibility import TASK
+from plugnproduce.reasoning.checks.refusals import Refusals
+from plugnproduce.reasoning.repairs import lifting, repairs
 
 WHOLE_UP_TO = 40
 """Tasks of at most this many steps are repaired whole (:func:`.repairs.repair`): fast enough, and

@@ -24,7 +24,7 @@ from plugnproduce.description.outcomes import loop_ending
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.asp.results import CheckResult, Problem, Reason
-from plugnproduce.reasoning.check.branches import Path, covering, renumbered
+from plugnproduce.reasoning.checks.branches import Path, covering, renumbered
 
 Check = Callable[[Task], CheckResult]
 """The chained check of a straight task (no loops) in the same cell."""

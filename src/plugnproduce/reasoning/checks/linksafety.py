@@ -16,7 +16,7 @@ from plugnproduce.description.model import Argument, Cell, Link, ProcessDescript
 from plugnproduce.description.ranges import OutputRange, output_ranges
 from plugnproduce.description.units import UnitError, convert
 from plugnproduce.reasoning.asp.results import CheckResult, LinkSafety
-from plugnproduce.reasoning.check.contracts import contracts_for
+from plugnproduce.reasoning.checks.contracts import contracts_for
 
 
 def link_safety(task: Task, cell: Cell, result: CheckResult,
