@@ -18,6 +18,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from plugnproduce.controller.interfaces import CellChangeRefused, RunRefused
 from plugnproduce.errors import (
     DescriptionError,
     PlugNProduceError,
@@ -27,7 +28,6 @@ from plugnproduce.errors import (
     excerpt,
     tidy,
 )
-from plugnproduce.hmi.interfaces import CellChangeRefused, RunRefused
 from plugnproduce.hmi.schemas import LOOP_TAG, STEP_TAG
 
 
