@@ -167,11 +167,11 @@ class _Drawing:
 
     def _state(self, graph: graphviz.Digraph, child: State | Parallel | Final) -> None:
         sid = child.id or ""
-        if _is_compound(child):
+        if isinstance(child, State | Parallel) and _is_compound(child):
             with graph.subgraph(name=f"cluster_{sid}") as sub:
                 style = "dashed" if isinstance(child, Parallel) else "rounded"
                 sub.attr(label=_cluster_label(child), style=style)
-                self.add(sub, child)  # type: ignore[arg-type]
+                self.add(sub, child)
                 if isinstance(child, State):
                     self.initial(sub, child)
         else:
