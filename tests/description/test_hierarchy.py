@@ -11,6 +11,7 @@ from plugnproduce import service
 from plugnproduce.description.charts import device_chart
 from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.description.paths import find_path
+from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.statechart import parse_chart
 
@@ -121,3 +122,25 @@ def test_a_targetless_superstate_transition_stays_in_the_state_it_is_taken_from(
   </state>"""), "ping.scxml")
     pings = device_chart(chart, "ping.scxml").transitions
     assert [(t.source, t.target, t.origin) for t in pings] == [("a", "a", "outer"), ("b", "b", "outer")]
+
+
+def test_a_chart_whose_superstate_transitions_multiply_beyond_the_limit_is_refused_at_once() -> None:
+    """400 states inside a superstate with 300 transitions would take 120,000: refused before any is built."""
+    leaves = "".join(f'<state id="s{i}"/>' for i in range(400))
+    moves = "".join(f'<transition event="xirp.request.R{i}" target="s0"/>' for i in range(300))
+    chart = parse_chart(_chart(f'<state id="outer">{moves}{leaves}</state>'), "wide.scxml")
+    with pytest.raises(DescriptionError, match="take 120000 transitions, counting each compound state's once for "
+                                               "every state inside it; at most 100000 are accepted") as err:
+        device_chart(chart, "wide.scxml")
+    assert str(err.value).startswith("wide.scxml:1:")
+
+
+def test_a_superstate_transition_on_an_event_prefix_is_shadowed_by_an_inner_one() -> None:
+    """SCXML event descriptors match by prefix: an inner ``xirp.request`` takes every request first."""
+    chart = parse_chart(_chart("""
+  <state id="outer"><transition event="xirp.request.Stop" target="b"/>
+    <state id="a"><transition event="xirp.request" target="a"/></state><state id="b"/>
+  </state>"""), "prefix.scxml")
+    lifted = device_chart(chart, "prefix.scxml").transitions
+    assert [(t.source, t.event, t.target) for t in lifted] == [("a", "xirp.request", "a"),
+                                                              ("b", "xirp.request.Stop", "b")]

@@ -41,6 +41,8 @@ from plugnproduce.statechart.model import (
 )
 
 ACCEPTS = pnp("accepts")
+MAX_TRANSITIONS = 100_000
+"""The most transitions a chart's atomic states may take (a compound state's count once per state inside it)."""
 Leaf = State | Final
 
 
@@ -160,16 +162,35 @@ def _domain(tree: _Tree, holder: str, target: str, t: Transition) -> str | None:
     return next((a for a in tree.chain(holder)[1:] if a in target_chain[1:]), None)
 
 
-def _matches(descriptor: str, event: str) -> bool:
-    return descriptor in ("*", event) or event.startswith(descriptor.rstrip(".*") + ".")
+def _descriptor(d: str) -> str:
+    """An event descriptor without the ``.*`` or ``.`` it may end with (``error.*`` matches as ``error``)."""
+    return d[:-2] if d.endswith(".*") else d.rstrip(".")
 
 
-def _shadowed(t: Transition, inner: list[Transition]) -> bool:
-    """Whether a transition nearer to the atomic state always takes ``t``'s event first."""
-    taken = [u for u in inner if not u.cond]
-    if not t.events:
-        return any(not u.events for u in taken)
-    return all(any(_matches(d, e) for u in taken for d in u.events) for e in t.events)
+@dataclass
+class _Taken:
+    """The events the transitions nearer to an atomic state always take (no ``cond``), as descriptors."""
+
+    descriptors: set[str] = field(default_factory=set)
+    eventless: bool = False
+
+    def add(self, transitions: Iterable[Transition]) -> None:
+        for u in transitions:
+            if not u.cond:
+                self.descriptors.update(_descriptor(d) for d in u.events)
+                self.eventless = self.eventless or not u.events
+
+    def shadows(self, t: Transition) -> bool:
+        """Whether every event ``t`` takes is taken first by a transition nearer to the atomic state."""
+        if not t.events:
+            return self.eventless
+        return all(self._matched(e) for e in t.events)
+
+    def _matched(self, event: str) -> bool:
+        if "*" in self.descriptors:
+            return True
+        parts = event.split(".")
+        return any(".".join(parts[:n]) in self.descriptors for n in range(1, len(parts) + 1))
 
 
 def _lifted(tree: _Tree, leaf: Leaf, holder: str, t: Transition) -> ChartTransition:
@@ -189,7 +210,7 @@ def _lifted(tree: _Tree, leaf: Leaf, holder: str, t: Transition) -> ChartTransit
 
 
 def _leaf_transitions(tree: _Tree, leaf: Leaf) -> Iterator[ChartTransition]:
-    inner: list[Transition] = []
+    taken = _Taken()
     for holder in tree.chain(leaf.id or ""):
         node = tree.nodes[holder]
         own = node.transitions if isinstance(node, State) else []
@@ -197,15 +218,26 @@ def _leaf_transitions(tree: _Tree, leaf: Leaf) -> Iterator[ChartTransition]:
             done = f"done.state.{holder}"
             if holder != leaf.id and t.event == done and not isinstance(leaf, Final):
                 continue  # a compound's done event comes only once a final child is entered
-            if not _shadowed(t, inner):
+            if holder == leaf.id or not taken.shadows(t):
                 yield _lifted(tree, leaf, holder, t)
-        inner += own
+        taken.add(own)
+
+
+def _count(tree: _Tree) -> int:
+    """How many transitions the atomic states take, before shadowing: what lifting them costs at most."""
+    own = {sid: len(n.transitions) if isinstance(n, State) else 0 for sid, n in tree.nodes.items()}
+    leaves = (n for n in tree.order if not (isinstance(n, State) and not n.is_atomic))
+    return sum(own[a] for n in leaves for a in tree.chain(n.id or ""))
 
 
 def device_chart(chart: Chart, path: str | Path) -> DeviceChart:
     """The initial state, atomic and compound states and transitions of a Device State Chart read from ``path``."""
     tree = _Tree(path)
     tree.add(chart.children, None)
+    lifted = _count(tree)
+    if lifted > MAX_TRANSITIONS:
+        raise DescriptionError(f"the chart's states take {lifted} transitions, counting each compound state's once "
+                               f"for every state inside it; at most {MAX_TRANSITIONS} are accepted", path, chart.line)
     states: list[ChartState] = []
     compounds: list[ChartState] = []
     transitions: list[ChartTransition] = []
