@@ -144,3 +144,12 @@ def test_a_superstate_transition_on_an_event_prefix_is_shadowed_by_an_inner_one(
     lifted = device_chart(chart, "prefix.scxml").transitions
     assert [(t.source, t.event, t.target) for t in lifted] == [("a", "xirp.request", "a"),
                                                               ("b", "xirp.request.Stop", "b")]
+
+
+@pytest.mark.parametrize(("body", "message"), [
+    ('<state id="a"><state id="b"><state id="a"/></state></state>', "state id 'a' is used twice"),  # the reader
+    ("<state><state/></state>", "two states of the chart have no id"),
+])
+def test_a_state_id_twice_is_refused_not_looped_on(body: str, message: str) -> None:
+    with pytest.raises(DescriptionError, match=message):
+        device_chart(parse_chart(_chart(body), "twice.scxml"), "twice.scxml")

@@ -76,6 +76,10 @@ class _Tree:
                                        "in one state at a time; expected <state> and <final> only", self.path, c.line)
             if isinstance(c, State | Final):
                 sid = c.id or ""
+                if sid in self.nodes:
+                    raise DescriptionError(f"two states of the chart are called {sid!r}" if sid else
+                                           "two states of the chart have no id; expected an id on each", self.path,
+                                           c.line)
                 self.nodes[sid], self.parent[sid] = c, parent
                 self.order.append(c)
                 if isinstance(c, State):
