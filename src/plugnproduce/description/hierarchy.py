@@ -154,6 +154,8 @@ def initial_state(chart: Chart, tree: _Tree) -> str:
     if not tree.order:
         return ""
     first = chart.initial[0] if chart.initial else (tree.order[0].id or "")
+    if first not in tree.nodes:
+        return first  # no state of the chart: the structure checks say so, at the chart's line
     return _enter(tree, None, first, chart.line)[0]
 
 
