@@ -7,8 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from plugnproduce import service
-from plugnproduce.reasoning import schema as s
-from plugnproduce.reasoning.facts import device_facts
+from plugnproduce.reasoning.asp import schema as s
+from plugnproduce.reasoning.asp.facts import device_facts
 
 LIBRARY = Path(__file__).parents[1] / "data" / "libraries" / "packml-screwing"
 CELL = LIBRARY / "cells" / "packml-screwing.yaml"
