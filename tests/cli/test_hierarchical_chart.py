@@ -113,3 +113,20 @@ def test_draw_shows_the_compound_states_as_clusters(tmp_path: Path) -> None:
         assert f"<title>cluster_{name}</title>" in svg
     running = svg[svg.index("<title>cluster_Running</title>"):]
     assert "Running «Screwing»" in running[: running.index("</g>")]
+
+
+def test_the_same_skill_over_upnp_runs_on_the_simulated_cell(library: Path, tmp_path: Path) -> None:
+    """The hierarchical chart behind UPnP: its actions are the requests of every state, nested ones included."""
+    chart = library / "devices" / "packml-screwdriver.scxml"
+    chart.write_text(chart.read_text().replace("xirp.", "upnp.").replace('type="xirp"', 'type="upnp"'))
+    ttl = library / "devices" / "packml-screwdriver.ttl"
+    ttl.write_text(ttl.read_text().replace("pnp:XIRP", "pnp:UPnP").replace("xirp://", "upnp://"))
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(library / "tasks" / "screw-twice.yaml"), "--cell",
+                 str(library / "cells" / "packml-screwing.yaml"), "--sim", "--journal", str(journal))
+    assert result.returncode == 0, result.stdout + result.stderr
+    records = [json.loads(line) for line in journal.read_text().splitlines()]
+    assert [r["command"] for r in records if r["kind"] == "command" and r["device"] == "packml-screwdriver"] == [
+        "Start", "Reset", "Start"]
+    assert records[-1]["device_states"]["packml-screwdriver"] == "Complete"
+    assert records[0]["devices"]["packml-screwdriver"].startswith("http://127.0.0.1:")  # its UPnP description
