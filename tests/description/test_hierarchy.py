@@ -153,3 +153,14 @@ def test_a_superstate_transition_on_an_event_prefix_is_shadowed_by_an_inner_one(
 def test_a_state_id_twice_is_refused_not_looped_on(body: str, message: str) -> None:
     with pytest.raises(DescriptionError, match=message):
         device_chart(parse_chart(_chart(body), "twice.scxml"), "twice.scxml")
+
+
+def test_a_chart_whose_lifted_transitions_would_send_too_many_events_is_refused() -> None:
+    """600 states inside a superstate whose one transition enters a state sending 2,000 events on entry: 1.2 million
+    events lifted, beyond the bound, refused instead of built."""
+    leaves = "".join(f'<state id="s{i}"/>' for i in range(600))
+    sends = "".join(f'<send event="xirp.event.e{i}" type="xirp"/>' for i in range(2000))
+    chart = parse_chart(_chart(f'<state id="outer"><transition event="xirp.request.Go" target="big"/>{leaves}</state>'
+                               f'<state id="big"><onentry>{sends}</onentry></state>'), "loud.scxml")
+    with pytest.raises(DescriptionError, match="send more than 1000000 events in all"):
+        device_chart(chart, "loud.scxml")

@@ -42,6 +42,8 @@ from plugnproduce.statechart.model import (
 
 ACCEPTS = pnp("accepts")
 MAX_TRANSITIONS = 100_000
+MAX_SENDS = 1_000_000
+"""The most events the lifted transitions may send in all (each counts what the states it leaves and enters send)."""
 """The most transitions a chart's atomic states may take (a compound state's count once per state inside it)."""
 Leaf = State | Final
 
@@ -67,6 +69,10 @@ class _Tree:
     nodes: dict[str, Leaf] = field(default_factory=dict)
     parent: dict[str, str | None] = field(default_factory=dict)
     order: list[Leaf] = field(default_factory=list)
+    sends: int = 0
+    _entry: dict[str, list[Command]] = field(default_factory=dict)
+    _exit: dict[str, list[Command]] = field(default_factory=dict)
+    _own: dict[int, list[Command]] = field(default_factory=dict)
 
     def add(self, children: Iterable[Node], parent: str | None) -> None:
         for c in children:
@@ -92,6 +98,33 @@ class _Tree:
             out.append(sid)
             sid = self.parent.get(sid)
         return out
+
+    def entry(self, sid: str) -> list[Command]:
+        """What a state sends on entry (read once per state)."""
+        if sid not in self._entry:
+            self._entry[sid] = _sends(self.nodes[sid].onentry)
+        return self._entry[sid]
+
+    def exit(self, sid: str) -> list[Command]:
+        """What a state sends on exit (read once per state)."""
+        if sid not in self._exit:
+            self._exit[sid] = _sends(self.nodes[sid].onexit)
+        return self._exit[sid]
+
+    def sent_by(self, t: Transition) -> list[Command]:
+        """What a transition's own content sends (read once per transition)."""
+        if id(t) not in self._own:
+            self._own[id(t)] = _sends([t])
+        return self._own[id(t)]
+
+    def counted(self, sends: list[Command], line: int | None) -> tuple[Command, ...]:
+        """``sends`` for one more lifted transition, within the budget of all the chart's lifted sends."""
+        self.sends += len(sends)
+        if self.sends > MAX_SENDS:
+            raise DescriptionError(f"the chart's transitions send more than {MAX_SENDS} events in all, counting what "
+                                   "the states they leave and enter send; at most that many are accepted", self.path,
+                                   line)
+        return tuple(sends)
 
     def state(self, sid: str, line: int | None) -> Leaf:
         if sid not in self.nodes:
@@ -134,7 +167,7 @@ def _enter(tree: _Tree, domain: str | None, target: str, line: int | None) -> tu
     entered = chain[: chain.index(domain)] if domain in chain else chain
     sends: list[Command] = []
     for sid in reversed(entered):
-        sends += _sends(tree.nodes[sid].onentry)
+        sends += tree.entry(sid)
     node = tree.nodes[target]
     while isinstance(node, State) and not node.is_atomic:
         child, initial_sends = _default_child(tree, node)
@@ -144,7 +177,7 @@ def _enter(tree: _Tree, domain: str | None, target: str, line: int | None) -> tu
             raise DescriptionError(f"state {node.id!r} starts in {child!r}, which is not inside it", tree.path,
                                    node.line)
         for sid in reversed(below[: below.index(node.id or "")]):
-            sends += _sends(tree.nodes[sid].onentry)
+            sends += tree.entry(sid)
         node = tree.nodes[child]
     return node.id or "", sends
 
@@ -203,16 +236,18 @@ def _lifted(tree: _Tree, leaf: Leaf, holder: str, t: Transition) -> ChartTransit
     accepts = tuple(concept_iri(a) for a in t.extra_attrs.get(ACCEPTS, "").split())
     source = leaf.id or ""
     if not t.targets:
-        return ChartTransition(source, source, t.event, tuple(_sends([t])), accepts, t.line, _concept(t), holder)
+        return ChartTransition(source, source, t.event, tree.counted(tree.sent_by(t), t.line), accepts, t.line,
+                               _concept(t), holder)
     if len(t.targets) > 1:
         raise DescriptionError("a transition of a Device State Chart has one target; found "
                                f"{len(t.targets)}", tree.path, t.line)
     domain = _domain(tree, holder, t.targets[0], t)
     chain = tree.chain(source)
     exited = chain[: chain.index(domain)] if domain in chain else chain
-    sends = [c for sid in exited for c in _sends(tree.nodes[sid].onexit)] + _sends([t])
+    sends = [c for sid in exited for c in tree.exit(sid)] + tree.sent_by(t)
     target, entered = _enter(tree, domain, t.targets[0], t.line)
-    return ChartTransition(source, target, t.event, tuple(sends + entered), accepts, t.line, _concept(t), holder)
+    return ChartTransition(source, target, t.event, tree.counted(sends + entered, t.line), accepts, t.line,
+                           _concept(t), holder)
 
 
 def _leaf_transitions(tree: _Tree, leaf: Leaf) -> Iterator[ChartTransition]:
