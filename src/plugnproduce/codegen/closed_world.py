@@ -84,6 +84,8 @@ def _device_region(device: DeviceDescription) -> tuple[State, list[Data]]:
         for node in walk(s, into_charts=False):
             if isinstance(node, State | Final | Parallel | History | Send) and node.id:
                 node.id = f"{prefix}__{node.id}"
+            if isinstance(node, State) and node.initial:  # a compound state's initial child
+                node.initial = [f"{prefix}__{t}" for t in node.initial]
             if isinstance(node, Transition):
                 node.targets = [f"{prefix}__{t}" for t in node.targets]
                 node.event = " ".join(f"{device.id}.{e}" for e in node.events) or None

@@ -23,7 +23,7 @@ from plugnproduce.codegen.specific import (
     specific_region,
 )
 from plugnproduce.description.model import Cell, ChartTransition, Command, Link, ProcessDescription, Step, Task
-from plugnproduce.description.paths import NoPath
+from plugnproduce.description.paths import NoPath, in_concept
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
@@ -285,8 +285,7 @@ def _step(
     for role in process.roles:
         device = cell.device(binding[role.name])
         state = current[device.id]
-        concept = device.state(state).concept
-        if concept is None or not taxonomy.is_a(concept, role.start_concept):
+        if not in_concept(device.state(state), role.start_concept, taxonomy):
             raise ImplausibleStep(step, device.id, state, role.start_concept)
         try:
             region = specific_region(step.index, process, role, device, state, values, ids, taxonomy)

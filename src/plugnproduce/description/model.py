@@ -57,11 +57,25 @@ class Command:
 
 @dataclass(frozen=True)
 class ChartState:
-    """A state of a Device State Chart, with the ontology concept it is annotated with."""
+    """A state of a Device State Chart, with the ontology concept it is annotated with.
+
+    In a chart with compound states, the states a device can be in are the atomic ones; each has its
+    own concept and those of the compound states around it (:mod:`plugnproduce.description.hierarchy`).
+    """
 
     id: str
     concept: str | None
+    """Its own concept, else the nearest enclosing state's."""
     line: int | None
+    concepts: tuple[str, ...] = ()
+    """Every concept it has: its own, then the enclosing states', nearest first (empty: just :attr:`concept`)."""
+    within: tuple[str, ...] = ()
+    """The compound states around it, outermost first."""
+
+    @property
+    def every_concept(self) -> tuple[str, ...]:
+        """Its own concept and those of the compound states around it."""
+        return self.concepts or ((self.concept,) if self.concept else ())
 
 
 @dataclass(frozen=True)
@@ -79,6 +93,8 @@ class ChartTransition:
     line: int | None
     concept: str | None = None
     """The concept the transition is annotated with (``pnp:concept``), e.g. ``pnp:SafeStop``."""
+    origin: str | None = None
+    """The state the transition is written on: :attr:`source` or a compound state around it (None: the source)."""
 
     @property
     def request(self) -> Command | None:
@@ -138,6 +154,8 @@ class DeviceDescription:
     """The parsed Device State Chart (``chart_file`` as read by the one SCXML reader)."""
     reported_state: bool = False
     """Whether :attr:`initial` is the state the device reported (a live cell), not its chart's initial state."""
+    compounds: tuple[ChartState, ...] = ()
+    """The compound states of its chart (their own concepts); :attr:`states` are the atomic ones."""
     stops: tuple[ChartTransition, ...] = ()
     """The safe-stop transitions (a request annotated ``pnp:SafeStop``): sent only to stop the device,
     never planned with, so they are not among :attr:`transitions`."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 import heapq
 from dataclasses import dataclass
 
-from plugnproduce.description.model import ChartTransition, DeviceDescription
+from plugnproduce.description.model import ChartState, ChartTransition, DeviceDescription
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
 
@@ -55,9 +55,15 @@ def chart_edges(device: DeviceDescription) -> Edges:
     return out
 
 
+def in_concept(state: ChartState, concept: str, taxonomy: Taxonomy) -> bool:
+    """Whether a device in ``state`` is in a state of ``concept``: by the state's own concept or that of a
+    compound state around it (``Execute`` inside ``Running``), subsumption counting."""
+    return any(taxonomy.is_a(c, concept) for c in state.every_concept)
+
+
 def matching_states(device: DeviceDescription, concept: str, taxonomy: Taxonomy) -> list[str]:
     """The device's states whose concept the wanted concept subsumes (ClosedWithPart satisfies Closed)."""
-    return [s.id for s in device.states if s.concept and taxonomy.is_a(s.concept, concept)]
+    return [s.id for s in device.states if in_concept(s, concept, taxonomy)]
 
 
 def find_path(

@@ -217,7 +217,8 @@ def _turtle(
         # complete device gets the structure checks.
         subject = device_subject(loaded, taxonomy)
         chart = g.value(subject, PNP.stateChart)
-        states = device_chart(read_chart(file_of(chart)), file_of(chart))[1] if chart is not None else ()
+        lifted = device_chart(read_chart(file_of(chart)), file_of(chart)) if chart is not None else None
+        states = (*lifted.states, *lifted.compounds) if lifted is not None else ()
         classes = [str(c) for c in g.objects(subject, RDF.type)]
         skills = taxonomy.device_skills(classes, [str(k) for k in g.objects(subject, PNP.hasSkill)])
         kg.add_device_facts(str(subject), skills, str(file_of(chart)) if chart is not None else "", states)

@@ -115,7 +115,8 @@ class ClosedWorld:
                          for d in self.devices]
         self._vars = assigned_variables(self.controller)
         self._device_vars = [assigned_variables(s) for s in self.sessions]
-        self._transitions = [{(t.source, t.event): t for t in d.transitions} for d in self.devices]
+        # by the state a transition is written on: a compound state's transition is taken from every state inside it
+        self._transitions = [{(t.origin or t.source, t.event): t for t in d.transitions} for d in self.devices]
 
     def start(self) -> tuple[World, Violation | None]:
         """The initial world: every session started."""
