@@ -44,6 +44,7 @@ from plugnproduce.errors import (
     shorten_words,
     tidy,
 )
+from plugnproduce.protocols.interface import LOOPBACK_ADDRESS, chosen_address
 
 T = TypeVar("T")
 
@@ -52,12 +53,14 @@ T = TypeVar("T")
 class SsdpNetwork:
     """Where SSDP runs: the local address all sockets use, and the multicast group and port.
 
-    The default, :data:`LOOPBACK`, keeps everything on ``127.0.0.1`` with the standard
-    group ``239.255.255.250:1900``. A different ``port`` gives a private SSDP
+    ``interface`` is an IPv4 address of this machine: SSDP sends its multicast out of that
+    interface and joins the group on it, and the devices' servers listen on it. The default,
+    :data:`LOOPBACK`, keeps everything on ``127.0.0.1`` with the standard group
+    ``239.255.255.250:1900``. A different ``port`` gives a private SSDP
     "network" (tests use a free port so that parallel runs do not see each other).
     """
 
-    interface: str = "127.0.0.1"
+    interface: str = LOOPBACK_ADDRESS
     group: str = SSDP_IP_V4
     port: int = SSDP_PORT
 
@@ -79,22 +82,28 @@ SSDP_PORT_VARIABLE = "PNP_SSDP_PORT"
 """Environment variable naming another SSDP port, for a private simulated cell (see :func:`network_from_env`)."""
 
 
-def private_network() -> SsdpNetwork:
-    """Loopback SSDP on a free port: a network only the devices and controller told about it share."""
+def private_network(interface: str = LOOPBACK_ADDRESS) -> SsdpNetwork:
+    """SSDP on a free port of ``interface`` (an address): a network only the devices and controller told about it
+    share."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind((LOOPBACK.interface, 0))
-        return SsdpNetwork(port=int(sock.getsockname()[1]))
+        sock.bind((interface, 0))
+        return SsdpNetwork(interface=interface, port=int(sock.getsockname()[1]))
 
 
-def network_from_env() -> SsdpNetwork:
-    """:data:`LOOPBACK`, or loopback on the port ``PNP_SSDP_PORT`` names, so that ``pnp sim up`` and
-    ``pnp discover`` started with the same value see each other and nobody else."""
+def network_from_env(interface: str | None = None) -> SsdpNetwork:
+    """SSDP on the interface the command line chose and on the standard port, or the one ``PNP_SSDP_PORT`` names,
+    so that ``pnp sim up`` and ``pnp discover`` started with the same values see each other and nobody else.
+
+    ``interface``: the ``--interface`` option, a name or an address; without it ``PNP_INTERFACE``, else loopback
+    (see :func:`~plugnproduce.protocols.interface.chosen_address`).
+    """
+    address = chosen_address(interface)
     value = os.environ.get(SSDP_PORT_VARIABLE, "")
     if not value:
-        return LOOPBACK
+        return SsdpNetwork(interface=address)
     if not value.isdigit() or not 0 < int(value) < 65536:
         raise ProtocolError(f"{SSDP_PORT_VARIABLE}={value!r}: expected a UDP port number (1-65535)")
-    return SsdpNetwork(port=int(value))
+    return SsdpNetwork(interface=address, port=int(value))
 
 
 class UntrustedUrlError(ProtocolError):
