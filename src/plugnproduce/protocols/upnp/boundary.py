@@ -15,6 +15,7 @@ import asyncio
 import ipaddress
 import os
 import socket
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -104,6 +105,26 @@ def network_from_env(interface: str | None = None) -> SsdpNetwork:
     if not value.isdigit() or not 0 < int(value) < 65536:
         raise ProtocolError(f"{SSDP_PORT_VARIABLE}={value!r}: expected a UDP port number (1-65535)")
     return SsdpNetwork(interface=address, port=int(value))
+
+
+IP_MULTICAST_ALL = getattr(socket, "IP_MULTICAST_ALL", 49)
+"""Linux's socket option (``<linux/in.h>``; Python 3.11 does not name it): 0 keeps a socket to its own memberships."""
+
+
+def hear_only_the_interface(transport: object) -> None:
+    """Have an SSDP socket bound to the group's port receive the group's datagrams only from its own interface.
+
+    async-upnp-client joins the group on the chosen interface, but binds the socket to every address; Linux then
+    hands it the group's datagrams arriving on *any* interface some other socket joined it on (a device on loopback
+    would be heard by a controller on ``eth0``). ``IP_MULTICAST_ALL`` 0 limits it to its own membership.
+
+    Only the controller's listeners are so limited. A device's search responder is not: with two such limited
+    sockets on the group's port of one host, Linux was seen to drop announcements arriving on the chosen
+    interface, and a device that hears a search from elsewhere only answers it with its own address.
+    """
+    sock = getattr(transport, "get_extra_info", lambda _name: None)("socket")
+    if sock is not None and sys.platform.startswith("linux") and sock.family == socket.AF_INET:
+        sock.setsockopt(socket.IPPROTO_IP, IP_MULTICAST_ALL, 0)
 
 
 class UntrustedUrlError(ProtocolError):

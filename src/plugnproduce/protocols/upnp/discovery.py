@@ -33,6 +33,7 @@ from plugnproduce.protocols.upnp.boundary import (
     NoRedirectRequester,
     SsdpNetwork,
     TrustedRequester,
+    hear_only_the_interface,
     reason,
 )
 from plugnproduce.protocols.upnp.client import load_device
@@ -97,7 +98,7 @@ class Discovery:
 
 
 def _drop_malformed_datagrams(listener: SsdpSearchListener | SsdpAdvertisementListener) -> None:
-    """Have ``listener``'s socket drop every datagram async-upnp-client cannot parse.
+    """Have ``listener``'s socket drop every datagram async-upnp-client cannot parse, and hear only its interface.
 
     The library ignores a datagram with an invalid header line but lets other malformed ones
     (a duplicate header: aiohttp's ``BadHttpMessage``; a header that is not UTF-8: a
@@ -107,6 +108,7 @@ def _drop_malformed_datagrams(listener: SsdpSearchListener | SsdpAdvertisementLi
     transport = getattr(listener, "_transport", None)
     if transport is None:
         return
+    hear_only_the_interface(transport)
     protocol = transport.get_protocol()
     received = protocol.datagram_received
 
