@@ -96,7 +96,7 @@ async def run_task(
     """
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.interface import chosen_address
-    from plugnproduce.protocols.upnp import network_from_env, private_network
+    from plugnproduce.protocols.upnp import LOOPBACK, network_from_env, private_network
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
@@ -110,7 +110,8 @@ async def run_task(
     network = private_network(chosen_address(interface)) if simulate else network_from_env(interface)
     async with contextlib.AsyncExitStack() as stack:
         if simulate:
-            say(f"starting {len(the_cell.devices)} simulated device(s) on {network.interface}")
+            where = "loopback" if network.interface == LOOPBACK.interface else network.interface
+            say(f"starting {len(the_cell.devices)} simulated device(s) on {where}")
             parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
             sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices), bin=parts)
             await stack.enter_async_context(sim)
