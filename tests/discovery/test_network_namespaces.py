@@ -59,8 +59,8 @@ def host_of(endpoint: str) -> str | None:
 
 
 def test_a_task_runs_on_devices_in_another_namespace(tmp_path: Path) -> None:
-    """``pnp sim up --interface NAME`` on one host; ``pnp discover`` and ``pnp run --cell`` on the other find the
-    devices by SSDP across the link and run the task over XIRP and UPnP there."""
+    """``pnp sim up --interface NAME`` on one host; ``pnp discover``, ``pnp check --live`` and ``pnp run --cell`` on
+    the other find the devices by SSDP across the link, ask their states and run the task over XIRP and UPnP there."""
     with linked_hosts() as (devices, controller), simulated(devices, CELL, tmp_path, "--interface", devices.interface):
         env = environment(tmp_path)
         found = pnp(controller, "discover", "--json", "--cell", CELL, "--timeout", "3600",
@@ -70,6 +70,11 @@ def test_a_task_runs_on_devices_in_another_namespace(tmp_path: Path) -> None:
         assert sorted(d["id"] for d in listed["devices"]) == BIN_PICKING
         assert {host_of(d["endpoint"]) for d in listed["devices"]} == {devices.address}
         assert {d["protocol"] for d in listed["devices"]} == {"xirp", "upnp"}
+
+        checked = pnp(controller, "check", TASK, "--cell", CELL, "--live", "--interface", controller.interface,
+                      env=env)
+        assert checked.returncode == 0, checked.stdout + checked.stderr
+        assert "plausible" in checked.stdout
 
         ran = pnp(controller, "run", TASK, "--cell", CELL, "--json",
                   env={**env, "PNP_INTERFACE": controller.interface})

@@ -73,6 +73,8 @@ def _pnp(*args: str, **env: str) -> subprocess.CompletedProcess[str]:
     ("sim", "up", CELL, "--interface", "no-such0"),
     ("run", TASK, "--cell", CELL, "--interface", "no-such0"),
     ("check", TASK, "--cell", CELL, "--live", "--interface", "no-such0"),
+    ("repair", TASK, "--cell", CELL, "--live", "--interface", "no-such0"),
+    ("serve", "--interface", "no-such0"),
 ])
 def test_an_unknown_interface_is_one_line_and_exit_2(args: tuple[str, ...]) -> None:
     result = _pnp(*args)
