@@ -10,7 +10,9 @@ check and the code generation) to its end:
 - the controller's CPU time (user+sys of this process, ``time.process_time``);
 - the devices' busy time: the union of the intervals in which some device works on a command
   (from a command to that device's next event, read from the run's journal);
-- the devices' process CPU time over the same run (``/proc/PID/stat``), for reference.
+- the devices' process CPU time over the same run (``/proc/PID/stat``), for reference;
+- the share of the run's wall time in which no device was busy (the cell waiting on the
+  controller, the network or the machine's load), for reference: wall time, so load moves it.
 
 Two tasks on the built-in bin-picking cell: ``bin-picking`` (three bin-picks and places) and
 ``until-empty`` (localise, pick and place until a simulated bin of ``--parts`` parts is empty).
@@ -91,44 +93,49 @@ class Devices:
             self.process.wait()
 
 
-async def one_run(task: Path, journal: Path, devices_pid: int) -> tuple[float, float, float, int]:
-    """The controller's CPU, the devices' busy time, the devices' process CPU and the steps of one run."""
+async def one_run(task: Path, journal: Path, devices_pid: int) -> tuple[float, float, float, int, float]:
+    """The controller's CPU, the devices' busy time, the devices' process CPU, the steps and the wall time of one
+    run."""
     marks: dict[str, float] = {}
 
     def started(_: object) -> None:
         marks["cpu"], marks["devices"] = time.process_time(), _process_cpu(devices_pid)
+        marks["wall"] = time.perf_counter()
 
     report = await controller.run_task(task, CELL, journal=journal, started=started)
     cpu, devices_cpu = time.process_time() - marks["cpu"], _process_cpu(devices_pid) - marks["devices"]
+    wall = time.perf_counter() - marks["wall"]
     if report.outcome != "succeeded":
         raise SystemExit(f"{task.name}: the run ended {report.outcome}: {report.fault}")
     records = read_journal(report.journal).records
     steps = sum(1 for r in records if r["kind"] == "step")
-    return cpu, busy_time(records), devices_cpu, steps
+    return cpu, busy_time(records), devices_cpu, steps, wall
 
 
 def measure(name: str, runs: int, parts: int, folder: Path) -> None:
     """Print the controller's CPU per step and its share of the devices' busy time for task ``name``."""
-    shares, per_step, device_share = [], [], []
+    shares, per_step, device_share, idle = [], [], [], []
     load = os.getloadavg()[0]
     for i in range(runs):
         devices = Devices(folder, parts if name == "until-empty" else None)
         try:
             devices.wait_up()
             os.environ["PNP_SSDP_PORT"] = str(devices.port)
-            cpu, busy, devices_cpu, steps = asyncio.run(one_run(TASKS[name], folder / f"{name}-{i}.jsonl",
+            cpu, busy, devices_cpu, steps, wall = asyncio.run(one_run(TASKS[name], folder / f"{name}-{i}.jsonl",
                                                                 devices.process.pid))
         finally:
             devices.stop()
         shares.append(cpu / busy)
         per_step.append(cpu / steps)
         device_share.append(devices_cpu / busy)
+        idle.append((wall - busy) / wall)
         print(f"  run {i + 1}: {steps} steps, controller CPU {cpu:.3f} s, devices busy {busy:.2f} s, "
-              f"devices' process CPU {devices_cpu:.3f} s", flush=True)
+              f"devices' process CPU {devices_cpu:.3f} s, wall {wall:.2f} s", flush=True)
     share = statistics.median(shares)
     print(f"{name}: controller CPU {1000 * statistics.median(per_step):.2f} ms per step = {100 * share:.1f} % of "
           f"the devices' busy time (target <= {100 * TARGET:.0f} %; devices' own process "
-          f"{100 * statistics.median(device_share):.1f} %) | load {load:.2f} -> {os.getloadavg()[0]:.2f}",
+          f"{100 * statistics.median(device_share):.1f} %); no device busy {100 * statistics.median(idle):.1f} % of "
+          f"the run's wall time | load {load:.2f} -> {os.getloadavg()[0]:.2f}",
           flush=True)
 
 
