@@ -25,7 +25,8 @@ from plugnproduce.executor.journal import read_journal
 
 def busy_time(records: list[dict[str, object]]) -> float:
     """Length of the union of the intervals in which a device works on a command."""
-    intervals, waiting = [], {}
+    intervals: list[tuple[float, float]] = []
+    waiting: dict[object, float] = {}
     for r in records:
         if r["kind"] == "command":
             waiting.setdefault(r["device"], float(r["t"]))  # type: ignore[arg-type]
