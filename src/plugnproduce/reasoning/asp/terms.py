@@ -74,6 +74,12 @@ _CODECS: dict[object, tuple[Callable[[Any], str], Callable[[clingo.Symbol], Any]
 _CODECS.update({str: _CODECS["str"], int: _CODECS["int"], clingo.Symbol: _CODECS["clingo.Symbol"]})
 
 
+def codec(type_name: str, encode: Callable[[Any], str], decode: Callable[[clingo.Symbol], Any]) -> None:
+    """Let a predicate's field be of the type named ``type_name`` (as annotated): written by ``encode``, read by
+    ``decode`` (which raises :class:`EncodingError` for a symbol that does not fit)."""
+    _CODECS[type_name] = (encode, decode)
+
+
 @dataclass_transform(frozen_default=True)
 def predicate(name: str) -> Callable[[type[A]], type[A]]:
     """Class decorator: make a frozen dataclass a typed ASP predicate called ``name``."""
