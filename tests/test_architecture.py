@@ -13,6 +13,7 @@ SRC = Path(__file__).parent.parent / "src" / "plugnproduce"
 LAYERS = {
     "cli": 7,  # the command line may also start the web HMI (pnp serve)
     "hmi": 6,
+    "controller": 5.5,  # runs a cell: the cell sources, the runs (discovery, executor, sim) over the service
     "service": 5,
     "executor": 4, "sim": 4, "discovery": 4,
     "verification": 3.5,  # explores the generated program (codegen) in the runtime (statechart)

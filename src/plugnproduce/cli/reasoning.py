@@ -21,13 +21,14 @@ from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
     from plugnproduce import batch as batching
-    from plugnproduce import reasoning, service
+    from plugnproduce import controller, reasoning, service
     from plugnproduce.description import loader
     from plugnproduce.description.model import Cell
 else:
     loader = lazy_module("plugnproduce.description.loader")
     batching = lazy_module("plugnproduce.batch")
     reasoning = lazy_module("plugnproduce.reasoning")
+    controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 
 CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
@@ -41,7 +42,7 @@ def _cell(cell: Path, live: bool, discovery_timeout: float | None) -> Path | Cel
         return cell
     import asyncio
 
-    return asyncio.run(service.live_cell(cell, knowledge(cell), discovery_timeout or service.DISCOVERY_SECONDS))
+    return asyncio.run(controller.live_cell(cell, knowledge(cell), discovery_timeout or controller.DISCOVERY_SECONDS))
 VERBOSE_OPTION = typer.Option(False, "--verbose", "-v",
                               help="The engineer's view: ontology terms, rule instances, axioms and file:line.")
 

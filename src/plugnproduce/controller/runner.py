@@ -1,8 +1,8 @@
-"""The executor as the HMI's :class:`~plugnproduce.hmi.interfaces.Runner`.
+"""The executor as the HMI's :class:`~plugnproduce.controller.interfaces.Runner`.
 
 A run takes the service's one path: :func:`plugnproduce.service.plan_run` checks the task for
 the cell as it is now, each device in the state it reports, and generates only its task chart;
-:func:`plugnproduce.service.start_run` runs it against the cell's devices at the endpoints
+:func:`plugnproduce.controller.run.start_run` runs it against the cell's devices at the endpoints
 discovery found, journalling into the runs folder. A device the cell source sees leave during
 the run is a lost device: the run stops with a fault.
 One run at a time.
@@ -17,11 +17,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from plugnproduce import service
+from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
+from plugnproduce.controller.run import StateNotReported, reported_states, start_run
+from plugnproduce.controller.simcell import SimulatedCellSource
 from plugnproduce.description.model import Cell, Task
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
-from plugnproduce.hmi.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
-from plugnproduce.hmi.simcell import SimulatedCellSource
 from plugnproduce.knowledge import Knowledge
 
 log = logging.getLogger(__name__)
@@ -65,11 +66,11 @@ class ExecutorRunner:
         if isinstance(self._source, SimulatedCellSource):
             self._source.prepare_run(task)  # its default bin, for a task that loops on a localized pose
         try:  # planned from the state each device reports, not its chart's initial state
-            reported = cell.reported(await service.reported_states(cell))
+            reported = cell.reported(await reported_states(cell))
             generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)
             prefixes = await asyncio.to_thread(  # how devices may name concepts (pnp:PartFound)
                 lambda: (self._knowledge or service.knowledge()).prefixes)
-        except service.StateNotReported as exc:
+        except StateNotReported as exc:
             raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
         except service.ImplausibleTask as exc:
             first = exc.result.problems[0]
@@ -81,7 +82,7 @@ class ExecutorRunner:
             started.set()
             observer(run_id, record)
 
-        run = service.start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes)
+        run = start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes)
         self._loop = asyncio.get_running_loop()
         running = asyncio.create_task(run.run(), name=f"run {run_id}")
         running.add_done_callback(self._finished)

@@ -1,8 +1,8 @@
 """What the HMI needs from the rest of the controller, as small protocols.
 
 The HMI shows a cell that changes (devices plug in and unplug) and runs tasks on it; it is
-written against these interfaces, which :mod:`plugnproduce.hmi.livecell` and
-:mod:`plugnproduce.hmi.simcell` (discovery) and :mod:`plugnproduce.hmi.executorrunner`
+written against these interfaces, which :mod:`plugnproduce.controller.livecell` and
+:mod:`plugnproduce.controller.simcell` (discovery) and :mod:`plugnproduce.controller.runner`
 (the executor) implement:
 
 - :class:`CellSource` gives the current :class:`~plugnproduce.description.model.Cell`

@@ -1,8 +1,8 @@
-"""The cell as discovery sees it, as a :class:`~plugnproduce.hmi.interfaces.CellSource`.
+"""The cell as discovery sees it, as a :class:`~plugnproduce.controller.interfaces.CellSource`.
 
 Every :class:`~plugnproduce.discovery.CellChange` of a :class:`~plugnproduce.discovery.LiveCell`
 (an SSDP ``alive`` or ``byebye``, or a device refused) becomes a
-:class:`~plugnproduce.hmi.interfaces.CellUpdate` for the listeners, in the order discovery saw them.
+:class:`~plugnproduce.controller.interfaces.CellUpdate` for the listeners, in the order discovery saw them.
 """
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ import threading
 from collections.abc import Callable
 
 from plugnproduce import service
+from plugnproduce.controller.interfaces import CellListener, CellUpdate
 from plugnproduce.description.model import Cell
 from plugnproduce.discovery import LiveCell
-from plugnproduce.hmi.interfaces import CellListener, CellUpdate
 from plugnproduce.knowledge import Knowledge
 from plugnproduce.protocols.upnp import SsdpNetwork
 

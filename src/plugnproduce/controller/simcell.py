@@ -1,4 +1,4 @@
-"""A simulated cell followed by discovery, as a :class:`~plugnproduce.hmi.interfaces.PluggableCellSource`.
+"""A simulated cell followed by discovery, as a :class:`~plugnproduce.controller.interfaces.PluggableCellSource`.
 
 The devices of a cell file run their own charts behind XIRP and UPnP servers on a
 private loopback SSDP network (:class:`~plugnproduce.sim.cell.SimulatedCell`). The HMI
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from plugnproduce import service
+from plugnproduce.controller.interfaces import CellChangeRefused
+from plugnproduce.controller.livecell import LiveCellSource
+from plugnproduce.controller.run import SIMULATED_DISCOVERY_SECONDS, DevicesMissing, default_bin_parts
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import ProtocolTimeout
-from plugnproduce.hmi.interfaces import CellChangeRefused
-from plugnproduce.hmi.livecell import LiveCellSource
 from plugnproduce.knowledge import Knowledge
 from plugnproduce.protocols.upnp import private_network
 from plugnproduce.sim.bin import SimulatedBin
@@ -34,12 +34,12 @@ class SimulatedCellSource(LiveCellSource):
     ``bin`` the simulated bin they work on as ``pnp run --bin-parts`` (none: their charts' fixed values).
 
     Without a ``bin``, a ``default_bin`` is the bin of the runs whose task takes a reported value (a localized
-    pose: :func:`plugnproduce.service.default_bin_parts`), as ``pnp run --sim`` gives one; other runs work on
+    pose: :func:`plugnproduce.controller.run.default_bin_parts`), as ``pnp run --sim`` gives one; other runs work on
     the charts' fixed values. It is one bin for the session: what one run takes out of it is gone for the next.
     """
 
     def __init__(self, cell: Cell, catalogue: list[DeviceDescription], faults: str = "",
-                 wait: float = service.SIMULATED_DISCOVERY_SECONDS, knowledge: Knowledge | None = None,
+                 wait: float = SIMULATED_DISCOVERY_SECONDS, knowledge: Knowledge | None = None,
                  bin: SimulatedBin | None = None, default_bin: SimulatedBin | None = None) -> None:  # noqa: A002
         """``wait``: seconds a plug, unplug or the start may take until discovery has seen it."""
         super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS, knowledge=knowledge)
@@ -53,7 +53,7 @@ class SimulatedCellSource(LiveCellSource):
         """Before a run of ``task``: the default bin for a task that takes a reported value, else none (a bin
         given at the start stays)."""
         if self._default_bin is not None:
-            self.sim.use_bin(self._default_bin if service.default_bin_parts(task) is not None else None)
+            self.sim.use_bin(self._default_bin if default_bin_parts(task) is not None else None)
 
     def catalogue(self) -> list[DeviceDescription]:
         """The devices that can be plugged in: the catalogue and the cell file's own devices."""
@@ -66,7 +66,7 @@ class SimulatedCellSource(LiveCellSource):
             await self.sim.plug(device_id)
         if not await self.wait_until(lambda cell: {d.id for d in cell.devices} >= set(self._wanted), self._wait):
             missing = sorted(set(self._wanted) - {d.id for d in self.cell.devices})
-            raise service.DevicesMissing(f"simulated device(s) {', '.join(missing)} of cell {self.cell.name} "
+            raise DevicesMissing(f"simulated device(s) {', '.join(missing)} of cell {self.cell.name} "
                                          f"not seen by discovery within {self._wait:g} s")
 
     async def stop(self) -> None:
