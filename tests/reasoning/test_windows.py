@@ -19,12 +19,12 @@ KNOWLEDGE = service.knowledge()
 
 
 def whole(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None = None, top: int = 1) -> list:
-    return repairs.repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, catalogue, top=top)
+    return repairs.repair(task, cell, KNOWLEDGE, catalogue, top=top)
 
 
 def windowed(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None = None, top: int = 1,
              margin: int = windows.MARGIN) -> list:
-    return windows.windowed_repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, catalogue, top=top,
+    return windows.windowed_repair(task, cell, KNOWLEDGE, catalogue, top=top,
                                    margin=margin)
 
 
@@ -43,9 +43,9 @@ def test_when_swapping_is_cheaper_than_inserting_the_windows_widen_until_the_cos
     costs = RepairCosts(insert=10, insert_per_role=1, remove=8, swap=1, rebind=1, reset=5)
     assert not windows.edits_stay_local(costs, KNOWLEDGE.processes)
     task = faulty_task(8, 1, 113371)  # with windows of the problem alone: remove a step (8), not swap two (1)
-    best = windows.windowed_repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs, top=1,
+    best = windows.windowed_repair(task, cell, KNOWLEDGE, costs=costs, top=1,
                                    margin=0)[0]
-    assert best.cost == repairs.repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs,
+    assert best.cost == repairs.repair(task, cell, KNOWLEDGE, costs=costs,
                                        top=1)[0].cost == 1
 
 

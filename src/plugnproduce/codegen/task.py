@@ -10,6 +10,7 @@ the executor raises, ends the task in ``failed``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from plugnproduce.codegen.flow import OUTCOME, Outcomes, branch_variable, flow_data, flow_transitions, outcome_names
@@ -169,7 +170,7 @@ def generate_task(
     task: Task,
     cell: Cell,
     bindings: list[dict[str, str]],
-    processes: dict[str, ProcessDescription],
+    processes: Mapping[str, ProcessDescription],
     taxonomy: Taxonomy,
 ) -> GeneratedTask:
     """Generate the Task State Chart of a task whose steps are bound to devices (``bindings[i]`` for step i+1).
@@ -214,7 +215,7 @@ def _plan(
     task: Task,
     cell: Cell,
     bindings: list[dict[str, str]],
-    processes: dict[str, ProcessDescription],
+    processes: Mapping[str, ProcessDescription],
     taxonomy: Taxonomy,
     consumed: dict[str, set[str]],
 ) -> tuple[list[_Key], list[dict[str, object]]]:

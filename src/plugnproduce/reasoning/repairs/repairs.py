@@ -11,9 +11,9 @@ program with the catalogue is never grounded.
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable, Sequence
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book, task_facts
@@ -24,6 +24,9 @@ from plugnproduce.reasoning.checks.contracts import normalised
 from plugnproduce.reasoning.checks.offers import CELL, cell_program
 from plugnproduce.reasoning.checks.plausibility import TASK, check
 from plugnproduce.reasoning.checks.refusals import Refusals, refusal_facts, reset_reason
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 PER_GAP = 2
 """Default number of commands that may be inserted before each step."""
@@ -89,7 +92,7 @@ def task_program(task: Task, devices: Sequence[DeviceDescription], book: FactBoo
     cell's and the catalogue's) refuse which of them (:mod:`..checks.refusals`; ``known``: the answers so far)."""
     readable, _ = normalised(task, book.processes, keep_unreadable=True)
     return program(task_facts(readable, TASK)
-                   + refusal_facts(readable, TASK, devices, book.processes, book.taxonomy, known))
+                   + refusal_facts(readable, TASK, devices, book.knowledge, known))
 
 
 def _optimise(book: FactBook, task: Task, cell: Cell, extra: Sequence[DeviceDescription], top: int,
@@ -104,8 +107,7 @@ def _optimise(book: FactBook, task: Task, cell: Cell, extra: Sequence[DeviceDesc
 def repair(
     task: Task,
     cell: Cell,
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     catalogue: Sequence[DeviceDescription] | None = None,
     top: int = 3,
     costs: RepairCosts | None = None,
@@ -114,12 +116,12 @@ def repair(
 ) -> list[Repair]:
     """The ``top`` cheapest distinct repairs of ``task`` in ``cell`` (empty if it is plausible already)."""
     costs = costs or RepairCosts()
-    if top < 1 or check(task, cell, taxonomy, processes).plausible:
+    if top < 1 or check(task, cell, knowledge).plausible:
         return []
-    book = fact_book(taxonomy, processes)
+    book = fact_book(knowledge)
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
-    known = Refusals(taxonomy)
+    known = Refusals(knowledge.taxonomy)
     models = _optimise(book, task, cell, (), top, costs, per_gap, max_inserts, known)
     cheapest_add = min((add_cost(costs, d) for d in extra), default=None)
     if cheapest_add is not None and (len(models) < top or models[-1].cost[0] > cheapest_add):

@@ -56,9 +56,9 @@ import heapq
 from collections import defaultdict
 from collections.abc import Hashable, Iterable, Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book, task_facts
@@ -70,6 +70,9 @@ from plugnproduce.reasoning.checks.offers import CELL, cell_program
 from plugnproduce.reasoning.checks.plausibility import TASK
 from plugnproduce.reasoning.checks.refusals import Refusals
 from plugnproduce.reasoning.repairs import lifting, repairs
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 WHOLE_UP_TO = 40
 """Tasks of at most this many steps are repaired whole (:func:`.repairs.repair`): fast enough, and
@@ -184,8 +187,7 @@ def windows(spans: Iterable[Window], n: int, margin: int) -> list[Window]:
 def repair(
     task: Task,
     cell: Cell,
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     catalogue: Sequence[DeviceDescription] | None = None,
     top: int = 3,
     costs: RepairCosts | None = None,
@@ -195,17 +197,16 @@ def repair(
     """The ``top`` cheapest distinct repairs of ``task`` in ``cell``: whole if short, else window by window;
     each lifted onto the written task, its loops and branches kept where that is plausible (:mod:`lifting`)."""
     if len(task.steps) <= WHOLE_UP_TO or max_inserts is not None:
-        found = repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap, max_inserts)
+        found = repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap, max_inserts)
     else:
-        found = windowed_repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
-    return lifting.lifted(found, task, cell, taxonomy, processes, catalogue or ())
+        found = windowed_repair(task, cell, knowledge, catalogue, top, costs, per_gap)
+    return lifting.lifted(found, task, cell, knowledge, catalogue or ())
 
 
 def windowed_repair(
     task: Task,
     cell: Cell,
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     catalogue: Sequence[DeviceDescription] | None = None,
     top: int = 3,
     costs: RepairCosts | None = None,
@@ -217,21 +218,21 @@ def windowed_repair(
     ``margin``: unbroken steps first added on each side of a problem (doubled until doubling it
     changes no cost)."""
     costs = costs or RepairCosts()
-    book = fact_book(taxonomy, processes)
-    readable, _ = normalised(task, processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
+    book = fact_book(knowledge)
+    readable, _ = normalised(task, knowledge.processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
     facts = cell_program(book, cell) + program(task_facts(readable, TASK)) + program([s.Check(CELL, TASK)])
     chain = _Chain(task, decode(solver.symbols(solver.CHECK, facts)))
     if top < 1 or chain.plausible:  # plausible to the encodings: whatever else check() finds, repair.lp cannot fix
-        return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap) if top >= 1 else []
+        return repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap) if top >= 1 else []
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
     narrower: list[Repair] | None = None
     memo: dict[Hashable, list[Model]] = {}
-    local = edits_stay_local(costs, processes)
+    local = edits_stay_local(costs, knowledge.processes)
     while True:
         wins = windows(chain.spans(), chain.n, margin)
         if wins == [Window(1, chain.n)]:
-            return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
+            return repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap)
         found = _Solver(book, chain, cell, costs, per_gap, top, memo).best(wins, extra)
         if found is not None and (local or (narrower is not None
                                             and [r.cost for r in found] == [r.cost for r in narrower])):
