@@ -39,4 +39,4 @@ def test_a_windows_edit_is_moved_to_the_whole_tasks_step_and_an_added_device_sta
 @pytest.mark.parametrize("text", ['paint(2,"red")', "remove(2,3)", 'remove("two")', "remove"])
 def test_an_edit_of_no_known_kind_is_an_error_of_the_encodings_naming_it(text: str) -> None:
     with pytest.raises(EncodingError, match=r"repair\.lp shows an (unknown )?edit"):
-        decode([clingo.parse_term(f"edit({text})")])
+        decode([clingo.parse_term(f"edit({text})")])[s.Edit]
