@@ -107,3 +107,14 @@ def test_a_short_task_is_repaired_whole(cell: Cell) -> None:
 ])
 def test_windows_widen_and_merge(spans: list[Window], margin: int, expected: list[Window]) -> None:
     assert windows.windows(spans, 100, margin) == expected
+
+
+def test_a_long_task_is_repaired_in_a_cell_with_a_device_that_lacks_an_argument(cell: Cell, device) -> None:
+    # the vacuum gripper needs a vacuum no gripping process supplies (missing_arg/5, a shown atom with no step):
+    # the windowed repair took the first number of every shown atom it did not know as a problem's step
+    with_vacuum = cell.with_device(device("vacuum-gripper"))
+    task = faulty_task(30, 2, 7)
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    best = service.repair(task, with_vacuum, top=1)[0]
+    assert best.cost == whole(task, with_vacuum)[0].cost
+    assert service.check(best.task, with_vacuum).plausible
