@@ -23,13 +23,13 @@ from pyshacl import validate as shacl_validate
 
 from plugnproduce.description.datagraph import DataGraph
 from plugnproduce.validation import validate as validation
-from plugnproduce.validation.findings import Problem
+from plugnproduce.validation.findings import Finding
 from plugnproduce.validation.shapes import shape_problems, shapes_graph
 
 DESCRIPTIONS = Path(__file__).resolve().parents[1] / "descriptions"
 
 
-def plain(kg: DataGraph) -> list[Problem]:
+def plain(kg: DataGraph) -> list[Finding]:
     """The shapes run as pySHACL runs them unaided; the problems read off as :func:`shape_problems` reads them."""
     captured: list[object] = []
     real = shacl_validate
@@ -53,7 +53,7 @@ def graph_of(paths: list[Path]) -> DataGraph:
     seen: list[DataGraph] = []
     real = validation.shape_problems
 
-    def keep(kg: DataGraph) -> list[Problem]:
+    def keep(kg: DataGraph) -> list[Finding]:
         seen.append(kg)
         return []
 

@@ -20,7 +20,7 @@ import rdflib
 
 from plugnproduce.description.loader import load_device, load_process
 from plugnproduce.description.model import DeviceDescription, ProcessDescription
-from plugnproduce.errors import DescriptionError, OntologyError
+from plugnproduce.errors import DescriptionError, OntologyError, UnknownName
 from plugnproduce.ontology.sources import with_imports
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
 from plugnproduce.ontology.vocabulary import PNP_IRI
@@ -106,7 +106,7 @@ class Knowledge:
         """The process a command names."""
         found = self.processes_by_id.get(command)
         if found is None:
-            raise KeyError(command)
+            raise UnknownName("process command", command, self.processes_by_id)
         return found
 
     @cached_property

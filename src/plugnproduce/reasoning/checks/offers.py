@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.errors import UnknownName
 from plugnproduce.reasoning.asp import render, solver
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.facts import FactBook, config_facts, fact_book
@@ -115,5 +116,4 @@ def explain_process(cell: Cell, command: str, knowledge: Knowledge) -> ProcessEx
     for n in caps.not_offered:
         if n.command == command:
             return ProcessExplanation(n.command, n.label, False, (), n.reasons)
-    known = ", ".join(sorted(knowledge.processes_by_id))
-    raise KeyError(f"process command {command!r} (known: {known})")
+    raise UnknownName("process command", command, knowledge.processes_by_id)

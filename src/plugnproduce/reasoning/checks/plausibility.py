@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, Task, Where
 from plugnproduce.description.outcomes import flow_findings
+from plugnproduce.errors import UnknownName
 from plugnproduce.reasoning.asp import render, solver
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.facts import fact_book, task_facts
@@ -135,7 +136,7 @@ def _branched(task: Task, cell: Cell, knowledge: Knowledge) -> CheckResult:
 def explain_step(task: Task, cell: Cell, n: int, knowledge: Knowledge) -> StepExplanation:
     """Why step ``n`` (1-based) is (not) plausible: each device it uses, its state and what the step needs."""
     if not 1 <= n <= len(task.steps):
-        raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+        raise UnknownName("step", n, detail=f"the task has steps 1 to {len(task.steps)}")
     if task.branches:  # along a path that runs the step, so that its states are the ones it starts from
         straight, positions = on_a_path(task, n, knowledge)
         ex = explain_step(straight, cell, positions.index(n) + 1, knowledge)

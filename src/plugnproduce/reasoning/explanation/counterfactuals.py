@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.description.paths import in_concept
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book
@@ -124,12 +125,12 @@ def needed_states(result: CheckResult, task: Task, n: int, cell: Cell, knowledge
             continue
         dev = next(d for d in cell.devices if d.id == p.device)
         for st in dev.states:
-            if st.concept is None or not knowledge.taxonomy.is_a(st.concept, p.needed):
+            if not in_concept(st, p.needed, knowledge.taxonomy):
                 continue
             states = {**step.states, p.device: st.id}
             ok = check(alone, _from_states(cell, states), knowledge).plausible
             if ok:
-                label = knowledge.taxonomy.label(st.concept)
+                label = knowledge.taxonomy.label(st.concept or p.needed)
                 out.append(Counterfactual("state", f"if device '{p.device}' were in state '{st.id}' ({label}) when "
                                                    f"step {n} starts, the step would be plausible", True,
                                           (p.device,), state=st.id, step=n))

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task, Where
+from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.asp import schema as s
@@ -345,7 +346,7 @@ def explain_offered(command: str, cell: Cell, knowledge: Knowledge, ontology: On
     """Why ``command`` is (not) offered in ``cell``: the derivation, and the confirmed counterfactuals — devices
     to add or swap in for a "no", the devices a "yes" rests on."""
     if command not in knowledge.processes_by_id:
-        raise KeyError(f"process command {command!r} (known: {', '.join(sorted(knowledge.processes_by_id))})")
+        raise UnknownName("process command", command, knowledge.processes_by_id)
     w = words(cell, knowledge, ontology, language)
     model = derivation_model(cell, knowledge)
     if any(a.p == command for a in model[s.Offered]):
@@ -365,7 +366,7 @@ def explain_plausible(task: Task, n: int, cell: Cell, knowledge: Knowledge, onto
     devices would have to be in (the service adds the repairs, with their side effects, from
     :func:`sideeffects.assess`)."""
     if not 1 <= n <= len(task.steps):
-        raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+        raise UnknownName("step", n, detail=f"the task has steps 1 to {len(task.steps)}")
     if task.branches:  # along the path that makes the step (not) plausible, numbered as the task numbers it
         straight, positions = on_a_path(task, n, knowledge, lambda t: check(t, cell, knowledge))
         ex = explain_plausible(straight, positions.index(n) + 1, cell, knowledge, ontology, language)
