@@ -17,7 +17,7 @@ from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 
 if TYPE_CHECKING:  # the knowledge is loaded by the commands that need it
-    from plugnproduce.knowledge import Knowledge
+    from plugnproduce.service import Knowledge
 
 app = PlainTyper(
     no_args_is_help=True,
