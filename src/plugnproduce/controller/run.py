@@ -199,8 +199,7 @@ def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
     """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
     real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
 
-    Both faces start runs this way: ``pnp run`` after discovering the cell's devices
-    (:func:`run_task`), the HMI with the devices its cell source follows.
+    :func:`planned_run` makes every run this way, once the task is planned.
     """
     from plugnproduce.executor.run import TaskRun
 
