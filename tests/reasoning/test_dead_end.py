@@ -2,7 +2,7 @@
 
 The library under tests/data/libraries/transport-lock (written outside the package) has a gripper delivered
 locked open for transport: its chart starts in an Open state from which no transition leads to Closed. The
-check (``stuck`` in rules/chain.lp), the batch (its twin in reasoning/feasibility.py) and code generation must
+check (``stuck`` in rules/chain.lp), the batch (its twin in batch/feasibility.py) and code generation must
 all say no, and say it alike.
 """
 
@@ -17,11 +17,11 @@ import pytest
 from typer.testing import CliRunner
 
 from plugnproduce import reasoning, service
+from plugnproduce.batch import Configuration
 from plugnproduce.cli import app
 from plugnproduce.codegen import generate_task
 from plugnproduce.codegen.task import StuckStep
 from plugnproduce.description.model import Cell
-from plugnproduce.reasoning import Configuration
 from plugnproduce.service import checks
 
 LIBRARY = Path(__file__).parent.parent / "data" / "libraries" / "transport-lock"

@@ -93,6 +93,15 @@ from plugnproduce.service.programs import (
 
 if TYPE_CHECKING:
     from plugnproduce import reasoning
+    from plugnproduce.batch import (
+        BATCH_CSV_HEADER,
+        ClusterAccess,
+        bounded_lines,
+        check_cluster_address,
+        configurations_from,
+        read_configurations,
+    )
+    from plugnproduce.batch import generate as random_configurations
     from plugnproduce.codegen import GeneratedTask, ImplausibleStep
     from plugnproduce.codegen.outputs import GeneratedChart
     from plugnproduce.knowledge.vocab import taxonomy_tree, vocabulary, vocabulary_text, vocabulary_tree
@@ -100,18 +109,7 @@ if TYPE_CHECKING:
     from plugnproduce.ontology.taxonomy import Taxonomy
     from plugnproduce.ontology.vocabulary import concept_value, local_name
     from plugnproduce.planning import Plan, Unreachable
-    from plugnproduce.reasoning import (
-        BATCH_CSV_HEADER,
-        CheckResult,
-        ClusterAccess,
-        Explanation,
-        Reason,
-        bounded_lines,
-        check_cluster_address,
-        configurations_from,
-        read_configurations,
-    )
-    from plugnproduce.reasoning import generate as random_configurations
+    from plugnproduce.reasoning import CheckResult, Explanation, Reason
     from plugnproduce.resources import rules_path
     from plugnproduce.safeio import MAX_BYTES, MAX_DIGITS
     from plugnproduce.verification import Budget, Verification
@@ -127,9 +125,10 @@ _ELSEWHERE = {
     "Taxonomy": "plugnproduce.ontology.taxonomy",
     **dict.fromkeys(("concept_value", "local_name"), "plugnproduce.ontology.vocabulary"),
     **dict.fromkeys(("Plan", "Unreachable"), "plugnproduce.planning"),
-    **dict.fromkeys(("BATCH_CSV_HEADER", "CheckResult", "ClusterAccess", "Explanation", "Reason", "bounded_lines",
-                     "check_cluster_address", "configurations_from", "read_configurations"), "plugnproduce.reasoning"),
-    "random_configurations": "plugnproduce.reasoning:generate",
+    **dict.fromkeys(("BATCH_CSV_HEADER", "ClusterAccess", "bounded_lines", "check_cluster_address",
+                     "configurations_from", "read_configurations"), "plugnproduce.batch"),
+    "random_configurations": "plugnproduce.batch:generate",
+    **dict.fromkeys(("CheckResult", "Explanation", "Reason"), "plugnproduce.reasoning"),
     "rules_path": "plugnproduce.resources",
     **dict.fromkeys(("MAX_BYTES", "MAX_DIGITS"), "plugnproduce.safeio"),
     **dict.fromkeys(("Budget", "Verification"), "plugnproduce.verification"),

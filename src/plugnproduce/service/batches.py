@@ -19,38 +19,38 @@ from plugnproduce.service.descriptions import (
 )
 
 if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
-    from plugnproduce import reasoning
+    from plugnproduce import batch as batching
 else:
-    reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
+    batching = lazy_module("plugnproduce.batch")  # a validation needs no batch engine
 
 
 def batch(
-    configurations: Iterable[reasoning.Configuration] | str | Path,
+    configurations: Iterable[batching.Configuration] | str | Path,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     tasks: list[Task | str | Path] | None = None,
     workers: int = 2,
     progress: Callable[[int], None] | None = None,
     knowledge: Knowledge | None = None,
     top: int = 1,
-    cluster: str | reasoning.ClusterAccess | None = None,
-) -> Iterator[reasoning.BatchRow]:
+    cluster: str | batching.ClusterAccess | None = None,
+) -> Iterator[batching.BatchRow]:
     """Feasibility of many configurations (an iterable, or a JSONL/CSV file of device lists) of catalogue
     devices, streamed in order: per configuration the offered processes, the plausible tasks, and when
     some task is not, the ``top`` cheapest sets of catalogue devices to add (or why none suffices).
     ``cluster``: a Dask scheduler address (``tcp://host:8786``) or ``local:N`` (N local worker processes), or a
-    :class:`~plugnproduce.reasoning.ClusterAccess` with its connect timeout and TLS files; a cluster address is
+    :class:`~plugnproduce.batch.ClusterAccess` with its connect timeout and TLS files; a cluster address is
     trusted code execution (it runs what the batch sends, and what comes back is unpickled)."""
     k = _k(knowledge)
     devices = _devices(catalogue_or_folder, k)
-    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+    configs = (batching.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
-    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
-    return reasoning.batch(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+    mapper = batching.cluster_mapper(cluster) if cluster is not None else None
+    return batching.batch(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
                            workers=workers, progress=progress, top=top, mapper=mapper)
 
 
 def batch_report(
-    configurations: Iterable[reasoning.Configuration] | str | Path,
+    configurations: Iterable[batching.Configuration] | str | Path,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     tasks: list[Task | str | Path] | None = None,
     form: str = "jsonl",
@@ -58,7 +58,7 @@ def batch_report(
     progress: Callable[[int], None] | None = None,
     knowledge: Knowledge | None = None,
     top: int = 1,
-    cluster: str | reasoning.ClusterAccess | None = None,
+    cluster: str | batching.ClusterAccess | None = None,
     tally: dict[str, int] | None = None,
 ) -> Iterator[str]:
     """:func:`batch`'s answers as report text (JSONL, or CSV rows with ``form`` "csv"), a chunk at a time,
@@ -66,10 +66,10 @@ def batch_report(
     (all plausible, a purchase, a role to bind, nothing helps)."""
     k = _k(knowledge)
     devices = _devices(catalogue_or_folder, k)
-    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+    configs = (batching.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
-    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
-    return reasoning.report(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+    mapper = batching.cluster_mapper(cluster) if cluster is not None else None
+    return batching.report(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
                             form=form, workers=workers, progress=progress, top=top, mapper=mapper, tally=tally)
 
 
@@ -79,38 +79,38 @@ def batch_engine(
     top: int = 1,
     libraries: tuple[str | Path, ...] = (),
     builtin: bool = True,
-) -> reasoning.Engine:
+) -> batching.Engine:
     """What a batch over files reasons once (the catalogue devices and tasks against the libraries' processes),
     kept in the user's cache folder: a later batch over the same files, unchanged, reads it back instead of
-    reading and reasoning over every description again (:mod:`.reasoning.enginecache`)."""
-    from plugnproduce.reasoning import enginecache
+    reading and reasoning over every description again (:mod:`.batch.enginecache`)."""
+    from plugnproduce.batch import enginecache
 
     folder = Path(catalogue_folder) if catalogue_folder is not None else None
     libs = ((builtin_library(),) if builtin else ()) + library_folders(libraries)
 
-    def build() -> reasoning.Engine:
+    def build() -> batching.Engine:
         k = knowledge(libraries, builtin)
-        return reasoning.engine(catalogue(folder, k), [task(p) for p in tasks], k.taxonomy, k.processes, top)
+        return batching.engine(catalogue(folder, k), [task(p) for p in tasks], k.taxonomy, k.processes, top)
 
     key = enginecache.digest(libs, folder, [Path(p) for p in tasks], top)
     found = enginecache.cached(key, build)
-    return found if isinstance(found, reasoning.Engine) else build()
+    return found if isinstance(found, batching.Engine) else build()
 
 
 def batch_report_from(
-    engine: reasoning.Engine,
-    configurations: Iterable[reasoning.Configuration] | str | Path,
+    engine: batching.Engine,
+    configurations: Iterable[batching.Configuration] | str | Path,
     form: str = "jsonl",
     workers: int = 2,
     progress: Callable[[int], None] | None = None,
-    cluster: str | reasoning.ClusterAccess | None = None,
+    cluster: str | batching.ClusterAccess | None = None,
     tally: dict[str, int] | None = None,
 ) -> Iterator[str]:
     """:func:`batch_report` by an engine already built (:func:`batch_engine`)."""
-    configs = (reasoning.read_configurations(configurations) if isinstance(configurations, str | Path)
+    configs = (batching.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
-    mapper = reasoning.cluster_mapper(cluster) if cluster is not None else None
-    return reasoning.report_from(engine, configs, form=form, workers=workers, progress=progress, mapper=mapper,
+    mapper = batching.cluster_mapper(cluster) if cluster is not None else None
+    return batching.report_from(engine, configs, form=form, workers=workers, progress=progress, mapper=mapper,
                                  tally=tally)
 
 
@@ -120,6 +120,6 @@ def generate_configurations(
     seed: int,
     catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
     knowledge: Knowledge | None = None,
-) -> Iterator[reasoning.Configuration]:
+) -> Iterator[batching.Configuration]:
     """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices, generated lazily."""
-    return reasoning.generate(_devices(catalogue_or_folder, _k(knowledge)), count, sizes, seed)
+    return batching.generate(_devices(catalogue_or_folder, _k(knowledge)), count, sizes, seed)

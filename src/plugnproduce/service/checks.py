@@ -28,7 +28,7 @@ def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None,
 
 def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.CheckResult:
     """Whether a task is plausible in a cell: per step its bindings, device states and problems."""
-    from plugnproduce.reasoning.linksafety import link_safety
+    from plugnproduce.reasoning.checks.linksafety import link_safety
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     task = as_task(task_or_path)
@@ -81,7 +81,7 @@ def assessed_repairs(
     checked: reasoning.CheckResult | None = None,
 ) -> list[reasoning.AssessedRepair]:
     """The repairs of :func:`repair` that checking them again confirms, with their side effects, ranked by their
-    worst side effect, then by cost (:func:`plugnproduce.reasoning.sideeffects.ranking`). When the check refuses
+    worst side effect, then by cost (:func:`plugnproduce.reasoning.repairs.sideeffects.ranking`). When the check refuses
     some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds. ``checked``: the
     task's :func:`check` in that cell, when the caller has it (it is not checked again)."""
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)

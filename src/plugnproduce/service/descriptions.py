@@ -24,7 +24,7 @@ from plugnproduce.resources import descriptions_path
 if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
     from plugnproduce import reasoning
     from plugnproduce.ontology.taxonomy import Taxonomy
-    from plugnproduce.reasoning.impact import Impact
+    from plugnproduce.reasoning.repairs.impact import Impact
     from plugnproduce.validation import Report
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
@@ -153,7 +153,7 @@ def impact(extensions: list[Path], cell_files: list[Path] | None = None,
     """What adding the TBox files ``extensions`` to ``knowledge`` changes: offered commands per cell
     (default: every cell of the loaded libraries), catalogue roles, the libraries' tasks, and the
     validation findings (shapes, structure) of every catalogue device and cell, before and after."""
-    from plugnproduce.reasoning.impact import impact as compute
+    from plugnproduce.reasoning.repairs.impact import impact as compute
 
     return compute(_k(knowledge), extensions, cell_files, _findings)
 
