@@ -15,7 +15,7 @@ from plugnproduce.controller.interfaces import CellChangeRefused
 from plugnproduce.controller.livecell import LiveCellSource
 from plugnproduce.controller.run import SIMULATED_DISCOVERY_SECONDS, DevicesMissing, default_bin_parts
 from plugnproduce.description.model import Cell, DeviceDescription, Task
-from plugnproduce.errors import ProtocolTimeout
+from plugnproduce.errors import ProtocolTimeout, UnknownName
 from plugnproduce.knowledge import Knowledge
 from plugnproduce.protocols.upnp import private_network
 from plugnproduce.sim.bin import SimulatedBin
@@ -79,7 +79,7 @@ class SimulatedCellSource(LiveCellSource):
     async def plug(self, device_id: str) -> None:
         """Start a catalogue device; return once discovery has seen it join."""
         if device_id not in self.sim.catalogue:
-            raise KeyError(f"device {device_id!r} (the catalogue has: {', '.join(sorted(self.sim.catalogue))})")
+            raise UnknownName("device", device_id, self.sim.catalogue, owner="the catalogue")
         if device_id in self.sim.devices:
             raise CellChangeRefused(f"device {device_id!r} is in cell {self.cell.name!r} already")
         await self.sim.plug(device_id)
@@ -90,8 +90,7 @@ class SimulatedCellSource(LiveCellSource):
     async def unplug(self, device_id: str) -> None:
         """Stop a device of the cell; return once discovery has seen it leave."""
         if device_id not in self.sim.devices:
-            present = ", ".join(sorted(self.sim.devices)) or "none"
-            raise KeyError(f"device {device_id!r} in cell {self.cell.name!r} (present: {present})")
+            raise UnknownName("device", device_id, self.sim.devices, owner=f"cell {self.cell.name}")
         await self.sim.unplug(device_id)
         if not await self.wait_until(lambda cell: not _has(device_id)(cell), self._wait):
             raise ProtocolTimeout(f"device {device_id!r} was stopped but discovery did not see it leave "

@@ -10,6 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from plugnproduce.errors import UnknownName
 from plugnproduce.service import drawings
 
 if TYPE_CHECKING:
@@ -81,12 +82,12 @@ class GeneratedCharts:
         return digest
 
     def chart(self, generation: str, name: str) -> GeneratedChart:
-        """One chart of a generation (KeyError if either is unknown)."""
+        """One chart of a generation (:class:`UnknownName` if either is unknown)."""
         with self._lock:
             charts = self._store.get(generation)
         if not isinstance(charts, dict):
-            raise KeyError(f"generation {generation!r} (generate the task again)")
+            raise UnknownName("generation", generation, detail="generate the task again")
         if name not in charts:
-            raise KeyError(f"chart {name!r} of generation {generation} (it has: {', '.join(charts)})")
+            raise UnknownName("chart", name, charts, owner=f"generation {generation}")
         chart: GeneratedChart = charts[name]
         return chart

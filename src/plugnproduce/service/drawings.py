@@ -10,7 +10,7 @@ from plugnproduce.description.model import DeviceDescription
 
 if TYPE_CHECKING:  # drawing loads graphviz: imported by the use cases that draw
     from plugnproduce.codegen.outputs import GeneratedChart
-    from plugnproduce.drawing import Step
+    from plugnproduce.drawing import PlanStep
 
 
 def draw(chart: str | Path, output: str | Path, step: int | None = None) -> Path:
@@ -49,7 +49,7 @@ def picture_of_chart(chart: GeneratedChart, step: int | None = None) -> bytes:
     return render_chart(parse_chart(chart.data, chart.name), "svg", chart.name, name="chart", expand=step)
 
 
-def task_steps(chart: GeneratedChart) -> tuple[Step, ...]:
+def task_steps(chart: GeneratedChart) -> tuple[PlanStep, ...]:
     """The steps a generated task chart runs, in order (none for a chart without a plan of processes)."""
     from plugnproduce.drawing import find_plan
     from plugnproduce.statechart import parse_chart

@@ -46,7 +46,7 @@ from async_upnp_client.server import (
     unsubscribe_handler,
 )
 
-from plugnproduce.errors import ProtocolConnectionError, ProtocolError
+from plugnproduce.errors import PlugNProduceError, ProtocolConnectionError, ProtocolError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.upnp.boundary import LOOPBACK, SsdpNetwork, reason
 from plugnproduce.protocols.upnp.spec import (
@@ -74,7 +74,7 @@ SCPD_PATH = "/DeviceControl.xml"
 _CONTENT_TYPES = {".ttl": "text/turtle", ".scxml": "application/scxml+xml"}
 
 
-class ActionFailed(Exception):
+class ActionFailed(PlugNProduceError):
     """Raised by an action handler to refuse or fail an action; the caller gets a UPnP error ``code``.
 
     Use 501 (Action Failed) for a failure, a code from 700 to 799 for an
