@@ -11,7 +11,16 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
+from plugnproduce.cli.app import (
+    INTERFACE_OPTION,
+    JSON_OPTION,
+    app,
+    boundary,
+    emit_json,
+    fail,
+    interface_address,
+    knowledge,
+)
 from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.lazy import lazy_module
@@ -63,16 +72,19 @@ def discover(
     cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
                                      help="Wait (up to --timeout) for this cell's devices; exit 1 naming those "
                                           "missing."),
+    interface: str | None = INTERFACE_OPTION,
 ) -> None:
-    """List the devices found on the network (SSDP on loopback), with class and skills, and those refused.
+    """List the devices found on the network (SSDP on loopback or --interface), with class and skills, and those
+    refused.
 
     The search ends when no new device answered for --settle seconds, at the latest after --timeout;
     with --expect or --cell it waits for those devices instead. Exit 0 found, 1 some expected device
     missing, 2 bad input.
     """
+    address = interface_address(interface)
     wanted = [d.id for d in service.cell(cell, knowledge(cell)).devices] if cell is not None else []
     try:
-        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted)))
+        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted), address))
     except KeyboardInterrupt:
         return
     if missing:
@@ -112,10 +124,11 @@ class Search:
                 f"(--expect N or --cell CELL waits for them)")
 
 
-async def _discover(json_out: bool, watch: bool, search: Search) -> list[str]:
+async def _discover(json_out: bool, watch: bool, search: Search, address: str) -> list[str]:
     began = time.monotonic()
     async with devices.discovery(knowledge(), search_timeout=search.timeout, expected=search.wanted,
-                                 expected_count=search.expect, quiet=None if search.waits else search.settle) as live:
+                                 expected_count=search.expect, quiet=None if search.waits else search.settle,
+                                 interface=address) as live:
         cell, seconds = live.cell, time.monotonic() - began
         missing = search.missing(cell)
         _show_found(live, cell, json_out, watch, {"searched_seconds": round(seconds, 1), "missing": missing,
@@ -227,17 +240,21 @@ def sim_up(
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
                                          help="A simulated bin of N parts at random poses for the devices to work on."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
+    interface: str | None = INTERFACE_OPTION,
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
 
     Plug in more with 'pnp sim plug DEVICE' (a device of the libraries, or a device description file).
+    The devices announce themselves and listen on --interface (default PNP_INTERFACE, else loopback);
     PNP_SSDP_PORT chooses a private SSDP port.
 
     Exit 0 stopped by Ctrl-C or SIGTERM, 2 bad input (a cell that cannot be read or started).
     """
+    address = interface_address(interface)  # an unknown interface is said before anything is loaded
     the_cell = service.cell(cell, knowledge())
     k = knowledge(cell)
-    sim = devices.simulated_cell(the_cell, service.catalogue(knowledge=k), k, faults, bin_parts, bin_seed)
+    sim = devices.simulated_cell(the_cell, service.catalogue(knowledge=k), k, faults, bin_parts, bin_seed,
+                                 interface=address)
     try:
         asyncio.run(devices.run_simulated(sim, state_file, echo=typer.echo))
     except KeyboardInterrupt:

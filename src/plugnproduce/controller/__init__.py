@@ -46,6 +46,8 @@ if TYPE_CHECKING:
     from plugnproduce.controller.simcell import SimulatedCellSource
     from plugnproduce.discovery import CellChange, LiveCell
     from plugnproduce.executor.run import TaskRun
+    from plugnproduce.protocols.interface import chosen_address
+    from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.bin import SimulatedBin
 
 _WHERE = {
@@ -60,6 +62,8 @@ _WHERE = {
     "SimulatedCellSource": "plugnproduce.controller.simcell",
     **dict.fromkeys(("CellChange", "LiveCell"), "plugnproduce.discovery"),
     "TaskRun": "plugnproduce.executor.run",
+    "chosen_address": "plugnproduce.protocols.interface",
+    "network_from_env": "plugnproduce.protocols.upnp",
     "SimulatedBin": "plugnproduce.sim.bin",
 }
 """Where each name of the controller lives: it is imported on first use, so that importing one module of the
@@ -97,9 +101,11 @@ __all__ = [
     "SimulatedCellSource",
     "StateNotReported",
     "TaskRun",
+    "chosen_address",
     "default_bin_parts",
     "find_devices",
     "live_cell",
+    "network_from_env",
     "planned_run",
     "reported_states",
     "run_task",

@@ -18,26 +18,27 @@ if TYPE_CHECKING:
 
 
 def discovery(knowledge: Knowledge, *, search_timeout: float, expected: Collection[str] = (),
-              expected_count: int | None = None, quiet: float | None = None) -> LiveCell:
-    """The cell as discovery sees it on the network ``PNP_SSDP_PORT`` names, followed while the context is open;
-    the search at its start waits for the ``expected`` devices, ``expected_count`` of them, or ``quiet`` seconds
-    without news, within ``search_timeout``."""
+              expected_count: int | None = None, quiet: float | None = None, interface: str | None = None) -> LiveCell:
+    """The cell as discovery sees it on ``interface`` (an address) and the SSDP port ``PNP_SSDP_PORT`` names,
+    followed while the context is open; the search at its start waits for the ``expected`` devices,
+    ``expected_count`` of them, or ``quiet`` seconds without news, within ``search_timeout``."""
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env
 
-    return LiveCell(knowledge.taxonomy, network=network_from_env(), search_timeout=search_timeout,
+    return LiveCell(knowledge.taxonomy, network=network_from_env(interface), search_timeout=search_timeout,
                     expected=expected, expected_count=expected_count, quiet=quiet)
 
 
 def simulated_cell(cell: Cell, catalogue: list[DeviceDescription], knowledge: Knowledge, faults: str = "",
-                   bin_parts: int | None = None, bin_seed: int = 0) -> SimulatedCell:
-    """The devices of ``cell`` simulated on the network ``PNP_SSDP_PORT`` names, ``catalogue`` the devices that
-    may be plugged in later, with ``faults`` (``pnp run --faults``), on a bin of ``bin_parts`` parts if given."""
+                   bin_parts: int | None = None, bin_seed: int = 0, interface: str | None = None) -> SimulatedCell:
+    """The devices of ``cell`` simulated on ``interface`` (an address) and the SSDP port ``PNP_SSDP_PORT`` names,
+    ``catalogue`` the devices that may be plugged in later, with ``faults`` (``pnp run --faults``), on a bin of
+    ``bin_parts`` parts if given."""
     from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
-    return SimulatedCell(cell, catalogue=catalogue, network=network_from_env(),
+    return SimulatedCell(cell, catalogue=catalogue, network=network_from_env(interface),
                          faults=parse_faults(faults, cell.devices), taxonomy=knowledge.taxonomy,
                          bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None)
 
