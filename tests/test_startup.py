@@ -128,3 +128,25 @@ def test_plugging_a_simulated_device_loads_only_the_control_channel() -> None:
     unneeded = ("aiohttp", "async_upnp_client", "rdflib", "owlready2", "clingo", "plugnproduce.service",
                 "plugnproduce.discovery", "plugnproduce.executor", "plugnproduce.protocols", "plugnproduce.sim.cell")
     assert sorted(h for h in unneeded if h in loaded) == []
+
+
+@pytest.mark.parametrize("package", ["plugnproduce.reasoning", "plugnproduce.reasoning.asp", "plugnproduce.reasoning.checks",
+                                     "plugnproduce.reasoning.repairs", "plugnproduce.reasoning.explanation",
+                                     "plugnproduce.batch"])
+def test_importing_the_reasoning_layer_loads_neither_a_reasoner_nor_its_other_parts(package: str) -> None:
+    loaded = _loaded_after(f"import {package}")
+    parts = ("plugnproduce.reasoning.", "plugnproduce.batch.")
+    assert sorted(m for m in loaded if m in ("clingo", "owlready2", "rdflib", "pint", "distributed")
+                  or (m.startswith(parts) and m != package)) == []
+
+
+def test_the_reasoning_layer_loads_what_is_used_on_first_use() -> None:
+    code = ("import sys\nimport plugnproduce.reasoning as r\nimport plugnproduce.reasoning.checks\n"
+            "print('clingo' in sys.modules, r.check.__module__, r.repair.__module__, 'capabilities' in dir(r))\n"
+            "from plugnproduce.reasoning import Repair, explain_offered\n"
+            "print('clingo' in sys.modules, Repair.__name__, explain_offered.__module__)\n"
+            "import plugnproduce.batch as b\n"
+            "print([n for p in (r, b) for n in p.__all__ if getattr(p, n, None) is None] == [])")
+    assert _run(code).split() == ["False", "plugnproduce.reasoning.checks.plausibility",
+                                  "plugnproduce.reasoning.repairs.windows", "True",
+                                  "True", "Repair", "plugnproduce.reasoning.explanation.why", "True"]
