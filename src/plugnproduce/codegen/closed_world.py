@@ -16,7 +16,7 @@ import copy
 import dataclasses
 
 from plugnproduce.codegen.task import DONE, FAILED, GeneratedTask
-from plugnproduce.description.model import Cell, DeviceDescription
+from plugnproduce.description.model import PROTOCOLS, Cell, DeviceDescription
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (
     Cancel,
@@ -42,7 +42,7 @@ def closed_world_chart(generated: GeneratedTask, cell: Cell) -> bytes:
     controller = copy.deepcopy(next(c for c in task.children if isinstance(c, State) and c.id == "task"))
     controller.id = "controller"
     for node in walk(controller, into_charts=False):
-        if isinstance(node, Send) and node.type in ("xirp", "upnp"):
+        if isinstance(node, Send) and node.type in PROTOCOLS:
             node.event, node.type, node.target = f"{node.target}.{node.event}", None, None
         elif isinstance(node, Transition):
             node.targets = [_TARGETS.get(t, t) for t in node.targets]
