@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from asyncua import Client, Node, ua
+from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.opcua.spec import (
@@ -121,8 +122,7 @@ class OpcUaDeviceClient:
                 raise ProtocolError(f"device {self.device}: method {name} needs argument {arg}; none given")
             value, vtype = to_wire(params[arg], kind, f"device {self.device}: {name} argument {arg}")
             arguments.append(ua.Variant(value, getattr(ua.VariantType, vtype)))
-        results = await self._node.call_method(method, *arguments)
-        values = results if isinstance(results, list) else ([] if results is None else [results])
+        values = list((await call_method_full(self._node, method, *arguments)).OutputArguments or [])
         if len(values) != len(outputs):
             raise ProtocolError(f"device {self.device}: method {name} answered {len(values)} output arguments; "
                                 f"it declares {len(outputs)}")

@@ -16,7 +16,6 @@ import math
 import re
 from dataclasses import dataclass, field
 from typing import Any, Literal
-from urllib.parse import urlparse
 
 from plugnproduce.errors import ProtocolError
 
@@ -103,13 +102,13 @@ _ENDPOINT = re.compile(r"opc\.tcp://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9.\-]{1,253}):(
 
 def parse_endpoint(endpoint: str) -> tuple[str, int, str]:
     """``opc.tcp://host:port/path`` as (host, port, path); a ProtocolError says what is wrong with any other."""
-    if not isinstance(endpoint, str) or not _ENDPOINT.fullmatch(endpoint):
+    match = _ENDPOINT.fullmatch(endpoint) if isinstance(endpoint, str) else None
+    if match is None:
         raise ProtocolError(f"OPC UA endpoint {str(endpoint)[:80]!r} is not opc.tcp://HOST:PORT[/PATH]")
-    parsed = urlparse(endpoint)
-    port = parsed.port
-    if parsed.hostname is None or port is None or not 0 < port < 65536:
+    host, port = match.group(1).strip("[]"), int(match.group(2))
+    if not 0 < port < 65536:
         raise ProtocolError(f"OPC UA endpoint {endpoint!r} has no port from 1 to 65535")
-    return parsed.hostname, port, parsed.path
+    return host, port, match.group(3) or ""
 
 
 def format_endpoint(host: str, port: int, path: str = "") -> str:
