@@ -5,7 +5,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun
 
@@ -15,7 +15,7 @@ LIBRARY = Path(__file__).parents[1] / "data" / "libraries" / "opcua-glue"
 
 
 async def test_the_mixed_task_runs_and_the_journal_shows_the_opc_ua_steps_with_their_values(tmp_path: Path) -> None:
-    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl")
+    report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl")
     assert report.outcome == "succeeded", report.fault
     run = read_journal(report.journal)
     assert run.start is not None and run.start["devices"]["screwdriver-ua"].startswith("opc.tcp://127.0.0.1:")
@@ -38,7 +38,7 @@ async def test_a_stop_during_the_screwing_skill_sends_its_stop(tmp_path: Path) -
             runs[0].stop()
 
     runs: list[TaskRun] = []
-    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
+    report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
                                     observer=stop_once_screwing, started=runs.append)
     assert report.outcome == "stopped" and report.fault is not None and report.fault.kind == "stopped"
     stops = {r["device"]: r for r in read_journal(report.journal).of_kind("stop")}
@@ -49,7 +49,7 @@ async def test_a_stop_during_the_screwing_skill_sends_its_stop(tmp_path: Path) -
 async def test_a_library_written_outside_the_package_runs_its_opc_ua_device(tmp_path: Path) -> None:
     """A user's glue dispenser over OPC UA: its own terms (bead length, glue kind) become method arguments."""
     library = shutil.copytree(LIBRARY, tmp_path / "opcua-glue")
-    report = await service.run_task(library / "tasks" / "glue.yaml", library / "cells" / "glue-cell.yaml",
+    report = await controller.run_task(library / "tasks" / "glue.yaml", library / "cells" / "glue-cell.yaml",
                                     simulate=True, journal=tmp_path / "run.jsonl")
     assert report.outcome == "succeeded", report.fault
     run = read_journal(report.journal)

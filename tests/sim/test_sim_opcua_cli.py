@@ -31,7 +31,7 @@ def test_sim_up_prints_opc_tcp_endpoints_and_run_cell_runs_the_mixed_task(tmp_pa
     with log.open("w") as out, started(command("sim", "up", CELL, "--state-file", str(state)), env=env, stdout=out,
                                        stderr=subprocess.STDOUT) as up:
         deadline = time.monotonic() + WAIT
-        while not state.exists():  # polling a file the process writes once its devices are announced
+        while not state.exists() or "is up" not in log.read_text():  # it writes both once its devices are announced
             assert up.poll() is None, log.read_text()
             assert time.monotonic() < deadline, "pnp sim up did not come up"
             time.sleep(0.05)
