@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import shutil
 from pathlib import Path
 
@@ -57,3 +58,27 @@ async def test_a_library_written_outside_the_package_runs_its_opc_ua_device(tmp_
     assert ("dispenser", "Dispense", {"BeadLength": 120, "GlueKind": "polyurethane"}) in sent
     assert [(r["device"], r["event"]) for r in run.of_kind("event") if r["device"] == "dispenser"] \
         == [("dispenser", "bead_laid")]
+
+
+async def test_an_opc_ua_device_unplugged_during_its_skill_is_lost(tmp_path: Path) -> None:
+    from plugnproduce.discovery import LiveCell
+    from plugnproduce.ontology.taxonomy import load_taxonomy
+    from plugnproduce.protocols import upnp
+    from plugnproduce.sim.cell import SimulatedCell
+
+    cell = service.cell(CELL)
+    generated = service.generate(TASK, cell).task
+    network = upnp.private_network()
+    async with SimulatedCell(cell, network=network) as sim, LiveCell(load_taxonomy(), network=network) as live:
+        devices = await controller.find_devices(live, [d.id for d in cell.devices],
+                                                controller.SIMULATED_DISCOVERY_SECONDS)
+
+        def unplug_while_screwing(record: dict[str, object]) -> None:
+            if record["kind"] == "state" and (record["device"], record["state"]) == ("screwdriver-ua", "Execute"):
+                asyncio.get_running_loop().create_task(sim.unplug("screwdriver-ua"))
+
+        report = await TaskRun(generated, devices, tmp_path / "run.jsonl", unplug_while_screwing).run()
+    assert report.outcome == "failed"
+    assert report.fault is not None and (report.fault.kind, report.fault.device) == ("lost", "screwdriver-ua")
+    stops = {r["device"]: r for r in read_journal(report.journal).of_kind("stop")}
+    assert stops["screwdriver-ua"]["answer"].startswith("no state reported")

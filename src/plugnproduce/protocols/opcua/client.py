@@ -155,12 +155,15 @@ class OpcUaDeviceClient:
             node = await base.get_child(f"{self._ns}:{name}")
             types[node.nodeid] = name
         handler = _Events(self, types, on_event, on_lost, on_anomaly)
+        _on_close(self._client, lambda: handler.lost("the server closed the connection"))
         self._subscription = await self._client.create_subscription(50, handler)
         if types:
             await self._subscription.subscribe_events(self._node, [self._client.get_node(t) for t in types])
 
     async def close(self) -> None:
-        """End the session (politely when the server still answers)."""
+        """End the session (politely when the server still answers); its end is then no lost connection."""
+        if self.lost is None:
+            self.lost = "closed by the controller"
         await _quietly_close(self._client)
 
 
@@ -190,8 +193,13 @@ class _Events:
         self._on_event(name, values)
 
     def status_change_notification(self, status: Any) -> None:
-        self._client.lost = f"the OPC UA session ended ({getattr(status, 'Status', status)})"
-        self._on_lost(self._client.lost)
+        self.lost(f"the OPC UA session ended ({getattr(status, 'Status', status)})")
+
+    def lost(self, reason: str) -> None:
+        """Tell the first way the session was found lost (the socket closing, the watchdog's failed read)."""
+        if self._client.lost is None:
+            self._client.lost = reason
+            self._on_lost(reason)
 
     def datachange_notification(self, *_: Any) -> None:
         """Not subscribed to: nothing to do."""
@@ -201,6 +209,21 @@ _STANDARD_FIELDS = frozenset({"EventId", "EventType", "SourceNode", "SourceName"
                               "LocalTime", "Message", "Severity", "ConditionClassId", "ConditionClassName",
                               "ConditionSubClassId", "ConditionSubClassName"})
 """The fields every ``BaseEventType`` has; the others are the values an event carries."""
+
+
+def _on_close(client: Client, then: Callable[[], None]) -> None:
+    """Call ``then`` as soon as the connection's socket closes: asyncua's own watchdog notices a closed session
+    only at its next read, a second or more later."""
+    protocol = client.uaclient.protocol
+    if protocol is None:
+        return
+    closed = protocol.connection_lost
+
+    def connection_lost(exc: Exception | None) -> None:
+        closed(exc)
+        then()
+
+    protocol.connection_lost = connection_lost
 
 
 async def _device_node(client: Client, device: str) -> tuple[int, Node]:
