@@ -50,7 +50,7 @@ async def test_a_stop_during_the_screwing_skill_sends_its_stop(tmp_path: Path) -
 async def test_a_library_written_outside_the_package_runs_its_opc_ua_device(tmp_path: Path) -> None:
     """A user's glue dispenser over OPC UA: its own terms (bead length, glue kind) become method arguments."""
     library = shutil.copytree(LIBRARY, tmp_path / "opcua-glue")
-    report = await controller.run_task(library / "tasks" / "glue.yaml", library / "cells" / "glue-cell.yaml",
+    report = await controller.run_task(library / "tasks" / "opcua-glue.yaml", library / "cells" / "opcua-glue-cell.yaml",
                                     simulate=True, journal=tmp_path / "run.jsonl")
     assert report.outcome == "succeeded", report.fault
     run = read_journal(report.journal)

@@ -65,9 +65,12 @@ class SimulatedDevice:
     """One device running its chart behind its protocol; ``async with`` starts and stops it."""
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
-                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
-        """``bin``: the simulated bin the device works on, if any."""
+                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None,  # noqa: A002
+                 lds: str | None = None) -> None:
+        """``bin``: the simulated bin the device works on, if any; ``lds``: the Local Discovery Server an OPC UA
+        device registers with, if any."""
         self.description = device
+        self.lds = lds
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
         self.bin = bin
@@ -128,8 +131,10 @@ class SimulatedDevice:
             from plugnproduce.sim.opcua import node_spec
 
             self._opcua = OpcUaDeviceServer(node_spec(d), self._on_opcua_call, lambda: self.state,
-                                            host=self.network.interface)
+                                            host=self.network.interface, files=self._files)
             await self._opcua.start()
+            if self.lds is not None:
+                await self._opcua.register(self.lds)
             assert self._opcua.endpoint is not None
             spec = upnp.service_spec_from_chart_events({}, [])
             files = self._files(self._opcua.endpoint)

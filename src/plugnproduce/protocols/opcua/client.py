@@ -16,8 +16,11 @@ from typing import Any
 from asyncua import Client, Node, ua
 from asyncua.common.methods import call_method_full
 
-from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
+from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
+from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.opcua.spec import (
+    DESCRIPTION_OBJECT,
+    DESCRIPTION_VARIABLES,
     MAX_ARGUMENTS,
     MAX_CHUNKS,
     MAX_MESSAGE,
@@ -29,6 +32,7 @@ from plugnproduce.protocols.opcua.spec import (
     parse_endpoint,
     to_wire,
 )
+from plugnproduce.safeio import MAX_BYTES
 
 EventCallback = Callable[[str, dict[str, Any]], None]
 """Called with an event's name and its values."""
@@ -159,6 +163,30 @@ class OpcUaDeviceClient:
         self._subscription = await self._client.create_subscription(50, handler)
         if types:
             await self._subscription.subscribe_events(self._node, [self._client.get_node(t) for t in types])
+
+    async def fetch_files(self, timeout: float) -> DeviceFiles:
+        """The device's own description files, read from ``ns:Description`` (each at most ``MAX_BYTES``)."""
+        try:
+            texts = await asyncio.wait_for(self._read_files(), timeout)
+        except ProtocolError:
+            raise
+        except Exception as exc:
+            raise _wrapped(exc, self.device, f"read its {DESCRIPTION_OBJECT}", timeout) from exc
+        try:
+            return DeviceFiles(*texts)
+        except DescriptionError as exc:
+            raise ProtocolError(f"device {self.device}: {exc.message}") from exc
+
+    async def _read_files(self) -> list[str]:
+        folder = await self._node.get_child(f"{self._ns}:{DESCRIPTION_OBJECT}")
+        texts = []
+        for name in DESCRIPTION_VARIABLES:
+            value = await (await folder.get_child(f"{self._ns}:{name}")).read_value()
+            if not isinstance(value, str) or not value or len(value.encode("utf-8")) > MAX_BYTES:
+                raise ProtocolError(f"device {self.device}: {DESCRIPTION_OBJECT}/{name} is no text of 1 to "
+                                    f"{MAX_BYTES} bytes")
+            texts.append(value)
+        return texts
 
     async def close(self) -> None:
         """End the session (politely when the server still answers); its end is then no lost connection."""

@@ -10,11 +10,23 @@ from __future__ import annotations
 import logging
 from collections.abc import Awaitable, Callable, Mapping
 from typing import Any
+from urllib.parse import urlparse
 
 from asyncua import Node, Server, ua
 
 from plugnproduce.errors import ProtocolError
-from plugnproduce.protocols.opcua.spec import STATE_VARIABLE, Kind, MethodSpec, NodeSpec, format_endpoint, from_wire
+from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.protocols.opcua.spec import (
+    DESCRIPTION_OBJECT,
+    DESCRIPTION_VARIABLES,
+    STATE_VARIABLE,
+    Kind,
+    MethodSpec,
+    NodeSpec,
+    application_uri_for,
+    format_endpoint,
+    from_wire,
+)
 
 RequestHandler = Callable[[str, Mapping[str, Any]], Awaitable[Mapping[str, Any] | None]]
 """Takes a request and its arguments; returns the values of its output arguments, or raises
@@ -44,8 +56,12 @@ class OpcUaDeviceServer:
     """One device as an OPC UA server; ``await start()``, ``await stop()``."""
 
     def __init__(self, spec: NodeSpec, handler: RequestHandler, state: Callable[[], str], *,
-                 host: str = "127.0.0.1", port: int = 0) -> None:
+                 host: str = "127.0.0.1", port: int = 0,
+                 files: Callable[[str], DeviceFiles] | None = None) -> None:
+        """``files``: the device's own description for the endpoint it listens on, served as the String
+        variables of ``ns:Description``."""
         self.spec = spec
+        self.files = files
         self._handler = handler
         self._state = state
         self._host = host
@@ -63,6 +79,7 @@ class OpcUaDeviceServer:
         server.set_server_name(f"Plug'n'Produce {self.spec.device}")
         server.set_endpoint(format_endpoint(self._host, self._port, f"/pnp/{self.spec.device}"))
         server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        await server.set_application_uri(application_uri_for(self.spec.device))
         idx = await server.register_namespace(self.spec.namespace)
         self._device = await server.nodes.objects.add_object(idx, self.spec.device)
         state = await self._device.add_variable(idx, STATE_VARIABLE, "", varianttype=ua.VariantType.String)
@@ -78,6 +95,22 @@ class OpcUaDeviceServer:
         self._server = server
         port = server.bserver._server.sockets[0].getsockname()[1]
         self.endpoint = format_endpoint(self._host, port, f"/pnp/{self.spec.device}")
+        if self.files is not None:
+            await self._add_files(idx, self.files(self.endpoint))
+
+    async def _add_files(self, idx: int, files: DeviceFiles) -> None:
+        assert self._device is not None
+        folder = await self._device.add_object(idx, DESCRIPTION_OBJECT)
+        for name, value in zip(DESCRIPTION_VARIABLES, (files.description_name, files.description, files.chart_name,
+                                                       files.chart), strict=True):
+            await folder.add_variable(idx, name, value, varianttype=ua.VariantType.String)
+
+    async def register(self, lds: str) -> None:
+        """Register with the Local Discovery Server at ``lds`` (``RegisterServer``), under the real endpoint."""
+        if self._server is None or self.endpoint is None:
+            raise RuntimeError(f"device {self.spec.device}: start the server before registering it")
+        self._server.endpoint = urlparse(self.endpoint)  # the port it listens on, not the 0 it was asked for
+        await self._server.register_to_discovery(lds, period=0)
 
     async def stop(self) -> None:
         """Stop listening (the connected clients lose their sessions)."""

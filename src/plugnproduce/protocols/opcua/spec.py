@@ -6,6 +6,8 @@ The naming rule (``docs/opcua.md``): the device registers the namespace ``NAMESP
 * one method ``ns:NAME`` per request ``opcua.request.NAME`` of its device state chart, whose input
   arguments are the quantities the request carries (named by the quantity, typed by :data:`KINDS`);
 * a String variable ``ns:State``: the id of the chart state the device is in (the state query);
+* an object ``ns:Description`` with String variables ``TurtleName``, ``Turtle``, ``ChartName`` and ``Chart``:
+  the device's own description files (read, as over UPnP, within a size and time budget);
 * the object is the source (``EventNotifier``) of the device's events: each ``opcua.event.NAME`` is an
   event of the type ``ns:NAME`` (a subtype of ``BaseEventType``) whose fields are the values it carries.
 """
@@ -24,6 +26,13 @@ NAMESPACE_PREFIX = "http://plugnproduce.org/opcua/"
 
 STATE_VARIABLE = "State"
 """The browse name of the variable that holds the id of the chart state the device is in."""
+
+DESCRIPTION_OBJECT = "Description"
+"""The browse name of the object whose String variables hold the device's own description files."""
+DESCRIPTION_VARIABLES = ("TurtleName", "Turtle", "ChartName", "Chart")
+"""Its variables: the Turtle's file name and text, the chart's file name and text."""
+APPLICATION_URI_PREFIX = "urn:plugnproduce:device:"
+"""A device's server registers with a Local Discovery Server under this plus its id."""
 
 REQUEST_PREFIX = "opcua.request."
 EVENT_PREFIX = "opcua.event."
@@ -90,6 +99,11 @@ class NodeSpec:
     def namespace(self) -> str:
         """The device's namespace URI."""
         return namespace_for(self.device)
+
+
+def application_uri_for(device: str) -> str:
+    """The application URI a device's server has (and registers with a Local Discovery Server)."""
+    return APPLICATION_URI_PREFIX + device
 
 
 def namespace_for(device: str) -> str:
