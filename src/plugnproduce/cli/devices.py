@@ -73,9 +73,12 @@ def discover(
                                      help="Wait (up to --timeout) for this cell's devices; exit 1 naming those "
                                           "missing."),
     interface: str | None = INTERFACE_OPTION,
+    lds: str | None = typer.Option(None, "--lds", metavar="opc.tcp://HOST:PORT",
+                                   help="Also the OPC UA devices registered with this Local Discovery Server "
+                                        "(FindServers); default PNP_LDS."),
 ) -> None:
-    """List the devices found on the network (SSDP on loopback or --interface), with class and skills, and those
-    refused.
+    """List the devices found on the network (SSDP on loopback or --interface, and the OPC UA devices registered
+    with --lds), with class and skills, and those refused.
 
     The search ends when no new device answered for --settle seconds, at the latest after --timeout;
     with --expect or --cell it waits for those devices instead. Exit 0 found, 1 some expected device
@@ -84,7 +87,7 @@ def discover(
     address = interface_address(interface)
     wanted = [d.id for d in service.cell(cell, knowledge(cell)).devices] if cell is not None else []
     try:
-        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted), address))
+        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted), address, lds))
     except KeyboardInterrupt:
         return
     if missing:
@@ -124,11 +127,11 @@ class Search:
                 f"(--expect N or --cell CELL waits for them)")
 
 
-async def _discover(json_out: bool, watch: bool, search: Search, address: str) -> list[str]:
+async def _discover(json_out: bool, watch: bool, search: Search, address: str, lds: str | None) -> list[str]:
     began = time.monotonic()
     async with devices.discovery(knowledge(), search_timeout=search.timeout, expected=search.wanted,
                                  expected_count=search.expect, quiet=None if search.waits else search.settle,
-                                 interface=address) as live:
+                                 interface=address, lds=lds) as live:
         cell, seconds = live.cell, time.monotonic() - began
         missing = search.missing(cell)
         _show_found(live, cell, json_out, watch, {"searched_seconds": round(seconds, 1), "missing": missing,
@@ -241,6 +244,11 @@ def sim_up(
                                          help="A simulated bin of N parts at random poses for the devices to work on."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
     interface: str | None = INTERFACE_OPTION,
+    lds: str | None = typer.Option(None, "--lds", metavar="opc.tcp://HOST:PORT",
+                                   help="The OPC UA devices register with this Local Discovery Server."),
+    serve_lds: int | None = typer.Option(None, "--serve-lds", metavar="PORT", min=0, max=65535,
+                                         help="Start a Local Discovery Server on the cell's address at PORT "
+                                              "(0: a free one) and register the OPC UA devices with it."),
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
 
@@ -253,9 +261,11 @@ def sim_up(
     address = interface_address(interface)  # an unknown interface is said before anything is loaded
     the_cell = service.cell(cell, knowledge())
     k = knowledge(cell)
+    if lds is not None and serve_lds is not None:
+        fail("--lds and --serve-lds: give one (register with that LDS, or with the one started here)")
     sim = devices.simulated_cell(the_cell, service.catalogue(knowledge=k), k, faults, bin_parts, bin_seed,
-                                 interface=address)
+                                 interface=address, lds=lds)
     try:
-        asyncio.run(devices.run_simulated(sim, state_file, echo=typer.echo))
+        asyncio.run(devices.run_simulated(sim, state_file, echo=typer.echo, serve_lds=serve_lds))
     except KeyboardInterrupt:
         typer.echo("stopped")

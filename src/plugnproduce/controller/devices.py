@@ -18,38 +18,59 @@ if TYPE_CHECKING:
 
 
 def discovery(knowledge: Knowledge, *, search_timeout: float, expected: Collection[str] = (),
-              expected_count: int | None = None, quiet: float | None = None, interface: str | None = None) -> LiveCell:
+              expected_count: int | None = None, quiet: float | None = None, interface: str | None = None,
+              lds: str | None = None) -> LiveCell:
     """The cell as discovery sees it on ``interface`` (an address) and the SSDP port ``PNP_SSDP_PORT`` names,
     followed while the context is open; the search at its start waits for the ``expected`` devices,
-    ``expected_count`` of them, or ``quiet`` seconds without news, within ``search_timeout``."""
+    ``expected_count`` of them, or ``quiet`` seconds without news, within ``search_timeout``; the OPC UA devices
+    registered with the Local Discovery Server ``lds`` (else ``PNP_LDS``, else none) are in it too."""
+    import os
+
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env
 
     return LiveCell(knowledge.taxonomy, network=network_from_env(interface), search_timeout=search_timeout,
-                    expected=expected, expected_count=expected_count, quiet=quiet)
+                    expected=expected, expected_count=expected_count, quiet=quiet,
+                    lds=lds or os.environ.get("PNP_LDS", "").strip() or None)
 
 
 def simulated_cell(cell: Cell, catalogue: list[DeviceDescription], knowledge: Knowledge, faults: str = "",
-                   bin_parts: int | None = None, bin_seed: int = 0, interface: str | None = None) -> SimulatedCell:
+                   bin_parts: int | None = None, bin_seed: int = 0, interface: str | None = None,
+                   lds: str | None = None) -> SimulatedCell:
     """The devices of ``cell`` simulated on ``interface`` (an address) and the SSDP port ``PNP_SSDP_PORT`` names,
     ``catalogue`` the devices that may be plugged in later, with ``faults`` (``pnp run --faults``), on a bin of
-    ``bin_parts`` parts if given."""
+    ``bin_parts`` parts if given; its OPC UA devices register with the Local Discovery Server ``lds`` if given."""
     from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     return SimulatedCell(cell, catalogue=catalogue, network=network_from_env(interface),
                          faults=parse_faults(faults, cell.devices), taxonomy=knowledge.taxonomy,
-                         bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None)
+                         bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None, lds=lds)
 
 
-async def run_simulated(sim: SimulatedCell, state_file: Path | None, echo: Callable[[str], None]) -> None:
+async def run_simulated(sim: SimulatedCell, state_file: Path | None, echo: Callable[[str], None],
+                        serve_lds: int | None = None) -> None:
     """``pnp sim up``: run the cell and its control channel until cancelled, its address recorded in
-    ``state_file`` (default: the user's state folder)."""
+    ``state_file`` (default: the user's state folder); with ``serve_lds`` (a port, 0: any free one) beside a
+    Local Discovery Server on the cell's address, which its OPC UA devices register with."""
     from plugnproduce.sim import control
     from plugnproduce.sim.cell import run_simulated_cell
 
-    await run_simulated_cell(sim, state_file or control.default_state_file(), echo=echo)
+    if serve_lds is None:
+        await run_simulated_cell(sim, state_file or control.default_state_file(), echo=echo)
+        return
+    from plugnproduce.protocols.opcua.discovery import LocalDiscoveryServer
+
+    lds = LocalDiscoveryServer(sim.network.interface, serve_lds)
+    await lds.start()
+    try:
+        assert lds.endpoint is not None
+        echo(f"{'lds':16} opcua {lds.endpoint}")
+        sim.lds = lds.endpoint
+        await run_simulated_cell(sim, state_file or control.default_state_file(), echo=echo)
+    finally:
+        await lds.stop()
 
 
 def control_address() -> tuple[str, int]:

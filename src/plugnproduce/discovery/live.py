@@ -47,6 +47,7 @@ from plugnproduce.protocols.upnp import (
     AdvertisementListener,
     DeviceSearch,
     FoundDevice,
+    Refusal,
     RemoteFiles,
     SearchHit,
     SsdpNetwork,
@@ -67,6 +68,9 @@ CONFIRM_TIMEOUT = 1.0
 
 MAX_REFUSED = 100
 """Refused devices kept for :attr:`LiveCell.refused` (the latest)."""
+
+LDS_POLL = 1.0
+"""Seconds between two questions (FindServers) to the Local Discovery Server, when one is given."""
 
 DEVICE_BUDGET = 15.0
 """Seconds reading one discovered device (its UPnP description, Turtle description and chart) may take in all."""
@@ -113,7 +117,10 @@ class LiveCell:
         expected_count: int | None = None,
         quiet: float | None = None,
         device_budget: float = DEVICE_BUDGET,
+        lds: str | None = None,
     ) -> None:
+        """``lds``: a Local Discovery Server (``opc.tcp://HOST:PORT``) whose registered OPC UA devices are in
+        the cell too, asked every :data:`LDS_POLL` seconds (a device no longer registered is unplugged)."""
         self.taxonomy = taxonomy
         self.network = network
         self.name = name
@@ -137,6 +144,10 @@ class LiveCell:
         self._changes: asyncio.Queue[CellChange] = asyncio.Queue()
         self._listener = AdvertisementListener(network)
         self._task: asyncio.Task[None] | None = None
+        self.lds = lds
+        self._lds_task: asyncio.Task[None] | None = None
+        self._on_lds: dict[str, str] = {}  # application URI -> URL, of the devices plugged through the LDS
+        self._lds_refused: dict[str, str] = {}  # application URI -> URL refused there (not read again)
 
     @property
     def cell(self) -> Cell:
@@ -153,6 +164,16 @@ class LiveCell:
             await self._listener.stop()
             raise
         self._news = asyncio.get_running_loop().time()
+        if self.lds is not None:
+            from plugnproduce.discovery.opcua import registered  # asyncua loads only for an LDS
+
+            try:
+                self._ask_lds(await registered(self.lds, self.device_budget))
+            except BaseException:
+                search.stop()
+                await self._listener.stop()
+                raise
+            self._lds_task = asyncio.create_task(self._follow_lds(self.lds))
         self._search = asyncio.create_task(self._follow_search(search))
         self._task = asyncio.create_task(self._follow())
         try:
@@ -203,7 +224,7 @@ class LiveCell:
         return len(self._readings)
 
     async def __aexit__(self, *exc_info: object) -> None:
-        for task in (self._task, self._search, *self._readings):
+        for task in (self._task, self._search, self._lds_task, *self._readings):
             if task is not None:
                 task.cancel()
                 with contextlib.suppress(asyncio.CancelledError):
@@ -257,6 +278,46 @@ class LiveCell:
                 self._read(ad)
             elif ad.udn in self._devices:
                 self._start(self._unplug_confirmed(ad.udn), ad)
+
+    async def _follow_lds(self, lds: str) -> None:
+        """Ask the LDS again and again: plug the devices newly registered, unplug those no longer registered."""
+        from plugnproduce.discovery.opcua import registered
+
+        while True:
+            await asyncio.sleep(LDS_POLL)
+            try:
+                self._ask_lds(await registered(lds, self.device_budget))
+            except ProtocolError as exc:  # the LDS is away for now: the cell stays as it is
+                _LOGGER.warning("%s", exc)
+
+    def _ask_lds(self, servers: list[tuple[str, str]]) -> None:
+        listed = {opcua_spec.application_uri_for(device): (device, url) for device, url in servers}
+        for uri in [u for u in self._on_lds if u not in listed]:
+            self._on_lds.pop(uri)
+            gone = self._devices.pop(uri, None)
+            if gone is not None:
+                self._publish(CellChange("unplug", gone.id, self.cell))
+        self._lds_refused = {u: url for u, url in self._lds_refused.items() if listed.get(u, ("", ""))[1] == url}
+        for uri, (device, url) in listed.items():
+            if uri not in self._on_lds and self._lds_refused.get(uri) != url:
+                task = asyncio.create_task(self._plug_registered(uri, device, url))
+                self._readings.add(task)
+                task.add_done_callback(self._readings.discard)
+
+    async def _plug_registered(self, uri: str, device_id: str, url: str) -> None:
+        from plugnproduce.discovery.opcua import read_registered
+
+        async with self._turn(uri):
+            if uri in self._on_lds or any(d.id == device_id for d in self._devices.values()):
+                return  # plugged meanwhile, or found by SSDP already
+            result = await read_registered(device_id, url, self.taxonomy, self.device_budget)
+            if isinstance(result, Refusal):
+                self._lds_refused[uri] = url
+                self._publish(CellChange("refused", uri, self.cell, result.reason, url))
+                return
+            self._devices[uri], self._on_lds[uri] = result, url
+            self.refused.pop(uri, None)
+            self._publish(CellChange("plug", result.id, self.cell))
 
     def _read(self, ad: Advertisement | SearchHit) -> None:
         """Read a device that answered or announced itself, beside the others."""

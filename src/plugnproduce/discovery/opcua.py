@@ -27,12 +27,20 @@ async def discover_on_lds(lds: str, taxonomy: Taxonomy, timeout: float
     from plugnproduce.protocols.opcua.discovery import find_servers  # asyncua loads only when asked
 
     servers = await find_servers(lds, timeout)
-    results = await asyncio.gather(*(_read(device, url, taxonomy, timeout) for device, url in servers))
+    results = await asyncio.gather(*(read_registered(device, url, taxonomy, timeout) for device, url in servers))
     return ([r for r in results if isinstance(r, DeviceDescription)],
             [r for r in results if isinstance(r, Refusal)])
 
 
-async def _read(device: str, url: str, taxonomy: Taxonomy, timeout: float) -> DeviceDescription | Refusal:
+async def registered(lds: str, timeout: float) -> list[tuple[str, str]]:
+    """The devices registered with the LDS at ``lds`` now: (device id, discovery URL) each."""
+    from plugnproduce.protocols.opcua.discovery import find_servers  # asyncua loads only when asked
+
+    return await find_servers(lds, timeout)
+
+
+async def read_registered(device: str, url: str, taxonomy: Taxonomy, timeout: float) -> DeviceDescription | Refusal:
+    """The device registered as ``device`` at ``url``, read from itself within ``timeout``, or its refusal."""
     from plugnproduce.protocols.opcua import OpcUaDeviceClient
 
     host = urlparse(url).hostname or ""

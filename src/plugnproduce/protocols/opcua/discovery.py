@@ -3,20 +3,35 @@
 Any asyncua server answers ``RegisterServer`` and ``FindServers``, so the LDS is a plain asyncua server on its
 own port (4840 by convention). A device's server registers with it under ``urn:plugnproduce:device:ID``
 (:func:`~plugnproduce.protocols.opcua.spec.application_uri_for`); :func:`find_servers` lists those.
+
+A registration lasts :data:`KEEP` seconds unless renewed (a device renews every
+:data:`~plugnproduce.protocols.opcua.spec.REGISTRATION_PERIOD`), and ends at once when the server says it goes
+offline (``IsOnline`` false, as a device that stops says): so a device that stops, or dies, leaves the list.
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
+import time
+from typing import Any
 
 from asyncua import Client, Server, ua
 
 from plugnproduce.errors import ProtocolError
-from plugnproduce.protocols.opcua.spec import APPLICATION_URI_PREFIX, MAX_CHUNKS, MAX_MESSAGE, format_endpoint
+from plugnproduce.protocols.opcua.spec import (
+    APPLICATION_URI_PREFIX,
+    MAX_CHUNKS,
+    MAX_MESSAGE,
+    REGISTRATION_PERIOD,
+    format_endpoint,
+)
 
 MAX_SERVERS = 256
 """Most servers a FindServers answer may list."""
+
+KEEP = 3 * REGISTRATION_PERIOD
+"""Seconds a registration lasts without being renewed."""
 
 logging.getLogger("asyncua.server.internal_server").setLevel(logging.ERROR)
 
@@ -24,9 +39,13 @@ logging.getLogger("asyncua.server.internal_server").setLevel(logging.ERROR)
 class LocalDiscoveryServer:
     """An LDS on ``host``:``port`` (0: a free port); ``await start()``, ``await stop()``."""
 
-    def __init__(self, host: str = "127.0.0.1", port: int = 4840) -> None:
-        self._host, self._port = host, port
+    def __init__(self, host: str = "127.0.0.1", port: int = 4840, keep: float = KEEP) -> None:
+        """``keep``: seconds a registration lasts unless renewed."""
+        self._host, self._port, self.keep = host, port, keep
         self._server: Server | None = None
+        self._renewed: dict[str, float] = {}  # application URI -> monotonic time of its last registration
+        self.registrations = 0
+        """How many RegisterServer calls it took (first registrations and renewals)."""
         self.endpoint: str | None = None
 
     async def start(self) -> None:
@@ -37,9 +56,34 @@ class LocalDiscoveryServer:
         server.set_endpoint(format_endpoint(self._host, self._port))
         server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
         await server.set_application_uri("urn:plugnproduce:lds")
+        internal = server.iserver
+        register, find = internal.register_server, internal.find_servers
+
+        def register_server(registered: Any, conf: Any = None) -> None:
+            self.registrations += 1
+            if not registered.IsOnline:  # the server goes offline: it leaves the list now
+                internal._known_servers.pop(registered.ServerUri, None)
+                self._renewed.pop(registered.ServerUri, None)
+                return
+            self._renewed[registered.ServerUri] = time.monotonic()
+            register(registered, conf)
+
+        def find_servers(params: Any, sockname: Any = None) -> Any:
+            self._expire(internal._known_servers)
+            return find(params, sockname)
+
+        internal.register_server, internal.find_servers = register_server, find_servers
         await server.start()
         self._server = server
         self.endpoint = format_endpoint(self._host, server.bserver._server.sockets[0].getsockname()[1])
+
+    def _expire(self, known: dict[str, Any]) -> None:
+        """Forget the registrations not renewed within ``keep`` seconds."""
+        now = time.monotonic()
+        for uri, renewed in list(self._renewed.items()):
+            if now - renewed > self.keep:
+                known.pop(uri, None)
+                del self._renewed[uri]
 
     async def stop(self) -> None:
         """Stop listening."""

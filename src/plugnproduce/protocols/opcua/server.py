@@ -7,6 +7,8 @@ variable (read when asked, never stale) and sends the chart's events as OPC UA e
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import logging
 from collections.abc import Awaitable, Callable, Mapping
 from typing import Any
@@ -19,6 +21,7 @@ from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
+    REGISTRATION_PERIOD,
     STATE_VARIABLE,
     Kind,
     MethodSpec,
@@ -27,6 +30,9 @@ from plugnproduce.protocols.opcua.spec import (
     format_endpoint,
     from_wire,
 )
+
+REGISTER_TIMEOUT = 5.0
+"""Seconds a registration with (or leaving of) a Local Discovery Server may take."""
 
 RequestHandler = Callable[[str, Mapping[str, Any]], Awaitable[Mapping[str, Any] | None]]
 """Takes a request and its arguments; returns the values of its output arguments, or raises
@@ -71,6 +77,7 @@ class OpcUaDeviceServer:
         self._device: Node | None = None
         self.endpoint: str | None = None
         """``opc.tcp://HOST:PORT/pnp/DEVICE`` once started."""
+        self._registered: list[str] = []
 
     async def start(self) -> None:
         """Build the address space and listen."""
@@ -105,17 +112,28 @@ class OpcUaDeviceServer:
                                                        files.chart), strict=True):
             await folder.add_variable(idx, name, value, varianttype=ua.VariantType.String)
 
-    async def register(self, lds: str) -> None:
-        """Register with the Local Discovery Server at ``lds`` (``RegisterServer``), under the real endpoint."""
+    async def register(self, lds: str, period: int = REGISTRATION_PERIOD) -> None:
+        """Register with the Local Discovery Server at ``lds`` (``RegisterServer``), under the real endpoint,
+        renewed every ``period`` seconds (0: never) until stopped."""
         if self._server is None or self.endpoint is None:
             raise RuntimeError(f"device {self.spec.device}: start the server before registering it")
         self._server.endpoint = urlparse(self.endpoint)  # the port it listens on, not the 0 it was asked for
-        await self._server.register_to_discovery(lds, period=0)
+        try:
+            await asyncio.wait_for(self._server.register_to_discovery(lds, period=period), REGISTER_TIMEOUT)
+        except Exception as exc:  # an LDS that is not there or not an LDS: said, one line
+            raise ProtocolError(f"device {self.spec.device}: cannot register with the Local Discovery Server "
+                                f"{lds}: {str(exc)[:200] or type(exc).__name__}") from exc
+        self._registered.append(lds)
 
     async def stop(self) -> None:
-        """Stop listening (the connected clients lose their sessions)."""
+        """Leave the Local Discovery Servers it registered with (offline at once), then stop listening (the
+        connected clients lose their sessions)."""
         if self._server is not None:
             server, self._server = self._server, None
+            for lds in self._registered:
+                with contextlib.suppress(Exception):  # a gone LDS forgets the registration by itself
+                    await asyncio.wait_for(server.unregister_from_discovery(lds), REGISTER_TIMEOUT)
+            self._registered.clear()
             await server.stop()
 
     def _read_state(self, *_: Any) -> ua.DataValue:

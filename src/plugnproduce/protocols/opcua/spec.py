@@ -34,6 +34,10 @@ DESCRIPTION_VARIABLES = ("TurtleName", "Turtle", "ChartName", "Chart")
 APPLICATION_URI_PREFIX = "urn:plugnproduce:device:"
 """A device's server registers with a Local Discovery Server under this plus its id."""
 
+REGISTRATION_PERIOD = 30
+"""Seconds between a device's renewals of its registration with a Local Discovery Server (whole seconds, as
+asyncua renews; OPC UA asks for at most 10 minutes)."""
+
 REQUEST_PREFIX = "opcua.request."
 EVENT_PREFIX = "opcua.event."
 
