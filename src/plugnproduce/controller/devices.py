@@ -24,14 +24,13 @@ def discovery(knowledge: Knowledge, *, search_timeout: float, expected: Collecti
     followed while the context is open; the search at its start waits for the ``expected`` devices,
     ``expected_count`` of them, or ``quiet`` seconds without news, within ``search_timeout``; the OPC UA devices
     registered with the Local Discovery Server ``lds`` (else ``PNP_LDS``, else none) are in it too."""
-    import os
-
     from plugnproduce.discovery import LiveCell
+    from plugnproduce.protocols.opcua.spec import chosen_lds
     from plugnproduce.protocols.upnp import network_from_env
 
     return LiveCell(knowledge.taxonomy, network=network_from_env(interface), search_timeout=search_timeout,
                     expected=expected, expected_count=expected_count, quiet=quiet,
-                    lds=lds or os.environ.get("PNP_LDS", "").strip() or None)
+                    lds=chosen_lds(lds))
 
 
 def simulated_cell(cell: Cell, catalogue: list[DeviceDescription], knowledge: Knowledge, faults: str = "",

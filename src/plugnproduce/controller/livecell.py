@@ -18,6 +18,7 @@ from plugnproduce.controller.interfaces import CellListener, CellUpdate
 from plugnproduce.description.model import Cell
 from plugnproduce.discovery import LiveCell
 from plugnproduce.knowledge import Knowledge
+from plugnproduce.protocols.opcua.spec import chosen_lds
 from plugnproduce.protocols.upnp import SsdpNetwork, network_from_env
 
 log = logging.getLogger(__name__)
@@ -31,7 +32,7 @@ class LiveCellSource:
                  knowledge: Knowledge | None = None) -> None:
         self.network = network if network is not None else network_from_env()
         self._live = LiveCell((knowledge or service.knowledge()).taxonomy, network=self.network, name=name,
-                              search_timeout=search_timeout)
+                              search_timeout=search_timeout, lds=chosen_lds())
         self._cell = Cell(name, ())
         self._listeners: list[CellListener] = []
         self._lock = threading.Lock()

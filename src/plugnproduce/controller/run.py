@@ -98,6 +98,7 @@ async def run_task(
     """
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.interface import chosen_address
+    from plugnproduce.protocols.opcua.spec import chosen_lds
     from plugnproduce.protocols.upnp import LOOPBACK, network_from_env, private_network
 
     say = progress or (lambda _: None)
@@ -116,7 +117,7 @@ async def run_task(
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         wanted = [d.id for d in the_cell.devices]
         live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
-                                                        expected=wanted))
+                                                        expected=wanted, lds=None if simulate else chosen_lds()))
         devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
                                                                          else DISCOVERY_SECONDS))
         run = await planned_run(the_task, the_cell, devices, journal, knowledge=k, observer=observer,
@@ -190,12 +191,13 @@ async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
     ``PNP_INTERFACE`` or loopback, and the SSDP port ``PNP_SSDP_PORT`` names) and asked their states. For ``check``,
     ``repair`` and ``explain`` on a live cell."""
     from plugnproduce.discovery import LiveCell
+    from plugnproduce.protocols.opcua.spec import chosen_lds
     from plugnproduce.protocols.upnp import network_from_env
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     wanted = [d.id for d in the_cell.devices]
     async with LiveCell(k.taxonomy, network=network_from_env(interface), name=the_cell.name,
-                        expected=wanted) as live:
+                        expected=wanted, lds=chosen_lds()) as live:
         devices = await find_devices(live, wanted, discovery_timeout)
         return the_cell.reported(await reported_states(devices))
 

@@ -15,6 +15,7 @@ The naming rule (``docs/opcua.md``): the device registers the namespace ``NAMESP
 from __future__ import annotations
 
 import math
+import os
 import re
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -127,6 +128,19 @@ def parse_endpoint(endpoint: str) -> tuple[str, int, str]:
     if not 0 < port < 65536:
         raise ProtocolError(f"OPC UA endpoint {endpoint!r} has no port from 1 to 65535")
     return host, port, match.group(3) or ""
+
+
+LDS_VARIABLE = "PNP_LDS"
+"""Environment variable naming the Local Discovery Server to ask when no ``--lds`` is given."""
+
+
+def chosen_lds(option: str | None = None) -> str | None:
+    """The Local Discovery Server the command line chose (``--lds``, else ``PNP_LDS``, else none), checked to be
+    ``opc.tcp://HOST:PORT`` (a ProtocolError, one line, otherwise)."""
+    lds = (option or os.environ.get(LDS_VARIABLE, "")).strip() or None
+    if lds is not None:
+        parse_endpoint(lds)
+    return lds
 
 
 def format_endpoint(host: str, port: int, path: str = "") -> str:
