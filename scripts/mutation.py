@@ -65,7 +65,8 @@ class Guard:
 
 
 GUARDS = (
-    Guard("evaluator", ("src/plugnproduce/statechart/runtime/evaluator.py",),
+    Guard("evaluator", ("src/plugnproduce/statechart/runtime/evaluator.py",
+                     "src/plugnproduce/statechart/runtime/budgets.py"),
           ("tests/statechart/test_evaluator_guards.py", "tests/statechart/test_evaluator_budgets.py",
            "tests/statechart/test_interpreter.py")),
     Guard("safeio", ("src/plugnproduce/safeio.py",),
