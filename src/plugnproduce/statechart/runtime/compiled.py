@@ -6,7 +6,7 @@ transition domains and event matchers), executable content compiled to actions.
 from __future__ import annotations
 
 import logging
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from plugnproduce.statechart.model import (
     Chart,
@@ -20,6 +20,9 @@ from plugnproduce.statechart.model import (
 )
 from plugnproduce.statechart.runtime.actions import Block, compile_block, compile_donedata, compile_invoke
 from plugnproduce.statechart.runtime.evaluator import Evaluator, Expr
+
+if TYPE_CHECKING:
+    from plugnproduce.statechart.runtime.session import EntrySet
 
 log = logging.getLogger(__name__)
 
@@ -87,7 +90,7 @@ class CTransition:
         self.actions = actions
         self.has_history = False
         self.domain: CState | None = None
-        self.entry_cache: Any = None
+        self.entry_cache: EntrySet | None = None
 
     def matches(self, name: str) -> bool:
         """True when the event ``name`` matches one of the transition's descriptors."""

@@ -125,7 +125,7 @@ class Microstep:
     def _entry_set(self: MicrostepSession, enabled: list[CTransition]) -> EntrySet:
         single = enabled[0] if len(enabled) == 1 else None
         if single is not None and single.entry_cache is not None:
-            return single.entry_cache  # type: ignore[no-any-return]
+            return single.entry_cache
         builder = EntryBuilder(self._history)
         for t in enabled:
             builder.add(t)
