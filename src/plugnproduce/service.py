@@ -9,7 +9,6 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import dataclasses
-import os
 import secrets
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
@@ -18,6 +17,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, TypedDict
 
+from plugnproduce import folders
 from plugnproduce.description.loader import (
     cell_libraries,
     load_cell,
@@ -526,8 +526,9 @@ class DevicesMissing(PlugNProduceError):
 
 
 def runs_folder() -> Path:
-    """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``~/.local/state/plugnproduce/runs``."""
-    return Path(os.environ.get("PNP_RUNS") or Path.home() / ".local" / "state" / "plugnproduce" / "runs")
+    """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``runs`` in the user's state folder
+    (:func:`plugnproduce.folders.runs_folder`)."""
+    return folders.runs_folder()
 
 
 def new_run_id(task_name: str) -> str:

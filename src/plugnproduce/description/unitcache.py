@@ -24,6 +24,8 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from plugnproduce import folders
+
 if TYPE_CHECKING:
     import pint
 
@@ -39,7 +41,7 @@ class Incompatible(ValueError):
 
 def cache_folder() -> Path:
     """The user's cache folder for plugnproduce, where the taxonomy's closure is cached too."""
-    return Path.home() / ".cache" / "plugnproduce"
+    return folders.cache_folder()
 
 
 class Quantity:
