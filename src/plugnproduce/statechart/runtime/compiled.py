@@ -83,8 +83,8 @@ class CTransition:
         self.wildcard = "*" in descriptors
         self.exact = frozenset(descriptors)
         self.prefixes = tuple(d + "." for d in descriptors)
-        blank = node.cond is None or not node.cond.strip()  # an empty cond is read as no cond
-        self.cond: Expr | None = None if blank else evaluator.expr(node.cond)  # type: ignore[arg-type]
+        cond = node.cond if node.cond is not None and node.cond.strip() else None  # an empty cond is no cond
+        self.cond: Expr | None = None if cond is None else evaluator.expr(cond)
         self.targets: list[CState] = []
         self.internal = node.type == "internal"
         self.actions = actions
