@@ -9,8 +9,8 @@ import platformdirs
 import pytest
 
 from plugnproduce import folders, helpcache, service
+from plugnproduce.batch import enginecache
 from plugnproduce.description import unitcache
-from plugnproduce.reasoning import enginecache
 from plugnproduce.sim import control
 
 
