@@ -30,9 +30,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from plugnproduce.codegen import DONE, GeneratedTask
-from plugnproduce.codegen.flow import branch_variable
-from plugnproduce.codegen.task import STEP
+from plugnproduce.chartnames import DONE, STEP, branch_variable
+from plugnproduce.codegen import GeneratedTask
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import outcomes, values

@@ -15,8 +15,10 @@ import ast
 import re
 from typing import Any
 
+from plugnproduce.errors import ExecutionError
 
-class EvaluationError(Exception):
+
+class EvaluationError(ExecutionError):
     """An expression could not be evaluated (the interpreter raises ``error.execution``)."""
 
 
