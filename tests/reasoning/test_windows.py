@@ -71,6 +71,15 @@ def test_the_next_best_repairs_are_distinct_and_no_cheaper(cell: Cell) -> None:
     assert all(service.check(r.task, cell).plausible for r in found)
 
 
+def test_a_step_rebound_in_a_window_names_its_new_device_in_the_repaired_task(cell: Cell) -> None:
+    task = faulty_task(25, 2, 5, kinds=("absent",))  # places 20 and 42 bound to a SCARA the cell does not have
+    best = windowed(task, cell)[0]
+    assert [(e.kind, e.step, e.role, e.device) for e in best.edits] == [("rebind", 20, "robot", "robot"),
+                                                                         ("rebind", 42, "robot", "robot")]
+    assert [(n, st.bind) for n, st in enumerate(best.task.steps, start=1) if st.bind] == [
+        (20, {"robot": "robot"}), (42, {"robot": "robot"})]
+
+
 def _screws(task: Task, at: tuple[int, ...]) -> Task:
     steps = list(task.steps)
     for i in sorted(at, reverse=True):
