@@ -40,9 +40,9 @@ from pathlib import Path
 from naive_batch import Naive
 
 from plugnproduce import service
+from plugnproduce.batch import Configuration, batch, engine, report
+from plugnproduce.batch.batches import task_names
 from plugnproduce.description.model import Cell, DeviceDescription, Task
-from plugnproduce.reasoning import Configuration, batch, engine, report
-from plugnproduce.reasoning.batches import task_names
 
 TASKS = ("bin-picking", "pick-and-place", "bin-picking-invalid")
 COPIES = 4

@@ -18,7 +18,7 @@ import os
 import statistics
 import time
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.discovery import LiveCell
 from plugnproduce.protocols.upnp import private_network
 from plugnproduce.sim.cell import SimulatedCell
@@ -41,7 +41,7 @@ async def main(rounds: int) -> None:
         print(f"nothing expected: the whole search window is waited, {window:.2f} s")
         t = time.perf_counter()
         async with LiveCell(service.knowledge().taxonomy, network=network, expected=ids) as live:
-            await service.find_devices(live, ids, 5)
+            await controller.find_devices(live, ids, 5)
             found = time.perf_counter() - t
             print(f"four devices expected and found in {found:.2f} s = {found / window:.2f}× the search window "
                   "(target < 5 s)")

@@ -26,9 +26,9 @@ import rdflib
 from rdflib.namespace import OWL, RDF
 
 from plugnproduce import service
+from plugnproduce.batch import Configuration
 from plugnproduce.description.model import Step, Task
 from plugnproduce.ontology.taxonomy import ontology_files, read_tbox
-from plugnproduce.reasoning import Configuration
 
 PNP = rdflib.Namespace("http://plugnproduce.org/ontology#")
 BENCH = rdflib.Namespace("http://plugnproduce.org/bench#")

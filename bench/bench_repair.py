@@ -28,7 +28,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # the checkout'
 
 from plugnproduce import service  # noqa: E402
 from plugnproduce.description.model import Cell, DeviceDescription, Task  # noqa: E402
-from plugnproduce.reasoning import Repair, repairs, windows  # noqa: E402
+from plugnproduce.reasoning import Repair  # noqa: E402
+from plugnproduce.reasoning.repairs import repairs, windows  # noqa: E402
 from tests.reasoning.faulty_tasks import faulty_task  # noqa: E402
 
 K = service.knowledge()

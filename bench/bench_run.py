@@ -19,7 +19,7 @@ import statistics
 import tempfile
 from pathlib import Path
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.executor.journal import read_journal
 
 
@@ -56,7 +56,7 @@ async def main(runs: int) -> None:
     walls, devices = [], []
     with tempfile.TemporaryDirectory() as folder:
         for i in range(runs):
-            report = await service.run_task(task, cell, simulate=True, journal=Path(folder) / f"run{i}.jsonl")
+            report = await controller.run_task(task, cell, simulate=True, journal=Path(folder) / f"run{i}.jsonl")
             assert report.outcome == "succeeded", report.fault
             for wall, busy in cycles(read_journal(report.journal).records):
                 walls.append(wall)

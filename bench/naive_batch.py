@@ -28,10 +28,10 @@ from pathlib import Path
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.reasoning import schema as s
-from plugnproduce.reasoning.accepts import accepts
-from plugnproduce.reasoning.contracts import normalised, refuses
-from plugnproduce.reasoning.facts import device_facts, process_facts, task_facts
+from plugnproduce.reasoning.asp import schema as s
+from plugnproduce.reasoning.asp.facts import device_facts, process_facts, task_facts
+from plugnproduce.reasoning.checks.accepts import accepts
+from plugnproduce.reasoning.checks.contracts import normalised, refuses
 
 MAX_BUY = 4
 """Largest purchase the reference tries."""
@@ -232,7 +232,7 @@ def _reach(edges: dict[tuple[str, str], set[str]], d: str, x: str) -> set[str]:
 def main() -> None:
     """Answer a JSONL file of configurations as a script: offered processes and plausible tasks per line."""
     from plugnproduce import service
-    from plugnproduce.reasoning.batches import task_names
+    from plugnproduce.batch.batches import task_names
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("configs", type=Path)

@@ -13,9 +13,11 @@ SRC = Path(__file__).parent.parent / "src" / "plugnproduce"
 LAYERS = {
     "cli": 7,  # the command line may also start the web HMI (pnp serve)
     "hmi": 6,
+    "controller": 5.5,  # runs a cell: the cell sources, the runs (discovery, executor, sim) over the service
     "service": 5,
     "executor": 4, "sim": 4, "discovery": 4,
     "verification": 3.5,  # explores the generated program (codegen) in the runtime (statechart)
+    "batch": 3.5,  # checks a product family in many cells with the reasoning layer; not part of it
     "codegen": 3, "reasoning": 3, "validation": 3, "drawing": 3,
     "planning": 3.2,  # plans from goals with the reasoning layer
     "knowledge": 2.5,  # the loaded libraries: their taxonomy, descriptions and catalogue
@@ -25,6 +27,9 @@ LAYERS = {
     "errors": -1,
 }
 """Rank of each subpackage or top-level module: a module imports only from lower ranks or its own part."""
+
+REASONING_PARTS = ("asp", "checks", "repairs", "explanation")
+"""The parts of ``reasoning/`` in order: each imports only from itself and the parts before it."""
 
 SCXML_NAMESPACE = "http://www.w3.org/2005/07/scxml"
 
@@ -82,3 +87,19 @@ def test_no_reasoning_module_imports_codegen() -> None:
     offenders = [str(p.relative_to(SRC)) for p in (SRC / "reasoning").rglob("*.py")
                  if any(_part(m) == "codegen" for m in _imports(p))]
     assert offenders == []
+
+
+@pytest.mark.parametrize("part", REASONING_PARTS)
+def test_reasoning_parts_import_one_way(part: str) -> None:
+    later = {f"plugnproduce.reasoning.{p}" for p in REASONING_PARTS[REASONING_PARTS.index(part) + 1:]}
+    offenders = sorted(f"{p.relative_to(SRC)} imports {m}" for p in (SRC / "reasoning" / part).rglob("*.py")
+                       for m in _imports(p) if m == "plugnproduce.reasoning"
+                       or any(m == x or m.startswith(x + ".") for x in later))
+    assert offenders == []
+
+
+def test_the_reasoning_layer_and_the_batch_hold_at_most_15_modules_flat() -> None:
+    folders = [SRC / "batch", *(d for d in [SRC / "reasoning", *(SRC / "reasoning").rglob("*")] if d.is_dir())]
+    crowded = {str(d.relative_to(SRC)): n for d in folders
+               if (n := len([m for m in d.glob("*.py") if m.name != "__init__.py"])) > 15}
+    assert crowded == {}

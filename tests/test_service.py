@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.codegen import outputs
 from plugnproduce.description.model import Task
 
@@ -59,7 +59,7 @@ def test_a_run_is_planned_without_the_closed_world_chart_or_device_programs(
     monkeypatch.setattr(outputs, "all_charts", refuse)
     planned = service.plan_run(TASK, CELL)
     assert planned.task_chart() == expected
-    run = service.start_run(planned, service.cell(CELL), tmp_path / "run.jsonl")
+    run = controller.start_run(planned, service.cell(CELL), tmp_path / "run.jsonl")
     assert run.journal_path == tmp_path / "run.jsonl" and run.cell.name == service.cell(CELL).name
 
 

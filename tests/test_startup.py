@@ -87,9 +87,9 @@ def test_a_submodule_imported_before_its_lazy_package_is_used_runs_once_after_it
     # submodule), the submodule would run twice and its registry of ASP predicates would exist twice
     code = ("import sys\nfrom plugnproduce.lazy import lazy_module\n"
             "lazy_module('plugnproduce.reasoning')\n"
-            "from plugnproduce.reasoning.terms import _REGISTRY\n"
-            "from plugnproduce.reasoning import solver\n"
-            "import plugnproduce.reasoning.linksafety\n"  # a package runs before its submodules: no partial import
+            "from plugnproduce.reasoning.asp.terms import _REGISTRY\n"
+            "from plugnproduce.reasoning.asp import solver\n"
+            "import plugnproduce.reasoning.checks.linksafety\n"  # a package runs before its submodules: no partial import
             "print(solver.decode.__globals__['_REGISTRY'] is _REGISTRY)")
     assert _run(code).split() == ["True"]
 

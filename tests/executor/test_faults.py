@@ -7,7 +7,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.codegen import FAILED
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun
@@ -25,7 +25,7 @@ async def test_a_stop_is_told_to_the_chart_which_ends_in_failed_with_one_fault(t
             runs[0].stop("first stop")
             runs[0].stop("second stop")
 
-    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
+    report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
                                     observer=stop_twice_at_step_2, started=runs.append)
     assert runs[0].interpreter.final_state == FAILED
     assert report.fault is not None and report.fault.message == "first stop" and report.fault.kind == "stopped"
@@ -44,7 +44,7 @@ async def test_a_device_outside_the_cell_leaving_does_not_stop_the_run(tmp_path:
         if record["kind"] == "step" and record["step"] == 2:
             runs[0].device_lost("stranger", "byebye")
 
-    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
+    report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
                                     observer=stranger_leaves_at_step_2, started=runs.append)
     assert report.outcome == "succeeded" and report.fault is None
     run = read_journal(report.journal)
@@ -58,7 +58,7 @@ async def test_a_device_of_the_cell_leaving_stops_the_run_naming_it(tmp_path: Pa
         if record["kind"] == "step" and record["step"] == 2:
             runs[0].device_lost("gripper", "its byebye was confirmed")
 
-    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
+    report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
                                     observer=gripper_leaves_at_step_2, started=runs.append)
     assert report.outcome == "failed" and runs[0].interpreter.final_state == FAILED
     assert report.fault is not None
@@ -106,7 +106,7 @@ async def test_a_safe_stop_waits_at_most_five_seconds_for_each_answer_even_from_
                 links[device] = NotedBounds(device, link, noted)  # type: ignore[assignment]
             runs[0].stop("operator stop")
 
-    report = await service.run_task(TASK, cell, simulate=True, journal=tmp_path / "run.jsonl",
+    report = await controller.run_task(TASK, cell, simulate=True, journal=tmp_path / "run.jsonl",
                                     observer=stop_at_step_2, started=runs.append)
     assert report.outcome == "stopped"
     stop_requests = {device for device, what, _ in noted if what != "state"}

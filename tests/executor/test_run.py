@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.discovery import LiveCell
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.executor.journal import read_journal
@@ -24,7 +24,7 @@ CELL = service.builtin("cells", "bin-picking.yaml")
 async def test_bin_picking_runs_to_the_end_and_the_journal_has_every_command_in_order(
         tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     with caplog.at_level(logging.ERROR, logger="asyncio"):
-        report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl")
+        report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl")
     assert report.outcome == "succeeded", report.fault
     assert [r.getMessage() for r in caplog.records if r.levelno >= logging.ERROR] == []  # nothing went wrong unseen
     run = read_journal(report.journal)
@@ -54,7 +54,7 @@ FAULTS = {
 @pytest.mark.parametrize("spec", FAULTS)
 async def test_each_fault_stops_the_run_safely_with_a_report(spec: str, tmp_path: Path) -> None:
     kind, text = FAULTS[spec]
-    report = await service.run_task(TASK, CELL, simulate=True, faults=spec, journal=tmp_path / "run.jsonl")
+    report = await controller.run_task(TASK, CELL, simulate=True, faults=spec, journal=tmp_path / "run.jsonl")
     assert report.outcome == "failed"
     fault = report.fault
     assert fault is not None and (fault.kind, fault.device) == (kind, "gripper")
@@ -86,7 +86,7 @@ async def test_each_fault_stops_the_run_safely_with_a_report(spec: str, tmp_path
 
 async def test_an_unanswered_command_fails_the_run_at_the_step_that_sent_it(tmp_path: Path) -> None:
     """The robot's first MoveTo is carried out but never answered: the run does not end ``succeeded``."""
-    report = await service.run_task(TASK, CELL, simulate=True, faults="robot:drop-response:MoveTo",
+    report = await controller.run_task(TASK, CELL, simulate=True, faults="robot:drop-response:MoveTo",
                                     journal=tmp_path / "run.jsonl")
     assert report.outcome == "failed"
     fault = report.fault
@@ -100,7 +100,7 @@ async def test_an_unanswered_command_fails_the_run_at_the_step_that_sent_it(tmp_
 
 
 async def test_after_an_unanswered_close_the_fault_names_the_step_that_sent_it(tmp_path: Path) -> None:
-    report = await service.run_task(TASK, CELL, simulate=True, faults="gripper:drop-response:Close",
+    report = await controller.run_task(TASK, CELL, simulate=True, faults="gripper:drop-response:Close",
                                     journal=tmp_path / "run.jsonl")
     run = read_journal(report.journal)
     close = next(r for r in run.of_kind("command") if r["command"] == "Close")
@@ -113,7 +113,7 @@ async def test_a_device_unplugged_mid_task_stops_the_run(tmp_path: Path, taxonom
     generated = service.generate(TASK, cell).task
     network = upnp.private_network()
     async with SimulatedCell(cell, network=network) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
+        devices = await controller.find_devices(live, [d.id for d in cell.devices], controller.SIMULATED_DISCOVERY_SECONDS)
 
         def unplug_after_first_gripper_event(record: dict[str, object]) -> None:
             if record["kind"] == "event" and record["device"] == "gripper":
@@ -131,7 +131,7 @@ async def test_an_operator_stop_ends_the_run_as_stopped(tmp_path: Path) -> None:
             runs[0].stop()
 
     runs: list[TaskRun] = []
-    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
+    report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
                                     observer=stop_at_step_2, started=runs.append)
     assert report.outcome == "stopped"
     run = read_journal(report.journal)
@@ -150,7 +150,7 @@ async def test_a_device_cable_pulled_while_it_has_nothing_to_do_stops_the_run(tm
     generated = service.generate(TASK, cell).task
     network = upnp.private_network()
     async with SimulatedCell(cell, network=network) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
+        devices = await controller.find_devices(live, [d.id for d in cell.devices], controller.SIMULATED_DISCOVERY_SECONDS)
 
         def pull_the_gripper_cable_once_closed(record: dict[str, object]) -> None:
             if record["kind"] == "event" and record["event"] == "gripper_closed" and record["step"] == 1:
@@ -179,7 +179,7 @@ STOP_FAULTS = {
 
 @pytest.mark.parametrize("spec", STOP_FAULTS)
 async def test_a_safe_stop_the_robot_does_not_accept_is_reported_as_incomplete(spec: str, tmp_path: Path) -> None:
-    report = await service.run_task(TASK, CELL, simulate=True, faults=f"gripper:error-response:Close,{spec}",
+    report = await controller.run_task(TASK, CELL, simulate=True, faults=f"gripper:error-response:Close,{spec}",
                                     journal=tmp_path / "run.jsonl")
     assert report.outcome == "failed" and report.fault is not None and report.fault.kind == "refused"
     run = read_journal(report.journal)
@@ -197,7 +197,7 @@ async def test_a_device_gone_before_the_run_stops_the_devices_already_reached(tm
     network = upnp.private_network()
     faults = parse_faults("robot:drop-response:state", cell.devices)
     async with SimulatedCell(cell, network=network, faults=faults) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
+        devices = await controller.find_devices(live, [d.id for d in cell.devices], controller.SIMULATED_DISCOVERY_SECONDS)
         await sim.unplug("gripper")
         report = await TaskRun(generated, devices, tmp_path / "run.jsonl").run()
     assert report.outcome == "failed"
@@ -213,7 +213,7 @@ async def test_the_journal_says_what_each_event_brought_and_where_each_value_wen
     """One part in a simulated bin: the bin-picking PC's PartLocalized is journalled at its step with the pose it
     found, that pose as a value the step produced, and the robot's next MoveTo as the step that uses it."""
     task = service.builtin("tasks", "bin-picking-until-empty.yaml")
-    report = await service.run_task(task, CELL, simulate=True, bin_parts=1, bin_seed=1, journal=tmp_path / "run.jsonl")
+    report = await controller.run_task(task, CELL, simulate=True, bin_parts=1, bin_seed=1, journal=tmp_path / "run.jsonl")
     assert report.outcome == "succeeded", report.fault
     run = read_journal(report.journal)
     assert all(set(r) >= {"step", "device", "event", "params"} for r in run.of_kind("event"))
@@ -237,7 +237,7 @@ async def test_an_event_the_task_does_not_wait_for_stops_the_run_naming_it(tmp_p
     generated = service.generate(TASK, cell).task
     network = upnp.private_network()
     async with SimulatedCell(cell, network=network) as sim, LiveCell(taxonomy, network=network) as live:
-        devices = await service.find_devices(live, [d.id for d in cell.devices], service.SIMULATED_DISCOVERY_SECONDS)
+        devices = await controller.find_devices(live, [d.id for d in cell.devices], controller.SIMULATED_DISCOVERY_SECONDS)
 
         def gripper_speaks_up_during_the_first_move(record: dict[str, object]) -> None:
             if record["kind"] == "command" and record["command"] == "MoveTo" and record["step"] == 1:
@@ -271,7 +271,7 @@ async def test_the_controller_sends_only_requests_to_devices_of_the_cell(tmp_pat
                     refusals.append(str(exc))
             runs[0].stop("asked")
 
-    report = await service.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
+    report = await controller.run_task(TASK, CELL, simulate=True, journal=tmp_path / "run.jsonl",
                                     observer=ask_the_odd_things_at_step_1, started=runs.append)
     assert refusals == [
         "cannot send 'xirp.request.MoveTo' to 'stranger': not a request to a device of the cell",

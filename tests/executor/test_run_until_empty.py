@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.sim.bin import SimulatedBin
 
 TASKS = service.builtin("tasks")
@@ -82,6 +82,6 @@ def test_with_sim_alone_the_task_empties_a_default_bin_of_five_parts_and_says_so
 
 
 def test_only_a_task_that_loops_on_an_outcome_and_takes_a_localized_pose_gets_a_default_bin() -> None:
-    assert service.default_bin_parts(TASKS / "bin-picking.yaml") is None  # its fixed pick pose: no bin
-    assert service.default_bin_parts(TASKS / "bin-picking-localized.yaml") is None  # three rounds: the charts' poses
-    assert service.default_bin_parts(TASKS / "bin-picking-until-empty.yaml") == 5
+    assert controller.default_bin_parts(TASKS / "bin-picking.yaml") is None  # its fixed pick pose: no bin
+    assert controller.default_bin_parts(TASKS / "bin-picking-localized.yaml") is None  # three rounds: the charts' poses
+    assert controller.default_bin_parts(TASKS / "bin-picking-until-empty.yaml") == 5

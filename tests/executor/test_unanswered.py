@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.executor.journal import describe, read_journal
 
 TASK = service.builtin("tasks", "bin-picking.yaml")
@@ -12,7 +12,7 @@ CELL = service.builtin("cells", "bin-picking.yaml")
 
 
 async def test_no_command_goes_out_after_an_unanswered_close(tmp_path: Path) -> None:
-    report = await service.run_task(TASK, CELL, simulate=True, faults="gripper:drop-response:Close",
+    report = await controller.run_task(TASK, CELL, simulate=True, faults="gripper:drop-response:Close",
                                     journal=tmp_path / "run.jsonl")
     assert report.outcome == "failed" and report.fault is not None
     run = read_journal(report.journal)
@@ -23,7 +23,7 @@ async def test_no_command_goes_out_after_an_unanswered_close(tmp_path: Path) -> 
 
 
 async def test_an_unanswered_close_is_reported_at_its_step_with_what_is_known(tmp_path: Path) -> None:
-    report = await service.run_task(TASK, CELL, simulate=True, faults="gripper:drop-response:Close",
+    report = await controller.run_task(TASK, CELL, simulate=True, faults="gripper:drop-response:Close",
                                     journal=tmp_path / "run.jsonl")
     fault = report.fault
     assert fault is not None and (fault.kind, fault.step, fault.request, fault.state) == ("timeout", 1, "Close", "open")

@@ -15,7 +15,7 @@ import httpx
 import pytest
 from typer.testing import CliRunner
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.cli import app
 from plugnproduce.protocols.upnp import private_network
 from plugnproduce.sim.bin import SimulatedBin
@@ -237,11 +237,11 @@ def test_serve_sim_gives_the_runs_of_a_localizing_task_a_default_bin_and_says_so
 def test_issue_24_serve_takes_the_discovery_timeout_for_its_simulated_devices() -> None:
     # hmi/simcell.py waited a fixed 10 s: pnp serve --sim failed to start at load 18-20
     from plugnproduce.cli.serve import cell_source
-    from plugnproduce.hmi.simcell import SimulatedCellSource
+    from plugnproduce.controller.simcell import SimulatedCellSource
 
     default = cell_source(None, sim=True)
     given = cell_source(None, sim=True, discovery_timeout=240.0)
     assert isinstance(default, SimulatedCellSource) and isinstance(given, SimulatedCellSource)
-    assert (default._wait, given._wait) == (service.SIMULATED_DISCOVERY_SECONDS, 240.0)
+    assert (default._wait, given._wait) == (controller.SIMULATED_DISCOVERY_SECONDS, 240.0)
     help_text = CliRunner().invoke(app, ["serve", "--help"], terminal_width=200).stdout
     assert "--discovery-timeout SECONDS" in help_text

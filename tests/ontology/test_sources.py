@@ -25,7 +25,7 @@ from plugnproduce.cli import app
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.sources import read_tbox_file
 from plugnproduce.ontology.taxonomy import classify, load_taxonomy, read_tbox
-from plugnproduce.reasoning.axioms import Axiom, load_ontology
+from plugnproduce.reasoning.explanation.axioms import Axiom, load_ontology
 from plugnproduce.resources import ontology_path
 
 runner = CliRunner()

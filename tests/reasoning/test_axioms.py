@@ -7,8 +7,8 @@ from pathlib import Path
 import rdflib
 
 from plugnproduce import service
-from plugnproduce.reasoning.axioms import Labels, load_ontology
-from plugnproduce.reasoning.derivation import rule
+from plugnproduce.reasoning.asp.derivation import rule
+from plugnproduce.reasoning.explanation.axioms import Labels, load_ontology
 
 PNP = "http://plugnproduce.org/ontology#"
 

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from plugnproduce import service
+from plugnproduce.batch import Configuration, batches, engine, generate, read_configurations
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
-from plugnproduce.reasoning import Configuration, batches, engine, generate, read_configurations
 from tests.reasoning.conftest import DESCRIPTIONS, task, write
 
 PAPER = ("binpicking-pc", "gripper", "robot", "sensor3d")

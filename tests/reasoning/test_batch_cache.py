@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
+from plugnproduce.batch import enginecache
 from plugnproduce.cli import app
-from plugnproduce.reasoning import enginecache
 from tests.reasoning.conftest import TASKS, write
 
 runner = CliRunner()
@@ -39,7 +39,7 @@ def test_a_second_batch_reads_the_kept_engine_and_answers_alike(tmp_path: Path, 
     def no_reasoning(*args: object) -> object:
         raise AssertionError("reasoned again over unchanged files")
 
-    monkeypatch.setattr("plugnproduce.reasoning.engine", no_reasoning)
+    monkeypatch.setattr("plugnproduce.batch.engine", no_reasoning)
     assert batch(tmp_path, task) == first
     assert [r["plausible"] for r in first] == [["pick-and-place"], [], []]
 

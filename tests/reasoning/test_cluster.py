@@ -11,8 +11,8 @@ from distributed import Client, LocalCluster
 from typer.testing import CliRunner
 
 from plugnproduce import service
+from plugnproduce.batch import BatchRow, batch, cluster_mapper, generate
 from plugnproduce.cli import app
-from plugnproduce.reasoning import BatchRow, batch, cluster_mapper, generate
 from tests.reasoning.conftest import TASKS
 
 runner = CliRunner()

@@ -2,7 +2,7 @@
 
 The library under tests/data/libraries/transport-lock (written outside the package) has a gripper delivered
 locked open for transport: its chart starts in an Open state from which no transition leads to Closed. The
-check (``stuck`` in rules/chain.lp), the batch (its twin in reasoning/feasibility.py) and code generation must
+check (``stuck`` in rules/chain.lp), the batch (its twin in batch/feasibility.py) and code generation must
 all say no, and say it alike.
 """
 
@@ -17,11 +17,12 @@ import pytest
 from typer.testing import CliRunner
 
 from plugnproduce import reasoning, service
+from plugnproduce.batch import Configuration
 from plugnproduce.cli import app
 from plugnproduce.codegen import generate_task
 from plugnproduce.codegen.task import StuckStep
 from plugnproduce.description.model import Cell
-from plugnproduce.reasoning import Configuration
+from plugnproduce.service import checks
 
 LIBRARY = Path(__file__).parent.parent / "data" / "libraries" / "transport-lock"
 CELL = LIBRARY / "cells" / "bin-picking-locked.yaml"
@@ -79,7 +80,7 @@ def test_generate_says_it_in_one_line_even_when_the_check_lets_the_step_through(
     def lenient(*args: object, **kwargs: object) -> reasoning.CheckResult:  # the check with the stuck rule gone
         return dataclasses.replace(real(*args, **kwargs), plausible=True, problems=())  # type: ignore[arg-type]
 
-    monkeypatch.setattr(service, "check", lenient)
+    monkeypatch.setattr(checks, "check", lenient)  # where generate looks it up
     result = CliRunner().invoke(app, ["--library", str(LIBRARY), "generate", str(CLOSE), "--cell", str(CELL), "-o",
                                       str(tmp_path / "out"), "--no-verify"])
     assert isinstance(result.exception, SystemExit | None), result.exception

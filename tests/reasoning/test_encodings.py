@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from plugnproduce.reasoning import solver
+from plugnproduce.reasoning.asp import solver
 from plugnproduce.resources import rules_path
 from tests.reasoning.conftest import answer_sets
 

@@ -8,9 +8,9 @@ import pytest
 from plugnproduce import service
 from plugnproduce.description.model import Cell
 from plugnproduce.errors import EncodingError
-from plugnproduce.reasoning import schema as s
-from plugnproduce.reasoning.facts import device_facts, milli, process_facts, task_facts, value_kinds
-from plugnproduce.reasoning.terms import decode, program, quote
+from plugnproduce.reasoning.asp import schema as s
+from plugnproduce.reasoning.asp.facts import device_facts, milli, process_facts, task_facts, value_kinds
+from plugnproduce.reasoning.asp.terms import decode, program, quote
 from tests.reasoning.conftest import task
 
 PNP = "http://plugnproduce.org/ontology#"

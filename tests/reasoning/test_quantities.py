@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 
 from plugnproduce import service
 from plugnproduce.cli import app
-from plugnproduce.reasoning.facts import milli
+from plugnproduce.reasoning.asp.facts import milli
 from tests.reasoning.conftest import BIN_PICKING, write
 
 
@@ -27,7 +27,7 @@ def _pick(tmp_path: Path, grip_force: str) -> Path:
 ])
 def test_issue_24_a_quantity_that_is_no_finite_number_is_one_line_at_its_line(
         tmp_path: Path, command: str, value: str, says: str) -> None:
-    # 1e308 kN became 1e311 N, an infinity: OverflowError traceback in reasoning/facts.py milli
+    # 1e308 kN became 1e311 N, an infinity: OverflowError traceback in reasoning/asp/facts.py milli
     task = _pick(tmp_path, f"'{value}'")
     extra = ["-o", str(tmp_path / "out")] if command == "generate" else []
     result = CliRunner().invoke(app, [command, str(task), "--cell", str(BIN_PICKING), *extra])

@@ -20,7 +20,7 @@ from plugnproduce import service
 from plugnproduce.cli import app
 from plugnproduce.description.model import Cell
 from plugnproduce.reasoning import AssessedRepair
-from plugnproduce.reasoning.sideeffects import ranking
+from plugnproduce.reasoning.repairs.sideeffects import ranking
 from tests.reasoning.conftest import BIN_PICKING
 
 LIBRARIES = Path(__file__).parents[1] / "data" / "libraries"

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from plugnproduce import service
 from plugnproduce.description.model import Cell, Step, Task
-from plugnproduce.reasoning.sideeffects import new_steps
+from plugnproduce.reasoning.repairs.sideeffects import new_steps
 from tests.reasoning.conftest import TASKS, task
 
 INVALID = TASKS / "bin-picking-invalid.yaml"

@@ -10,8 +10,9 @@ from hypothesis import strategies as st
 
 from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription, Step, Task
-from plugnproduce.reasoning import RepairCosts, repairs, windows
-from plugnproduce.reasoning.windows import Window
+from plugnproduce.reasoning import RepairCosts
+from plugnproduce.reasoning.repairs import repairs, windows
+from plugnproduce.reasoning.repairs.windows import Window
 from tests.reasoning.faulty_tasks import faulty_task
 
 KNOWLEDGE = service.knowledge()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.discovery import LiveCell
 from plugnproduce.errors import ProtocolError, ProtocolTimeout
 from plugnproduce.protocols import upnp, xirp
@@ -102,7 +102,7 @@ async def test_the_simulated_cell_is_discovered_and_follows_plug_and_unplug(netw
     cell = service.cell(service.builtin("cells", "bin-picking.yaml"))
     async with SimulatedCell(cell, catalogue=service.catalogue(), network=network) as sim, \
             LiveCell(taxonomy, network=network) as live:
-        found = await service.find_devices(live, ["robot", "gripper", "sensor3d", "binpicking-pc"], WAIT)
+        found = await controller.find_devices(live, ["robot", "gripper", "sensor3d", "binpicking-pc"], WAIT)
         assert found.device("gripper").endpoint == sim.devices["gripper"].endpoint
         assert "pick" in service.capabilities(live.cell).commands()
         await sim.unplug("gripper")

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.description.model import Step, Task
 from plugnproduce.resources import descriptions_path
 
@@ -90,5 +90,5 @@ async def test_an_offered_binding_is_plausible_proved_and_runs_as_the_table_says
         return  # not plausible as one step: nothing to prove or run (the table says why)
     result = service.verify(task, cell)
     assert result.proved is proved, result.problem
-    run = await service.run_task(task, cell, simulate=True, journal=tmp_path / "run.jsonl")
+    run = await controller.run_task(task, cell, simulate=True, journal=tmp_path / "run.jsonl")
     assert (run.outcome, run.fault) == ("succeeded", None)

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from plugnproduce import service
+from plugnproduce import controller, service
 from plugnproduce.cli import app
 from plugnproduce.resources import descriptions_path
 from plugnproduce.verification.arguments import argument_problems
@@ -77,7 +77,7 @@ def test_a_deadlock_only_some_interleavings_hit_is_refuted_with_description_line
 
 async def test_the_seeded_deadlock_is_not_hit_by_a_simulated_run(tmp_path: Path) -> None:
     cell = seeded_cell(tmp_path, napping_gripper())
-    report = await service.run_task(TASK, cell, simulate=True, journal=tmp_path / "run.jsonl")
+    report = await controller.run_task(TASK, cell, simulate=True, journal=tmp_path / "run.jsonl")
     assert report.outcome == "succeeded", report.fault
 
 

@@ -20,12 +20,15 @@ from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
-    from plugnproduce import reasoning, service
+    from plugnproduce import batch as batching
+    from plugnproduce import controller, reasoning, service
     from plugnproduce.description import loader
     from plugnproduce.description.model import Cell
 else:
     loader = lazy_module("plugnproduce.description.loader")
+    batching = lazy_module("plugnproduce.batch")
     reasoning = lazy_module("plugnproduce.reasoning")
+    controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 
 CELL_OPTION = typer.Option(..., "--cell", metavar="CELL", help="The cell file (YAML).")
@@ -39,7 +42,7 @@ def _cell(cell: Path, live: bool, discovery_timeout: float | None) -> Path | Cel
         return cell
     import asyncio
 
-    return asyncio.run(service.live_cell(cell, knowledge(cell), discovery_timeout or service.DISCOVERY_SECONDS))
+    return asyncio.run(controller.live_cell(cell, knowledge(cell), discovery_timeout or controller.DISCOVERY_SECONDS))
 VERBOSE_OPTION = typer.Option(False, "--verbose", "-v",
                               help="The engineer's view: ontology terms, rule instances, axioms and file:line.")
 
@@ -287,9 +290,9 @@ def batch(
         fail("give either CONFIGS (a JSONL or CSV file, or -) or --generate N")
     access = None
     if cluster is not None:
-        access = reasoning.ClusterAccess(cluster, cluster_timeout, cluster_ca, cluster_cert, cluster_key)
+        access = batching.ClusterAccess(cluster, cluster_timeout, cluster_ca, cluster_cert, cluster_key)
         try:
-            reasoning.check_cluster_address(cluster)
+            batching.check_cluster_address(cluster)
             access.check()
         except ValueError as exc:
             fail(f"--cluster: {exc}")
@@ -297,18 +300,18 @@ def batch(
     total: int | None = generate
     if generate is not None:
         try:
-            configurations = reasoning.generate(engine.devices, generate, _sizes(sizes), seed)
+            configurations = batching.generate(engine.devices, generate, _sizes(sizes), seed)
         except ValueError as exc:
             fail(f"--sizes: {exc}")
     elif configs == "-":
-        configurations = reasoning.configurations_from(reasoning.bounded_lines(sys.stdin), "<stdin>")
+        configurations = batching.configurations_from(batching.bounded_lines(sys.stdin), "<stdin>")
     else:
-        configurations = reasoning.read_configurations(configs)  # type: ignore[arg-type]
+        configurations = batching.read_configurations(configs)  # type: ignore[arg-type]
     as_csv = output is not None and output.suffix.lower() == ".csv"
     with contextlib.ExitStack() as stack:
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
         if as_csv:
-            csv.writer(out, lineterminator="\n").writerow(reasoning.BATCH_CSV_HEADER)
+            csv.writer(out, lineterminator="\n").writerow(batching.BATCH_CSV_HEADER)
         tally: dict[str, int] = {}
         written = _write(lambda progress: service.batch_report_from(
             engine, configurations, "csv" if as_csv else "jsonl", workers, progress, cluster=access, tally=tally),

@@ -16,9 +16,10 @@ from plugnproduce.executor.journal import describe
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
-    from plugnproduce import service
+    from plugnproduce import controller, service
     from plugnproduce.executor.run import TaskRun
 else:
+    controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 
 
@@ -56,7 +57,7 @@ def run(
         cell = service.builtin("cells", "bin-picking.yaml")
     if bin_parts is not None and not sim:
         raise typer.BadParameter("--bin-parts works on simulated devices: add --sim")
-    if sim and bin_parts is None and (bin_parts := service.default_bin_parts(task)) is not None:
+    if sim and bin_parts is None and (bin_parts := controller.default_bin_parts(task)) is not None:
         typer.echo(f"simulated bin: {bin_parts} parts at random poses (seed {bin_seed}); --bin-parts N for another",
                    err=json_out)
 
@@ -75,7 +76,7 @@ def run(
 
     try:
         with phases:
-            report = asyncio.run(service.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
+            report = asyncio.run(controller.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
                                                   observer=show, started=started, progress=phases,
                                                   knowledge=knowledge(cell), bin_parts=bin_parts, bin_seed=bin_seed,
                                                   assume_initial=assume_initial,

@@ -21,9 +21,10 @@ if TYPE_CHECKING:
     import uvicorn
     from fastapi import FastAPI
 
-    from plugnproduce import service
+    from plugnproduce import controller, service
     from plugnproduce.hmi import CellSource, Runner
 else:
+    controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 
 LOOPBACK_NAMES = ("127.0.0.1", "localhost")
@@ -36,31 +37,31 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int |
     With ``sim`` the devices of ``cell`` (default: the built-in bin-picking cell) are simulated
     on a private loopback SSDP network and can be plugged and unplugged from the page, working on
     a simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given (else, for the runs of tasks that loop
-    on a localized pose, a bin of :data:`~plugnproduce.service.DEFAULT_BIN_PARTS` parts); without, the devices are
+    on a localized pose, a bin of :data:`~plugnproduce.controller.DEFAULT_BIN_PARTS` parts); without, the devices are
     the ones on the network (``PNP_SSDP_PORT``) and plug in themselves. ``discovery_timeout`` bounds the
     wait for discovery to see the simulated devices start, plug or unplug (default
-    ``service.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s).
+    ``controller.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s).
     """
     if not sim:
-        from plugnproduce.hmi.livecell import LiveCellSource
+        from plugnproduce.controller.livecell import LiveCellSource
         from plugnproduce.protocols.upnp import network_from_env
 
         return LiveCellSource(network_from_env(), name=service.cell(cell, knowledge()).name if cell else "live",
                               knowledge=knowledge(cell), search_timeout=discovery_timeout or 1.0)
-    from plugnproduce.hmi.simcell import SimulatedCellSource
+    from plugnproduce.controller.simcell import SimulatedCellSource
     from plugnproduce.sim.bin import SimulatedBin
 
     cell = cell or service.builtin("cells", "bin-picking.yaml")
     k = knowledge(cell)
     parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
     return SimulatedCellSource(service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k,
-                               bin=parts, default_bin=SimulatedBin(service.DEFAULT_BIN_PARTS, bin_seed),
-                               wait=discovery_timeout or service.SIMULATED_DISCOVERY_SECONDS)
+                               bin=parts, default_bin=SimulatedBin(controller.DEFAULT_BIN_PARTS, bin_seed),
+                               wait=discovery_timeout or controller.SIMULATED_DISCOVERY_SECONDS)
 
 
 def runner_for(source: CellSource, cell: Path | None = None) -> Runner:
     """Who runs tasks: the executor, on the devices of the source's cell, journalling into the runs folder."""
-    from plugnproduce.hmi.executorrunner import ExecutorRunner
+    from plugnproduce.controller.runner import ExecutorRunner
 
     return ExecutorRunner(source, service.runs_folder(), knowledge(cell))
 
@@ -128,8 +129,8 @@ def serve(
         typer.echo(f"open {url}#token={token}")
         typer.echo(f"token: {token}")
     if sim and bin_parts is None:
-        typer.echo(f"simulated bin: {service.DEFAULT_BIN_PARTS} parts at random poses (seed {bin_seed}) for the runs "
-                   "of tasks that loop on a localized pose; --bin-parts N for another")
+        typer.echo(f"simulated bin: {controller.DEFAULT_BIN_PARTS} parts at random poses (seed {bin_seed}) for the "
+                   "runs of tasks that loop on a localized pose; --bin-parts N for another")
     config = uvicorn.Config(application, log_level="warning", timeout_graceful_shutdown=2, lifespan="on", ws="none")
     previous = signal.signal(signal.SIGTERM, _interrupt)  # uvicorn re-raises the signal it stopped on: as Ctrl-C
     try:

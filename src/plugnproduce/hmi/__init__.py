@@ -3,15 +3,19 @@
 :func:`create_app` builds the FastAPI application over a :class:`CellSource` (where the
 cell comes from) and a :class:`Runner` (who runs tasks): :class:`LiveCellSource` follows
 discovery, :class:`SimulatedCellSource` follows a simulated cell through discovery and
-plugs its devices, and :class:`ExecutorRunner` runs tasks on the devices with the executor.
+plugs its devices, and :class:`ExecutorRunner` runs tasks on the devices with the executor:
+they are the controller's (:mod:`plugnproduce.controller`), named here for the HMI's users.
 ``pnp serve`` starts it.
 """
 
 from __future__ import annotations
 
-from plugnproduce.hmi.app import create_app
-from plugnproduce.hmi.executorrunner import ExecutorRunner
-from plugnproduce.hmi.interfaces import (
+from plugnproduce.controller import (
+    ExecutorRunner,
+    LiveCellSource,
+    SimulatedCellSource,
+)
+from plugnproduce.controller.interfaces import (
     CellChangeRefused,
     CellListener,
     CellSource,
@@ -22,8 +26,7 @@ from plugnproduce.hmi.interfaces import (
     RunObserver,
     RunRefused,
 )
-from plugnproduce.hmi.livecell import LiveCellSource
-from plugnproduce.hmi.simcell import SimulatedCellSource
+from plugnproduce.hmi.app import create_app
 
 __all__ = [
     "CellChangeRefused",

@@ -13,10 +13,10 @@ from fastapi.staticfiles import StaticFiles
 from starlette.middleware.trustedhost import TrustedHostMiddleware
 
 from plugnproduce import service
+from plugnproduce.controller.interfaces import CellSource, Runner
 from plugnproduce.description.model import DeviceDescription
 from plugnproduce.hmi import errors
 from plugnproduce.hmi.hub import Hub
-from plugnproduce.hmi.interfaces import CellSource, Runner
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
 from plugnproduce.hmi.routes import cell, charts, runs, sources, task
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders

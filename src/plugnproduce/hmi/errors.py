@@ -14,8 +14,8 @@ from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
+from plugnproduce.controller.interfaces import CellChangeRefused, RunRefused
 from plugnproduce.errors import DescriptionError, PlugNProduceError, QuantityError, excerpt, tidy
-from plugnproduce.hmi.interfaces import CellChangeRefused, RunRefused
 from plugnproduce.hmi.schemas import LOOP_TAG, STEP_TAG
 
 

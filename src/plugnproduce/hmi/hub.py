@@ -1,6 +1,6 @@
 """The HMI's live picture of the cell and its runs, and the fan-out of events to every open page.
 
-The :class:`Hub` listens to the :class:`~plugnproduce.hmi.interfaces.CellSource` and to the
+The :class:`Hub` listens to the :class:`~plugnproduce.controller.interfaces.CellSource` and to the
 run observer; each change re-infers the offered process commands (``service.capabilities``)
 and is pushed to every subscriber as a server-sent event. Changes may arrive from any
 thread; delivery always happens on the server's event loop.
@@ -15,9 +15,9 @@ from collections.abc import Callable
 from typing import Any
 
 from plugnproduce import service
+from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, Runner
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.executor.journal import describe
-from plugnproduce.hmi.interfaces import CellSource, CellUpdate, JournalRecord, Runner
 from plugnproduce.hmi.views import cell_json
 from plugnproduce.knowledge import Knowledge
 

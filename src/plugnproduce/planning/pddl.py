@@ -22,9 +22,9 @@ from plugnproduce.description.model import Cell, ProcessDescription
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.planning.planner import check_goal, feeding
-from plugnproduce.reasoning.facts import effects
-from plugnproduce.reasoning.offers import capabilities
-from plugnproduce.reasoning.schema import Leaves
+from plugnproduce.reasoning.asp.facts import effects
+from plugnproduce.reasoning.asp.schema import Leaves
+from plugnproduce.reasoning.checks.offers import capabilities
 
 PENALTY = 1000
 """Cost of a value left to its default although the cell could measure it, or of a measured value no step takes."""

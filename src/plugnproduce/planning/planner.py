@@ -25,10 +25,10 @@ from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.planning import schema as ps
-from plugnproduce.reasoning import solver
-from plugnproduce.reasoning.facts import fact_book
-from plugnproduce.reasoning.offers import capabilities, cell_program
-from plugnproduce.reasoning.terms import Atom, Model, program
+from plugnproduce.reasoning.asp import solver
+from plugnproduce.reasoning.asp.facts import fact_book
+from plugnproduce.reasoning.asp.terms import Atom, Model, program
+from plugnproduce.reasoning.checks.offers import capabilities, cell_program
 from plugnproduce.safeio import PlainDumper
 
 MAX_STEPS = 12

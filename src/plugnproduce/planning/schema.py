@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from plugnproduce.reasoning.terms import Atom, predicate
+from plugnproduce.reasoning.asp.terms import Atom, predicate
 
 # ------------------------------------------------------------------ input
 

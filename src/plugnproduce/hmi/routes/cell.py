@@ -6,9 +6,9 @@ from typing import Any
 
 from fastapi import APIRouter, Depends, HTTPException, Request, status
 
+from plugnproduce.controller.interfaces import PluggableCellSource
 from plugnproduce.hmi import jobs
 from plugnproduce.hmi.hub import Hub
-from plugnproduce.hmi.interfaces import PluggableCellSource
 from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.schemas import PlugIn
 from plugnproduce.hmi.security import allow_read, require_token

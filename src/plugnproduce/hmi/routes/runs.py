@@ -1,4 +1,4 @@
-"""Runs (start, stop, status, journal) through the :class:`~plugnproduce.hmi.interfaces.Runner`, and the
+"""Runs (start, stop, status, journal) through the :class:`~plugnproduce.controller.interfaces.Runner`, and the
 server-sent event stream every page listens to: cell changes, device states and run progress."""
 
 from __future__ import annotations

@@ -1,0 +1,67 @@
+"""The controller: what runs a cell.
+
+- the cell sources: :class:`LiveCellSource` follows discovery, :class:`SimulatedCellSource` follows a
+  simulated cell through discovery and plugs its devices (:mod:`.interfaces` says what a source is);
+- the runs: :func:`run_task` finds a cell's devices and runs a task on them (``pnp run``), and
+  :class:`ExecutorRunner` runs tasks on a cell source's devices, one at a time (the HMI);
+- the live cell: :func:`live_cell` asks each device its state (``pnp check --live``).
+
+The faces (``cli``, ``hmi``) use it and the service; it uses the service and the concepts (discovery,
+protocols, executor, sim).
+"""
+
+from __future__ import annotations
+
+from plugnproduce.controller.interfaces import (
+    CellChangeRefused,
+    CellListener,
+    CellSource,
+    CellUpdate,
+    JournalRecord,
+    PluggableCellSource,
+    Runner,
+    RunObserver,
+    RunRefused,
+)
+from plugnproduce.controller.livecell import LiveCellSource
+from plugnproduce.controller.run import (
+    DEFAULT_BIN_PARTS,
+    DISCOVERY_SECONDS,
+    SIMULATED_DISCOVERY_SECONDS,
+    DevicesMissing,
+    StateNotReported,
+    default_bin_parts,
+    find_devices,
+    live_cell,
+    reported_states,
+    run_task,
+    start_run,
+)
+from plugnproduce.controller.runner import ExecutorRunner
+from plugnproduce.controller.simcell import SimulatedCellSource
+
+__all__ = [
+    "DEFAULT_BIN_PARTS",
+    "DISCOVERY_SECONDS",
+    "SIMULATED_DISCOVERY_SECONDS",
+    "CellChangeRefused",
+    "CellListener",
+    "CellSource",
+    "CellUpdate",
+    "DevicesMissing",
+    "ExecutorRunner",
+    "JournalRecord",
+    "LiveCellSource",
+    "PluggableCellSource",
+    "RunObserver",
+    "RunRefused",
+    "Runner",
+    "SimulatedCellSource",
+    "StateNotReported",
+    "default_bin_parts",
+    "find_devices",
+    "live_cell",
+    "reported_states",
+    "run_task",
+    "start_run",
+]

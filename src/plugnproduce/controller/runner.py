@@ -1,0 +1,126 @@
+"""The executor as the HMI's :class:`~plugnproduce.controller.interfaces.Runner`.
+
+A run takes the service's one path: :func:`plugnproduce.service.plan_run` checks the task for
+the cell as it is now, each device in the state it reports, and generates only its task chart;
+:func:`plugnproduce.controller.run.start_run` runs it against the cell's devices at the endpoints
+discovery found, journalling into the runs folder. A device the cell source sees leave during
+the run is a lost device: the run stops with a fault.
+One run at a time.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from plugnproduce import service
+from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
+from plugnproduce.controller.run import StateNotReported, reported_states, start_run
+from plugnproduce.controller.simcell import SimulatedCellSource
+from plugnproduce.description.model import Cell, Task
+from plugnproduce.executor.journal import read_journal
+from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
+from plugnproduce.knowledge import Knowledge
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class _Run:
+    run: TaskRun
+    task: asyncio.Task[object]
+
+
+class ExecutorRunner:
+    """Runs tasks on the devices of ``source``'s cell, one at a time, journalling into ``runs_dir``."""
+
+    def __init__(self, source: CellSource, runs_dir: Path, knowledge: Knowledge | None = None) -> None:
+        self._dir = Path(runs_dir)
+        self._source = source
+        self._knowledge = knowledge
+        self._runs: dict[str, _Run] = {}
+        self._loop: asyncio.AbstractEventLoop | None = None
+        source.subscribe(self._on_cell)
+
+    def active(self) -> str | None:
+        """The id of the run in progress, if any."""
+        return next((run_id for run_id, r in self._runs.items() if not r.task.done()), None)
+
+    def runs(self) -> list[str]:
+        """The ids of the runs started since this runner was made, oldest first."""
+        return list(self._runs)
+
+    def journal(self, run_id: str) -> list[JournalRecord]:
+        """The journal records of a run so far, read back from its file."""
+        return read_journal(self._run(run_id).run.journal_path).records
+
+    async def start(self, task: Task, cell: Cell, observer: RunObserver) -> str:
+        """Check and generate ``task`` for ``cell`` and start running it; RunRefused if a run is active or
+        the task implausible. Returns once the run's journal has its ``start`` record."""
+        active = self.active()
+        if active is not None:
+            raise RunRefused(f"run {active} is still running; stop it first")
+        if isinstance(self._source, SimulatedCellSource):
+            self._source.prepare_run(task)  # its default bin, for a task that loops on a localized pose
+        try:  # planned from the state each device reports, not its chart's initial state
+            reported = cell.reported(await reported_states(cell))
+            generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)
+            prefixes = await asyncio.to_thread(  # how devices may name concepts (pnp:PartFound)
+                lambda: (self._knowledge or service.knowledge()).prefixes)
+        except StateNotReported as exc:
+            raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
+        except service.ImplausibleTask as exc:
+            first = exc.result.problems[0]
+            raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc
+        run_id = service.new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", task.name))
+        started = asyncio.Event()
+
+        def observe(record: JournalRecord) -> None:
+            started.set()
+            observer(run_id, record)
+
+        run = start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes)
+        self._loop = asyncio.get_running_loop()
+        running = asyncio.create_task(run.run(), name=f"run {run_id}")
+        running.add_done_callback(self._finished)
+        self._runs[run_id] = _Run(run, running)
+        waiting = asyncio.create_task(started.wait())
+        await asyncio.wait({waiting, running}, return_when=asyncio.FIRST_COMPLETED)
+        waiting.cancel()
+        if not started.is_set():  # it ended before its journal began (e.g. the runs folder cannot be written)
+            del self._runs[run_id]
+            running.result()
+        return run_id
+
+    async def stop(self, run_id: str) -> None:
+        """Stop a run (no further command goes out) and wait until it has ended."""
+        entry = self._run(run_id)
+        if not entry.task.done():
+            entry.run.stop("stopped by the operator")
+        await self.finished(run_id)
+
+    async def finished(self, run_id: str) -> None:
+        """Wait until a run has ended (succeeded, failed or stopped)."""
+        await asyncio.wait({self._run(run_id).task})  # a run that crashed is logged by _finished
+
+    def _run(self, run_id: str) -> _Run:
+        if run_id not in self._runs:
+            raise KeyError(f"run {run_id!r}")
+        return self._runs[run_id]
+
+    def _finished(self, task: asyncio.Task[object]) -> None:
+        if not task.cancelled() and task.exception() is not None:
+            log.error("run %s crashed", task.get_name(), exc_info=task.exception())
+
+    def _on_cell(self, update: CellUpdate) -> None:
+        """A device that leaves the cell during a run is lost to the run (called from any thread)."""
+        if update.kind == "unplug" and self._loop is not None and not self._loop.is_closed():
+            self._loop.call_soon_threadsafe(self._lost, update.device)
+
+    def _lost(self, device: str) -> None:
+        active = self.active()
+        if active is not None:
+            self._runs[active].run.device_lost(device, "the device left the cell (SSDP byebye)")

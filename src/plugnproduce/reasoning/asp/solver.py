@@ -1,0 +1,157 @@
+"""The only module that touches clingo's ``Control``: load encodings, ground, solve.
+
+Encodings are read from ``rules/`` (package data, :func:`plugnproduce.resources.rules_path`)
+once per process. Programs with no choice are grounded and solved once (one model);
+repairs are optimised, then the next-best distinct ones are found in the same ``Control``
+by forbidding each found edit set (multi-shot).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable, Iterable, Iterator, Sequence
+from functools import cache
+
+import clingo
+
+from plugnproduce.errors import EncodingError
+from plugnproduce.reasoning.asp.terms import Model, decode
+from plugnproduce.resources import rules_path
+
+PROGRAMS: dict[str, tuple[tuple[str, ...], str]] = {
+    "capabilities": (("roles.lp", "offered.lp", "explain.lp"), "show_capabilities.lp"),
+    "bindings": (("roles.lp", "offered.lp", "bindings.lp", "explain.lp"), "show_capabilities.lp"),
+    "offered": (("roles.lp", "offered.lp"), "show_capabilities.lp"),
+    "check": (("roles.lp", "resolve.lp", "chain.lp", "params.lp", "provenance.lp"), "show_check.lp"),
+    "abilities": (("roles.lp", "params.lp"), "show_abilities.lp"),
+    "repair": (("roles.lp", "chain.lp", "params.lp", "repair.lp"), "show_repair.lp"),
+    "window": (("roles.lp", "chain.lp", "params.lp", "repair.lp", "window.lp"), "show_window.lp"),
+    "derivation": (("roles.lp", "offered.lp", "explain.lp"), "show_derivation.lp"),
+    "plan": (("roles.lp", "offered.lp", "plan.lp"), "show_plan.lp"),
+}
+"""The one list of what makes each program: its encodings by concern, then the file that says what it shows."""
+
+
+def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
+    """The encodings of a program of :data:`PROGRAMS`, with its ``#show`` file unless ``show`` is False."""
+    concerns, shown = PROGRAMS[program]
+    return concerns + (shown,) if show else concerns
+
+
+CAPABILITIES, BINDINGS, OFFERED, CHECK, ABILITIES, REPAIR, WINDOW, PLAN = (
+    rules(p) for p in ("capabilities", "bindings", "offered", "check", "abilities", "repair", "window", "plan"))
+
+OPTIMISE = ("--opt-strategy=usc,disjoint",)
+"""Core-guided optimisation: default branch-and-bound is unstable on these programs."""
+
+
+@cache
+def encoding(name: str) -> str:
+    """The text of one encoding file in ``rules/``."""
+    path = rules_path() / name
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise EncodingError(f"encoding {name} not found in {rules_path()}") from exc
+
+
+def _control(arguments: Sequence[str]) -> tuple[clingo.Control, list[str]]:
+    messages: list[str] = []
+
+    def log(code: clingo.MessageCode, message: str) -> None:
+        messages.append(message.strip())
+
+    return clingo.Control(list(arguments), logger=log, message_limit=50), messages
+
+
+def _ground(ctl: clingo.Control, messages: list[str], rules: Sequence[str], facts: str) -> None:
+    try:
+        for name in rules:
+            ctl.add("base", [], encoding(name))
+        ctl.add("base", [], facts)
+        ctl.ground([("base", [])])
+    except RuntimeError as exc:
+        detail = "; ".join(m for m in messages if "error" in m) or str(exc)
+        raise EncodingError(f"clingo could not ground {', '.join(rules)}: {detail}") from exc
+
+
+def solve(rules: Sequence[str], facts: str) -> Model:
+    """The one model of a program that needs no search (stratified encodings plus facts)."""
+    ctl, messages = _control(["--warn=none"])
+    _ground(ctl, messages, rules, facts)
+    found: list[Model] = []
+    result = ctl.solve(on_model=lambda m: found.append(decode(m.symbols(shown=True))))
+    if not result.satisfiable or not found:
+        raise EncodingError(f"{', '.join(rules)} has no model for these facts; stratified encodings always have one")
+    return found[-1]
+
+
+def symbols(rules: Sequence[str], facts: str) -> list[clingo.Symbol]:
+    """The shown atoms of the one model of a program that needs no search, undecoded (for large models)."""
+    ctl, messages = _control(["--warn=none"])
+    _ground(ctl, messages, rules, facts)
+    found: list[Sequence[clingo.Symbol]] = []
+    result = ctl.solve(on_model=lambda m: found.append(m.symbols(shown=True)))
+    if not result.satisfiable or not found:
+        raise EncodingError(f"{', '.join(rules)} has no model for these facts; stratified encodings always have one")
+    return list(found[-1])
+
+
+def optimise(
+    rules: Sequence[str],
+    facts: str,
+    top: int,
+    forbid: Callable[[Model], str],
+    same: Callable[[Model], Hashable] | None = None,
+    arguments: Sequence[str] = OPTIMISE,
+) -> list[Model]:
+    """Up to ``top`` optimal models, each optimal once the ones before it are forbidden.
+
+    ``forbid`` turns a model into an integrity constraint (ASP text) that rules it, and
+    every model containing it, out; it is added as a new program part of the same Control.
+    A model whose ``same`` key equals an earlier one's (another way to the same result)
+    is forbidden too but not returned; at most ``2 * top`` such extra solves are made.
+    """
+    ctl, messages = _control(["--warn=none", *arguments])
+    _ground(ctl, messages, rules, facts)
+    models: list[Model] = []
+    seen: set[Hashable] = set()
+    for k in range(3 * top):
+        best = _optimum(ctl)
+        if best is None:
+            break
+        key = same(best) if same is not None else k
+        if key not in seen:
+            seen.add(key)
+            models.append(best)
+        if len(models) == top:
+            break
+        part = f"forbid{k}"
+        ctl.add(part, [], forbid(best))
+        ctl.ground([(part, [])])
+    return models
+
+
+def grow(rules: Sequence[str], facts: str, horizons: Iterable[int],
+         arguments: Sequence[str] = OPTIMISE) -> Iterator[tuple[int, Model | None]]:
+    """Incremental solving, the horizon growing one step at a time: for each horizon, the optimal model or None.
+
+    The encodings have program parts ``step(t)`` (what one more step adds) and ``check(t)`` (the goal at
+    horizon t, active while the external ``query(t)`` is true); each horizon grounds only its own parts.
+    """
+    ctl, messages = _control(["--warn=none", *arguments])
+    _ground(ctl, messages, rules, facts)
+    before = None
+    for t in horizons:
+        ctl.ground([("step", [clingo.Number(t)]), ("check", [clingo.Number(t)])])
+        if before is not None:
+            ctl.release_external(before)
+        before = clingo.Function("query", [clingo.Number(t)])
+        ctl.assign_external(before, True)
+        yield t, _optimum(ctl)
+
+
+def _optimum(ctl: clingo.Control) -> Model | None:
+    """The last (optimal) model of an optimising solve, or None if there is none."""
+    found: list[Model] = []
+    result = ctl.solve(on_model=lambda m: found.append(decode(m.symbols(shown=True), m.cost)))
+    return found[-1] if result.satisfiable and found else None

@@ -1,0 +1,40 @@
+"""Plan: a task that reaches a goal in a cell, or why none does; the goal as PDDL."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from plugnproduce.description.model import DeviceDescription
+from plugnproduce.knowledge import Knowledge
+from plugnproduce.service.descriptions import CellArg, _devices, cell_and_knowledge
+
+if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
+    from plugnproduce.description.goalfile import Goal
+    from plugnproduce.planning import Plan, Unreachable
+
+
+def plan(goal_or_path: Goal | str | Path, cell_or_path: CellArg, knowledge: Knowledge | None = None,
+         catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+         source: str | None = None) -> Plan | Unreachable:
+    """A task that reaches a goal in a cell, from its devices' states (a cell with reported states plans from
+    those), or why none does, with the cheapest catalogue device (built-in and library) that would make one.
+    ``source`` names the written task file."""
+    from plugnproduce.description.goalfile import Goal, load_goal
+    from plugnproduce.planning import plan as make_plan
+
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
+    goal = goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path)
+    devices = list(k.devices) if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
+    return make_plan(goal, the_cell, k.taxonomy, k.processes, devices, source=source)
+
+
+def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,
+              knowledge: Knowledge | None = None) -> tuple[str, str]:
+    """A goal without ``until`` as a PDDL domain and problem whose optimal plans cost what :func:`plan` optimises."""
+    from plugnproduce.description.goalfile import Goal, load_goal
+    from plugnproduce.planning.pddl import export
+
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
+    return export(goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path), the_cell, k.taxonomy,
+                  k.processes)
