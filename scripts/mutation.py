@@ -138,7 +138,7 @@ CORE = (
     Guard("executor-links", (_S + "executor/links.py",),
           ("tests/executor/test_run.py", "tests/executor/test_faults.py")),
     Guard("executor-values", (_S + "executor/values.py",),
-          ("tests/executor/test_run.py", "tests/executor/test_relative_pose.py")),
+          ("tests/executor/test_values.py", "tests/executor/test_run.py", "tests/executor/test_relative_pose.py")),
     Guard("verification", tuple(_S + f"verification/{n}.py" for n in ("arguments", "results", "search", "trace",
                                                                          "world")),
           ("tests/verification/test_verify.py", "tests/verification/test_branch_verify.py",
