@@ -11,7 +11,8 @@ from plugnproduce.resources import descriptions_path
 from plugnproduce.statechart import parse_chart, schema_problems
 from plugnproduce.statechart.model import Assign, Transition, walk
 from tests.codegen.conftest import bind_by_skill
-from tests.codegen.test_loops_and_links import run, size
+from tests.codegen.test_loops_and_links import rule_taken, run, size
+from tests.executor.test_run_nested_loops import NESTED
 
 ROUNDS = (descriptions_path() / "tasks" / "bin-picking-in-rounds.yaml").read_text(encoding="utf-8")
 
@@ -52,3 +53,15 @@ def test_another_outer_iteration_restarts_the_inner_loop_of_its_body(bin_picking
 def test_the_closed_world_runs_the_nested_loops_to_done(bin_picking_cell, processes) -> None:
     _, closed = generated(ROUNDS, bin_picking_cell, processes)
     assert run(closed) == {"done"}
+
+
+def test_where_an_inner_loop_ends_the_outer_body_the_inner_loop_decides_first(bin_picking_cell, processes) -> None:
+    # outer loop 1 (positions 1-4), its body only an inner loop: loop 2 in the first copy (1-2), loop 3 in the later
+    # one (3-4); both loops end at position 4 (pnp_step counts the steps done: a loop goes on from its later copy)
+    chart, _ = generated(NESTED.format(outer=3, inner=3), bin_picking_cell, processes)
+    in_both = {"pnp_step": 4, "pnp_rounds_1": 1, "pnp_rounds_2": -1, "pnp_outcome": None}
+    assert rule_taken(chart, {**in_both, "pnp_rounds_3": 1}) == [("pnp_rounds_3", "pnp_rounds_3 + 1"),
+                                                                 ("pnp_step", "3")]
+    assert rule_taken(chart, {**in_both, "pnp_rounds_3": 2}) == [("pnp_rounds_3", "-1")]
+    assert rule_taken(chart, {**in_both, "pnp_rounds_3": -1}) == [("pnp_rounds_1", "pnp_rounds_1 + 1"),
+                                                                  ("pnp_step", "2"), ("pnp_rounds_3", "0")]
