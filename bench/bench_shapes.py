@@ -23,13 +23,13 @@ from pyshacl import validate as shacl_validate
 
 from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.validation import validate as validation
-from plugnproduce.validation.findings import Problem
+from plugnproduce.validation.findings import Finding
 from plugnproduce.validation.shapes import shape_problems, shapes_graph
 
 DESCRIPTIONS = Path(__file__).resolve().parents[1] / "descriptions"
 
 
-def plain(kg: KnowledgeGraph) -> list[Problem]:
+def plain(kg: KnowledgeGraph) -> list[Finding]:
     """The shapes run as pySHACL runs them unaided; the problems read off as :func:`shape_problems` reads them."""
     captured: list[object] = []
     real = shacl_validate
@@ -53,7 +53,7 @@ def graph_of(paths: list[Path]) -> KnowledgeGraph:
     seen: list[KnowledgeGraph] = []
     real = validation.shape_problems
 
-    def keep(kg: KnowledgeGraph) -> list[Problem]:
+    def keep(kg: KnowledgeGraph) -> list[Finding]:
         seen.append(kg)
         return []
 

@@ -23,6 +23,7 @@ LAYERS = {
     "knowledge": 2.5,  # the loaded libraries: their taxonomy, descriptions and catalogue
     "description": 2,
     "ontology": 1, "statechart": 1, "protocols": 1,
+    "chartnames": 0.5,  # the generated task chart's variable names: codegen writes them, the executor reads them
     "resources": 0, "safeio": 0,
     "errors": -1,
 }
@@ -80,6 +81,19 @@ def test_scxml_is_parsed_written_and_named_only_in_statechart() -> None:
 def test_codegen_builds_model_objects_not_xml() -> None:
     offenders = [str(p.relative_to(SRC)) for p in (SRC / "codegen").rglob("*.py")
                  if any(m.split(".")[0] == "lxml" or m.startswith("xml.") for m in _imports(p))]
+    assert offenders == []
+
+
+def test_the_executor_takes_the_chart_s_names_from_chartnames_not_codegen() -> None:
+    """The executor reads the generated program (codegen's product types) but names its variables and ending
+    states through :mod:`plugnproduce.chartnames`, the one place that defines them."""
+    names = {"DONE", "FAILED", "NEXT", "OUTCOME", "PLAN", "STEP", "VALUES", "branch_variable", "output_variable",
+             "rounds"}
+    offenders = []
+    for path in [*(SRC / "executor").rglob("*.py"), *(SRC / "verification").rglob("*.py")]:
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and _part(node.module or "") == "codegen":
+                offenders += [f"{path.relative_to(SRC)}: {a.name}" for a in node.names if a.name in names]
     assert offenders == []
 
 

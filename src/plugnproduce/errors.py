@@ -7,7 +7,9 @@ the machinery itself.
 
 from __future__ import annotations
 
+import difflib
 import re
+from collections.abc import Iterable
 from pathlib import Path
 
 MAX_EXCERPT = 60
@@ -52,6 +54,56 @@ def shorten_words(text: str, limit: int = MAX_EXCERPT) -> str:
 
 class PlugNProduceError(Exception):
     """Base class of every error the project raises on purpose."""
+
+
+MAX_KNOWN = 12
+"""Most known names an :class:`UnknownName` message lists when none is close to the one given."""
+
+
+class UnknownName(PlugNProduceError, KeyError):
+    """A name the user gave that names nothing known: a device, process command, role, state, parameter, run...
+
+    Carries what kind of name it is (``kind``), the name, where it was looked up (``owner``: ``device
+    gripper``), the known names and the nearest of them, for a "did you mean" in the message. It is a
+    :class:`KeyError` too, so that code asking "is it there?" by catching one goes on working; the faces
+    map it to bad input (exit 2, HTTP 404), and any other ``KeyError`` to a bug.
+    """
+
+    def __init__(self, kind: str, name: object, known: Iterable[object] = (), owner: str | None = None,
+                 detail: str | None = None):
+        self.kind, self.name, self.owner, self.detail = kind, name, owner, detail
+        self.known = tuple(sorted({str(k) for k in known}))
+        self.close = tuple(difflib.get_close_matches(str(name), self.known, n=2)) if isinstance(name, str) else ()
+        super().__init__(self.message())
+
+    def message(self) -> str:
+        """``unknown state 'Opne' of device gripper; did you mean Open?`` (or the known names, or ``detail``)."""
+        name = repr(excerpt(self.name)) if isinstance(self.name, str) else str(self.name)
+        text = f"unknown {self.kind} {name}" + (f" of {self.owner}" if self.owner else "")
+        if self.detail is not None:
+            return f"{text}; {self.detail}"
+        if self.close:
+            return f"{text}; did you mean {' or '.join(self.close)}?"
+        if not self.known:
+            return text
+        more = f", … ({len(self.known)} in all)" if len(self.known) > MAX_KNOWN else ""
+        return f"{text} (known: {', '.join(self.known[:MAX_KNOWN])}{more})"
+
+    def __str__(self) -> str:  # a KeyError's str() is the repr of its argument
+        return self.message()
+
+    def __reduce__(self) -> tuple[type[UnknownName], tuple[str, object, tuple[str, ...], str | None, str | None]]:
+        # raised in an HMI worker process and re-raised in the server: rebuilt from its fields, not its message
+        return UnknownName, (self.kind, self.name, self.known, self.owner, self.detail)
+
+
+def bug_message(exc: BaseException, traceback_at: str) -> str:
+    """The one line a face shows for an exception that is none of the family's: a bug, not the user's mistake.
+
+    ``traceback_at`` says where the traceback went (a log file, the server's log)."""
+    what = tidy(f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__, 200)
+    return (f"error: a bug in plugnproduce, not a mistake in the input ({what}); the traceback is in "
+            f"{traceback_at}: please report it with that traceback")
 
 
 class DescriptionError(PlugNProduceError):

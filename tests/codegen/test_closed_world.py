@@ -48,3 +48,14 @@ def test_broken_device_model_does_not_reach_done(tmp_path: Path, bin_picking_cel
     generated = generate("bin-picking", bin_picking_cell, processes)
     configuration = run(closed_world_chart(generated, bin_picking_cell.with_device(broken)))
     assert configuration == {"failed"}
+
+
+def test_a_hierarchical_device_chart_runs_in_the_closed_world_chart() -> None:
+    """The PackML-style screwdriver (compound states, a superstate's Abort) as a responding region: its nested
+    states and their initial children renamed with it, and the independent interpreter reaches done."""
+    library = Path(__file__).parents[1] / "data" / "libraries" / "packml-screwing"
+    cell = service.cell(library / "cells" / "packml-screwing.yaml")
+    generated = service.generate(library / "tasks" / "screw-twice.yaml", cell)
+    world = next(c.data for c in generated.charts if c.name.endswith(".closed-world.scxml"))
+    assert b'initial="packml_screwdriver__Starting"' in world  # Running's initial child, renamed
+    assert run(world) == {"done"}

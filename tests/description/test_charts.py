@@ -27,12 +27,12 @@ def test_a_process_description_carries_its_parsed_chart(taxonomy: Taxonomy) -> N
     assert set(process_regions(pick.chart, pick.chart_file)) == {r.name for r in pick.roles}
 
 
-def test_a_device_chart_that_is_not_flat_is_refused_with_its_line() -> None:
+def test_a_device_chart_with_a_parallel_state_is_refused_with_its_line() -> None:
     text = b"""<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" initial="a">
   <state id="a">
-    <state id="a1"/>
+    <parallel id="p"><state id="p1"/><state id="p2"/></parallel>
   </state>
 </scxml>"""
-    with pytest.raises(DescriptionError, match="must be flat") as err:
+    with pytest.raises(DescriptionError, match="has no <parallel>: a device is in one state at a time") as err:
         device_chart(parse_chart(text, "nested.scxml"), "nested.scxml")
-    assert str(err.value).startswith("nested.scxml:2:")
+    assert str(err.value).startswith("nested.scxml:3:")

@@ -10,7 +10,7 @@ import pytest
 
 from plugnproduce import service
 from plugnproduce.description.model import ChartState, ChartTransition, Command, DeviceDescription
-from plugnproduce.description.paths import NoPath, Path, commands, find_path
+from plugnproduce.description.paths import ChartPath, NoPath, commands, find_path
 from plugnproduce.ontology.taxonomy import Taxonomy
 
 P = "http://plugnproduce.org/ontology#"
@@ -18,11 +18,11 @@ LIBRARIES = service.builtin("devices").parents[1] / "tests" / "data" / "librarie
 
 
 def networkx_path(device: DeviceDescription, source: str, concept: str, taxonomy: Taxonomy,
-                  wanted: frozenset[str] = frozenset()) -> Path:
+                  wanted: frozenset[str] = frozenset()) -> ChartPath:
     """The search as it was written with networkx (a multigraph, a goal node, ``all_shortest_paths``)."""
     goals = [s.id for s in device.states if s.concept and taxonomy.is_a(s.concept, concept)]
     if source in goals:
-        return Path(source, source, ())
+        return ChartPath(source, source, ())
     g = nx.MultiDiGraph()
     g.add_nodes_from(s.id for s in device.states)
     for i, t in enumerate(device.transitions):
@@ -42,17 +42,17 @@ def networkx_path(device: DeviceDescription, source: str, concept: str, taxonomy
         accepted = sum(len(wanted.intersection(t.accepts)) for t in steps)
         ranked.append((-accepted, tuple(nodes[:-1]), tuple(t.line or 0 for t in steps), steps))
     _, nodes, _, steps = min(ranked)
-    return Path(source, nodes[-1], steps)
+    return ChartPath(source, nodes[-1], steps)
 
 
 def same_answer(device: DeviceDescription, source: str, concept: str, taxonomy: Taxonomy,
                 wanted: frozenset[str]) -> None:
     try:
-        expected: Path | str = networkx_path(device, source, concept, taxonomy, wanted)
+        expected: ChartPath | str = networkx_path(device, source, concept, taxonomy, wanted)
     except NoPath as exc:
         expected = str(exc)
     try:
-        found: Path | str = find_path(device, source, concept, taxonomy, wanted)
+        found: ChartPath | str = find_path(device, source, concept, taxonomy, wanted)
     except NoPath as exc:
         found = str(exc)
     assert found == expected, (device.id, source, concept, wanted)

@@ -8,7 +8,7 @@ import shutil
 from pathlib import Path
 
 from plugnproduce import controller, service
-from plugnproduce.codegen import FAILED
+from plugnproduce.chartnames import FAILED
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun
 from tests.conftest import edit

@@ -10,8 +10,8 @@ import pytest
 from plugnproduce.errors import ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.protocols.xirp import (
     Event,
-    Fault,
     FaultKind,
+    FaultRule,
     Faults,
     MessageError,
     RemoteFailure,
@@ -114,7 +114,7 @@ async def test_a_rule_without_name_hits_any_request_and_times_none_every_time(
 
 
 async def test_faults_given_at_construction_are_used(recorder: Recorder) -> None:
-    faults = Faults([Fault(FaultKind.ERROR_RESPONSE, "Open", code="busy")])
+    faults = Faults([FaultRule(FaultKind.ERROR_RESPONSE, "Open", code="busy")])
     async with XirpServer("g", "http://x/#G", recorder, faults=faults) as device:
         async with await XirpClient.connect(HOST, device.port, timeout=WAIT) as controller:
             with pytest.raises(RemoteFailure, match="busy"):
@@ -197,4 +197,4 @@ def test_rules_fire_in_the_order_they_were_added() -> None:
 )
 def test_a_nonsensical_rule_is_refused(kwargs: dict[str, object], complaint: str) -> None:
     with pytest.raises((MessageError, ValueError), match=complaint):
-        Fault(**kwargs)  # type: ignore[arg-type]
+        FaultRule(**kwargs)  # type: ignore[arg-type]

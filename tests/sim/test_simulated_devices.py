@@ -120,7 +120,9 @@ def test_fault_specs_are_read_or_refused_with_the_reason() -> None:
     faults = parse_faults("gripper:drop-response:Close, robot:delay-event:arrived:3", devices)
     assert [(f.kind, f.name) for f in faults["gripper"].rules] == [(xirp.FaultKind.DROP_RESPONSE, "Close")]
     assert faults["robot"].rules[0].delay == 3.0
-    for spec, reason in [("tool:disconnect", "no device 'tool'"), ("gripper:explode", "unknown kind"),
+    for spec, reason in [("tool:disconnect", r"unknown device 'tool' of the cell \(known: binpicking-pc, gripper,"),
+                         ("griper:disconnect", r"unknown device 'griper' of the cell; did you mean gripper\?"),
+                         ("gripper:explode", "unknown kind"),
                          ("sensor3d:disconnect", "speaks upnp"), ("gripper", "expected DEVICE:KIND")]:
         with pytest.raises(FaultSpecError, match=reason):
             parse_faults(spec, devices)

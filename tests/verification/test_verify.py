@@ -204,6 +204,7 @@ EXPECTED = {
     ("bin-picking-counting", "bin-picking-counting"): (True, "proved", set()),
     ("gentle-tending", "tending-without-gripper"): (False, None, {"absent", "no_device"}),
     ("tending-door-shut", "tending-without-gripper"): (False, None, {"wrong_state", "no_device"}),
+    ("screw-twice", "packml-screwing"): (True, "proved", set()),  # a hierarchical (PackML-style) device chart
 }
 """What the check and verification answer for every pair: a change in either is a failing row, never a skip."""
 

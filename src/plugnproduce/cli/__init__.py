@@ -2,7 +2,8 @@
 
 Exit codes: 0 done/ok; 1 a finding (invalid, infeasible, implausible, refuted, failed run);
 2 bad input or usage, reported as one ``file:line: message`` line, never a traceback;
-3 no answer within a budget (``pnp verify`` inconclusive).
+3 no answer within a budget (``pnp verify`` inconclusive); 4 a bug of pnp itself (one line saying so,
+the traceback in ``~/.local/state/plugnproduce/bugs.log``).
 Each command module registers its commands on :data:`app`.
 """
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 import typer
 
 from plugnproduce.cli.helptext import PlainTyper
-from plugnproduce.errors import DescriptionError, PlugNProduceError
+from plugnproduce.errors import DescriptionError, PlugNProduceError, bug_message
 
 if TYPE_CHECKING:  # the knowledge is loaded by the commands that need it
     from plugnproduce.knowledge import Knowledge
@@ -45,6 +45,17 @@ JSON_OPTION = typer.Option(False, "--json", help="Machine-readable output.")
 DISCOVERY_OPTION = typer.Option(None, "--discovery-timeout", metavar="SECONDS", min=0.1, max=3600,
                                 help="Most seconds to wait for the cell's devices on the network (default 10; "
                                      "60 for simulated devices). The wait ends as soon as all have answered.")
+INTERFACE_OPTION = typer.Option(None, "--interface", metavar="NAME|ADDRESS",
+                                help="The network interface the devices are on: a name (eth0) or one of this "
+                                     "machine's IPv4 addresses (default: PNP_INTERFACE, else loopback).")
+
+
+def interface_address(interface: str | None) -> str:
+    """The address ``--interface`` (else ``PNP_INTERFACE``, else loopback) names; an unknown one is exit 2, said
+    before anything is loaded."""
+    from plugnproduce.protocols.interface import chosen_address
+
+    return chosen_address(interface)
 
 
 QUIET_LOGGERS = ("rdflib.term",)
@@ -91,8 +102,40 @@ def fail(message: str, code: int = 2) -> NoReturn:
     raise typer.Exit(code)
 
 
+BUG = 4
+"""Exit code of a command that failed on a bug of its own: 1 is a finding, 2 bad input, 3 no answer within a
+budget (`pnp verify` inconclusive), so a bug takes the next."""
+
+log = logging.getLogger("plugnproduce.cli")
+
+
+def bug_log() -> Path:
+    """The file where the command line writes the traceback of a bug."""
+    return Path.home() / ".local" / "state" / "plugnproduce" / "bugs.log"
+
+
+def report_bug(exc: Exception, command: str) -> NoReturn:
+    """Log ``exc`` of ``command`` with its traceback to :func:`bug_log`, say in one line that it is a bug, and
+    exit :data:`BUG`."""
+    path = bug_log()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handler = logging.FileHandler(path, encoding="utf-8")
+    except OSError as err:
+        fail(bug_message(exc, f"no file ({path} could not be written: {err.strerror or err})"), BUG)
+    handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
+    log.addHandler(handler)
+    try:
+        log.error("bug in the command %s (pnp %s)", command, " ".join(sys.argv[1:]), exc_info=exc)
+    finally:
+        log.removeHandler(handler)
+        handler.close()
+    fail(bug_message(exc, str(path)), BUG)
+
+
 def boundary(func: F) -> F:
-    """Turn the project's errors into one line and exit code 2, never a traceback."""
+    """Turn the project's errors into one line and exit code 2, never a traceback; anything else is a bug:
+    one line saying so, the traceback in :func:`bug_log`, exit code :data:`BUG`."""
 
     @wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -100,13 +143,16 @@ def boundary(func: F) -> F:
             return func(*args, **kwargs)
         except DescriptionError as exc:
             fail(exc.location_message())
-        except KeyError as exc:
-            fail(f"error: unknown {exc.args[0] if exc.args else 'name'}")
-        except PlugNProduceError as exc:
+        except PlugNProduceError as exc:  # an UnknownName too: "error: unknown device 'x'; did you mean y?"
             fail(f"error: {exc}")
         except OSError as exc:
             fail(f"{getattr(exc, 'filename', None) or 'error'}: {exc.strerror or exc}")
+        except (typer.Exit, typer.Abort, typer.TyperException):
+            raise  # the command's own exit code or usage error
+        except Exception as exc:  # noqa: BLE001 - the boundary: whatever is left is a bug
+            report_bug(exc, func.__name__)
 
+    wrapper.under_boundary = True  # type: ignore[attr-defined]  # kept by typer's own wrapper (functools.wraps)
     return wrapper  # type: ignore[return-value]
 
 

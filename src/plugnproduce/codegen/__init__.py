@@ -4,6 +4,6 @@ the closed-world simulation chart and per-device programs, built as
 
 from __future__ import annotations
 
-from plugnproduce.codegen.task import DONE, FAILED, GeneratedTask, ImplausibleStep, generate_task
+from plugnproduce.codegen.task import GeneratedTask, ImplausibleStep, generate_task
 
-__all__ = ["DONE", "FAILED", "GeneratedTask", "ImplausibleStep", "generate_task"]
+__all__ = ["GeneratedTask", "ImplausibleStep", "generate_task"]

@@ -15,7 +15,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 
-from plugnproduce.codegen.task import DONE, FAILED, GeneratedTask
+from plugnproduce.chartnames import DONE, FAILED
+from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (
@@ -83,6 +84,8 @@ def _device_region(device: DeviceDescription) -> tuple[State, list[Data]]:
         for node in walk(s, into_charts=False):
             if isinstance(node, State | Final | Parallel | History | Send) and node.id:
                 node.id = f"{prefix}__{node.id}"
+            if isinstance(node, State) and node.initial:  # a compound state's initial child
+                node.initial = [f"{prefix}__{t}" for t in node.initial]
             if isinstance(node, Transition):
                 node.targets = [f"{prefix}__{t}" for t in node.targets]
                 node.event = " ".join(f"{device.id}.{e}" for e in node.events) or None

@@ -32,20 +32,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from plugnproduce.codegen.specific import STEP
+from plugnproduce.chartnames import OUTCOME, STEP, branch_variable, rounds
 from plugnproduce.description.model import Branch, Loop, ProcessDescription, Task
 from plugnproduce.description.outcomes import body_outcomes, falling_under, taken_by
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.model import Assign, Data, Transition
-
-OUTCOME = "pnp_outcome"
-"""The outcome the last step with outcomes in a loop reported."""
-
-
-def rounds(n: int) -> str:
-    """The datamodel variable counting the iterations of loop ``n`` (1-based)."""
-    return f"pnp_rounds_{n}"
 
 
 def _among(variable: str, names: tuple[str, ...]) -> str:
@@ -56,11 +48,6 @@ def _among(variable: str, names: tuple[str, ...]) -> str:
 def _none_of(variable: str, names: tuple[str, ...]) -> str:
     """``variable`` is none of ``names``."""
     return "(" + " and ".join(f"{variable} != {n!r}" for n in names) + ")" if names else "True"
-
-
-def branch_variable(index: int) -> str:
-    """The datamodel variable holding the outcome the step at position ``index`` reported (it has branches)."""
-    return f"pnp_branch_{index}"
 
 
 @dataclass(frozen=True)

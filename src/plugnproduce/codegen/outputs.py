@@ -5,9 +5,10 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+from plugnproduce.chartnames import STEP
 from plugnproduce.codegen.closed_world import closed_world_chart
 from plugnproduce.codegen.projection import device_program
-from plugnproduce.codegen.task import STEP, GeneratedTask, specific_name, values_data
+from plugnproduce.codegen.task import GeneratedTask, specific_name, values_data
 from plugnproduce.description.model import Cell
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import Chart, Data, Final, Transition, pnp

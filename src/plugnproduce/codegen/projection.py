@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import copy
 
-from plugnproduce.codegen.task import NEXT, PLAN, STEP, GeneratedTask
+from plugnproduce.chartnames import NEXT, PLAN, STEP
+from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.vocabulary import concept_value
 from plugnproduce.statechart.io.writer import write_chart
@@ -69,12 +70,14 @@ def _visit(device: DeviceDescription, sid: str, state_id: str, *, entry: bool) -
 
 
 def _chart_state(device: DeviceDescription, state_id: str) -> State | Final | None:
-    return next((s for s in device.chart.children if isinstance(s, State | Final) and s.id == state_id), None)
+    """The chart's state ``state_id``, at any depth."""
+    found = device.chart.find(state_id)
+    return found if isinstance(found, State | Final) else None
 
 
 def _step(device: DeviceDescription, transition: ChartTransition, target: str) -> Transition:
     """The chart's transition taken at this point, copied with a new target."""
-    source = _chart_state(device, transition.source)
+    source = _chart_state(device, transition.origin or transition.source)  # a compound state's transition
     taken = source.transitions if isinstance(source, State) else []
     original = next(t for t in taken if t.line == transition.line)
     t = copy.deepcopy(original)

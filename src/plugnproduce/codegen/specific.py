@@ -13,16 +13,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from plugnproduce.chartnames import STEP, VALUES
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.description.paths import find_path
 from plugnproduce.description.units import convert
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
-
-PLAN, STEP, VALUES = "pnp_plan", "pnp_step", "pnp_values"
-"""Task chart datamodel: the chart each step runs (then 0), how many steps have ended, and each
-step's parameter values that differ between the steps sharing a chart."""
 
 
 @dataclass(frozen=True)
@@ -51,11 +48,6 @@ class Flow:
         if self.offset is None:
             return self.variable
         return "[" + ", ".join(f"{self.variable}[{i}] + {o!r}" for i, o in enumerate(self.offset)) + "]"
-
-
-def output_variable(step_name: str, output: str) -> str:
-    """The datamodel variable that holds a named step's output (``pnp_out_localize_part_pose``)."""
-    return f"pnp_out_{step_name}_{output}"
 
 
 @dataclass

@@ -12,21 +12,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from plugnproduce.codegen.flow import OUTCOME, Outcomes, branch_variable, flow_data, flow_transitions, outcome_names
+from plugnproduce.chartnames import DONE, FAILED, NEXT, OUTCOME, PLAN, STEP, VALUES, branch_variable, output_variable
+from plugnproduce.codegen.flow import Outcomes, flow_data, flow_transitions, outcome_names
 from plugnproduce.codegen.specific import (
-    PLAN,
-    STEP,
-    VALUES,
     Flow,
     RegionResult,
     Varying,
     controller_ids,
     literal,
-    output_variable,
     specific_region,
 )
 from plugnproduce.description.model import Cell, ChartTransition, Command, Link, ProcessDescription, Step, Task
-from plugnproduce.description.paths import NoPath
+from plugnproduce.description.paths import NoPath, in_concept
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
@@ -46,10 +43,7 @@ from plugnproduce.statechart.model import (
     pnp,
 )
 
-DONE, FAILED = "done", "failed"
-NEXT = "next_step"
-"""The state that picks the next step's chart from the plan."""
-__all__ = ["DONE", "FAILED", "NEXT", "PLAN", "STEP", "VALUES", "GeneratedTask", "ImplausibleStep", "StepChart",
+__all__ = ["GeneratedTask", "ImplausibleStep", "StepChart",
            "StuckStep", "generate_task", "specific_name", "step_values", "values_data"]
 
 
@@ -291,8 +285,7 @@ def _step(
     for role in process.roles:
         device = cell.device(binding[role.name])
         state = current[device.id]
-        concept = device.state(state).concept
-        if concept is None or not taxonomy.is_a(concept, role.start_concept):
+        if not in_concept(device.state(state), role.start_concept, taxonomy):
             raise ImplausibleStep(step, device.id, state, role.start_concept)
         try:
             region = specific_region(step.index, process, role, device, state, values, ids, taxonomy)

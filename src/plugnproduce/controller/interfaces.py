@@ -78,11 +78,11 @@ class PluggableCellSource(CellSource, Protocol):
         ...
 
     async def plug(self, device_id: str) -> None:
-        """Plug in the catalogue device ``device_id`` (KeyError if unknown, CellChangeRefused if present)."""
+        """Plug in the catalogue device ``device_id`` (UnknownName if unknown, CellChangeRefused if present)."""
         ...
 
     async def unplug(self, device_id: str) -> None:
-        """Unplug the device ``device_id`` (KeyError if it is not in the cell)."""
+        """Unplug the device ``device_id`` (UnknownName if it is not in the cell)."""
         ...
 
 
@@ -116,7 +116,7 @@ class Runner(Protocol):
         ...
 
     async def stop(self, run_id: str) -> None:
-        """Stop a run, leaving every device in a safe state (KeyError if the run is unknown)."""
+        """Stop a run, leaving every device in a safe state (UnknownName if the run is unknown)."""
         ...
 
     def active(self) -> str | None:
@@ -128,5 +128,5 @@ class Runner(Protocol):
         ...
 
     def journal(self, run_id: str) -> list[JournalRecord]:
-        """The journal records of a run so far (KeyError if the run is unknown)."""
+        """The journal records of a run so far (UnknownName if the run is unknown)."""
         ...

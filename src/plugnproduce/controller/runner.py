@@ -21,6 +21,7 @@ from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRe
 from plugnproduce.controller.run import StateNotReported, reported_states, start_run
 from plugnproduce.controller.simcell import SimulatedCellSource
 from plugnproduce.description.model import Cell, Task
+from plugnproduce.errors import UnknownName
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
 from plugnproduce.knowledge import Knowledge
@@ -108,7 +109,7 @@ class ExecutorRunner:
 
     def _run(self, run_id: str) -> _Run:
         if run_id not in self._runs:
-            raise KeyError(f"run {run_id!r}")
+            raise UnknownName("run", run_id, self._runs)
         return self._runs[run_id]
 
     def _finished(self, task: asyncio.Task[object]) -> None:

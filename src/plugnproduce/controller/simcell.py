@@ -15,8 +15,9 @@ from plugnproduce.controller.interfaces import CellChangeRefused
 from plugnproduce.controller.livecell import LiveCellSource
 from plugnproduce.controller.run import SIMULATED_DISCOVERY_SECONDS, DevicesMissing, default_bin_parts
 from plugnproduce.description.model import Cell, DeviceDescription, Task
-from plugnproduce.errors import ProtocolTimeout
+from plugnproduce.errors import ProtocolTimeout, UnknownName
 from plugnproduce.knowledge import Knowledge
+from plugnproduce.protocols.interface import LOOPBACK_ADDRESS
 from plugnproduce.protocols.upnp import private_network
 from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.sim.cell import SimulatedCell, parse_faults
@@ -40,9 +41,12 @@ class SimulatedCellSource(LiveCellSource):
 
     def __init__(self, cell: Cell, catalogue: list[DeviceDescription], faults: str = "",
                  wait: float = SIMULATED_DISCOVERY_SECONDS, knowledge: Knowledge | None = None,
-                 bin: SimulatedBin | None = None, default_bin: SimulatedBin | None = None) -> None:  # noqa: A002
-        """``wait``: seconds a plug, unplug or the start may take until discovery has seen it."""
-        super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS, knowledge=knowledge)
+                 bin: SimulatedBin | None = None, default_bin: SimulatedBin | None = None,  # noqa: A002
+                 interface: str = LOOPBACK_ADDRESS) -> None:
+        """``wait``: seconds a plug, unplug or the start may take until discovery has seen it; ``interface``: the
+        address the devices and discovery are on."""
+        super().__init__(private_network(interface), name=cell.name, search_timeout=SEARCH_SECONDS,
+                         knowledge=knowledge)
         self._wanted = [d.id for d in cell.devices]
         self._wait = wait
         self._default_bin = None if bin is not None else default_bin
@@ -79,7 +83,7 @@ class SimulatedCellSource(LiveCellSource):
     async def plug(self, device_id: str) -> None:
         """Start a catalogue device; return once discovery has seen it join."""
         if device_id not in self.sim.catalogue:
-            raise KeyError(f"device {device_id!r} (the catalogue has: {', '.join(sorted(self.sim.catalogue))})")
+            raise UnknownName("device", device_id, self.sim.catalogue, owner="the catalogue")
         if device_id in self.sim.devices:
             raise CellChangeRefused(f"device {device_id!r} is in cell {self.cell.name!r} already")
         await self.sim.plug(device_id)
@@ -90,8 +94,7 @@ class SimulatedCellSource(LiveCellSource):
     async def unplug(self, device_id: str) -> None:
         """Stop a device of the cell; return once discovery has seen it leave."""
         if device_id not in self.sim.devices:
-            present = ", ".join(sorted(self.sim.devices)) or "none"
-            raise KeyError(f"device {device_id!r} in cell {self.cell.name!r} (present: {present})")
+            raise UnknownName("device", device_id, self.sim.devices, owner=f"cell {self.cell.name}")
         await self.sim.unplug(device_id)
         if not await self.wait_until(lambda cell: not _has(device_id)(cell), self._wait):
             raise ProtocolTimeout(f"device {device_id!r} was stopped but discovery did not see it leave "

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Iterable
 from pathlib import Path
 
-from plugnproduce.description.model import ChartState, ChartTransition, Command, RegionState
+from plugnproduce.description.hierarchy import DeviceChart as DeviceChart
+from plugnproduce.description.hierarchy import device_chart as device_chart
+from plugnproduce.description.model import RegionState
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.vocabulary import concept_iri
 from plugnproduce.statechart.model import (
@@ -22,61 +23,19 @@ from plugnproduce.statechart.model import (
     Final,
     Node,
     Parallel,
-    Send,
     State,
     StateNode,
     Transition,
     pnp,
-    walk,
 )
 
 ACCEPTS, ROLE, PARAMS, OUTCOMES = pnp("accepts"), pnp("role"), pnp("params"), pnp("outcomes")
 _IN = re.compile(r"""In\(\s*['"]([^'"]+)['"]\s*\)""")
 
 
-def _sends(nodes: Iterable[Node]) -> list[Command]:
-    """The protocol events sent anywhere below ``nodes``, in document order."""
-    out: list[Command] = []
-    for top in nodes:
-        for node in walk(top, into_charts=False):
-            if isinstance(node, Send):
-                cmd = Command.parse(node.event or "")
-                if cmd is not None and cmd.kind == "event":
-                    out.append(cmd)
-    return out
-
-
 def _concept(node: Node) -> str | None:
     value = node.extra_attrs.get(CONCEPT)
     return concept_iri(value) if value else None
-
-
-def _flat_states(chart: Chart, path: str | Path) -> list[State | Final]:
-    """The top-level states of a Device State Chart, refusing compound and parallel ones."""
-    states: list[State | Final] = []
-    for c in chart.children:
-        if isinstance(c, Parallel) or (isinstance(c, State) and not c.is_atomic):
-            raise DescriptionError("a Device State Chart must be flat: found a compound or parallel state; "
-                                   "expected only <state> and <final> at the top", path, c.line)
-        if isinstance(c, State | Final):
-            states.append(c)
-    return states
-
-
-def device_chart(chart: Chart, path: str | Path) -> tuple[str, tuple[ChartState, ...], tuple[ChartTransition, ...]]:
-    """The initial state, states and transitions of a (flat) Device State Chart read from ``path``."""
-    states = _flat_states(chart, path)
-    initial = (chart.initial[0] if chart.initial else (states[0].id or "")) if states else ""
-    entry = {s.id: _sends(s.onentry) for s in states}
-    chart_states = tuple(ChartState(s.id or "", _concept(s), s.line) for s in states)
-    transitions: list[ChartTransition] = []
-    for s in states:
-        for t in s.transitions if isinstance(s, State) else ():
-            for target in t.targets or [s.id or ""]:
-                sends = tuple(_sends([t])) + tuple(entry.get(target, ()))
-                accepts = tuple(concept_iri(a) for a in t.extra_attrs.get(ACCEPTS, "").split())
-                transitions.append(ChartTransition(s.id or "", target, t.event, sends, accepts, t.line, _concept(t)))
-    return initial, chart_states, tuple(transitions)
 
 
 def process_regions(chart: Chart, path: str | Path) -> dict[str, tuple[RegionState, ...]]:

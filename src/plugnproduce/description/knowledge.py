@@ -48,8 +48,8 @@ class KnowledgeGraph:
                 self.places[str(s)] = Where(str(loaded.path))
 
     def add_device(self, device: DeviceDescription) -> None:
-        """Lift a device's reasoned skills and its chart's states."""
-        self.add_device_facts(device.iri, device.skills, device.chart_file, device.states)
+        """Lift a device's reasoned skills and its chart's states, compound ones too."""
+        self.add_device_facts(device.iri, device.skills, device.chart_file, (*device.states, *device.compounds))
 
     def add_device_facts(self, iri: str, skills: Iterable[str], chart_file: str, states: Iterable[ChartState]) -> None:
         """Lift reasoned skills and chart states of the device ``iri``."""

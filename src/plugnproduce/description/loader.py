@@ -165,7 +165,8 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         raise DescriptionError(f"{local_name(str(s))} names chart {chart_file.name}; expected one of "
                                f"{', '.join(sorted(c.name for c in charts)) or 'none'}",
                                loaded.path, loaded.line(str(s)))
-    initial, states, every = device_chart(chart, chart_file)
+    lifted = device_chart(chart, chart_file)
+    every = lifted.transitions
     stops = tuple(t for t in every if t.concept is not None and taxonomy.is_a(t.concept, SAFE_STOP))
     transitions = tuple(t for t in every if t not in stops)
     timeout = _opt(loaded, s, PNP.commandTimeout)
@@ -183,9 +184,10 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         protocol=PROTOCOL_NAMES[protocol],
         endpoint=str(_one(loaded, s, PNP.endpoint, "endpoint")),
         chart_file=str(chart_file),
-        initial=initial,
-        states=states,
+        initial=lifted.initial,
+        states=lifted.states,
         transitions=transitions,
+        compounds=lifted.compounds,
         where=loaded.where(str(s)),
         command_timeout=_or(_finite(loaded, s, timeout, "command timeout"), 10.0),
         cost=_or(_finite(loaded, s, cost, "cost"), 0.0),

@@ -15,6 +15,7 @@ from typing import Literal
 from plugnproduce.description.flow import Branch as Branch
 from plugnproduce.description.flow import Loop as Loop
 from plugnproduce.description.flow import enclosing, outermost_first, path_name
+from plugnproduce.errors import UnknownName
 from plugnproduce.statechart.model import Chart
 
 Protocol = Literal["xirp", "upnp"]
@@ -56,11 +57,25 @@ class Command:
 
 @dataclass(frozen=True)
 class ChartState:
-    """A state of a Device State Chart, with the ontology concept it is annotated with."""
+    """A state of a Device State Chart, with the ontology concept it is annotated with.
+
+    In a chart with compound states, the states a device can be in are the atomic ones; each has its
+    own concept and those of the compound states around it (:mod:`plugnproduce.description.hierarchy`).
+    """
 
     id: str
     concept: str | None
+    """Its own concept, else the nearest enclosing state's."""
     line: int | None
+    concepts: tuple[str, ...] = ()
+    """Every concept it has: its own, then the enclosing states', nearest first (empty: just :attr:`concept`)."""
+    within: tuple[str, ...] = ()
+    """The compound states around it, outermost first."""
+
+    @property
+    def every_concept(self) -> tuple[str, ...]:
+        """Its own concept and those of the compound states around it."""
+        return self.concepts or ((self.concept,) if self.concept else ())
 
 
 @dataclass(frozen=True)
@@ -78,6 +93,8 @@ class ChartTransition:
     line: int | None
     concept: str | None = None
     """The concept the transition is annotated with (``pnp:concept``), e.g. ``pnp:SafeStop``."""
+    origin: str | None = None
+    """The state the transition is written on: :attr:`source` or a compound state around it (None: the source)."""
 
     @property
     def request(self) -> Command | None:
@@ -137,6 +154,8 @@ class DeviceDescription:
     """The parsed Device State Chart (``chart_file`` as read by the one SCXML reader)."""
     reported_state: bool = False
     """Whether :attr:`initial` is the state the device reported (a live cell), not its chart's initial state."""
+    compounds: tuple[ChartState, ...] = ()
+    """The compound states of its chart (their own concepts); :attr:`states` are the atomic ones."""
     stops: tuple[ChartTransition, ...] = ()
     """The safe-stop transitions (a request annotated ``pnp:SafeStop``): sent only to stop the device,
     never planned with, so they are not among :attr:`transitions`."""
@@ -165,7 +184,7 @@ class DeviceDescription:
         for s in self.states:
             if s.id == state_id:
                 return s
-        raise KeyError(f"device {self.id} has no state {state_id!r}")
+        raise UnknownName("state", state_id, (s.id for s in self.states), owner=f"device {self.id}")
 
 
 @dataclass(frozen=True)
@@ -257,14 +276,14 @@ class ProcessDescription:
         for r in self.roles:
             if r.name == name:
                 return r
-        raise KeyError(f"process {self.id} has no role {name!r}")
+        raise UnknownName("role", name, (r.name for r in self.roles), owner=f"process {self.id}")
 
     def parameter(self, name: str) -> Parameter:
         """The parameter called ``name``."""
         for p in self.parameters:
             if p.name == name:
                 return p
-        raise KeyError(f"process {self.id} has no parameter {name!r}")
+        raise UnknownName("parameter", name, (p.name for p in self.parameters), owner=f"process {self.id}")
 
     @property
     def outcomes(self) -> tuple[str, ...]:
@@ -280,7 +299,7 @@ class ProcessDescription:
         for o in self.outputs:
             if o.name == name:
                 return o
-        raise KeyError(f"process {self.id} has no output {name!r}")
+        raise UnknownName("output", name, (o.name for o in self.outputs), owner=f"process {self.id}")
 
 
 @dataclass(frozen=True)
@@ -407,7 +426,7 @@ class Cell:
         for d in self.devices:
             if d.id == device_id:
                 return d
-        raise KeyError(f"cell {self.name} has no device {device_id!r}")
+        raise UnknownName("device", device_id, (d.id for d in self.devices), owner=f"cell {self.name}")
 
     def without(self, device_id: str) -> Cell:
         """The same cell with one device unplugged."""

@@ -14,11 +14,12 @@ from __future__ import annotations
 import heapq
 from dataclasses import dataclass
 
-from plugnproduce.description.model import ChartTransition, DeviceDescription
+from plugnproduce.description.model import ChartState, ChartTransition, DeviceDescription
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy
 
 
-class NoPath(Exception):
+class NoPath(PlugNProduceError):
     """No path in a device's chart from a state to the wanted concept."""
 
     def __init__(self, device: str, source: str, concept: str):
@@ -28,7 +29,7 @@ class NoPath(Exception):
 
 
 @dataclass(frozen=True)
-class Path:
+class ChartPath:
     """The transitions taken from ``source`` to ``target`` (empty when already there)."""
 
     source: str
@@ -54,9 +55,15 @@ def chart_edges(device: DeviceDescription) -> Edges:
     return out
 
 
+def in_concept(state: ChartState, concept: str, taxonomy: Taxonomy) -> bool:
+    """Whether a device in ``state`` is in a state of ``concept``: by the state's own concept or that of a
+    compound state around it (``Execute`` inside ``Running``), subsumption counting."""
+    return any(taxonomy.is_a(c, concept) for c in state.every_concept)
+
+
 def matching_states(device: DeviceDescription, concept: str, taxonomy: Taxonomy) -> list[str]:
     """The device's states whose concept the wanted concept subsumes (ClosedWithPart satisfies Closed)."""
-    return [s.id for s in device.states if s.concept and taxonomy.is_a(s.concept, concept)]
+    return [s.id for s in device.states if in_concept(s, concept, taxonomy)]
 
 
 def find_path(
@@ -65,14 +72,14 @@ def find_path(
     concept: str,
     taxonomy: Taxonomy,
     wanted: frozenset[str] = frozenset(),
-) -> Path:
+) -> ChartPath:
     """The shortest path from state ``source`` to a state of ``concept`` (empty if ``source`` is one).
 
     ``wanted`` are the quantities of the parameters handed over on the way.
     """
     goals = matching_states(device, concept, taxonomy)
     if source in goals:
-        return Path(source, source, ())
+        return ChartPath(source, source, ())
     if not goals:
         raise NoPath(device.id, source, concept)
     edges = chart_edges(device)
@@ -87,7 +94,7 @@ def find_path(
         accepted = sum(len(wanted.intersection(t.accepts)) for t in steps)
         ranked.append((-accepted, tuple(nodes), tuple(t.line or 0 for t in steps), steps))
     _, best, _, steps = min(ranked)
-    return Path(source, best[-1], steps)
+    return ChartPath(source, best[-1], steps)
 
 
 def _shortest(edges: Edges, source: str, goals: set[str]) -> list[list[str]]:

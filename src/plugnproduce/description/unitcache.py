@@ -24,6 +24,8 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from plugnproduce.errors import PlugNProduceError
+
 if TYPE_CHECKING:
     import pint
 
@@ -33,7 +35,7 @@ MAX_ENTRIES = 10_000
 """Units and pairs kept at most; beyond, answers are still given but no longer written."""
 
 
-class Incompatible(ValueError):
+class Incompatible(PlugNProduceError, ValueError):
     """Two units of different dimensions (pint's ``DimensionalityError``, remembered)."""
 
 

@@ -15,6 +15,7 @@ from functools import cache
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.unitcache import Incompatible, UnitTable, table_file
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
@@ -33,7 +34,7 @@ _UNIT = re.compile(rf"^{_FACTOR}(?:\s*[*/· ]\s*{_FACTOR})*$")
 """Units as factors with small whole exponents (``N m``, ``mm/s``, ``m/s^2``): nothing pint would compute long on."""
 
 
-class UnitError(ValueError):
+class UnitError(PlugNProduceError, ValueError):
     """A unit the registry does not know, or a conversion between different dimensions."""
 
 

@@ -16,7 +16,7 @@ from itertools import pairwise
 
 import graphviz
 
-from plugnproduce.drawing.steps import Plan, Step, find_plan, pnp
+from plugnproduce.drawing.steps import Plan, PlanStep, find_plan, pnp
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.model import Chart, Final, Parallel, Raise, Send, State, StateNode, Transition, walk
 
@@ -91,7 +91,22 @@ def _state_label(node: StateNode) -> str:
     return f"{node.id}\\n«{local_name(concept)}»" if concept else str(node.id)
 
 
-def _step_label(step: Step) -> str:
+def _cluster_label(node: State | Parallel) -> str:
+    """A compound state's name, its concept (which every state inside it shares) and its role."""
+    concept, role = pnp(node, "concept"), pnp(node, "role")
+    return f"{node.id}" + (f" «{local_name(concept)}»" if concept else "") + (f" (role {role})" if role else "")
+
+
+def _initial_child(container: Chart | State) -> str | None:
+    """The state ``container`` enters by default: its ``initial``, its ``<initial>``'s target or its first child."""
+    if isinstance(container, State) and container.initial_element is not None:
+        return next(iter(container.initial_element.transition.targets), None)
+    if container.initial:
+        return container.initial[0]
+    return next((c.id for c in container.children if isinstance(c, State | Parallel | Final)), None)
+
+
+def _step_label(step: PlanStep) -> str:
     lines = [step.title, *step.binding_text()]
     if step.chart:
         lines.append(step.chart)
@@ -127,7 +142,7 @@ class _Drawing:
         self.ids = {node.id: node for node in chart.states() if node.id}
         self.edges: list[_Edge] = []
         self.hidden: set[str] = set()
-        self.expanded: Step | None = None
+        self.expanded: PlanStep | None = None
         self._segment_of = self._segment_states(plan) if plan and not plan.is_task else {}
         self._folded = False
         if plan and plan.is_task:
@@ -152,18 +167,28 @@ class _Drawing:
 
     def _state(self, graph: graphviz.Digraph, child: State | Parallel | Final) -> None:
         sid = child.id or ""
-        if _is_compound(child):
+        if isinstance(child, State | Parallel) and _is_compound(child):
             with graph.subgraph(name=f"cluster_{sid}") as sub:
                 style = "dashed" if isinstance(child, Parallel) else "rounded"
-                role = pnp(child, "role")
-                sub.attr(label=f"{sid}" + (f" (role {role})" if role else ""), style=style)
-                self.add(sub, child)  # type: ignore[arg-type]
+                sub.attr(label=_cluster_label(child), style=style)
+                self.add(sub, child)
+                if isinstance(child, State):
+                    self.initial(sub, child)
         else:
             final = "2" if isinstance(child, Final) else "1"
             graph.node(sid, _state_label(child), shape="box", style="rounded", peripheries=final)
         for t in child.transitions if isinstance(child, State | Parallel) else ():
             for target in t.targets:
                 self.edges.append((sid, target, _label(t), f"cluster_{sid}" if _is_compound(child) else None))
+
+    def initial(self, graph: graphviz.Digraph, container: Chart | State) -> None:
+        """A dot with an arrow to the state ``container`` starts in, when that is an atomic state (a compound one
+        shows its own); a chart run by a plan shows its steps instead."""
+        first = _initial_child(container)
+        if self.plan is None and first in self.ids and not _is_compound(self.ids[first]):
+            dot = f"{container.id if isinstance(container, State) else 'pnp'}__initial"
+            graph.node(dot, "", shape="point", width="0.1")
+            self.edges.append((dot, first, "", None))
 
     # ------------------------------------------------------------ a task's steps
 
@@ -317,5 +342,6 @@ def build_graph(chart: Chart, title: str, expand: int | None = None) -> graphviz
     graph.attr("edge", fontname="Helvetica", fontsize="8")
     drawing = _Drawing(graph, chart, plan, expand)
     drawing.add(graph, chart)
+    drawing.initial(graph, chart)
     drawing.draw_edges()
     return graph

@@ -25,7 +25,7 @@ def pnp(node: StateNode | Chart, attribute: str) -> str | None:
 
 
 @dataclass(frozen=True)
-class Step:
+class PlanStep:
     """One step of the task as the plan runs it."""
 
     number: int
@@ -60,7 +60,7 @@ class Plan:
     """``next_step``."""
     end: str | None
     """The state entered after the last step."""
-    steps: tuple[Step, ...]
+    steps: tuple[PlanStep, ...]
 
     @property
     def bodies(self) -> dict[str, StateNode]:
@@ -99,14 +99,14 @@ def _picker(container: Chart | State | Parallel) -> tuple[Chart | State, State] 
     return None
 
 
-def _step(number: int, body: StateNode) -> Step:
+def _step(number: int, body: StateNode) -> PlanStep:
     binding: list[tuple[str, str]] = []
     if isinstance(body, Parallel):
         for region in body.children:
             role, device = pnp(region, "role"), pnp(region, "device")
             if role and device:
                 binding.append((role, device))
-    return Step(number, body.id or "", pnp(body, "command"), pnp(body, "chart"), tuple(binding))
+    return PlanStep(number, body.id or "", pnp(body, "command"), pnp(body, "chart"), tuple(binding))
 
 
 def find_plan(chart: Chart) -> Plan | None:

@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from plugnproduce.codegen.specific import output_variable
+from plugnproduce.chartnames import output_variable
 from plugnproduce.codegen.task import GeneratedTask, StepChart
 from plugnproduce.description.contracts import breach, shorten
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Link

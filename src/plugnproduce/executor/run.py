@@ -31,9 +31,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from plugnproduce.codegen import DONE, GeneratedTask
-from plugnproduce.codegen.flow import branch_variable
-from plugnproduce.codegen.task import STEP
+from plugnproduce.chartnames import DONE, STEP, branch_variable
+from plugnproduce.codegen import GeneratedTask
 from plugnproduce.description.model import Cell, Command
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import outcomes, values

@@ -10,8 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from plugnproduce.codegen.flow import OUTCOME
-from plugnproduce.codegen.specific import output_variable
+from plugnproduce.chartnames import OUTCOME, output_variable
 from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.ontology.vocabulary import local_name
 

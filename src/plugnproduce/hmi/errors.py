@@ -2,20 +2,32 @@
 
 Every error response is ``{"detail": "ONE LINE"}``; a request that does not match its
 schema also lists each bad field: ``{"detail": "steps[0].command: field required",
-"errors": [{"field": "steps[0].command", "reason": "field required"}]}``.
+"errors": [{"field": "steps[0].command", "reason": "field required"}]}``. Only the project's
+own errors are the request's fault; any other exception is a bug of the server: 500, a line
+saying so, and the traceback in the server's log.
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from typing import Any, cast
 
 from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from plugnproduce.controller.interfaces import CellChangeRefused, RunRefused
-from plugnproduce.errors import DescriptionError, PlugNProduceError, QuantityError, excerpt, tidy
+from plugnproduce.errors import (
+    DescriptionError,
+    PlugNProduceError,
+    QuantityError,
+    UnknownName,
+    bug_message,
+    excerpt,
+    tidy,
+)
 from plugnproduce.hmi.schemas import LOOP_TAG, STEP_TAG
 
 
@@ -67,8 +79,7 @@ async def _quantity(_: Request, exc: Exception) -> JSONResponse:
 
 
 async def _unknown(_: Request, exc: Exception) -> JSONResponse:
-    name = exc.args[0] if exc.args else "name"
-    return _one(status.HTTP_404_NOT_FOUND, f"error: unknown {tidy(str(name))}")  # the name came in the request
+    return _one(status.HTTP_404_NOT_FOUND, f"error: {tidy(str(exc))}")  # the name came in the request
 
 
 async def _conflict(_: Request, exc: Exception) -> JSONResponse:
@@ -84,7 +95,42 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(RequestValidationError, _invalid_request)
     app.add_exception_handler(DescriptionError, _description)
     app.add_exception_handler(QuantityError, _quantity)
-    app.add_exception_handler(KeyError, _unknown)
+    app.add_exception_handler(UnknownName, _unknown)
     app.add_exception_handler(RunRefused, _conflict)
     app.add_exception_handler(CellChangeRefused, _conflict)
     app.add_exception_handler(PlugNProduceError, _other)
+    app.add_middleware(BugBoundary)  # added first: inside the others, so that a 500 has the security headers too
+
+
+log = logging.getLogger("plugnproduce.hmi")
+
+
+class BugBoundary:
+    """ASGI middleware: an exception that no handler answers is a bug, not the request's fault.
+
+    The answer is 500 with one line saying so, and the traceback goes to the server's log. (Starlette's
+    own last resort answers 500 too, but re-raises the exception after, into the server and the tests.)
+    """
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        started = False
+
+        async def sending(message: Message) -> None:
+            nonlocal started
+            started = started or message["type"] == "http.response.start"
+            await send(message)
+
+        try:
+            await self.app(scope, receive, sending)
+        except Exception as exc:
+            log.error("bug answering %s %s", scope.get("method"), scope.get("path"), exc_info=exc)
+            if started:  # too late for an answer of its own: the server ends the response
+                raise
+            detail = bug_message(exc, "the server's log")
+            await _one(status.HTTP_500_INTERNAL_SERVER_ERROR, detail)(scope, receive, send)

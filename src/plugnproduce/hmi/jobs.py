@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 from plugnproduce import service
 from plugnproduce.codegen.outputs import GeneratedChart
 from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.hmi import taskfiles
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.views import editor_rows, task_json
@@ -58,7 +59,7 @@ def _address_space() -> int:
     return pages * os.sysconf("SC_PAGE_SIZE")
 
 
-class OverMemory(Exception):
+class OverMemory(PlugNProduceError):
     """A job needed more memory than its budget (raised once the job's memory is free again)."""
 
 

@@ -11,7 +11,8 @@ from pathlib import Path
 
 from plugnproduce.codegen.outputs import GeneratedChart
 from plugnproduce.description.model import DeviceDescription
-from plugnproduce.drawing import Step, find_plan, render_chart
+from plugnproduce.drawing import PlanStep, find_plan, render_chart
+from plugnproduce.errors import UnknownName
 from plugnproduce.statechart import parse_chart, write_chart
 
 
@@ -65,7 +66,7 @@ class Pictures:
 
 
 
-def steps_of(chart: GeneratedChart) -> tuple[Step, ...]:
+def steps_of(chart: GeneratedChart) -> tuple[PlanStep, ...]:
     """The steps a generated task chart runs, in order (none for a chart without a plan of processes)."""
     plan = find_plan(parse_chart(chart.data, chart.name))
     return plan.steps if plan and plan.is_task else ()
@@ -85,12 +86,12 @@ class GeneratedCharts:
         return digest
 
     def chart(self, generation: str, name: str) -> GeneratedChart:
-        """One chart of a generation (KeyError if either is unknown)."""
+        """One chart of a generation (:class:`UnknownName` if either is unknown)."""
         with self._lock:
             charts = self._store.get(generation)
         if not isinstance(charts, dict):
-            raise KeyError(f"generation {generation!r} (generate the task again)")
+            raise UnknownName("generation", generation, detail="generate the task again")
         if name not in charts:
-            raise KeyError(f"chart {name!r} of generation {generation} (it has: {', '.join(charts)})")
+            raise UnknownName("chart", name, charts, owner=f"generation {generation}")
         chart: GeneratedChart = charts[name]
         return chart

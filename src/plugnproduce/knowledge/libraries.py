@@ -20,7 +20,7 @@ import rdflib
 
 from plugnproduce.description.loader import load_device, load_process
 from plugnproduce.description.model import DeviceDescription, ProcessDescription
-from plugnproduce.errors import DescriptionError, OntologyError
+from plugnproduce.errors import DescriptionError, OntologyError, UnknownName
 from plugnproduce.ontology.sources import with_imports
 from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
 from plugnproduce.ontology.vocabulary import PNP_IRI
@@ -99,7 +99,7 @@ class Knowledge:
         for p in self.processes:
             if p.id == command:
                 return p
-        raise KeyError(command)
+        raise UnknownName("process command", command, (p.id for p in self.processes))
 
     @cached_property
     def devices(self) -> tuple[DeviceDescription, ...]:

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 from plugnproduce.description.goalfile import Goal
 from plugnproduce.description.model import Cell, ProcessDescription
+from plugnproduce.description.paths import in_concept
 from plugnproduce.errors import DescriptionError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.planning.planner import check_goal, feeding
@@ -135,7 +136,7 @@ def export(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proce
     initial = ["(ready)", *(f"(at_{_id(d.id, d.initial)})" for d in cell.devices), "(= (total-cost) 0)"]
     wanted = [f"(done_{len(goal.achieve)})", *(f"(not ({f}))" for f in fresh)]
     for d, k in sorted(goal.end.items()):
-        ends = [f"(at_{_id(d, s.id)})" for s in cell.device(d).states if s.concept and taxonomy.is_a(s.concept, k)]
+        ends = [f"(at_{_id(d, s.id)})" for s in cell.device(d).states if in_concept(s, k, taxonomy)]
         wanted.append(f"(or {' '.join(ends)})" if ends else "(not (ready))")  # no such state: unreachable
     problem = "\n".join(["(define (problem goal)", "  (:domain pnp-cell)", f"  (:init {' '.join(initial)})",
                          f"  (:goal (and {' '.join(wanted)}))", "  (:metric minimize (total-cost)))"]) + "\n"

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from plugnproduce.errors import PlugNProduceError
+from plugnproduce.errors import PlugNProduceError, UnknownName
 
 if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
     from plugnproduce.executor.history import RunSummary
@@ -37,6 +37,8 @@ def report(run: str | Path | None = None) -> RunRecord:
     path = Path(run)
     if not path.exists() and not path.suffix:
         path = runs_folder() / f"{run}.jsonl"
+        if not path.exists():
+            raise UnknownName("run", str(run), (r.id for r in runs()))
     return read_journal(path)
 
 

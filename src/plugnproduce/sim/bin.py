@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from plugnproduce.description.model import DeviceDescription
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.vocabulary import local_name
 
 AREA = ((0.30, 0.50), (0.00, 0.20))
@@ -40,7 +41,7 @@ class Part:
     type: str
 
 
-class BinError(LookupError):
+class BinError(PlugNProduceError, LookupError):
     """A request the bin cannot let happen (no part where the robot goes)."""
 
 

@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from plugnproduce.description.model import Cell, DeviceDescription
-from plugnproduce.errors import DescriptionError, PlugNProduceError, ProtocolError
+from plugnproduce.errors import DescriptionError, PlugNProduceError, ProtocolError, UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.sim import control
@@ -39,7 +39,7 @@ def parse_faults(spec: str, devices: Iterable[DeviceDescription]) -> dict[str, x
             raise FaultSpecError(f"--faults {item!r}: expected DEVICE:KIND[:NAME[:SECONDS]]")
         device, kind = parts[0], parts[1]
         if device not in known:
-            raise FaultSpecError(f"--faults {item!r}: no device {device!r} in the cell; it has {', '.join(known)}")
+            raise FaultSpecError(f"--faults {item!r}: {UnknownName('device', device, known, owner='the cell')}")
         if known[device].protocol != "xirp":
             raise FaultSpecError(f"--faults {item!r}: faults are injected over XIRP; {device} speaks "
                                  f"{known[device].protocol}")

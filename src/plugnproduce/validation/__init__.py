@@ -7,7 +7,7 @@ input is reported as such (the CLI exits 2 for it).
 
 from __future__ import annotations
 
-from plugnproduce.validation.findings import Problem, Report
+from plugnproduce.validation.findings import Finding, Report
 from plugnproduce.validation.validate import validate_paths, validate_tasks
 
-__all__ = ["Problem", "Report", "validate_paths", "validate_tasks"]
+__all__ = ["Finding", "Report", "validate_paths", "validate_tasks"]

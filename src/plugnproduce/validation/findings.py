@@ -8,7 +8,7 @@ from plugnproduce.errors import MAX_MESSAGE, DescriptionError, UnreadableError, 
 
 
 @dataclass(frozen=True, order=True)
-class Problem:
+class Finding:
     """One problem: where it is and what is wrong (what was found, what was expected)."""
 
     file: str
@@ -24,7 +24,7 @@ class Problem:
         return f"{self.file}:{self.line}: {self.message}" if self.line else f"{self.file}: {self.message}"
 
     @classmethod
-    def from_error(cls, exc: DescriptionError) -> Problem:
+    def from_error(cls, exc: DescriptionError) -> Finding:
         """The problem a description error reports."""
         return cls(exc.file or "<input>", exc.line or 0, exc.message, isinstance(exc, UnreadableError))
 
@@ -37,7 +37,7 @@ class Problem:
 class Report:
     """What validation found, and what it looked at."""
 
-    problems: list[Problem] = field(default_factory=list)
+    problems: list[Finding] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
 
     @property
@@ -50,11 +50,11 @@ class Report:
         """Some input could not be read (malformed or hostile)."""
         return any(p.unreadable for p in self.problems)
 
-    def add(self, problem: Problem) -> None:
+    def add(self, problem: Finding) -> None:
         """Record a problem once."""
         if problem not in self.problems:
             self.problems.append(problem)
 
-    def sorted(self) -> list[Problem]:
+    def sorted(self) -> list[Finding]:
         """The problems by file and line."""
         return sorted(self.problems)

@@ -20,7 +20,7 @@ from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, concept_iri, local_name
 from plugnproduce.safeio import parse_xml
 from plugnproduce.statechart import SCXML_NS
-from plugnproduce.validation.findings import Problem
+from plugnproduce.validation.findings import Finding
 
 CONCEPT = "{" + PNP_IRI + "}concept"
 ACCEPTS = "{" + PNP_IRI + "}accepts"
@@ -34,7 +34,7 @@ TERM_PROPERTIES = {PNP.hasSkill: "Skill", PNP.requiresSkill: "Skill", PNP.quanti
 DESCRIPTION_CLASSES = {str(PNP.Process), str(PNP.Role), str(PNP.Parameter), str(PNP.Output)}
 
 
-def chart_name_problems(path: Path, taxonomy: Taxonomy) -> Iterator[Problem]:
+def chart_name_problems(path: Path, taxonomy: Taxonomy) -> Iterator[Finding]:
     """Unknown state concepts (``pnp:concept``) and quantities (``pnp:accepts``) in a chart."""
     root = parse_xml(path).getroot()
     process_chart = any(el.get(ROLE) for el in root.iter() if isinstance(el.tag, str))
@@ -46,14 +46,14 @@ def chart_name_problems(path: Path, taxonomy: Taxonomy) -> Iterator[Problem]:
             kind = "RequestConcept" if el.tag == TRANSITION else "StateConcept"
             message = unknown_term(concept_iri(concept), kind, taxonomy)
             if message:
-                yield Problem(str(path), el.sourceline or 0, f"pnp:concept: {message}")
+                yield Finding(str(path), el.sourceline or 0, f"pnp:concept: {message}")
         for name in (el.get(ACCEPTS) or "").split():
             message = unknown_term(concept_iri(name), "Quantity", taxonomy)
             if message:
-                yield Problem(str(path), el.sourceline or 0, f"pnp:accepts: {message}")
+                yield Finding(str(path), el.sourceline or 0, f"pnp:accepts: {message}")
 
 
-def turtle_name_problems(loaded: Loaded, taxonomy: Taxonomy) -> Iterator[Problem]:
+def turtle_name_problems(loaded: Loaded, taxonomy: Taxonomy) -> Iterator[Finding]:
     """Unknown classes, skills, quantities and state concepts in a Turtle description."""
     g = loaded.graph
     spell = turtle_spelling(g.namespace_manager)
@@ -62,12 +62,12 @@ def turtle_name_problems(loaded: Loaded, taxonomy: Taxonomy) -> Iterator[Problem
             continue
         line = loaded.line(str(s)) or 0
         if str(c).startswith((str(OWL), str(RDFS))):
-            yield Problem(str(loaded.path), line, f"{local_name(str(s))} is an ontology term ({local_name(str(c))}); "
+            yield Finding(str(loaded.path), line, f"{local_name(str(s))} is an ontology term ({local_name(str(c))}); "
                           "a description's class axioms are not read: put them in a library's ontology/ folder")
         else:
-            yield Problem(str(loaded.path), line, unknown_class(str(s), str(c), taxonomy, spell))
+            yield Finding(str(loaded.path), line, unknown_class(str(s), str(c), taxonomy, spell))
     for prop, kind in TERM_PROPERTIES.items():
         for s, o in sorted(g.subject_objects(prop)):
             message = unknown_term(str(o), kind, taxonomy, spell)
             if message:
-                yield Problem(str(loaded.path), loaded.line(str(s)) or 0, f"{local_name(str(prop))}: {message}")
+                yield Finding(str(loaded.path), loaded.line(str(s)) or 0, f"{local_name(str(prop))}: {message}")

@@ -19,7 +19,7 @@ from plugnproduce.errors import OntologyError, tidy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import parse_turtle
-from plugnproduce.validation.findings import Problem
+from plugnproduce.validation.findings import Finding
 
 VERBATIM = rdflib.URIRef("http://plugnproduce.org/shapes#verbatim")
 """The SPARQL function the shapes bind every value a message names with (see :func:`verbatim`)."""
@@ -64,7 +64,7 @@ def shapes_graph(path: Path | None = None) -> rdflib.Graph:
     return parse_turtle(path or ontology_path() / "shapes.ttl")[0]
 
 
-def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> list[Problem]:
+def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> list[Finding]:
     """Run the shapes over the knowledge graph; one problem per violation, at its node's place.
 
     A shape pySHACL cannot run (a SPARQL constraint it refuses, say ``{ SELECT ?x }`` in a
@@ -93,6 +93,6 @@ def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> li
         if not message.startswith("step ") and local_name(str(focus)) not in message:
             message = f"{local_name(str(focus))}: {message}"
         problems.append(
-            Problem(where.file if where else "<knowledge graph>", (where.line or 0) if where else 0, message)
+            Finding(where.file if where else "<knowledge graph>", (where.line or 0) if where else 0, message)
         )
     return sorted(problems)

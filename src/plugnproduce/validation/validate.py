@@ -35,7 +35,7 @@ from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import read_bytes
 from plugnproduce.statechart.io.reader import read_chart
 from plugnproduce.statechart.io.schema import schema_problems
-from plugnproduce.validation.findings import Problem, Report
+from plugnproduce.validation.findings import Finding, Report
 from plugnproduce.validation.names import chart_name_problems, turtle_name_problems
 from plugnproduce.validation.shapes import shape_problems
 from plugnproduce.validation.structure import device_problems, process_problems, task_problems
@@ -80,12 +80,12 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
     for f in files:
         try:
             if not f.is_file():
-                report.add(Problem(str(f), 0, "no such file", unreadable=True))
+                report.add(Finding(str(f), 0, "no such file", unreadable=True))
             elif f.suffix.lower() in XML_TBOX:
                 read_tbox_file(f)  # read (and refused if hostile or malformed); classified with the knowledge
             elif f.suffix == ".scxml":
                 for e in schema_problems(read_bytes(f), f):
-                    report.add(Problem.from_error(e))
+                    report.add(Finding.from_error(e))
                 for problem in chart_name_problems(f, taxonomy):
                     report.add(problem)
                     named.add((str(f.resolve()), problem.line))
@@ -100,13 +100,13 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
             else:
                 _cell(f, report, knowledge)
         except DescriptionError as exc:
-            report.add(Problem.from_error(exc))
+            report.add(Finding.from_error(exc))
     _tasks(tasks, knowledge, processes, kg, report)
     for goal in goals:  # after the loop: the processes the files define are known then
         try:
             check_terms(goal, taxonomy, {p.id: p for p in knowledge.processes} | processes)
         except DescriptionError as exc:
-            report.add(Problem.from_error(exc))
+            report.add(Finding.from_error(exc))
     if not report.unreadable:
         say("checking the SHACL shapes")
         for p in shape_problems(kg):
@@ -155,13 +155,13 @@ def _with_extensions(knowledge: Knowledge, files: list[Path], report: Report) ->
         try:
             extra |= {t for t in Library(root).files("ontology") if t not in known}
         except DescriptionError as exc:  # a malformed file or an unresolved import: a finding at its line
-            report.add(Problem.from_error(exc))
+            report.add(Finding.from_error(exc))
     if not extra:
         return knowledge
     try:
         return load_knowledge(knowledge.libraries, extra_tbox=sorted(extra), left_out=knowledge.left_out)
     except DescriptionError as exc:
-        report.add(Problem.from_error(exc))
+        report.add(Finding.from_error(exc))
         return knowledge
 
 
@@ -177,7 +177,7 @@ def _same_iri(loaded: Loaded, described: dict[str, Where], report: Report) -> No
     for s in sorted({str(s) for s in loaded.graph.subjects(RDF.type) if isinstance(s, rdflib.URIRef)}):
         first = described.setdefault(s, loaded.where(s))
         if first.file != str(loaded.path):
-            report.add(Problem(str(loaded.path), loaded.line(s) or 0,
+            report.add(Finding(str(loaded.path), loaded.line(s) or 0,
                                f"{local_name(s)} ({s}) is already described at {first}; "
                                "each IRI may be described by one file only"))
 
@@ -217,14 +217,15 @@ def _turtle(
         # complete device gets the structure checks.
         subject = device_subject(loaded, taxonomy)
         chart = g.value(subject, PNP.stateChart)
-        states = device_chart(read_chart(file_of(chart)), file_of(chart))[1] if chart is not None else ()
+        lifted = device_chart(read_chart(file_of(chart)), file_of(chart)) if chart is not None else None
+        states = (*lifted.states, *lifted.compounds) if lifted is not None else ()
         classes = [str(c) for c in g.objects(subject, RDF.type)]
         skills = taxonomy.device_skills(classes, [str(k) for k in g.objects(subject, PNP.hasSkill)])
         kg.add_device_facts(str(subject), skills, str(file_of(chart)) if chart is not None else "", states)
         try:
             device = device_from(loaded, taxonomy)
         except ContractError as exc:  # no shape can see a chart: a finding of its own
-            report.add(Problem(str(exc.file), exc.line or 0, exc.message))
+            report.add(Finding(str(exc.file), exc.line or 0, exc.message))
             return
         except DescriptionError as exc:
             if isinstance(exc, UnreadableError):
@@ -251,6 +252,6 @@ def _cell(path: Path, report: Report, knowledge: Knowledge) -> None:
     knowledge = knowledge.with_libraries(library_folders(cell_libraries(path)))
     for f, line in files:
         if (why := not_a_description(f)) is not None:
-            report.add(Problem(str(path), line, why))
+            report.add(Finding(str(path), line, why))
         elif not f.is_file() and (f.suffix == ".ttl" or knowledge.device(f.name) is None):
-            report.add(Problem(str(path), line, f"device description {excerpt(str(f), 120)} not found"))
+            report.add(Finding(str(path), line, f"device description {excerpt(str(f), 120)} not found"))

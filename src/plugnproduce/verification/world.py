@@ -25,7 +25,8 @@ from collections.abc import Hashable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from plugnproduce.codegen.task import DONE, STEP, GeneratedTask
+from plugnproduce.chartnames import DONE, STEP
+from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import Cell, ChartTransition, DeviceDescription
 from plugnproduce.errors import ExecutionError
 from plugnproduce.ontology.vocabulary import local_name
@@ -114,7 +115,8 @@ class ClosedWorld:
                          for d in self.devices]
         self._vars = assigned_variables(self.controller)
         self._device_vars = [assigned_variables(s) for s in self.sessions]
-        self._transitions = [{(t.source, t.event): t for t in d.transitions} for d in self.devices]
+        # by the state a transition is written on: a compound state's transition is taken from every state inside it
+        self._transitions = [{(t.origin or t.source, t.event): t for t in d.transitions} for d in self.devices]
 
     def start(self) -> tuple[World, Violation | None]:
         """The initial world: every session started."""

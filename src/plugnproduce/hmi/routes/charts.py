@@ -8,6 +8,7 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
 
+from plugnproduce.errors import UnknownName
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures, steps_of
 from plugnproduce.hmi.routes import hub_of
@@ -26,7 +27,7 @@ async def device_chart(device_id: str, request: Request, hub: Hub = Depends(hub_
     """The Device State Chart of a device in the cell or the catalogue."""
     known = {d.id: d for d in hub.catalogue} | {d.id: d for d in hub.cell.devices}
     if device_id not in known:
-        raise KeyError(f"device {device_id!r} (known: {', '.join(sorted(known))})")
+        raise UnknownName("device", device_id, known)
     pictures: Pictures = request.app.state.pictures
     return _svg(await run_in_threadpool(pictures.of_device, known[device_id]))
 
@@ -34,11 +35,7 @@ async def device_chart(device_id: str, request: Request, hub: Hub = Depends(hub_
 @router.get("/process/{command}.svg", response_class=Response, responses=SVG, summary="A General Process State Chart")
 async def process_chart(command: str, request: Request, hub: Hub = Depends(hub_of)) -> Response:
     """The General Process State Chart of a process."""
-    k = hub.knowledge
-    try:
-        process = k.process(command)
-    except KeyError:
-        raise KeyError(f"process command {command!r} (known: {', '.join(p.id for p in k.processes)})") from None
+    process = hub.knowledge.process(command)  # an unknown command: UnknownName, answered 404
     pictures: Pictures = request.app.state.pictures
     return _svg(await run_in_threadpool(pictures.of_file, process.chart_file))
 

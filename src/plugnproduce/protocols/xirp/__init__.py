@@ -16,7 +16,7 @@ from plugnproduce.protocols.xirp.answer import RequestFailed, RequestHandler, Re
 from plugnproduce.protocols.xirp.client import RemoteFailure, XirpClient
 from plugnproduce.protocols.xirp.codec import MAX_FRAME, encode, encode_frame, frame
 from plugnproduce.protocols.xirp.decoding import decode, schema
-from plugnproduce.protocols.xirp.faults import Fault, FaultKind, Faults
+from plugnproduce.protocols.xirp.faults import FaultKind, FaultRule, Faults
 from plugnproduce.protocols.xirp.inbox import EventCallback, LinkStats
 from plugnproduce.protocols.xirp.messages import (
     BAD_PARAMETER,
@@ -72,7 +72,7 @@ __all__ = [
     "Event",
     "EventCallback",
     "Failure",
-    "Fault",
+    "FaultRule",
     "FaultKind",
     "Faults",
     "Hello",

@@ -2,7 +2,7 @@
 
 :class:`Responder` decodes a frame and reacts: a request is answered by the
 device's handler (``describe`` by the device's files), a ``bye`` ends the
-connection, anything malformed or unexpected gets an ``error``. Fault rules
+connection, anything malformed or unexpected gets an ``error``. FaultRule rules
 (:mod:`~plugnproduce.protocols.xirp.faults`) are applied on the way.
 
 A reaction is synchronous whenever it can be: a plain-function handler is answered
@@ -18,10 +18,11 @@ import logging
 from collections.abc import Awaitable, Callable, Coroutine, Mapping
 from typing import Any
 
+from plugnproduce.errors import PlugNProduceError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.codec import encode_frame, frame
 from plugnproduce.protocols.xirp.decoding import decode
-from plugnproduce.protocols.xirp.faults import REQUEST_FAULTS, Fault, FaultKind, Faults
+from plugnproduce.protocols.xirp.faults import REQUEST_FAULTS, FaultKind, FaultRule, Faults
 from plugnproduce.protocols.xirp.messages import (
     BAD_PARAMETER,
     DESCRIBE,
@@ -54,7 +55,7 @@ Finish = Coroutine[Any, Any, None]
 """The rest of a reaction, when it has to wait for an asynchronous handler."""
 
 
-class RequestFailed(Exception):
+class RequestFailed(PlugNProduceError):
     """Raised by a request handler: the response is a failure with this ``code`` and the message as text."""
 
     def __init__(self, text: str, code: str = FAILED) -> None:
@@ -120,7 +121,7 @@ class Responder:
         return None
 
     async def _finish(
-        self, link: FrameLink, request: Request, pending: Awaitable[Results], fault: Fault | None
+        self, link: FrameLink, request: Request, pending: Awaitable[Results], fault: FaultRule | None
     ) -> None:
         try:
             results = await pending
@@ -145,7 +146,7 @@ class Responder:
             return _failed(request, BAD_PARAMETER, f"describe takes no parameters; got {', '.join(request.params)}")
         return Response(request.id, documents=documents_of(self.files))
 
-    def _send(self, link: FrameLink, response: Response, fault: Fault | None) -> None:
+    def _send(self, link: FrameLink, response: Response, fault: FaultRule | None) -> None:
         """Send the response, unless a fault drops it or sends garbage instead."""
         if fault is not None and fault.kind is FaultKind.DROP_RESPONSE:
             return

@@ -52,7 +52,7 @@ MALFORMED_PAYLOAD = b'<response xmlns="urn:plugnproduce-org:xirp:1" id="'
 
 
 @dataclass
-class Fault:
+class FaultRule:
     """One rule: do ``kind`` to the request or event called ``name`` (``None``: any but the state query
     ``state``, which a rule hits only by its name), ``times`` times."""
 
@@ -90,7 +90,7 @@ class Fault:
 class Faults:
     """The fault rules of one device, consulted in the order they were added (the first match fires)."""
 
-    rules: list[Fault] = field(default_factory=list)
+    rules: list[FaultRule] = field(default_factory=list)
     fired: list[tuple[FaultKind, str]] = field(default_factory=list)
     """Each firing so far: the kind and the request or event name it hit."""
 
@@ -104,9 +104,9 @@ class Faults:
         code: str = FAILED,
         text: str = "fault injected",
         payload: bytes = MALFORMED_PAYLOAD,
-    ) -> Fault:
-        """Add a rule (see :class:`Fault`) and return it."""
-        rule = Fault(FaultKind(kind), name, times, delay, code, text, payload)
+    ) -> FaultRule:
+        """Add a rule (see :class:`FaultRule`) and return it."""
+        rule = FaultRule(FaultKind(kind), name, times, delay, code, text, payload)
         self.rules.append(rule)
         return rule
 
@@ -114,7 +114,7 @@ class Faults:
         """Remove every rule (the record of firings stays)."""
         self.rules.clear()
 
-    def take(self, kinds: frozenset[FaultKind], name: str) -> Fault | None:
+    def take(self, kinds: frozenset[FaultKind], name: str) -> FaultRule | None:
         """The first rule of ``kinds`` that applies to ``name``, counted as fired; ``None`` if none applies."""
         for rule in self.rules:
             if rule.matches(kinds, name):

@@ -19,7 +19,7 @@ from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.xirp.answer import Finish, RequestHandler, Responder
 from plugnproduce.protocols.xirp.codec import MAX_FRAME, encode_frame, frame
-from plugnproduce.protocols.xirp.faults import EVENT_FAULTS, Fault, FaultKind, Faults
+from plugnproduce.protocols.xirp.faults import EVENT_FAULTS, FaultKind, FaultRule, Faults
 from plugnproduce.protocols.xirp.messages import (
     DESCRIBE,
     TOO_LARGE,
@@ -192,7 +192,7 @@ class XirpServer:
             self._event_fault(fault, data)
         return event
 
-    def _event_fault(self, fault: Fault, data: bytes) -> None:
+    def _event_fault(self, fault: FaultRule, data: bytes) -> None:
         if fault.kind is FaultKind.DUPLICATE_EVENT:
             self._broadcast(data + data)
         elif fault.kind is FaultKind.DELAY_EVENT:

@@ -17,7 +17,8 @@ from decimal import Decimal, InvalidOperation
 
 from plugnproduce.description.contracts import KINDS
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
-from plugnproduce.description.paths import NoPath, find_path
+from plugnproduce.description.paths import NoPath, find_path, in_concept
+from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.terms import Atom, program
@@ -110,7 +111,7 @@ def effects(device: DeviceDescription, process: ProcessDescription, taxonomy: Ta
         first: str | None = None
         missing: set[tuple[str, str]] = set()
         for state in device.states:
-            if state.concept is None or not taxonomy.is_a(state.concept, role.start_concept):
+            if not in_concept(state, role.start_concept, taxonomy):
                 continue
             walked = region_walk(device, process, role, state.id, taxonomy)
             if walked is not None:
@@ -131,9 +132,8 @@ def device_facts(device: DeviceDescription, taxonomy: Taxonomy,
     out += [s.HasSkill(d, k) for k in device.skills]
     for state in device.states:
         out.append(s.ChartState(d, state.id))
-        if state.concept is not None:
-            supers = taxonomy.superclasses.get(state.concept, frozenset((state.concept,)))
-            out += [s.StateIs(d, state.id, c) for c in sorted(supers)]
+        supers = {c for k in state.every_concept for c in taxonomy.superclasses.get(k, frozenset((k,)))}
+        out += [s.StateIs(d, state.id, c) for c in sorted(supers)]
     out += [s.Edge(d, t.source, t.target) for t in device.transitions]
     for p in processes:
         out += effects(device, p, taxonomy)
@@ -220,7 +220,7 @@ class FactBook:
         for p in self.processes:
             if p.id == command:
                 return p
-        raise KeyError(f"process command {command!r}")
+        raise UnknownName("process command", command, (p.id for p in self.processes))
 
 
 _BOOKS: dict[tuple[str, int], FactBook] = {}

@@ -7,6 +7,7 @@ from collections import defaultdict
 from collections.abc import Sequence
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import render, solver
 from plugnproduce.reasoning.asp import schema as s
@@ -114,5 +115,4 @@ def explain_process(cell: Cell, command: str, taxonomy: Taxonomy,
     for n in caps.not_offered:
         if n.command == command:
             return ProcessExplanation(n.command, n.label, False, (), n.reasons)
-    known = ", ".join(sorted(p.id for p in processes))
-    raise KeyError(f"process command {command!r} (known: {known})")
+    raise UnknownName("process command", command, (p.id for p in processes))

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 
 from plugnproduce.description.model import Cell, ProcessDescription, Task, Where
 from plugnproduce.description.outcomes import flow_findings
+from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import render, solver
 from plugnproduce.reasoning.asp import schema as s
@@ -137,7 +138,7 @@ def explain_step(task: Task, cell: Cell, n: int, taxonomy: Taxonomy,
                  processes: Sequence[ProcessDescription]) -> StepExplanation:
     """Why step ``n`` (1-based) is (not) plausible: each device it uses, its state and what the step needs."""
     if not 1 <= n <= len(task.steps):
-        raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+        raise UnknownName("step", n, detail=f"the task has steps 1 to {len(task.steps)}")
     if task.branches:  # along a path that runs the step, so that its states are the ones it starts from
         straight, positions = on_a_path(task, n, {p.id: p for p in processes}, taxonomy)
         ex = explain_step(straight, cell, positions.index(n) + 1, taxonomy, processes)

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.description.paths import in_concept
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
@@ -123,12 +124,12 @@ def needed_states(result: CheckResult, task: Task, n: int, cell: Cell, taxonomy:
             continue
         dev = next(d for d in cell.devices if d.id == p.device)
         for st in dev.states:
-            if st.concept is None or not taxonomy.is_a(st.concept, p.needed):
+            if not in_concept(st, p.needed, taxonomy):
                 continue
             states = {**step.states, p.device: st.id}
             ok = check(alone, _from_states(cell, states), taxonomy, processes).plausible
             if ok:
-                label = taxonomy.label(st.concept)
+                label = taxonomy.label(st.concept or p.needed)
                 out.append(Counterfactual("state", f"if device '{p.device}' were in state '{st.id}' ({label}) when "
                                                    f"step {n} starts, the step would be plausible", True,
                                           (p.device,), state=st.id, step=n))

@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task, Where
+from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.asp import schema as s
@@ -343,7 +344,7 @@ def explain_offered(command: str, cell: Cell, taxonomy: Taxonomy, ontology: Onto
     """Why ``command`` is (not) offered in ``cell``: the derivation, and the confirmed counterfactuals — devices
     to add or swap in for a "no", the devices a "yes" rests on."""
     if command not in {p.id for p in processes}:
-        raise KeyError(f"process command {command!r} (known: {', '.join(sorted(p.id for p in processes))})")
+        raise UnknownName("process command", command, (p.id for p in processes))
     w = words(cell, taxonomy, ontology, processes, language)
     model = derivation_model(cell, taxonomy, processes)
     if any(a.p == command for a in model[s.Offered]):
@@ -363,7 +364,7 @@ def explain_plausible(task: Task, n: int, cell: Cell, taxonomy: Taxonomy, ontolo
     devices would have to be in (the service adds the repairs, with their side effects, from
     :func:`sideeffects.assess`)."""
     if not 1 <= n <= len(task.steps):
-        raise KeyError(f"step {n}; the task has steps 1 to {len(task.steps)}")
+        raise UnknownName("step", n, detail=f"the task has steps 1 to {len(task.steps)}")
     if task.branches:  # along the path that makes the step (not) plausible, numbered as the task numbers it
         straight, positions = on_a_path(task, n, {p.id: p for p in processes}, taxonomy,
                                         lambda t: check(t, cell, taxonomy, processes))

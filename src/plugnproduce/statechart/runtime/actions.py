@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 
-class ActionError(Exception):
+class ActionError(ExecutionError):
     """An action failed in a way the chart sees as ``kind`` (``error.execution`` or ``error.communication``)."""
 
     def __init__(self, message: str, kind: str = "error.execution", sendid: str | None = None):

@@ -32,7 +32,7 @@ EXPRESSIONS_REMEMBERED = 4096
 """Compiled expressions kept for reuse (they depend only on their text and on trust)."""
 
 
-class EvaluationError(Exception):
+class EvaluationError(ExecutionError):
     """An expression could not be evaluated (the interpreter raises ``error.execution``)."""
 
 

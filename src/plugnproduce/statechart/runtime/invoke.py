@@ -90,11 +90,11 @@ class Invoker:
             chart, base = self._child_chart(inv)
             values = inv.payload.evaluate(rt) or {}
             child = rt._spawn(chart, invokeid, dict(values), base)
+        except ActionError as exc:  # before its base class: the action's own kind of error
+            rt._error(exc.kind, f"invoke {invokeid!r} failed: {exc.message}")
+            return
         except PlugNProduceError as exc:
             rt._error("error.execution", f"invoke {invokeid!r} failed: {exc}")
-            return
-        except ActionError as exc:
-            rt._error(exc.kind, f"invoke {invokeid!r} failed: {exc.message}")
             return
         except Exception as exc:  # an expression error while evaluating the invoke's attributes
             rt._error("error.execution", f"invoke {invokeid!r} failed: {exc}")
