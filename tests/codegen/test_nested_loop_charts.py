@@ -65,3 +65,39 @@ def test_where_an_inner_loop_ends_the_outer_body_the_inner_loop_decides_first(bi
     assert rule_taken(chart, {**in_both, "pnp_rounds_3": 2}) == [("pnp_rounds_3", "-1")]
     assert rule_taken(chart, {**in_both, "pnp_rounds_3": -1}) == [("pnp_rounds_1", "pnp_rounds_1 + 1"),
                                                                   ("pnp_step", "2"), ("pnp_rounds_3", "0")]
+
+
+WHILE_IN_WHILE = """task: look-again
+steps:
+  - loop:
+      while: NoPartFound
+      max: 3
+      steps:
+        - loop:
+            while: NoPartFound
+            max: 3
+            steps:
+              - command: localize-part
+"""
+"""Look again while no part is found, in rounds: loop 1 the rounds (1-4), loop 2 the looking in the first round
+(1-2), loop 3 in the later ones (3-4)."""
+
+
+def test_an_inner_while_loop_leaves_the_outcome_to_the_outer_loop_which_then_resets_it(
+        bin_picking_cell, processes) -> None:
+    chart, _ = generated(WHILE_IN_WHILE, bin_picking_cell, processes)
+    found = {"pnp_rounds_1": 1, "pnp_rounds_2": -1, "pnp_outcome": "PartFound"}
+    # the inner loops stop on a found part, at the end of their first iteration or a later one, keeping the outcome
+    assert rule_taken(chart, {**found, "pnp_step": 1, "pnp_rounds_2": 0}) == [("pnp_step", "2"), ("pnp_rounds_2", "-1")]
+    assert rule_taken(chart, {**found, "pnp_step": 4, "pnp_rounds_3": 1}) == [("pnp_rounds_3", "-1")]
+    # then the outer loop stops on it too, and only it forgets the outcome
+    assert rule_taken(chart, {**found, "pnp_step": 4, "pnp_rounds_3": -1}) == [("pnp_outcome", "None"),
+                                                                               ("pnp_rounds_1", "-1")]
+
+
+def test_a_while_loop_stops_after_its_first_iteration_and_forgets_the_outcome(bin_picking_cell, processes) -> None:
+    chart, _ = generated(WHILE_IN_WHILE.replace("        - loop:\n            while: NoPartFound\n            max: 3\n"
+                                                "            steps:\n              - command: localize-part\n",
+                                                "        - command: localize-part\n"), bin_picking_cell, processes)
+    assert rule_taken(chart, {"pnp_step": 1, "pnp_rounds_1": 0, "pnp_outcome": "PartFound"}) == [
+        ("pnp_step", "2"), ("pnp_outcome", "None"), ("pnp_rounds_1", "-1")]
