@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 
 from plugnproduce import service
+from plugnproduce.chartnames import output_variable
 from plugnproduce.codegen import generate_task
 from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.loader import parse_task
@@ -58,3 +59,27 @@ def test_a_request_outside_every_step_carries_nothing(look_until_empty: Generate
 
 def test_another_device_of_the_step_produces_nothing(look_until_empty: GeneratedTask) -> None:
     assert values.produced(look_until_empty, 4, "sensor3d", {"part_pose": POSE, "outcome": "PartFound"}) == []
+
+
+LINKED = """task: localize-then-pick
+steps:
+  - name: localize
+    command: localize-part
+    bind: {sensor: sensor3d, localizer: binpicking-pc}
+    params: {exposure: 25, part_type: bracket}
+  - command: pick
+    bind: {robot: robot, gripper: gripper}
+    params:
+      pick_pose: {from: localize, output: part_pose}
+      grip_force: 45
+"""
+
+
+def test_the_last_step_carries_the_value_an_earlier_step_produced() -> None:
+    k = service.knowledge()
+    processes = {p.id: p for p in k.processes}
+    cell = service.cell(service.builtin("cells", "bin-picking.yaml"))
+    task = parse_task(LINKED.encode(), "task.yaml")
+    generated = generate_task(task, cell, bind_by_skill(task, cell, processes), processes, k.taxonomy)
+    assert values.used(generated, 2, "robot", {"TargetPose": POSE}, {output_variable("localize", "part_pose"): POSE}) == [
+        {"value": "localize.part_pose", "used": POSE, "step": 2, "device": "robot", "parameter": "pick_pose"}]
