@@ -7,6 +7,7 @@ import json
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -67,3 +68,19 @@ def test_a_bad_lds_is_one_line_and_exit_2(tmp_path: Path) -> None:
     assert told.returncode == 2, told.stdout + told.stderr
     assert told.stderr.strip().splitlines() == [
         "error: OPC UA endpoint 'http://127.0.0.1:4840' is not opc.tcp://HOST:PORT[/PATH]"], told.stderr
+
+
+def test_sim_up_with_an_lds_that_is_not_there_is_one_line_and_exit_2(tmp_path: Path) -> None:
+    with socket.socket() as sock:  # a port nothing listens on
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+        told = subprocess.run(command("sim", "up", CELL, "--lds", f"opc.tcp://127.0.0.1:{port}", "--state-file",
+                                      str(tmp_path / "control.json")),
+                              env={**os.environ, "PNP_SSDP_PORT": str(private_network().port)}, capture_output=True,
+                              text=True, timeout=10 * WAIT)
+    assert told.returncode == 2, told.stdout + told.stderr
+    lines = told.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"error: device binpicking-pc-ua: cannot register with the Local Discovery Server opc.tcp://127.0.0.1:{port}: "
+    ), told.stderr
+    assert not (tmp_path / "control.json").exists()
