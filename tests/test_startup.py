@@ -140,3 +140,23 @@ def test_the_reasoning_layer_loads_what_is_used_on_first_use() -> None:
     assert _run(code).split() == ["False", "plugnproduce.reasoning.checks.plausibility",
                                   "plugnproduce.reasoning.repairs.windows", "True",
                                   "True", "Repair", "plugnproduce.reasoning.explanation.why", "True"]
+
+
+NOT_FOR_A_WARM_ANSWER = ("pydantic", "owlready2", "pyshacl", "xmlschema", "aiohttp", "fastapi", "uvicorn",
+                         "async_upnp_client", "graphviz", "pint", "numpy", "distributed", "plugnproduce.codegen",
+                         "plugnproduce.hmi", "plugnproduce.verification")
+"""What answering ``pnp capabilities`` and ``pnp check`` from files seen before has no use for (typer turns the
+file names into paths without pydantic; the taxonomy comes reasoned from the cache folder)."""
+
+
+@pytest.mark.parametrize("args", [("capabilities", "--cell", "descriptions/cells/bin-picking.yaml"),
+                                  ("check", "descriptions/tasks/bin-picking.yaml", "--cell",
+                                   "descriptions/cells/bin-picking.yaml")])
+def test_a_warm_capabilities_or_check_loads_nothing_it_has_no_use_for(tmp_path: Path, args: tuple[str, ...]) -> None:
+    code = _command(*args).replace("pass", "print('exit', sys.exc_info()[1].code)")
+    _run(code, tmp_path)  # the first answer keeps the units and the reasoned taxonomy in the cache folder
+    out = _run(code + "\nprint('loaded: ' + ' '.join(sorted(sys.modules)))", tmp_path)
+    answer = "9 of 12 process commands offered" if args[0] == "capabilities" else "bin-picking: plausible"
+    assert answer in out and "exit 0" in out
+    loaded = set(out.rsplit("loaded: ", 1)[1].split())
+    assert sorted(h for h in NOT_FOR_A_WARM_ANSWER if h in loaded) == []
