@@ -3,9 +3,9 @@
 typer turns every value of a command's parameters into its annotated type with a pydantic
 ``TypeAdapter``, even a file name into a ``Path``: importing pydantic and building the adapters
 costs several times a bare interpreter's start, in every command. Texts, paths (with typer's own
-checks of existence and kind) and lists of them are turned here as typer would turn them; any other
-parameter (a number with bounds, a choice) is left to typer, whose adapter is built only when a value
-is given to such a parameter.
+checks of existence and kind) and lists of them are turned here as typer would turn them; so are the
+numbers a command declares as defaults, within their bounds. Any other value (a number the user
+typed, a choice) is left to typer, whose adapter is built only then.
 """
 
 from __future__ import annotations
@@ -38,10 +38,21 @@ def is_plain(annotation: Any, info: ParameterInfo) -> bool:
     return _plain_leaf(annotation, info)
 
 
+def _a_number_in_bounds(annotation: Any, info: ParameterInfo, value: Any) -> bool:
+    """``value`` is already a number of the annotated kind (an int for a float too) within the bounds."""
+    if info.parser is not None or annotation not in (int, float) or isinstance(value, bool):
+        return False
+    if not isinstance(value, int) and not (annotation is float and isinstance(value, float)):
+        return False
+    return (info.min is None or value >= info.min) and (info.max is None or value <= info.max)
+
+
 class PlainRuntimeParam(RuntimeParam):
     """A text, a path or a flag (or a list of them), turned as typer's adapter turns it."""
 
     def _coerce_value(self, value: Any, param: _TyperParameter, ctx: click.Context) -> Any:
+        if _a_number_in_bounds(self.annotation, self.parameter_info, value):
+            return self.annotation(value)  # a default the command declares, not a text the user typed
         if not is_plain(self.annotation, self.parameter_info):
             return self._typer_own()._coerce_value(value, param, ctx)
         annotation: Any = self.annotation
