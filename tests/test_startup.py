@@ -142,11 +142,12 @@ def test_the_reasoning_layer_loads_what_is_used_on_first_use() -> None:
                                   "True", "Repair", "plugnproduce.reasoning.explanation.why", "True"]
 
 
-NOT_FOR_A_WARM_ANSWER = ("pydantic", "owlready2", "pyshacl", "xmlschema", "aiohttp", "fastapi", "uvicorn",
+NOT_FOR_A_WARM_ANSWER = ("pydantic", "asyncio", "owlready2", "pyshacl", "xmlschema", "aiohttp", "fastapi", "uvicorn",
                          "async_upnp_client", "graphviz", "pint", "numpy", "distributed", "plugnproduce.codegen",
                          "plugnproduce.hmi", "plugnproduce.verification")
 """What answering ``pnp capabilities`` and ``pnp check`` from files seen before has no use for (typer turns the
-file names into paths without pydantic; the taxonomy comes reasoned from the cache folder)."""
+file names into paths without pydantic; the event loop is started only by the commands that talk to devices;
+the taxonomy comes reasoned from the cache folder)."""
 
 
 @pytest.mark.parametrize("args", [("capabilities", "--cell", "descriptions/cells/bin-picking.yaml"),

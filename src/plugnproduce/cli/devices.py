@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import json
 import time
 from dataclasses import dataclass
@@ -25,12 +24,15 @@ from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.lazy import lazy_module
 
-if TYPE_CHECKING:  # the network stack is imported by the commands that use it
+if TYPE_CHECKING:
+    import asyncio  # the network stack is imported by the commands that use it
+
     from plugnproduce import service
     from plugnproduce.description.model import Cell
     from plugnproduce.discovery import CellChange, LiveCell
     from plugnproduce.sim import control
 else:
+    asyncio = lazy_module("asyncio")  # the event loop is started by the commands that use it
     control = lazy_module("plugnproduce.sim.control")
     service = lazy_module("plugnproduce.service")
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import signal
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -25,9 +24,12 @@ from plugnproduce.executor.journal import describe
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
+    import asyncio
+
     from plugnproduce import controller, service
     from plugnproduce.executor.run import TaskRun
 else:
+    asyncio = lazy_module("asyncio")  # the event loop is started by the commands that use it
     controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 
