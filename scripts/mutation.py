@@ -73,7 +73,8 @@ class Guard:
 
 
 GUARDS = (
-    Guard("evaluator", ("src/plugnproduce/statechart/runtime/evaluator.py",),
+    Guard("evaluator", ("src/plugnproduce/statechart/runtime/evaluator.py",
+                     "src/plugnproduce/statechart/runtime/budgets.py"),
           ("tests/statechart/test_evaluator_guards.py", "tests/statechart/test_evaluator_budgets.py",
            "tests/statechart/test_interpreter.py")),
     Guard("safeio", ("src/plugnproduce/safeio.py",),
@@ -94,10 +95,10 @@ GUARDS = (
            "tests/protocols/test_xirp_robustness.py"),
           ("x__escaped", "x__attr", "x__checked", "x__name", "x__decimal", "x__write_pose", "x__value", "x__positive",
            "x_encode", "x_decode", "x__decode_document", "x__number", "x__integer", "x__pose", "x__decode_event")),
-    Guard("executor-faults", ("src/plugnproduce/executor/run.py",),
+    Guard("executor-faults", ("src/plugnproduce/executor/run.py", "src/plugnproduce/executor/safestop.py"),
           ("tests/executor/test_faults.py", "tests/executor/test_run.py", "tests/executor/test_unanswered.py"),
           ("xǁTaskRunǁstop", "xǁTaskRunǁdevice_lost", "xǁTaskRunǁsend", "xǁTaskRunǁ_request",
-           "xǁTaskRunǁ_safe_stop", "xǁTaskRunǁ_stop_device", "xǁTaskRunǁ_on_event", "xǁTaskRunǁ_on_lost",
+           "x_stop_safely", "x__stop_device", "xǁTaskRunǁ_on_event", "xǁTaskRunǁ_on_lost",
            "xǁTaskRunǁ_on_anomaly", "xǁTaskRunǁ_on_step", "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail",
            "xǁTaskRunǁ_outcome", "xǁTaskRunǁ_send_one", "xǁTaskRunǁ_release", "xǁTaskRunǁ_deliver",
            "xǁTaskRunǁ_with_outcome")),

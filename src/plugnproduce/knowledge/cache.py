@@ -23,6 +23,7 @@ from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 import plugnproduce
+from plugnproduce import folders
 from plugnproduce.knowledge.libraries import Knowledge, Library, tbox_files
 
 FORMAT = 1
@@ -33,7 +34,7 @@ KEEP = 8
 
 def cache_folder() -> Path:
     """The user's cache folder, beside the taxonomy's closures and the batch's engines."""
-    return Path.home() / ".cache" / "plugnproduce"
+    return folders.cache_folder()
 
 
 def _files(root: Path) -> list[Path]:
