@@ -77,6 +77,16 @@ def test_a_lazy_module_loads_on_first_use() -> None:
     assert _run(code).split() == ["False", "False", "True", "True", "True"]
 
 
+def test_a_name_the_module_binds_anew_after_first_use_is_seen_through_its_stand_in() -> None:
+    code = ("from plugnproduce.lazy import lazy_module\n"
+            "m = lazy_module('plugnproduce.drawing')\n"
+            "m.draw_chart\n"  # first use
+            "import plugnproduce.drawing as real\n"
+            "real.draw_chart = 'patched'\n"  # as a test's monkeypatch or a module replacing a global does
+            "print(m.draw_chart)")
+    assert _run(code).split() == ["patched"]
+
+
 def test_a_missing_module_is_an_error_at_once() -> None:
     with pytest.raises(ModuleNotFoundError, match="plugnproduce.nowhere"):
         lazy_module("plugnproduce.nowhere")
