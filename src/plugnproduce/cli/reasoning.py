@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from plugnproduce import controller, reasoning, service
     from plugnproduce.description import loader
     from plugnproduce.description.model import Cell
+    from plugnproduce.timing import CycleTime
 else:
     loader = lazy_module("plugnproduce.description.loader")
     batching = lazy_module("plugnproduce.batch")
@@ -93,6 +94,14 @@ def _print_problems(result: reasoning.CheckResult, verbose: bool) -> None:
             typer.echo(f"    rests on: {', '.join(str(w) for w in p.reason.where)}")
 
 
+def _cycle_line(estimate: CycleTime) -> str:
+    """The text output's total line: the estimated cycle time, and what it counts once."""
+    line = f"estimated cycle time: {estimate.total:.2f} s"
+    per = [f"{lp.later_iteration:.2f} s per further iteration of steps {lp.entry}-{lp.last}"
+           for lp in estimate.loops if lp.count is None]
+    return line + (f" (loops ended by an outcome counted once; {', '.join(per)})" if per else "")
+
+
 @app.command()
 @boundary
 def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
@@ -103,15 +112,19 @@ def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state),
     2 bad input.
     """
-    result = service.check(task, _cell(cell, live, discovery_timeout), knowledge(cell))
+    the_cell, k = _cell(cell, live, discovery_timeout), knowledge(cell)
+    result = service.check(task, the_cell, k)
+    estimate = service.cycle_time(task, the_cell, k, result) if result.plausible else None
     if json_out:
-        emit_json(result.to_json())
+        emit_json({**result.to_json(), "cycle_time": estimate.to_json() if estimate is not None else None})
     else:
         verdict = "plausible" if result.plausible else f"implausible ({len(result.problems)} problem(s))"
         typer.echo(f"task {result.task} in cell {result.cell}: {verdict}")
         _print_problems(result, verbose)
         for link in result.links:  # what a device reports is proven here or held to the contract when it comes
             typer.echo(f"  {link}")
+        if estimate is not None:
+            typer.echo(_cycle_line(estimate))
     if not result.plausible:
         raise typer.Exit(1)
 

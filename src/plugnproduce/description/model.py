@@ -10,13 +10,16 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from plugnproduce.description.flow import Branch as Branch
 from plugnproduce.description.flow import Loop as Loop
 from plugnproduce.description.flow import enclosing, outermost_first, path_name
 from plugnproduce.errors import UnknownName
 from plugnproduce.statechart.model import Chart
+
+if TYPE_CHECKING:
+    from plugnproduce.description.durations import RequestDuration
 
 Protocol = Literal["xirp", "upnp"]
 PROTOCOLS: tuple[Protocol, ...] = ("xirp", "upnp")
@@ -171,6 +174,8 @@ class DeviceDescription:
         return dataclasses.replace(self, initial=state_id, reported_state=True)
     arguments: tuple[Argument, ...] = ()
     """Declared contracts of its requests' arguments (``pnp:hasArgument``)."""
+    durations: tuple[RequestDuration, ...] = ()
+    """Declared request durations (``pnp:hasDuration``); the chart's delays count for the others."""
 
     def argument(self, request: str, quantity: str) -> Argument:
         """The contract of a request's argument: the declared one, else required with no limits."""

@@ -66,6 +66,7 @@ from plugnproduce.service.programs import (
     Generation,
     ImplausibleTask,
     Unverified,
+    cycle_time,
     generate,
     generation,
     plan_run,
@@ -78,6 +79,7 @@ else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
 
 __all__ = [
+    "cycle_time",
     "MORE_REPAIRS",
     "Cell",
     "CellArg",

@@ -17,6 +17,7 @@ if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
     from plugnproduce import reasoning
     from plugnproduce.codegen import GeneratedTask
     from plugnproduce.codegen.outputs import GeneratedChart
+    from plugnproduce.timing import CycleTime
     from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
@@ -130,3 +131,20 @@ def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge 
     if progress is not None:
         progress(f"generating the charts of {len(the_task.steps)} step(s)")
     return _generate_task(the_task, the_cell, result, k)
+
+
+def cycle_time(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None,
+               result: reasoning.CheckResult | None = None) -> CycleTime | None:
+    """The estimated cycle time of a task in a cell, step by step (None: the task is not plausible there, or
+    its program cannot be generated). ``result``: the task's check, when it was checked already."""
+    from plugnproduce.timing import estimate_task
+
+    the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
+    result = result if result is not None else checks.check(the_task, the_cell, k)
+    if not result.plausible:
+        return None
+    try:
+        generated = _generate_task(the_task, the_cell, result, k)
+    except PlugNProduceError:
+        return None
+    return estimate_task(generated)
