@@ -79,6 +79,7 @@ async def run_task(
     bin_parts: int | None = None,
     bin_seed: int = 0,
     assume_initial: bool = False,
+    speed: float = 1.0,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
@@ -89,7 +90,8 @@ async def run_task(
     (default :data:`DISCOVERY_SECONDS`, simulated: :data:`SIMULATED_DISCOVERY_SECONDS`); ``progress`` is told
     each phase as it begins (checking, generating, starting devices, discovering, running). The task is
     checked and generated from the state each device reports once discovered (:func:`reported_states`), or, with
-    ``assume_initial``, from the charts' initial states before discovery. Raises :class:`ImplausibleTask`
+    ``assume_initial``, from the charts' initial states before discovery. Simulated devices work ``speed``
+    times faster than real time (their durations divided by it). Raises :class:`ImplausibleTask`
     before any command goes out.
     """
     from plugnproduce.discovery import LiveCell
@@ -109,7 +111,8 @@ async def run_task(
         if simulate:
             say(f"starting {len(the_cell.devices)} simulated device(s) on loopback")
             parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
-            sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices), bin=parts)
+            sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices), bin=parts,
+                                speed=speed)
             await stack.enter_async_context(sim)
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         wanted = [d.id for d in the_cell.devices]

@@ -53,6 +53,9 @@ def distance(a: object, b: object) -> float | None:
 
 
 def _position(value: object) -> tuple[float, float, float] | None:
+    """The position (x, y, z) of a pose: a list of numbers, or six numbers written in a string."""
+    if isinstance(value, str):
+        value = value.split()
     if not isinstance(value, (list, tuple)) or len(value) < 3:
         return None
     try:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import math
 import re
 from collections.abc import Mapping
 from pathlib import Path
@@ -27,6 +28,7 @@ from plugnproduce.statechart.model import Send, walk
 from plugnproduce.statechart.runtime.events import Event
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
+from plugnproduce.timing.requests import DeviceTimer
 
 _ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
 _CHART = re.compile(r"(pnp:stateChart\s+)<[^>]*>")
@@ -73,14 +75,21 @@ class SimulatedDevice:
     """One device running its chart behind its protocol; ``async with`` starts and stops it."""
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
-                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
-        """``bin``: the simulated bin the device works on, if any."""
+                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None,  # noqa: A002
+                 speed: float = 1.0) -> None:
+        """``bin``: the simulated bin the device works on, if any; ``speed``: how much faster than real time
+        the device works (its chart's delays and declared durations divided by it)."""
+        if not (math.isfinite(speed) and speed > 0):
+            raise ValueError(f"speed factor {speed!r}: expected a positive number")
         self.description = device
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
         self.bin = bin
         self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
+        self.speed = speed
+        self.timer = DeviceTimer(device)
+        self.interpreter.delay_policy = self._delay
         self._loop = ChartLoop(self.interpreter)
         self._task: asyncio.Task[None] | None = None
         self._xirp: xirp.XirpServer | None = None
@@ -170,7 +179,13 @@ class SimulatedDevice:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
         if self.bin is not None:
             self.bin.on_request(self.description, params, self.interpreter.dm)
+        self.timer.request(request, params)
         self._loop.queue(event, dict(params))
+
+    def _delay(self, nominal: float) -> float:
+        """A delayed send of the chart: the declared duration of the request just taken (once) or the chart's
+        delay, scaled by the speed factor."""
+        return self.timer.delay(nominal) / self.speed
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
         if request.name == xirp.STATE:

@@ -55,6 +55,9 @@ class Dispatcher:
     _observers: list[Callable[..., None]]
 
     def _init_dispatch(self) -> None:
+        self.delay_policy: Callable[[float], float] | None = None
+        """Maps a delayed send's delay (seconds, as the chart says) to the one it takes (a simulated device
+        scaled by a speed factor, or timed by its declared durations); None: as the chart says."""
         self._delayed: list[_Delayed] = []
         self._pending: dict[str, list[_Delayed]] = {}
         self._counter = 0
@@ -77,6 +80,8 @@ class Dispatcher:
         """Execute a ``<send>``: check it, record it, then deliver it now or after ``delay`` seconds."""
         kind = str(kind) if kind is not None else SCXML_IO
         target = str(target) if target is not None else None
+        if delay > 0 and self.delay_policy is not None:
+            delay = self.delay_policy(delay)
         if kind in SCXML_TYPES:
             if target is not None and not target.startswith("#_"):
                 raise ActionError(f"send target {target!r} is not supported by the SCXML processor; expected "
