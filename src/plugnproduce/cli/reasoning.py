@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import json
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -278,6 +279,8 @@ plausible; {"options": [], "ambiguous": "..."} when several devices of the confi
 play a step's role (bind it in the task: no purchase cures that); {"options": [], "impossible":
 "why"} when no set from the catalogue helps. A .csv output file gets the same columns as CSV.
 With -o, or on a terminal, a last line on stderr counts the configurations of each kind.
+--cycle-time adds "cost" and per task its estimated "cycle_time" (seconds, null where not plausible);
+--pareto prints only the front of cost x cycle time: {"config", "devices", "cost", "cycle_time"}.
 
 Exit 0 answered (whatever is feasible), 2 bad input.
 """
@@ -315,6 +318,12 @@ def batch(
                                              help="With tls://: this client's certificate."),
     cluster_key: Path | None = typer.Option(None, "--cluster-key", metavar="FILE",
                                             help="With tls://: this client's private key."),
+    cycle_time: bool = typer.Option(False, "--cycle-time",
+                                    help="Add each configuration's cost and per task its estimated cycle time "
+                                         "(seconds), answered in this process (JSONL)."),
+    pareto: bool = typer.Option(False, "--pareto",
+                                help="Print only the configurations on the front of cost x cycle time (every task "
+                                     "plausible; the time summed over the tasks), cheapest first (JSONL)."),
 ) -> None:
     if (configs is None) == (generate is None):
         fail("give either CONFIGS (a JSONL or CSV file, or -) or --generate N")
@@ -338,6 +347,11 @@ def batch(
     else:
         configurations = batching.read_configurations(configs)  # type: ignore[arg-type]
     as_csv = output is not None and output.suffix.lower() == ".csv"
+    if cycle_time or pareto:
+        if as_csv or cluster is not None:
+            fail("--cycle-time and --pareto write JSONL in this process: no .csv output, no --cluster")
+        _timed(engine, configurations, catalogue, list(tasks), output, pareto)
+        return
     with contextlib.ExitStack() as stack:
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
         if as_csv:
@@ -349,6 +363,26 @@ def batch(
     if output is not None or on_a_terminal():
         where = f" to {output}" if output is not None else ""
         typer.echo(f"wrote {written} configurations{where}: {_tally(tally)}", err=True)
+
+
+def _timed(engine: batching.Engine, configurations: Iterable[batching.Configuration], catalogue: Path | None,
+           tasks: list[Path], output: Path | None, pareto: bool) -> None:
+    """``pnp batch --cycle-time`` (every row with its cost and cycle times) or ``--pareto`` (the front only)."""
+    rows = service.batch_cycle_times(engine, configurations, catalogue, list(tasks), tuple(LIBRARIES["folders"]),
+                                     LIBRARIES["builtin"])
+    with contextlib.ExitStack() as stack:
+        out = stack.enter_context(output.open("w", encoding="utf-8")) if output else sys.stdout
+        if not pareto:
+            for row in rows:
+                out.write(json.dumps(row) + "\n")
+            return
+        from plugnproduce.batch.timings import ParetoFront
+
+        front = ParetoFront()
+        for row in rows:
+            front.add(row)
+        for point in front.front():
+            out.write(json.dumps(point.to_json()) + "\n")
 
 
 def _tally(tally: dict[str, int]) -> str:

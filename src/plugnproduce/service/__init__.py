@@ -25,6 +25,7 @@ from plugnproduce.knowledge import Knowledge, Library
 from plugnproduce.lazy import lazy_module
 from plugnproduce.service.batches import (
     batch,
+    batch_cycle_times,
     batch_engine,
     batch_report,
     batch_report_from,
@@ -79,6 +80,7 @@ else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
 
 __all__ = [
+    "batch_cycle_times",
     "cycle_time",
     "MORE_REPAIRS",
     "Cell",

@@ -137,14 +137,8 @@ def cycle_time(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledg
                result: reasoning.CheckResult | None = None) -> CycleTime | None:
     """The estimated cycle time of a task in a cell, step by step (None: the task is not plausible there, or
     its program cannot be generated). ``result``: the task's check, when it was checked already."""
-    from plugnproduce.timing import estimate_task
+    from plugnproduce.timing.tasks import task_cycle_time
 
     the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
     result = result if result is not None else checks.check(the_task, the_cell, k)
-    if not result.plausible:
-        return None
-    try:
-        generated = _generate_task(the_task, the_cell, result, k)
-    except PlugNProduceError:
-        return None
-    return estimate_task(generated)
+    return task_cycle_time(the_task, the_cell, k.taxonomy, k.processes, result)
