@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import dataclasses
 import json
 import sys
 from collections.abc import Callable, Iterable, Iterator
@@ -159,24 +160,36 @@ def repair(
     discovery_timeout: float | None = DISCOVERY_OPTION,
     interface: str | None = INTERFACE_OPTION,
     verbose: bool = VERBOSE_OPTION,
+    rank: str = typer.Option("side-effects", "--rank", metavar="side-effects|time",
+                             help="Order the repairs by their side effects, then cost (default), or by the cycle "
+                                  "time they add (the repaired task's estimate), fastest first."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
 
-    Ranked by their worst side effect (none first, a dropped part last), then by cost, cheapest first; each one
+    Ranked by their worst side effect (none first, a dropped part last), then by cost, cheapest first (or with
+    --rank time by the estimated cycle time of the repaired task); each one
     checked again, with the devices it buys and their own limits.
     A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists, 2 bad input.
     """
+    if rank not in ("side-effects", "time"):
+        raise typer.BadParameter(f"--rank {rank!r}: expected side-effects or time")
     the_cell = _cell(cell, live, discovery_timeout, interface)
     the_task = service.task(task)  # read once, checked once: the repairs' assessment starts from this check
     result = service.check(the_task, the_cell, knowledge(cell))
     repairs = [] if result.plausible else service.assessed_repairs(the_task, the_cell, catalogue, top,
                                                                    knowledge(cell), checked=result)
+    times = service.repair_cycle_times(repairs, the_cell, catalogue, knowledge(cell))
+    if rank == "time":
+        order = sorted(range(len(repairs)), key=lambda i: (_seconds(times[i]), repairs[i].rank))
+        repairs = [dataclasses.replace(repairs[i], rank=n) for n, i in enumerate(order, start=1)]
+        times = [times[i] for i in order]
     players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
-                   "repairs": [r.to_json() for r in repairs],
+                   "repairs": [{**r.to_json(), "cycle_time": _seconds(t, None)} for r, t in zip(repairs, times,
+                                                                                            strict=True)],
                    "catalogue_players": [{"step": i, "role": r, "devices": ds} for (i, r), ds in players.items()]})
     elif result.plausible:
         typer.echo(f"task {result.task} in cell {result.cell}: plausible; nothing to repair")
@@ -188,8 +201,9 @@ def repair(
                                                        + ("" if catalogue else " (repair with --catalogue to add one)")
                                                        if devices else "no catalogue device (built-in or library) "
                                                        "can play it"))
-        for r in repairs:
-            typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}):")
+        for r, t in zip(repairs, times, strict=True):
+            estimate = f", estimated cycle time {t.total:.2f} s" if t is not None else ""
+            typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}{estimate}):")
             for e in r.repair.edits:
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
             for x in r.side_effects:
@@ -200,6 +214,11 @@ def repair(
             typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.repair.task).splitlines()), nl=False)
     if not result.plausible and not repairs:
         raise typer.Exit(1)
+
+
+def _seconds(estimate: CycleTime | None, missing: float | None = float("inf")) -> float | None:
+    """A repaired task's estimated seconds (``missing`` when it has none)."""
+    return round(estimate.total, 3) if estimate is not None else missing
 
 
 def _tree(ex: reasoning.Explanation, depth: int | None, verbose: bool) -> None:

@@ -71,6 +71,7 @@ from plugnproduce.service.programs import (
     generate,
     generation,
     plan_run,
+    repair_cycle_times,
     verify,
 )
 
@@ -80,6 +81,7 @@ else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
 
 __all__ = [
+    "repair_cycle_times",
     "batch_cycle_times",
     "cycle_time",
     "MORE_REPAIRS",
