@@ -202,8 +202,9 @@ def repair(
                                                        if devices else "no catalogue device (built-in or library) "
                                                        "can play it"))
         for r, t in zip(repairs, times, strict=True):
-            estimate = f", estimated cycle time {t.total:.2f} s" if t is not None else ""
-            typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}{estimate}):")
+            typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}):")
+            if t is not None:
+                typer.echo(f"  estimated cycle time: {t.total:.2f} s")
             for e in r.repair.edits:
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
             for x in r.side_effects:
