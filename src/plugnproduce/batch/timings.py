@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 from plugnproduce.batch.batches import Configuration, Engine, task_names
 from plugnproduce.batch.feasibility import MEMORY, Key
-from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
-from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.knowledge import Knowledge
 from plugnproduce.timing.tasks import task_cycle_time
 
 Times = dict[str, float | None]
@@ -27,12 +27,11 @@ class CycleTimes:
     plausible), and ``cost``, the configuration's devices' cost."""
 
     def __init__(self, engine: Engine, catalogue: Sequence[DeviceDescription], tasks: Sequence[Task],
-                 taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> None:
+                 knowledge: Knowledge) -> None:
         self.engine = engine
         self._devices = {d.id: d for d in catalogue}
         self._tasks = task_names(tasks)
-        self._taxonomy = taxonomy
-        self._processes = list(processes)
+        self._knowledge = knowledge
         self._known: dict[Key, Times] = {}
 
     def times(self, config: Configuration, plausible: Sequence[str]) -> Times:
@@ -48,7 +47,7 @@ class CycleTimes:
         return found
 
     def _seconds(self, task: Task, cell: Cell) -> float | None:
-        estimate = task_cycle_time(task, cell, self._taxonomy, self._processes)
+        estimate = task_cycle_time(task, cell, self._knowledge)
         return round(estimate.total, 3) if estimate is not None else None
 
     def cost(self, config: Configuration) -> float:

@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import dataclasses
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import yaml
 
@@ -33,6 +34,9 @@ from plugnproduce.reasoning.asp.facts import fact_book
 from plugnproduce.reasoning.asp.terms import Atom, Model, program
 from plugnproduce.reasoning.checks.offers import capabilities, cell_program
 from plugnproduce.safeio import PlainDumper
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 MAX_STEPS = 12
 """Longest plan searched for, in steps (a loop's body)."""
@@ -71,7 +75,7 @@ class Unreachable:
     purchase: DeviceDescription | None = None
 
 
-def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
+def plan(goal: Goal, cell: Cell, knowledge: Knowledge,
          catalogue: Sequence[DeviceDescription] = (), max_steps: int = MAX_STEPS,
          source: str | None = None, minimize: str = "steps") -> Plan | Unreachable:
     """Plan ``goal`` in ``cell`` from its devices' states (their ``initial``: chart or reported).
@@ -82,19 +86,19 @@ def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Process
     """
     if minimize not in MINIMIZE:
         raise ValueError(f"minimize {minimize!r}: expected one of {', '.join(MINIMIZE)}")
-    by_id = {p.id: p for p in processes}
-    check_goal(goal, cell, taxonomy, by_id)
+    by_id = knowledge.processes_by_id
+    check_goal(goal, cell, knowledge)
     name = source or f"{goal.name}.yaml"
     if minimize == "cycle-time":
-        fastest = _fastest(goal, cell, taxonomy, processes, max_steps, name)
+        fastest = _fastest(goal, cell, knowledge, max_steps, name)
         if isinstance(fastest, Plan):
             return fastest
-    found = _search(goal, cell, taxonomy, processes, max_steps)
+    found = _search(goal, cell, knowledge, max_steps)
     if isinstance(found, Model):
         return _written(goal, found, by_id, name)
     for device in sorted((d for d in catalogue if d.id not in {c.id for c in cell.devices}),
                          key=lambda d: (d.cost, d.id)):
-        if isinstance(_search(goal, cell.with_device(device), taxonomy, processes, max_steps), Model):
+        if isinstance(_search(goal, cell.with_device(device), knowledge, max_steps), Model):
             return Unreachable(goal, found, device)
     return Unreachable(goal, found)
 
@@ -102,9 +106,9 @@ def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Process
 # ------------------------------------------------------------------ the goal against the knowledge
 
 
-def check_goal(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: dict[str, ProcessDescription]) -> None:
+def check_goal(goal: Goal, cell: Cell, knowledge: Knowledge) -> None:
     """Bad input in the goal file: unknown commands, parameters, roles, concepts, and devices not in the cell."""
-    check_terms(goal, taxonomy, processes)
+    check_terms(goal, knowledge.taxonomy, knowledge.processes_by_id)
     for item in goal.achieve:
         for d in item.bind.values():
             _device(d, cell, goal.file, item.line)
@@ -151,14 +155,13 @@ def feeding(process: ProcessDescription) -> dict[str, tuple[str, str]]:
     return {n: k for k, n in first.items()}
 
 
-def _search(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
-            max_steps: int) -> Model | tuple[str, ...]:
+def _search(goal: Goal, cell: Cell, knowledge: Knowledge, max_steps: int) -> Model | tuple[str, ...]:
     """The best plan's model, or why there is none."""
-    why = _cannot(goal, cell, taxonomy, processes)
+    why = _cannot(goal, cell, knowledge)
     if why:
         return why
-    book = fact_book(taxonomy, processes)
-    facts = cell_program(book, cell) + program(goal_facts(goal, processes, taxonomy))
+    book = fact_book(knowledge)
+    facts = cell_program(book, cell) + program(goal_facts(goal, knowledge.processes, knowledge.taxonomy))
     best: tuple[tuple[int, ...], Model] | None = None
     last = max_steps
     for t, model in solver.grow(solver.PLAN, facts, range(1, max_steps + 1)):
@@ -174,22 +177,22 @@ def _search(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proc
     return best[1]
 
 
-def _fastest(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
-             max_steps: int, source: str) -> Plan | tuple[str, ...]:
+def _fastest(goal: Goal, cell: Cell, knowledge: Knowledge, max_steps: int, source: str) -> Plan | tuple[str, ...]:
     """The plan of least estimated cycle time among the best of each horizon searched, or why there is none."""
     from plugnproduce.timing.tasks import task_cycle_time
 
-    why = _cannot(goal, cell, taxonomy, processes)
+    why = _cannot(goal, cell, knowledge)
     if why:
         return why
-    by_id = {p.id: p for p in processes}
-    facts = cell_program(fact_book(taxonomy, processes), cell) + program(goal_facts(goal, processes, taxonomy))
+    by_id = knowledge.processes_by_id
+    facts = cell_program(fact_book(knowledge), cell) + program(goal_facts(goal, knowledge.processes,
+                                                                           knowledge.taxonomy))
     best: tuple[tuple[float, ...], Plan] | None = None
     last = max_steps
     for t, models in solver.grow_optima(solver.PLAN, facts, range(1, max_steps + 1), MOST_PLANS):
         for model in models:
             written = _written(goal, model, by_id, source)
-            estimate = task_cycle_time(written.task, cell, taxonomy, processes)
+            estimate = task_cycle_time(written.task, cell, knowledge)
             seconds = estimate.total if estimate is not None else float("inf")
             key = (len(model[ps.Blind]) + sum(w.h == t for w in model[ps.Wasted]), seconds, t, len(model[ps.Bound]))
             if best is None or key < best[0]:
@@ -203,14 +206,14 @@ def _fastest(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Pro
     return best[1]
 
 
-def _cannot(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> tuple[str, ...]:
+def _cannot(goal: Goal, cell: Cell, knowledge: Knowledge) -> tuple[str, ...]:
     """Why no plan can exist, whatever its length: commands the cell does not offer, an outcome none reports."""
-    caps = capabilities(cell, taxonomy, processes)
+    caps = capabilities(cell, knowledge)
     offered = {o.command for o in caps.offered}
     why = [f"{n.command} is not offered: {r.plain}" for n in caps.not_offered
            if n.command in {i.command for i in goal.achieve} for r in n.reasons]
-    if goal.until is not None and not any(falling_under(goal.until, p.outcomes, taxonomy)
-                                          for p in processes if p.id in offered):
+    if goal.until is not None and not any(falling_under(goal.until, p.outcomes, knowledge.taxonomy)
+                                          for p in knowledge.processes if p.id in offered):
         why.append(f"no command the cell offers reports {local_name(goal.until)}")
     return tuple(why)
 
@@ -218,7 +221,7 @@ def _cannot(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proc
 # ------------------------------------------------------------------ the plan as a task file
 
 
-def _written(goal: Goal, model: Model, processes: dict[str, ProcessDescription], source: str) -> Plan:
+def _written(goal: Goal, model: Model, processes: Mapping[str, ProcessDescription], source: str) -> Plan:
     acts = {a.t: a.p for a in model[ps.Act]}
     binds: dict[int, dict[str, str]] = defaultdict(dict)
     for b in model[ps.Bound]:

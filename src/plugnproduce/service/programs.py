@@ -62,7 +62,7 @@ def _generate_task(the_task: Task, the_cell: Cell, result: reasoning.CheckResult
     from plugnproduce.codegen import generate_task
 
     in_units, _ = reasoning.normalised(the_task, k.processes)  # the values in their parameters' units
-    return generate_task(in_units, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
+    return generate_task(in_units, the_cell, result.bindings(), k.processes_by_id, k.taxonomy)
 
 
 def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,
@@ -142,7 +142,7 @@ def cycle_time(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledg
 
     the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
     result = result if result is not None else checks.check(the_task, the_cell, k)
-    return task_cycle_time(the_task, the_cell, k.taxonomy, k.processes, result)
+    return task_cycle_time(the_task, the_cell, k, result)
 
 
 def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path: CellArg,
@@ -159,5 +159,5 @@ def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path
         cell = the_cell
         for device in r.repair.added_devices:
             cell = cell.with_device(bought[device])
-        out.append(task_cycle_time(r.repair.task, cell, k.taxonomy, k.processes))
+        out.append(task_cycle_time(r.repair.task, cell, k))
     return out
