@@ -244,6 +244,9 @@ def sim_up(
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
                                          help="A simulated bin of N parts at random poses for the devices to work on."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
+    speed: float = typer.Option(1.0, "--speed", metavar="F", min=0.01, max=1000.0,
+                                help="The devices work F times faster than real time (their durations divided by F; "
+                                     "default 1)."),
     interface: str | None = INTERFACE_OPTION,
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
@@ -263,7 +266,7 @@ def sim_up(
     k = knowledge(cell)
     sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=k), network=network,
                         faults=parse_faults(faults, the_cell.devices), taxonomy=k.taxonomy,
-                        bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None)
+                        bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None, speed=speed)
     try:
         asyncio.run(run_simulated_cell(sim, state_file or control.default_state_file(), echo=typer.echo))
     except KeyboardInterrupt:
