@@ -52,7 +52,8 @@ def test_the_default_ranking_stays_by_side_effects_and_gives_the_estimates_too()
 def test_the_text_shows_each_estimate() -> None:
     result = repair("--rank", "time")
     assert result.returncode == 0, result.stdout + result.stderr
-    assert "repair 1 (cost 4):\n  estimated cycle time: 1.57 s\n" in result.stdout
+    first = result.stdout.split("repair 1 (cost 4):\n")[1].split("resulting task:")[0]
+    assert "  - remove step 1 (bin-pick) [cost 4]\n  estimated cycle time: 1.57 s\n" in first
 
 
 def test_an_unknown_ranking_is_bad_input() -> None:

@@ -203,14 +203,14 @@ def repair(
                                                        "can play it"))
         for r, t in zip(repairs, times, strict=True):
             typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}):")
-            if t is not None:
-                typer.echo(f"  estimated cycle time: {t.total:.2f} s")
             for e in r.repair.edits:
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
             for x in r.side_effects:
                 typer.echo(f"  side effect: {x.text}")
             if r.repair.unrolls:
                 typer.echo(f"  note: {r.repair.unrolls}")
+            if t is not None:
+                typer.echo(f"  estimated cycle time: {t.total:.2f} s")
             typer.echo("  resulting task:")
             typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.repair.task).splitlines()), nl=False)
     if not result.plausible and not repairs:
