@@ -12,38 +12,78 @@ protocols, executor, sim).
 
 from __future__ import annotations
 
-from plugnproduce.controller.interfaces import (
-    CellChangeRefused,
-    CellListener,
-    CellSource,
-    CellUpdate,
-    JournalRecord,
-    PluggableCellSource,
-    Runner,
-    RunObserver,
-    RunRefused,
-)
-from plugnproduce.controller.livecell import LiveCellSource
-from plugnproduce.controller.run import (
-    DEFAULT_BIN_PARTS,
-    DISCOVERY_SECONDS,
-    SIMULATED_DISCOVERY_SECONDS,
-    DevicesMissing,
-    StateNotReported,
-    default_bin_parts,
-    find_devices,
-    live_cell,
-    reported_states,
-    run_task,
-    start_run,
-)
-from plugnproduce.controller.runner import ExecutorRunner
-from plugnproduce.controller.simcell import SimulatedCellSource
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from plugnproduce.controller.interfaces import (
+        CellChangeRefused,
+        CellListener,
+        CellSource,
+        CellUpdate,
+        JournalRecord,
+        PluggableCellSource,
+        Runner,
+        RunObserver,
+        RunRefused,
+    )
+    from plugnproduce.controller.livecell import LiveCellSource
+    from plugnproduce.controller.run import (
+        DEFAULT_BIN_PARTS,
+        DISCOVERY_SECONDS,
+        SIMULATED_DISCOVERY_SECONDS,
+        DevicesMissing,
+        StateNotReported,
+        default_bin_parts,
+        find_devices,
+        live_cell,
+        planned_run,
+        reported_states,
+        run_task,
+        start_run,
+    )
+    from plugnproduce.controller.runner import ExecutorRunner
+    from plugnproduce.controller.simcell import SimulatedCellSource
+    from plugnproduce.discovery import CellChange, LiveCell
+    from plugnproduce.executor.run import TaskRun
+    from plugnproduce.protocols.interface import chosen_address
+    from plugnproduce.protocols.upnp import network_from_env
+    from plugnproduce.sim.bin import SimulatedBin
+
+_WHERE = {
+    **dict.fromkeys(("CellChangeRefused", "CellListener", "CellSource", "CellUpdate", "JournalRecord",
+                     "PluggableCellSource", "Runner", "RunObserver", "RunRefused"),
+                    "plugnproduce.controller.interfaces"),
+    "LiveCellSource": "plugnproduce.controller.livecell",
+    **dict.fromkeys(("DEFAULT_BIN_PARTS", "DISCOVERY_SECONDS", "SIMULATED_DISCOVERY_SECONDS", "DevicesMissing",
+                     "StateNotReported", "default_bin_parts", "find_devices", "live_cell", "planned_run",
+                     "reported_states", "run_task", "start_run"), "plugnproduce.controller.run"),
+    "ExecutorRunner": "plugnproduce.controller.runner",
+    "SimulatedCellSource": "plugnproduce.controller.simcell",
+    **dict.fromkeys(("CellChange", "LiveCell"), "plugnproduce.discovery"),
+    "TaskRun": "plugnproduce.executor.run",
+    "chosen_address": "plugnproduce.protocols.interface",
+    "network_from_env": "plugnproduce.protocols.upnp",
+    "SimulatedBin": "plugnproduce.sim.bin",
+}
+"""Where each name of the controller lives: it is imported on first use, so that importing one module of the
+controller (``pnp sim plug`` needs :mod:`.devices` alone) loads no network stack."""
+
+
+def __getattr__(name: str) -> object:
+    """A name of :data:`_WHERE`, imported from its module on first use."""
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_WHERE[name]), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "DEFAULT_BIN_PARTS",
     "DISCOVERY_SECONDS",
     "SIMULATED_DISCOVERY_SECONDS",
+    "CellChange",
     "CellChangeRefused",
     "CellListener",
     "CellSource",
@@ -51,16 +91,22 @@ __all__ = [
     "DevicesMissing",
     "ExecutorRunner",
     "JournalRecord",
+    "LiveCell",
     "LiveCellSource",
     "PluggableCellSource",
     "RunObserver",
     "RunRefused",
     "Runner",
+    "SimulatedBin",
     "SimulatedCellSource",
     "StateNotReported",
+    "TaskRun",
+    "chosen_address",
     "default_bin_parts",
     "find_devices",
     "live_cell",
+    "network_from_env",
+    "planned_run",
     "reported_states",
     "run_task",
     "start_run",

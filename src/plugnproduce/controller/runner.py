@@ -1,9 +1,9 @@
 """The executor as the HMI's :class:`~plugnproduce.controller.interfaces.Runner`.
 
-A run takes the service's one path: :func:`plugnproduce.service.plan_run` checks the task for
-the cell as it is now, each device in the state it reports, and generates only its task chart;
-:func:`plugnproduce.controller.run.start_run` runs it against the cell's devices at the endpoints
-discovery found, journalling into the runs folder. A device the cell source sees leave during
+A run takes the one path of every run, :func:`~plugnproduce.controller.run.planned_run` (as ``pnp run``
+does): the task is checked for the cell as it is now, each device in the state it reports, only its
+task chart is generated, and it runs against the cell's devices at the endpoints discovery found,
+journalling into the runs folder. A device the cell source sees leave during
 the run is a lost device: the run stops with a fault.
 One run at a time.
 """
@@ -16,15 +16,15 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from plugnproduce import service
 from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
-from plugnproduce.controller.run import StateNotReported, reported_states, start_run
+from plugnproduce.controller.run import StateNotReported, planned_run
 from plugnproduce.controller.simcell import SimulatedCellSource
 from plugnproduce.description.model import Cell, Task
 from plugnproduce.errors import UnknownName
 from plugnproduce.executor.journal import read_journal
-from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
+from plugnproduce.executor.run import TaskRun  # the type of a run
 from plugnproduce.knowledge import Knowledge
+from plugnproduce.service import ImplausibleTask, new_run_id
 
 log = logging.getLogger(__name__)
 
@@ -66,24 +66,21 @@ class ExecutorRunner:
             raise RunRefused(f"run {active} is still running; stop it first")
         if isinstance(self._source, SimulatedCellSource):
             self._source.prepare_run(task)  # its default bin, for a task that loops on a localized pose
-        try:  # planned from the state each device reports, not its chart's initial state
-            reported = cell.reported(await reported_states(cell))
-            generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)
-            prefixes = await asyncio.to_thread(  # how devices may name concepts (pnp:PartFound)
-                lambda: (self._knowledge or service.knowledge()).prefixes)
-        except StateNotReported as exc:
-            raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
-        except service.ImplausibleTask as exc:
-            first = exc.result.problems[0]
-            raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc
-        run_id = service.new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", task.name))
+        run_id = new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", task.name))
         started = asyncio.Event()
 
         def observe(record: JournalRecord) -> None:
             started.set()
             observer(run_id, record)
 
-        run = start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes)
+        try:  # planned from the state each device reports, not its chart's initial state
+            run = await planned_run(task, cell, cell, self._dir / f"{run_id}.jsonl", knowledge=self._knowledge,
+                                    observer=observe)
+        except StateNotReported as exc:
+            raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
+        except ImplausibleTask as exc:
+            first = exc.result.problems[0]
+            raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc
         self._loop = asyncio.get_running_loop()
         running = asyncio.create_task(run.run(), name=f"run {run_id}")
         running.add_done_callback(self._finished)

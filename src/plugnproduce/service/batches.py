@@ -143,3 +143,14 @@ def batch_cycle_times(
     times = CycleTimes(engine, catalogue(folder, k), [task(p) for p in tasks], k)
     for config in configurations:
         yield times.annotate(engine.line(config), config)
+
+
+def pareto_front(rows: Iterable[dict[str, object]]) -> list[dict[str, object]]:
+    """Of :func:`batch_cycle_times`'s rows, the configurations in which every task is plausible that no other beats
+    in both cost and cycle time (summed over the tasks), cheapest first: ``{config, devices, cost, cycle_time}``."""
+    from plugnproduce.batch.timings import ParetoFront
+
+    front = ParetoFront()
+    for row in rows:
+        front.add(row)
+    return [p.to_json() for p in front.front()]
