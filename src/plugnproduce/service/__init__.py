@@ -118,7 +118,7 @@ if TYPE_CHECKING:
     from plugnproduce.reasoning import CheckResult, Explanation, Reason
     from plugnproduce.resources import rules_path
     from plugnproduce.safeio import MAX_BYTES, MAX_DIGITS
-    from plugnproduce.timing import CycleTime
+    from plugnproduce.timing.estimate import CycleTime
     from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
@@ -132,7 +132,7 @@ _ELSEWHERE = {
     "Taxonomy": "plugnproduce.ontology.taxonomy",
     **dict.fromkeys(("concept_value", "local_name"), "plugnproduce.ontology.vocabulary"),
     **dict.fromkeys(("Plan", "Unreachable"), "plugnproduce.planning"),
-    "CycleTime": "plugnproduce.timing",
+    "CycleTime": "plugnproduce.timing.estimate",
     **dict.fromkeys(("BATCH_CSV_HEADER", "ClusterAccess", "Configuration", "Engine", "bounded_lines",
                      "check_cluster_address",
                      "configurations_from", "read_configurations"), "plugnproduce.batch"),

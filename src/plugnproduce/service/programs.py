@@ -18,7 +18,7 @@ if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
     from plugnproduce import reasoning
     from plugnproduce.codegen import GeneratedTask
     from plugnproduce.codegen.outputs import GeneratedChart
-    from plugnproduce.timing import CycleTime
+    from plugnproduce.timing.estimate import CycleTime
     from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
