@@ -18,6 +18,7 @@ from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.protocols.opcua.security import Security, check_plain, from_environment, secure_client
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
@@ -64,20 +65,31 @@ class OpcUaDeviceClient:
         self.lost: str | None = None
 
     @classmethod
-    async def connect(cls, endpoint: str, device: str, timeout: float) -> OpcUaDeviceClient:
-        """Open a session (security mode None) and find the device's object by its browse path."""
-        parse_endpoint(endpoint)
+    async def connect(cls, endpoint: str, device: str, timeout: float,
+                      security: Security | None = None) -> OpcUaDeviceClient:
+        """Open a session and find the device's object by its browse path.
+
+        ``security`` (default: from the environment, :func:`.security.from_environment`): mode None only on
+        loopback, Sign or SignAndEncrypt with the PKI folder's certificates.
+        """
+        host = parse_endpoint(endpoint)[0]
+        security = from_environment() if security is None else security
+        check_plain(security, device, endpoint, host)
         client = Client(endpoint, timeout=timeout)
         client.max_messagesize, client.max_chunkcount = MAX_MESSAGE, MAX_CHUNKS
         try:
-            await asyncio.wait_for(client.connect(), timeout)
+            await asyncio.wait_for(_secure_and_connect(client, security, device), timeout)
         except TimeoutError as exc:
             await _quietly_close(client)
             raise ProtocolTimeout(f"device {device}: {endpoint} did not open a session within {timeout:g} s") \
                 from exc
+        except ProtocolError:
+            await _quietly_close(client)
+            raise
         except Exception as exc:  # any failure of a foreign server is a refused connection, never a crash
             await _quietly_close(client)
-            raise ProtocolConnectionError(f"device {device}: cannot connect to {endpoint}: {_said(exc)}") from exc
+            raise ProtocolConnectionError(f"device {device}: cannot connect to {endpoint} "
+                                          f"(security mode {security.mode}): {_refusal(exc, security.mode)}") from exc
         try:
             ns, node = await asyncio.wait_for(_device_node(client, device), timeout)
         except ProtocolError:
@@ -252,6 +264,30 @@ def _on_close(client: Client, then: Callable[[], None]) -> None:
         then()
 
     protocol.connection_lost = connection_lost
+
+
+async def _secure_and_connect(client: Client, security: Security, device: str) -> None:
+    await secure_client(client, security, device)
+    await client.connect()
+
+
+_CERTIFICATE_REFUSALS = {
+    "BadCertificateUntrusted": "its certificate is not among the trusted ones (PKI/trusted)",
+    "BadCertificateUriInvalid": "its certificate does not name its application URI",
+    "BadCertificateTimeInvalid": "its certificate has expired or is not valid yet",
+    "BadSecurityChecksFailed": "it refused the controller's certificate, or asks for one",
+}
+
+
+def _refusal(exc: BaseException, mode: str) -> str:
+    """What a failed connection says, a refused certificate in words."""
+    if isinstance(exc, ua.UaStatusCodeError):
+        name = type(exc).__name__
+        if name in _CERTIFICATE_REFUSALS:
+            return f"{name}: {_CERTIFICATE_REFUSALS[name]}"
+    if str(exc).startswith("No matching endpoints"):
+        return f"the device offers no endpoint with security mode {mode} ({_said(exc)})"
+    return _said(exc)
 
 
 async def _device_node(client: Client, device: str) -> tuple[int, Node]:
