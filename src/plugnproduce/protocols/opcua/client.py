@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from asyncua import Client, Node, ua
+from asyncua.common.connection import TransportLimits
 from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
@@ -23,6 +24,7 @@ from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
     MAX_ARGUMENTS,
+    MAX_CHUNK,
     MAX_CHUNKS,
     MAX_MESSAGE,
     MAX_STRING,
@@ -77,6 +79,7 @@ class OpcUaDeviceClient:
         check_plain(security, device, endpoint, host)
         client = Client(endpoint, timeout=timeout)
         client.max_messagesize, client.max_chunkcount = MAX_MESSAGE, MAX_CHUNKS
+        _bound_transport(client)
         try:
             await asyncio.wait_for(_secure_and_connect(client, security, device), timeout)
         except TimeoutError as exc:
@@ -264,6 +267,39 @@ def _on_close(client: Client, then: Callable[[], None]) -> None:
         then()
 
     protocol.connection_lost = connection_lost
+
+
+class _Limits(TransportLimits):  # type: ignore[misc]
+    """The transport limits of one connection, held to ours whatever the server's Acknowledge says (asyncua
+    takes the server's limits as its own, and 0 from the server would mean none)."""
+
+    def update_client_limits(self, msg: ua.Acknowledge) -> None:
+        super().update_client_limits(msg)
+        _cap(self)
+
+
+def _cap(limits: Any) -> None:
+    limits.max_recv_buffer = _capped(limits.max_recv_buffer, MAX_CHUNK)
+    limits.max_chunk_count = _capped(limits.max_chunk_count, MAX_CHUNKS)
+    limits.max_message_size = _capped(limits.max_message_size, MAX_MESSAGE)
+
+
+def _capped(value: int, limit: int) -> int:
+    return limit if value <= 0 else min(value, limit)
+
+
+def _bound_transport(client: Client) -> None:
+    """Every connection the client opens (for its endpoints and its session) receives at most ``MAX_CHUNKS``
+    chunks of ``MAX_CHUNK`` bytes per message: a server's larger answer ends the connection."""
+    uaclient = client.uaclient
+    make = uaclient._make_protocol
+
+    def bounded() -> Any:
+        protocol = make()
+        protocol._connection._limits = _Limits(MAX_CHUNK, MAX_CHUNK, MAX_CHUNKS, MAX_MESSAGE)
+        return protocol
+
+    uaclient._make_protocol = bounded
 
 
 async def _secure_and_connect(client: Client, security: Security, device: str) -> None:
