@@ -14,15 +14,17 @@ from __future__ import annotations
 
 import asyncio
 import logging
-import re
 from collections.abc import Coroutine, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import rdflib
+
 from plugnproduce.description.model import Command, DeviceDescription
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.safeio import parse_turtle
 from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.sim.payloads import event_payloads
 from plugnproduce.statechart.runtime.events import Event, EventData
@@ -32,19 +34,37 @@ from plugnproduce.statechart.runtime.loop import ChartLoop
 if TYPE_CHECKING:
     from plugnproduce.protocols.opcua import OpcUaDeviceServer
 
-_ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
-_CHART = re.compile(r"(pnp:stateChart\s+)<[^>]*>")
-
 
 def served_description(device: DeviceDescription, endpoint: str) -> tuple[str, str]:
-    """The device's Turtle with its real endpoint, and its chart, as text."""
-    turtle = Path(device.where.file).read_text(encoding="utf-8")
-    turtle, found = _ENDPOINT.subn(lambda m: f'{m.group(1)}"{endpoint}"', turtle, count=1)
-    if not found:
-        raise ValueError(f"{device.where.file}: no pnp:endpoint literal to fill in")
-    # The chart is served beside the Turtle whatever folder it sits in, so the reference is its name.
-    turtle = _CHART.sub(lambda m: f"{m.group(1)}<{Path(device.chart_file).name}>", turtle, count=1)
-    return turtle, Path(device.chart_file).read_text(encoding="utf-8")
+    """The device's Turtle with its real endpoint, and its chart, as text.
+
+    The Turtle is edited as RDF: the device's ``pnp:endpoint`` becomes ``endpoint`` and its ``pnp:stateChart``
+    the chart's name, since the chart is served beside the Turtle whatever folder it sits in. Other IRIs the
+    file gave relative to its folder stay relative, so they name the served files, not the simulator's.
+    """
+    path = Path(device.where.file)
+    graph, _ = parse_turtle(path)
+    subject = rdflib.URIRef(device.iri)
+    if graph.value(subject, PNP.endpoint) is None:
+        raise ValueError(f"{device.where.file}: {device.id} has no pnp:endpoint to fill in")
+    served = _relative_to(graph, path.parent.resolve().as_uri() + "/")
+    served.set((subject, PNP.endpoint, rdflib.Literal(endpoint)))
+    served.set((subject, PNP.stateChart, rdflib.URIRef(Path(device.chart_file).name)))
+    return served.serialize(format="turtle"), Path(device.chart_file).read_text(encoding="utf-8")
+
+
+def _relative_to(graph: rdflib.Graph, folder: str) -> rdflib.Graph:
+    """A copy of ``graph`` whose IRIs inside ``folder`` are written relative to it."""
+    def relative(node: Any) -> Any:
+        return rdflib.URIRef(node[len(folder):]) if isinstance(node, rdflib.URIRef) and node.startswith(folder) \
+            else node
+
+    out = rdflib.Graph()
+    for prefix, namespace in graph.namespaces():
+        out.bind(prefix, namespace, override=True, replace=True)
+    for s, p, o in graph:
+        out.add((relative(s), relative(p), relative(o)))
+    return out
 
 
 def requests_and_events(device: DeviceDescription) -> tuple[dict[str, list[str]], list[str]]:
