@@ -77,14 +77,21 @@ async def test_a_client_without_a_certificate_is_refused_by_a_device_that_asks_f
         await OpcUaDeviceClient.connect(signed.endpoint, DEVICE, WAIT, Security())
 
 
-async def test_an_untrusted_device_certificate_is_refused(signed: SimulatedDevice, tmp_path: Path) -> None:
-    """The controller's own folder trusts no device: the device's certificate is refused, said in words."""
-    mine = tmp_path / "mine"
+async def test_an_untrusted_device_certificate_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The device trusts the controller, but the controller's own folder trusts no device: the device's
+    certificate is refused by the controller, said in words."""
+    mine, pki = tmp_path / "mine", tmp_path / "pki"
     await generate(mine, [])
-    with pytest.raises(ProtocolConnectionError, match=f"device {DEVICE}: cannot connect to .*: "
-                                                      "BadCertificateUntrusted: its certificate is not among the "
-                                                      "trusted ones"):
-        await OpcUaDeviceClient.connect(signed.endpoint, DEVICE, WAIT, Security("Sign", mine))
+    (pki / "clients").mkdir(parents=True)
+    shutil.copyfile(mine / "own" / "cert.der", pki / "clients" / "mine.der")
+    device = await _device(pki, "Sign", monkeypatch)
+    try:
+        with pytest.raises(ProtocolConnectionError, match=f"device {DEVICE}: cannot connect to .*: "
+                                                          "BadCertificateUntrusted: its certificate is not among "
+                                                          "the trusted ones \\(PKI/trusted\\)$"):
+            await OpcUaDeviceClient.connect(device.endpoint, DEVICE, WAIT, Security("Sign", mine))
+    finally:
+        await device.stop()
 
 
 async def test_a_controller_certificate_the_device_does_not_trust_is_refused(signed: SimulatedDevice,
@@ -93,7 +100,9 @@ async def test_a_controller_certificate_the_device_does_not_trust_is_refused(sig
     mine = tmp_path / "mine"
     await generate(mine, [])
     shutil.copyfile(tmp_path / "pki" / "trusted" / f"{DEVICE}.der", mine / "trusted" / f"{DEVICE}.der")
-    with pytest.raises(ProtocolConnectionError, match=f"device {DEVICE}: cannot connect to .*: Bad"):
+    with pytest.raises(ProtocolConnectionError, match=f"device {DEVICE}: cannot connect to .*: "
+                                                      "BadCertificateUntrusted: the device refused the controller's "
+                                                      "certificate"):
         await OpcUaDeviceClient.connect(signed.endpoint, DEVICE, WAIT, Security("Sign", mine))
 
 

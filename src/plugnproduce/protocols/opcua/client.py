@@ -19,7 +19,7 @@ from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.files import DeviceFiles
-from plugnproduce.protocols.opcua.security import Security, check_plain, from_environment, secure_client
+from plugnproduce.protocols.opcua.security import PeerRefused, Security, check_plain, from_environment, secure_client
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
@@ -311,16 +311,19 @@ _CERTIFICATE_REFUSALS = {
     "BadCertificateUntrusted": "its certificate is not among the trusted ones (PKI/trusted)",
     "BadCertificateUriInvalid": "its certificate does not name its application URI",
     "BadCertificateTimeInvalid": "its certificate has expired or is not valid yet",
-    "BadSecurityChecksFailed": "it refused the controller's certificate, or asks for one",
 }
 
 
 def _refusal(exc: BaseException, mode: str) -> str:
-    """What a failed connection says, a refused certificate in words."""
+    """What a failed connection says, a refused certificate in words: refused by the controller (its own
+    validator) or by the device."""
     if isinstance(exc, ua.UaStatusCodeError):
         name = type(exc).__name__
-        if name in _CERTIFICATE_REFUSALS:
-            return f"{name}: {_CERTIFICATE_REFUSALS[name]}"
+        if isinstance(exc.__cause__, PeerRefused):
+            return f"{name}: {_CERTIFICATE_REFUSALS.get(name, 'its certificate is refused')}"
+        if name.startswith("BadCertificate") or name == "BadSecurityChecksFailed":
+            return f"{name}: the device refused the controller's certificate (PKI/own/cert.der is not among " \
+                   "the certificates it trusts)"
     if str(exc).startswith("No matching endpoints"):
         return f"the device offers no endpoint with security mode {mode} ({_said(exc)})"
     return _said(exc)

@@ -95,6 +95,16 @@ def _readable(path: Path, what: str) -> Path:
     return path
 
 
+def _service_error() -> type[Exception]:
+    from asyncua.common.utils import ServiceError
+
+    return ServiceError  # type: ignore[no-any-return]
+
+
+class PeerRefused(_service_error()):  # type: ignore[misc]
+    """This side refused the peer's certificate (not the peer ours): asyncua's ServiceError, told apart."""
+
+
 async def _validator(trusted: Path, peer: str) -> Any:
     """A certificate validator: valid now, naming the peer's application URI, and one of the certificates
     (DER) in ``trusted`` itself (each trusted certificate is pinned; no chains of authorities)."""
@@ -109,9 +119,12 @@ async def _validator(trusted: Path, peer: str) -> Any:
     checks = CertificateValidator(O.TIME_RANGE | O.URI | role)
 
     async def validate(certificate: Any, application: Any) -> None:
-        await checks.validate(certificate, application)
+        try:
+            await checks.validate(certificate, application)
+        except ServiceError as exc:
+            raise PeerRefused(exc.code) from exc
         if certificate.public_bytes(Encoding.DER) not in pinned:
-            raise ServiceError(ua.StatusCodes.BadCertificateUntrusted)
+            raise PeerRefused(ua.StatusCodes.BadCertificateUntrusted)
 
     return validate
 
