@@ -157,10 +157,12 @@ class SimulatedDevice:
             files = self._xirp.files = self._files(self._xirp.endpoint)
         elif d.protocol == "opcua":
             from plugnproduce.protocols.opcua import OpcUaDeviceServer  # asyncua loads only for an OPC UA device
+            from plugnproduce.protocols.opcua.security import device_security
             from plugnproduce.sim.opcua import node_spec
 
+            security = await device_security(d.id)  # PNP_OPCUA_PKI: the folder's missing certificates are made
             self._opcua = OpcUaDeviceServer(node_spec(d), self._on_opcua_call, lambda: self.state,
-                                            host=self.network.interface, files=self._files)
+                                            host=self.network.interface, files=self._files, security=security)
             await self._opcua.start()
             if self.lds is not None:
                 await self._opcua.register(self.lds)
