@@ -27,6 +27,7 @@ LAYERS = {
     "batch": 3.5,  # checks a product family in many cells with the reasoning layer; not part of it
     "codegen": 3, "reasoning": 3, "validation": 3, "drawing": 3,
     "planning": 3.2,  # plans from goals with the reasoning layer
+    "timing": 3.1,  # cycle time: times the generated charts (codegen) with the devices' durations
     "knowledge": 2.5,  # the loaded libraries: their taxonomy, descriptions and catalogue
     "description": 2,
     "ontology": 1, "statechart": 1, "protocols": 1,

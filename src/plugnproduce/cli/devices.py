@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import json
 import time
 from dataclasses import dataclass
@@ -25,11 +24,14 @@ from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.lazy import lazy_module
 
-if TYPE_CHECKING:  # the network stack is imported by the commands that use it
+if TYPE_CHECKING:
+    import asyncio  # the network stack is imported by the commands that use it
+
     from plugnproduce import service
     from plugnproduce.controller import CellChange, LiveCell, devices
     from plugnproduce.service import Cell
 else:
+    asyncio = lazy_module("asyncio")  # the event loop is started by the commands that use it
     devices = lazy_module("plugnproduce.controller.devices")
     service = lazy_module("plugnproduce.service")
 
@@ -243,6 +245,9 @@ def sim_up(
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
                                          help="A simulated bin of N parts at random poses for the devices to work on."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
+    speed: float = typer.Option(1.0, "--speed", metavar="F", min=0.01, max=1000.0,
+                                help="The devices work F times faster than real time (their durations divided by F; "
+                                     "default 1)."),
     interface: str | None = INTERFACE_OPTION,
     lds: str | None = typer.Option(None, "--lds", metavar="opc.tcp://HOST:PORT",
                                    help="The OPC UA devices register with this Local Discovery Server."),
@@ -264,7 +269,7 @@ def sim_up(
     if lds is not None and serve_lds is not None:
         fail("--lds and --serve-lds: give one (register with that LDS, or with the one started here)")
     sim = devices.simulated_cell(the_cell, service.catalogue(knowledge=k), k, faults, bin_parts, bin_seed,
-                                 interface=address, lds=lds)
+                                 interface=address, speed=speed, lds=lds)
     try:
         asyncio.run(devices.run_simulated(sim, state_file, echo=typer.echo, serve_lds=serve_lds))
     except KeyboardInterrupt:

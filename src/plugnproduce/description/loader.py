@@ -17,6 +17,7 @@ import yaml
 from rdflib.namespace import RDF, RDFS, XSD
 
 from plugnproduce.description.charts import device_chart
+from plugnproduce.description.durations import RequestDuration
 from plugnproduce.description.model import (
     Argument,
     Cell,
@@ -123,6 +124,9 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
     arguments = tuple(sorted((_argument(loaded, a) for a in loaded.graph.objects(s, PNP.hasArgument)),
                              key=lambda a: (a.request, a.quantity)))
     _check_arguments(arguments, transitions, loaded.path)
+    durations = tuple(sorted((_duration(loaded, d) for d in loaded.graph.objects(s, PNP.hasDuration)),
+                             key=lambda d: d.request))
+    _check_durations(durations, transitions, loaded.path)
     device = DeviceDescription(
         id=local_name(str(s)),
         iri=str(s),
@@ -143,6 +147,7 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         chart=chart,
         stops=stops,
         arguments=arguments,
+        durations=durations,
     )
     try:  # a range its chart declares for a value it reports is a number, at its line
         output_ranges(device)
@@ -165,6 +170,42 @@ def _check_arguments(arguments: tuple[Argument, ...], transitions: tuple[ChartTr
             raise ContractError(f"argument {quantity} of request {request}: unknown unit "
                                    f"{excerpt(a.unit)!r}; expected a unit such as \"N\", \"mm/s\" or \"kPa\"",
                                    path, line)
+
+
+def _duration(loaded: Loaded, d: rdflib.term.Node) -> RequestDuration:
+    """One ``pnp:hasDuration`` of a device (the shapes check its terms; the numbers must be finite)."""
+    motion, share = optional_value(loaded, d, PNP.motionOf), optional_value(loaded, d, PNP.speedShare)
+    return RequestDuration(
+        request=str(one_value(loaded, d, PNP.forRequest, "request")),
+        seconds=finite_number(loaded, d, optional_value(loaded, d, PNP.seconds), "duration"),
+        motion_of=str(motion) if motion is not None else None,
+        top_speed=finite_number(loaded, d, optional_value(loaded, d, PNP.topSpeed), "top speed"),
+        speed_share=str(share) if share is not None else None,
+        where=loaded.where(str(d)),
+    )
+
+
+def _check_durations(durations: tuple[RequestDuration, ...], transitions: tuple[ChartTransition, ...],
+                     path: Path) -> None:
+    """Each duration belongs to a request of the chart, once, and a motion to a quantity the request takes."""
+    accepts = {t.request.name: set(t.accepts) for t in transitions if t.request}
+    seen: set[str] = set()
+    for d in durations:
+        line = d.where.line if d.where else None
+        request = excerpt(d.request)
+        if d.request not in accepts:
+            raise ContractError(f"duration of request {request}: no transition of the chart waits for request "
+                                f"{request}", path, line)
+        if d.request in seen:
+            raise ContractError(f"request {request} has more than one duration", path, line)
+        seen.add(d.request)
+        if d.seconds is None and (d.motion_of is None or d.top_speed is None):
+            raise ContractError(f"duration of request {request}: expected pnp:seconds, or pnp:motionOf with "
+                                "pnp:topSpeed", path, line)
+        for quantity in (d.motion_of, d.speed_share):
+            if quantity is not None and quantity not in accepts[d.request]:
+                raise ContractError(f"duration of request {request}: the request does not take "
+                                    f"{excerpt(local_name(quantity))} (its pnp:accepts)", path, line)
 
 
 def _argument(loaded: Loaded, a: rdflib.term.Node) -> Argument:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from plugnproduce.description.flow import Branch as Branch
 from plugnproduce.description.flow import Loop as Loop
@@ -23,6 +23,9 @@ from plugnproduce.description.tasks import plain_value as plain_value
 from plugnproduce.description.where import Where as Where
 from plugnproduce.errors import UnknownName
 from plugnproduce.statechart.model import Chart
+
+if TYPE_CHECKING:
+    from plugnproduce.description.durations import RequestDuration
 
 Protocol = Literal["xirp", "upnp", "opcua"]
 PROTOCOLS: tuple[Protocol, ...] = ("xirp", "upnp", "opcua")
@@ -166,6 +169,8 @@ class DeviceDescription:
         return dataclasses.replace(self, initial=state_id, reported_state=True)
     arguments: tuple[Argument, ...] = ()
     """Declared contracts of its requests' arguments (``pnp:hasArgument``)."""
+    durations: tuple[RequestDuration, ...] = ()
+    """Declared request durations (``pnp:hasDuration``); the chart's delays count for the others."""
 
     def answer_to(self, request: str) -> str | None:
         """The event the device answers ``request`` with at once: the one protocol event every transition taking

@@ -73,10 +73,12 @@ class SimulatedCell:
     def __init__(self, cell: Cell, *, catalogue: Iterable[DeviceDescription] = (),
                  network: upnp.SsdpNetwork = upnp.LOOPBACK, faults: dict[str, xirp.Faults] | None = None,
                  taxonomy: Taxonomy | None = None, bin: SimulatedBin | None = None,  # noqa: A002
-                 lds: str | None = None) -> None:
+                 speed: float = 1.0, lds: str | None = None) -> None:
         """``taxonomy`` reads device description files plugged in by path (default: the built-in ontology);
-        ``bin`` is the simulated bin the devices work on (none: they report their charts' fixed values); ``lds``
+        ``bin`` is the simulated bin the devices work on (none: they report their charts' fixed values);
+        ``speed`` how much faster than real time the devices work (their durations divided by it); ``lds``
         the Local Discovery Server the OPC UA devices register with (none: they do not)."""
+        self.speed = speed
         self.lds = lds
         self.cell = cell
         self.bin = bin
@@ -121,7 +123,7 @@ class SimulatedCell:
                                 "a library's device needs the cell started with it: "
                                 "pnp --library LIBRARY sim up CELL")
         device = SimulatedDevice(self.catalogue[device_id], network=self.network, faults=self.faults.get(device_id),
-                                 bin=self.bin, lds=self.lds)
+                                 bin=self.bin, speed=self.speed, lds=self.lds)
         await device.start()
         self.devices[device_id] = device
         return sorted(self.devices)

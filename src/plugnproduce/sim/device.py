@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import math
 from collections.abc import Coroutine, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -30,6 +31,7 @@ from plugnproduce.sim.payloads import event_payloads
 from plugnproduce.statechart.runtime.events import Event, EventData
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
+from plugnproduce.timing.requests import DeviceTimer
 
 if TYPE_CHECKING:
     from plugnproduce.protocols.opcua import OpcUaDeviceServer
@@ -86,9 +88,12 @@ class SimulatedDevice:
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
                  faults: xirp.Faults | None = None, bin: SimulatedBin | None = None,  # noqa: A002
-                 lds: str | None = None) -> None:
+                 lds: str | None = None, speed: float = 1.0) -> None:
         """``bin``: the simulated bin the device works on, if any; ``lds``: the Local Discovery Server an OPC UA
-        device registers with, if any."""
+        device registers with, if any; ``speed``: how much faster than real time the device works (its chart's
+        delays and declared durations divided by it)."""
+        if not (math.isfinite(speed) and speed > 0):
+            raise ValueError(f"speed factor {speed!r}: expected a positive number")
         self.description = device
         self.lds = lds
         self.network = network
@@ -96,6 +101,9 @@ class SimulatedDevice:
         self.bin = bin
         self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
+        self.speed = speed
+        self.timer = DeviceTimer(device)
+        self.interpreter.delay_policy = self._delay
         self._loop = ChartLoop(self.interpreter)
         self._task: asyncio.Task[None] | None = None
         self._xirp: xirp.XirpServer | None = None
@@ -149,10 +157,12 @@ class SimulatedDevice:
             files = self._xirp.files = self._files(self._xirp.endpoint)
         elif d.protocol == "opcua":
             from plugnproduce.protocols.opcua import OpcUaDeviceServer  # asyncua loads only for an OPC UA device
+            from plugnproduce.protocols.opcua.security import device_security
             from plugnproduce.sim.opcua import node_spec
 
+            security = await device_security(d.id)  # PNP_OPCUA_PKI: the folder's missing certificates are made
             self._opcua = OpcUaDeviceServer(node_spec(d), self._on_opcua_call, lambda: self.state,
-                                            host=self.network.interface, files=self._files)
+                                            host=self.network.interface, files=self._files, security=security)
             await self._opcua.start()
             if self.lds is not None:
                 await self._opcua.register(self.lds)
@@ -205,7 +215,13 @@ class SimulatedDevice:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
         if self.bin is not None:
             self.bin.on_request(self.description, params, self.interpreter.dm)
+        self.timer.request(request, params)
         self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too, as in any interpreter
+
+    def _delay(self, nominal: float) -> float:
+        """A delayed send of the chart: the declared duration of the request just taken (once) or the chart's
+        delay, scaled by the speed factor."""
+        return self.timer.delay(nominal) / self.speed
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
         if request.name == xirp.STATE:

@@ -56,6 +56,7 @@ class DispatchSession(Protocol):
     _observers: list[Callable[[MetaEvent], None]]
     _delayed: list[_Delayed]
     _pending: dict[str, list[_Delayed]]
+    delay_policy: Callable[[float], float] | None
 
     def _error(self, name: str, message: str, sendid: str | None = None) -> None: ...
 
@@ -87,6 +88,9 @@ class Dispatcher:
     _observers: list[Callable[[MetaEvent], None]]
 
     def _init_dispatch(self) -> None:
+        self.delay_policy: Callable[[float], float] | None = None
+        """Maps a delayed send's delay (seconds, as the chart says) to the one it takes (a simulated device
+        scaled by a speed factor, or timed by its declared durations); None: as the chart says."""
         self._delayed: list[_Delayed] = []
         self._pending: dict[str, list[_Delayed]] = {}
         self._counter = 0
@@ -109,6 +113,8 @@ class Dispatcher:
         """Execute a ``<send>``: check it, record it, then deliver it now or after ``delay`` seconds."""
         kind = str(kind) if kind is not None else SCXML_IO
         target = str(target) if target is not None else None
+        if delay > 0 and self.delay_policy is not None:
+            delay = self.delay_policy(delay)
         if kind in SCXML_TYPES:
             if target is not None and not target.startswith("#_"):
                 raise ActionError(f"send target {target!r} is not supported by the SCXML processor; expected "
