@@ -4,6 +4,7 @@
   simulated cell through discovery and plugs its devices (:mod:`.interfaces` says what a source is);
 - the runs: :func:`run_task` finds a cell's devices and runs a task on them (``pnp run``), and
   :class:`ExecutorRunner` runs tasks on a cell source's devices, one at a time (the HMI);
+- resume: :func:`resume_run` re-plans a stopped run from the devices' states and continues it (``pnp resume``);
 - the live cell: :func:`live_cell` asks each device its state (``pnp check --live``).
 
 The faces (``cli``, ``hmi``) use it and the service; it uses the service and the concepts (discovery,
@@ -24,6 +25,7 @@ from plugnproduce.controller.interfaces import (
     RunRefused,
 )
 from plugnproduce.controller.livecell import LiveCellSource
+from plugnproduce.controller.resume import NoCell, Resumed, continue_run, replan_live, resume_run
 from plugnproduce.controller.run import (
     DEFAULT_BIN_PARTS,
     DISCOVERY_SECONDS,
@@ -52,16 +54,21 @@ __all__ = [
     "ExecutorRunner",
     "JournalRecord",
     "LiveCellSource",
+    "NoCell",
     "PluggableCellSource",
+    "Resumed",
     "RunObserver",
     "RunRefused",
     "Runner",
     "SimulatedCellSource",
     "StateNotReported",
+    "continue_run",
     "default_bin_parts",
     "find_devices",
     "live_cell",
+    "replan_live",
     "reported_states",
+    "resume_run",
     "run_task",
     "start_run",
 ]

@@ -11,7 +11,7 @@ import asyncio
 import contextlib
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from plugnproduce.description.model import Cell, DeviceDescription, Link, Task
 from plugnproduce.errors import PlugNProduceError
@@ -117,6 +117,7 @@ async def run_task(
                                                         expected=wanted))
         devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
                                                                          else DISCOVERY_SECONDS))
+        devices = Cell(devices.name, devices.devices, the_cell.file)  # journalled, for a resume
         if generated is None:
             say("asking each device its state; checking the task from there")
             generated = plan_run(the_task, the_cell.reported(await reported_states(devices)), k, progress=say)
@@ -170,16 +171,18 @@ async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
 
 
 def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
-              observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> TaskRun:
+              observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None,
+              preamble: tuple[tuple[str, dict[str, Any]], ...] = ()) -> TaskRun:
     """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
     real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
 
+    ``preamble``: records journalled right after ``start`` (a resumed run's, :mod:`.resume`).
     Both faces start runs this way: ``pnp run`` after discovering the cell's devices
     (:func:`run_task`), the HMI with the devices its cell source follows.
     """
     from plugnproduce.executor.run import TaskRun
 
-    return TaskRun(generated, devices, journal, observer, prefixes)
+    return TaskRun(generated, devices, journal, observer, prefixes, preamble)
 
 
 async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:

@@ -4,8 +4,10 @@ Every run writes one record per line: ``start`` (task, cell, chart digest, numbe
 steps), then ``command`` (sent to a device), ``event`` (from a device or the chart), ``state``
 (a device region entered a state), ``step`` (a step began, with its role bindings), ``fault``, after a fault
 one ``stop`` per device (the safe-stop request sent, its answer, the state the device reports) and finally
-``end`` (outcome). A line is flushed and fsynced before the run goes on, so after a
-crash the journal holds everything up to the crash, and a run without ``end`` is
+``end`` (outcome). A run that resumes a stopped one (``pnp resume``) writes, right after its ``start``,
+``stopped`` (the run it resumes and how that one stopped), ``replan`` (the states the devices reported and the
+rest planned from them) and ``continue`` (who confirmed it). A line is flushed and fsynced before the run goes
+on, so after a crash the journal holds everything up to the crash, and a run without ``end`` is
 told apart from a finished one. Nothing is ever rewritten.
 """
 
@@ -21,7 +23,8 @@ from typing import Any, TextIO
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 
-KINDS = ("start", "step", "command", "event", "value", "state", "branch", "fault", "stop", "end")
+KINDS = ("start", "stopped", "replan", "continue", "step", "command", "event", "value", "state", "branch", "fault",
+         "stop", "end")
 
 
 class JournalInUse(PlugNProduceError):
@@ -164,6 +167,8 @@ def describe(record: dict[str, Any]) -> str:
     kind = record["kind"]
     if kind == "start":
         return f"start task {record.get('task')} on cell {record.get('cell')}"
+    if kind in ("stopped", "replan", "continue"):
+        return _resumed(record)
     if kind == "step":
         return f"step {record.get('step')}: {record.get('command')}"
     if kind == "command":
@@ -192,3 +197,15 @@ def describe(record: dict[str, Any]) -> str:
         return (f"stop {record.get('device')}: {record.get('request')} {record.get('answer')}; "
                 f"now in state {record.get('state')}")
     return f"end: {record.get('outcome')}" + (f" ({record.get('reason')})" if record.get("reason") else "")
+
+
+def _resumed(record: dict[str, Any]) -> str:
+    """The line of a ``stopped``, ``replan`` or ``continue`` record."""
+    kind = record["kind"]
+    if kind == "stopped":
+        at = f" at step {record['step']}" if record.get("step") is not None else ""
+        return f"resumes run {record.get('run')}, which {record.get('outcome')}{at}: {record.get('reason')}"
+    if kind == "replan":
+        states = ", ".join(f"{d} {s}" for d, s in sorted((record.get("states") or {}).items()))
+        return f"re-planned {record.get('plan')} from the devices' states ({states}): {record.get('steps')} step(s)"
+    return f"continues, confirmed by {record.get('confirmed_by')}"

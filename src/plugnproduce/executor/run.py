@@ -34,6 +34,7 @@ from typing import Any
 from plugnproduce.chartnames import DONE, STEP, branch_variable
 from plugnproduce.codegen import GeneratedTask
 from plugnproduce.description.model import Cell, Command
+from plugnproduce.description.taskfile import task_to_yaml
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import outcomes, values
 from plugnproduce.executor.journal import Journal, JournalWriteError
@@ -90,8 +91,12 @@ class TaskRun:
     """One run of a generated task in a cell whose devices carry their real endpoints."""
 
     def __init__(self, generated: GeneratedTask, cell: Cell, journal_path: Path,
-                 observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> None:
+                 observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None,
+                 preamble: tuple[tuple[str, dict[str, Any]], ...] = ()) -> None:
+        """``preamble``: records (kind, fields) journalled right after ``start``, before anything goes out (a
+        resumed run's ``stopped``, ``replan`` and ``continue``)."""
         self.generated = generated
+        self._preamble = preamble
         self.cell = cell
         self.journal_path = journal_path
         self._observer = observer
@@ -128,7 +133,10 @@ class TaskRun:
         """Connect to the devices, run the chart to its end, close everything; the report says how it went."""
         with Journal(self.journal_path) as self._journal:
             self._record("start", task=self.generated.task.name, cell=self.cell.name, chart_sha256=self._digest,
-                         steps=len(self.generated.steps), devices={d.id: d.endpoint for d in self.cell.devices})
+                         steps=len(self.generated.steps), devices={d.id: d.endpoint for d in self.cell.devices},
+                         task_file=task_to_yaml(self.generated.task), cell_file=self.cell.file)
+            for kind, fields in self._preamble:
+                self._record(kind, **fields)
             try:
                 await self._connect()
                 if self.fault is None:

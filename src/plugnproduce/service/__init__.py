@@ -10,7 +10,8 @@ group of use cases, every name here:
 - :mod:`.goals`: planning from a goal;
 - :mod:`.batches`: the feasibility of many configurations;
 - :mod:`.programs`: generate and verify, and what a run needs (:func:`plan_run`);
-- :mod:`.journals`: the runs folder and past runs' journals.
+- :mod:`.journals`: the runs folder and past runs' journals;
+- :mod:`.resumes`: what runs on after a stopped run, planned from the devices' states.
 
 Running a task on devices (discovery, the executor) is the controller's
 (:mod:`plugnproduce.controller`).
@@ -71,6 +72,7 @@ from plugnproduce.service.programs import (
     plan_run,
     verify,
 )
+from plugnproduce.service.resumes import NotResumable, NoWayOn, Replan, Stopped, replan, rest_of_task, stopped_run
 
 if TYPE_CHECKING:
     from plugnproduce import reasoning
@@ -86,6 +88,10 @@ __all__ = [
     "Generated",
     "Generation",
     "ImplausibleTask",
+    "NoWayOn",
+    "NotResumable",
+    "Replan",
+    "Stopped",
     "Knowledge",
     "Library",
     "Task",
@@ -122,9 +128,12 @@ __all__ = [
     "plan_run",
     "reasoning",
     "repair",
+    "replan",
     "report",
+    "rest_of_task",
     "runs",
     "runs_folder",
+    "stopped_run",
     "task",
     "task_from_text",
     "task_text",

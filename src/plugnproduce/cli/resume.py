@@ -1,0 +1,103 @@
+"""``pnp resume``: continue a run that ended by a fault or a stop, re-planned from the devices' states."""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import click
+import typer
+
+from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
+from plugnproduce.executor.journal import describe
+from plugnproduce.lazy import lazy_module
+
+if TYPE_CHECKING:
+    from plugnproduce import controller, service
+    from plugnproduce.executor.run import TaskRun
+else:
+    controller = lazy_module("plugnproduce.controller")
+    service = lazy_module("plugnproduce.service")
+
+
+@app.command()
+@boundary
+def resume(
+    run_id: str = typer.Argument(..., metavar="RUN", help="The run id or journal file of a failed or stopped run "
+                                                          "('pnp runs' lists them)."),
+    cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
+                                     help="The cell file (default: the one the run's journal names)."),
+    goal: Path | None = typer.Option(None, "--goal", metavar="GOAL",
+                                     help="Plan this goal afresh from the devices' states, instead of the rest of "
+                                          "the run's task (for a run of a planned task)."),
+    yes: bool = typer.Option(False, "--yes", "-y", help="Continue without asking (for scripts)."),
+    journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
+                                        help="Journal file of the continuation (default: a new file in PNP_RUNS)."),
+    discovery_timeout: float | None = DISCOVERY_OPTION,
+    json_out: bool = JSON_OPTION,
+) -> None:
+    """Resume a run after a fault or an operator's stop: find the cell's devices, ask each its state, re-plan the
+    rest of the task (or the goal) from there, show the plan and, once confirmed, run it.
+
+    The continuation's journal begins with the stop it resumes, the re-plan and who confirmed it.
+    Exit 0 the continuation succeeded, 1 it failed, was declined or nothing plausible goes on from the devices'
+    states, 2 bad input (no such run, a run that succeeded, devices not found).
+    """
+    k = knowledge(cell)
+
+    def confirm(plan: service.Replan) -> str | None:
+        _show(plan, json_out)
+        if yes:
+            return "--yes"
+        try:
+            return "the operator" if click.confirm("continue?", default=False, err=True) else None
+        except click.Abort:  # no answer (end of input)
+            return None
+
+    def show(record: dict[str, object]) -> None:
+        if not json_out:
+            typer.echo(describe(record))
+
+    def started(the_run: TaskRun) -> None:
+        loop = asyncio.get_running_loop()
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            loop.add_signal_handler(signum, the_run.stop)
+
+    try:
+        done = asyncio.run(controller.resume_run(run_id, cell, confirm, goal=goal, journal=journal, observer=show,
+                                                 started=started, discovery_timeout=discovery_timeout, knowledge=k))
+    except service.NoWayOn as exc:
+        typer.echo(f"not resumed: {exc}", err=True)
+        for reason in exc.reasons:
+            typer.echo(f"  {reason}", err=True)
+        raise typer.Exit(1) from None
+    _finish(done, json_out)
+
+
+def _show(plan: service.Replan, json_out: bool) -> None:
+    """The plan, before it is confirmed (to stderr with --json, whose stdout is the result)."""
+    stopped = plan.stopped
+    at = f" at step {stopped.step}" if stopped.step is not None else ""
+    lines = [f"run {stopped.run} {stopped.outcome}{at}: {stopped.reason}",
+             "the devices report: " + ", ".join(f"{d} {s}" for d, s in sorted(plan.states.items())),
+             f"plan: {plan.plan}, {len(plan.task.steps)} step(s)",
+             *(f"  repair: {edit}" for edit in plan.repairs), plan.text.rstrip()]
+    typer.echo("\n".join(lines), err=json_out)
+
+
+def _finish(done: controller.Resumed, json_out: bool) -> None:
+    report = done.report
+    if json_out:
+        emit_json({"stopped": done.replan.stopped.record(), "replan": done.replan.record(),
+                   "continued": report is not None, **({"run": report.to_json()} if report else {})})
+    if report is None:
+        typer.echo("not resumed: the plan was not confirmed; nothing was sent", err=True)
+        raise typer.Exit(1)
+    if not json_out:
+        typer.echo(f"{report.outcome}; journal {report.journal}")
+        if report.fault is not None:
+            typer.echo(f"fault: {report.fault}")
+    if report.outcome != "succeeded":
+        raise typer.Exit(1)
