@@ -5,6 +5,7 @@
 - the runs: :func:`run_task` finds a cell's devices and runs a task on them (``pnp run``), and
   :class:`ExecutorRunner` runs tasks on a cell source's devices, one at a time (the HMI);
 - resume: :func:`resume_run` re-plans a stopped run from the devices' states and continues it (``pnp resume``);
+- teach-in: :func:`teach` reads a value a device reports and holds it to its contracts (``pnp teach``);
 - the live cell: :func:`live_cell` asks each device its state (``pnp check --live``).
 
 The faces (``cli``, ``hmi``) use it and the service; it uses the service and the concepts (discovery,
@@ -41,6 +42,7 @@ from plugnproduce.controller.run import (
 )
 from plugnproduce.controller.runner import ExecutorRunner
 from plugnproduce.controller.simcell import SimulatedCellSource
+from plugnproduce.controller.teach import read_taught, teach
 
 __all__ = [
     "DEFAULT_BIN_PARTS",
@@ -67,8 +69,10 @@ __all__ = [
     "find_devices",
     "live_cell",
     "replan_live",
+    "read_taught",
     "reported_states",
     "resume_run",
     "run_task",
     "start_run",
+    "teach",
 ]

@@ -11,7 +11,8 @@ group of use cases, every name here:
 - :mod:`.batches`: the feasibility of many configurations;
 - :mod:`.programs`: generate and verify, and what a run needs (:func:`plan_run`);
 - :mod:`.journals`: the runs folder and past runs' journals;
-- :mod:`.resumes`: what runs on after a stopped run, planned from the devices' states.
+- :mod:`.resumes`: what runs on after a stopped run, planned from the devices' states;
+- :mod:`.teaching`: teach-in, a value a device reports held to its contracts.
 
 Running a task on devices (discovery, the executor) is the controller's
 (:mod:`plugnproduce.controller`).
@@ -73,6 +74,7 @@ from plugnproduce.service.programs import (
     verify,
 )
 from plugnproduce.service.resumes import NotResumable, NoWayOn, Replan, Stopped, replan, rest_of_task, stopped_run
+from plugnproduce.service.teaching import ReportsNothing, Taught, judge_taught, reported_value
 
 if TYPE_CHECKING:
     from plugnproduce import reasoning
@@ -91,7 +93,9 @@ __all__ = [
     "NoWayOn",
     "NotResumable",
     "Replan",
+    "ReportsNothing",
     "Stopped",
+    "Taught",
     "Knowledge",
     "Library",
     "Task",
@@ -120,6 +124,7 @@ __all__ = [
     "generate_configurations",
     "generation",
     "impact",
+    "judge_taught",
     "knowledge",
     "knowledge_for_cell",
     "new_run_id",
@@ -130,6 +135,7 @@ __all__ = [
     "repair",
     "replan",
     "report",
+    "reported_value",
     "rest_of_task",
     "runs",
     "runs_folder",

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from plugnproduce.description.model import Command, DeviceDescription
+from plugnproduce.description.reports import reported_values
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
@@ -86,6 +87,7 @@ class SimulatedDevice:
         self._xirp: xirp.XirpServer | None = None
         self._upnp: upnp.UpnpDeviceServer | None = None
         self._pending: set[asyncio.Task[Any]] = set()
+        self._reports = reported_values(device)
 
     @property
     def id(self) -> str:
@@ -173,8 +175,10 @@ class SimulatedDevice:
         self._loop.queue(event, dict(params))
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
-        if request.name == xirp.STATE:
-            return {xirp.STATE_RESULT: self.state}
+        if request.name == xirp.STATE:  # with the values its chart says it reports (teach-in reads them)
+            dm = self.interpreter.dm
+            return {xirp.STATE_RESULT: self.state, **{q: dm[r.variable] for q, r in self._reports.items()
+                                                      if r.variable in dm}}
         try:
             self._accept(request.name, request.params)
         except LookupError as exc:
