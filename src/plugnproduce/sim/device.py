@@ -25,7 +25,7 @@ from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.statechart.model import Send, walk
-from plugnproduce.statechart.runtime.events import Event
+from plugnproduce.statechart.runtime.events import Event, EventData
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
 
@@ -172,7 +172,7 @@ class SimulatedDevice:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
         if self.bin is not None:
             self.bin.on_request(self.description, params, self.interpreter.dm)
-        self._loop.queue(event, dict(params))
+        self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
         if request.name == xirp.STATE:  # with the values its chart says it reports (teach-in reads them)
