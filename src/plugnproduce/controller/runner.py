@@ -13,11 +13,13 @@ from __future__ import annotations
 import asyncio
 import logging
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from plugnproduce import service
 from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
+from plugnproduce.controller.resume import continue_run, replan_live
 from plugnproduce.controller.run import StateNotReported, reported_states, start_run
 from plugnproduce.controller.simcell import SimulatedCellSource
 from plugnproduce.description.model import Cell, Task
@@ -77,13 +79,58 @@ class ExecutorRunner:
             first = exc.result.problems[0]
             raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc
         run_id = service.new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", task.name))
+        return await self._launch(run_id, observer, lambda observe: start_run(
+            generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes))
+
+    async def replan(self, run_id: str, cell: Cell) -> service.Replan:
+        """What runs on after run ``run_id`` (failed or stopped), planned from the states ``cell``'s devices report
+        now (RunRefused while it runs or when nothing plausible goes on; NotResumable for a run that succeeded)."""
+        entry = self._run(run_id)
+        if not entry.task.done():
+            raise RunRefused(f"run {run_id} is still running; stop it first")
+        k = await self._known()
+        try:
+            stopped = await asyncio.to_thread(service.stopped_run, entry.run.journal_path)
+            return await replan_live(stopped, cell, cell, k)
+        except (StateNotReported, service.NoWayOn) as exc:
+            raise RunRefused(f"run {run_id} cannot be resumed: {exc}") from exc
+
+    async def resume(self, run_id: str, cell: Cell, observer: RunObserver, seen: dict[str, str] | None = None) -> str:
+        """Resume run ``run_id``: re-plan it (:meth:`replan`) and start the plan, its journal beginning with the
+        stop, the re-plan and the operator's confirmation; ``seen``: the devices' states of the plan the operator
+        confirmed (RunRefused when they have changed since). Returns the new run's id."""
+        active = self.active()
+        if active is not None:
+            raise RunRefused(f"run {active} is still running; stop it first")
+        plan = await self.replan(run_id, cell)
+        if seen is not None and seen != plan.states:
+            raise RunRefused("the devices changed since the plan was shown; look at the new plan and confirm it")
+        if isinstance(self._source, SimulatedCellSource):
+            self._source.prepare_run(plan.task)  # the session's bin, as the run it resumes had
+        k = await self._known()
+        new_id = service.new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", plan.task.name))
+        try:
+            run = await continue_run(plan, cell, cell, k, "the operator", self._dir / f"{new_id}.jsonl")
+        except service.NoWayOn as exc:
+            raise RunRefused(str(exc)) from exc
+        return await self._launch(new_id, observer, lambda observe: run.observed(observe))
+
+    async def _known(self) -> Knowledge:
+        """The knowledge runs are planned with (the built-in library unless given)."""
+        if self._knowledge is None:
+            self._knowledge = await asyncio.to_thread(service.knowledge)
+        return self._knowledge
+
+    async def _launch(self, run_id: str, observer: RunObserver,
+                      make: Callable[[Callable[[JournalRecord], None]], TaskRun]) -> str:
+        """Start the run ``make`` builds around an observer; return once its journal has its ``start`` record."""
         started = asyncio.Event()
 
         def observe(record: JournalRecord) -> None:
             started.set()
             observer(run_id, record)
 
-        run = start_run(generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes)
+        run = make(observe)
         self._loop = asyncio.get_running_loop()
         running = asyncio.create_task(run.run(), name=f"run {run_id}")
         running.add_done_callback(self._finished)

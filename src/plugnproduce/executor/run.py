@@ -162,6 +162,11 @@ class TaskRun:
             self._record("end", **end)
         return RunReport(outcome, self.journal_path, self.fault, dict(self.device_states))
 
+    def observed(self, observer: RecordObserver) -> TaskRun:
+        """The run, its records passed to ``observer`` from now on (before it starts)."""
+        self._observer = observer
+        return self
+
     def stop(self, reason: str = "stopped by the operator") -> None:
         """Stop the run as a fault of kind ``stopped``: no further command goes out."""
         self._fail(Fault("stopped", reason, self.step, self.command))
