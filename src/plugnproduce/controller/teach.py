@@ -36,6 +36,7 @@ async def read_taught(device: DeviceDescription, quantity: str) -> Taught:
     """Read and judge ``quantity`` from a device at its real endpoint (the HMI's cell source knows it)."""
     from plugnproduce.executor.links import query_report
 
+    reported_value(device, quantity)  # one it does not report is bad input, before the device is asked
     state, values = await query_report(device, device.command_timeout)
     if quantity not in values:
         raise ProtocolError(f"device {device.id} did not report {quantity} with its state "

@@ -74,7 +74,7 @@ from plugnproduce.service.programs import (
     verify,
 )
 from plugnproduce.service.resumes import NotResumable, NoWayOn, Replan, Stopped, replan, rest_of_task, stopped_run
-from plugnproduce.service.teaching import ReportsNothing, Taught, judge_taught, reported_value
+from plugnproduce.service.teaching import ReportsNothing, Taught, judge_taught, reported_quantities, reported_value
 
 if TYPE_CHECKING:
     from plugnproduce import reasoning
@@ -135,6 +135,7 @@ __all__ = [
     "repair",
     "replan",
     "report",
+    "reported_quantities",
     "reported_value",
     "rest_of_task",
     "runs",

@@ -54,6 +54,11 @@ class Taught:
         return f"{self.device} {self.quantity} = {shorten(self.value, 200)}{unit} ({self.device} is {self.state})"
 
 
+def reported_quantities(device: DeviceDescription) -> list[str]:
+    """The quantities the device reports with its state (``TargetPose``), sorted."""
+    return sorted(reported_values(device))
+
+
 def reported_value(device: DeviceDescription, quantity: str) -> ReportedValue:
     """The value ``quantity`` the device reports (UnknownName, with those it does report; ReportsNothing)."""
     reports = reported_values(device)
