@@ -18,7 +18,7 @@ from plugnproduce.description.model import DeviceDescription
 from plugnproduce.hmi import errors
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
-from plugnproduce.hmi.routes import cell, charts, runs, sources, task, teach
+from plugnproduce.hmi.routes import cell, charts, goal, runs, sources, task, teach
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders
 from plugnproduce.hmi.work import WAITING, WORK_MEMORY, WORK_SECONDS, WORKERS, Work, WorkLimits
 from plugnproduce.knowledge import Knowledge
@@ -86,7 +86,8 @@ def create_app(
     app.state.pictures = Pictures()
     app.state.generated = GeneratedCharts()
     errors.install(app)
-    for router in (cell.router, task.router, charts.router, runs.router, sources.router, teach.router):
+    for router in (cell.router, task.router, goal.router, charts.router, runs.router, sources.router,
+                   teach.router):
         app.include_router(router)
     folder = static_folder()
     app.mount("/static", StaticFiles(directory=folder), name="static")

@@ -6,6 +6,7 @@ import { initCharts, renderChartChoices, showChart } from "./charts.js";
 import { initDerivations } from "./derivation.js";
 import { $ } from "./dom.js";
 import { addStep, initEditor, renderTask, scheduleCheck } from "./editor.js";
+import { initGoal } from "./goal.js";
 import { initRun, renderRun, renderStart, takeDeviceState, takeRecord } from "./run.js";
 import { loadTask, on, state } from "./state.js";
 import { loadReports } from "./teach.js";
@@ -80,6 +81,7 @@ async function boot() {
   initCell({ onAdd: addStep, onChart: showChart });
   initDerivations();
   initEditor();
+  initGoal();
   initCharts();
   initZoom();
   loadTask();
