@@ -133,10 +133,10 @@ def throughput(folder: Path, count: int, sample: int, seed: int) -> None:
         rates = {}
         for workers in (1, 2):
             t = time.perf_counter()
-            lines = sum(part.count("\n") for part in report(configs, catalogue, given, k.taxonomy, k.processes,
+            lines = sum(part.count("\n") for part in report(configs, catalogue, given, k,
                                                              workers=workers))
             rates[workers] = lines / (time.perf_counter() - t)
-        rows = list(batch(configs[:sample], catalogue, given, k.taxonomy, k.processes, workers=1))
+        rows = list(batch(configs[:sample], catalogue, given, k, workers=1))
         ref = naive(catalogue, given)
         t = time.perf_counter()
         expected = []
@@ -267,7 +267,7 @@ def main() -> None:
     parser.add_argument("--only", choices=["agreement", "throughput", "end-to-end", "flow"])
     args = parser.parse_args()
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    engine(service.catalogue(), [], service.knowledge().taxonomy, service.knowledge().processes)
+    engine(service.catalogue(), [], service.knowledge())
     if args.only in (None, "agreement"):
         agreement(args.agree, args.seed)
     with tempfile.TemporaryDirectory(prefix="pnp-bench-batch-") as tmp:

@@ -56,7 +56,7 @@ def goal_of(steps: int) -> Goal:
 
 def ours(goal: Goal, cell: Cell, max_steps: int) -> tuple[float, float, int]:
     wall, start = time.perf_counter(), cpu()
-    found = planning.plan(goal, cell, K.taxonomy, K.processes, max_steps=max_steps)
+    found = planning.plan(goal, cell, K, max_steps=max_steps)
     assert isinstance(found, planning.Plan), found
     roles = sum(len(s.bind) for s in found.task.steps)
     cost = PENALTY * (len(found.blind) + len(found.wasted)) + STEP * found.steps + roles
@@ -64,7 +64,7 @@ def ours(goal: Goal, cell: Cell, max_steps: int) -> tuple[float, float, int]:
 
 
 def fast_downward(goal: Goal, cell: Cell) -> tuple[float, float, int]:
-    domain, problem = export(goal, cell, K.taxonomy, K.processes)
+    domain, problem = export(goal, cell, K)
     folder = Path(tempfile.mkdtemp())
     (folder / "domain.pddl").write_text(domain)
     (folder / "problem.pddl").write_text(problem)

@@ -39,7 +39,7 @@ Solver = Callable[..., list[Repair]]
 def timed(solve: Solver, task: Task, cell: Cell, catalogue: list[DeviceDescription] | None) -> tuple[float, Repair]:
     """Seconds and best repair of one solve."""
     t = time.perf_counter()
-    best = solve(task, cell, K.taxonomy, K.processes, catalogue, top=1)[0]
+    best = solve(task, cell, K, catalogue, top=1)[0]
     return time.perf_counter() - t, best
 
 
@@ -105,7 +105,7 @@ def main() -> None:
         return
     cell = service.cell(service.builtin("cells", "bin-picking.yaml"))
     catalogue = service.catalogue()
-    windows.windowed_repair(faulty_task(30, 2, args.seed), cell, K.taxonomy, K.processes, catalogue)  # warm up
+    windows.windowed_repair(faulty_task(30, 2, args.seed), cell, K, catalogue)  # warm up
     per_step = {}
     for steps in (100, 1000, 2000, 10000):
         task = faulty_task(steps // 2, steps // 100, args.seed, varied=True)

@@ -2,7 +2,7 @@
 
     python bench/bench_shapes.py [--rounds 5]
 
-The knowledge graphs ``pnp validate`` builds for two inputs (one shipped task; every built-in
+The data graphs ``pnp validate`` builds for two inputs (one shipped task; every built-in
 description), each run through the shapes by :func:`shape_problems` (each SPARQL constraint's
 text parsed once) and by the plain pySHACL call it made before (the data graph copied, the
 text parsed again for every focus node), in the same run, warm (each run once before timing),
@@ -21,7 +21,7 @@ from pathlib import Path
 
 from pyshacl import validate as shacl_validate
 
-from plugnproduce.description.knowledge import KnowledgeGraph
+from plugnproduce.description.datagraph import DataGraph
 from plugnproduce.validation import validate as validation
 from plugnproduce.validation.findings import Finding
 from plugnproduce.validation.shapes import shape_problems, shapes_graph
@@ -29,7 +29,7 @@ from plugnproduce.validation.shapes import shape_problems, shapes_graph
 DESCRIPTIONS = Path(__file__).resolve().parents[1] / "descriptions"
 
 
-def plain(kg: KnowledgeGraph) -> list[Finding]:
+def plain(kg: DataGraph) -> list[Finding]:
     """The shapes run as pySHACL runs them unaided; the problems read off as :func:`shape_problems` reads them."""
     captured: list[object] = []
     real = shacl_validate
@@ -48,12 +48,12 @@ def plain(kg: KnowledgeGraph) -> list[Finding]:
         shapes.shacl_validate = real
 
 
-def graph_of(paths: list[Path]) -> KnowledgeGraph:
-    """The knowledge graph ``pnp validate PATHS`` checks."""
-    seen: list[KnowledgeGraph] = []
+def graph_of(paths: list[Path]) -> DataGraph:
+    """The data graph ``pnp validate PATHS`` checks."""
+    seen: list[DataGraph] = []
     real = validation.shape_problems
 
-    def keep(kg: KnowledgeGraph) -> list[Finding]:
+    def keep(kg: DataGraph) -> list[Finding]:
         seen.append(kg)
         return []
 

@@ -3,7 +3,8 @@
     python bench/bench_startup.py [--rounds 7] [--slowest 12]
 
 CPU time (user+sys of the child, ``resource.getrusage(RUSAGE_CHILDREN)``) and wall time of
-``pnp --help``, ``pnp validate`` of a device, a warm ``pnp capabilities`` on the bin-picking
+``pnp --help``, importing the reasoning layer (which loads none of its parts until used), ``pnp validate`` of a
+device, a warm ``pnp capabilities`` on the bin-picking
 cell and ``pnp check`` of the bin-picking task, each against a bare ``python -c pass``
 measured in the same run, interleaved (so a burst of load hits every command alike). Targets,
 in CPU time: ``--help`` ≤ 3×, warm ``capabilities`` ≤ 10×, ``check`` ≤ 15× ``python -c pass``.
@@ -30,6 +31,7 @@ DEVICE = ROOT / "descriptions" / "devices" / "gripper.ttl"
 COMMANDS: dict[str, list[str]] = {
     "python -c pass": ["-c", "pass"],
     "pnp --help": ["-m", "plugnproduce", "--help"],
+    "import reasoning": ["-c", "import plugnproduce.reasoning"],
     "pnp validate DEVICE": ["-m", "plugnproduce", "validate", str(DEVICE)],
     "pnp capabilities (warm)": ["-m", "plugnproduce", "capabilities", "--cell", str(CELL)],
     "pnp check bin-picking": ["-m", "plugnproduce", "check", str(TASK), "--cell", str(CELL)],

@@ -32,3 +32,9 @@ def test_setup_says_what_it_is_doing() -> None:
 
 def test_virtual_environments_are_not_committed() -> None:
     assert ".venv/" in (ROOT / ".gitignore").read_text().splitlines()
+
+
+def test_setup_installs_ip_for_the_network_namespace_tests() -> None:
+    # tests/namespaces.py makes namespaces and a veth link with 'ip' (iproute2), not on every fresh machine
+    text = SETUP.read_text()
+    assert "command -v ip " in text and "need+=(iproute2)" in text

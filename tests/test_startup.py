@@ -118,3 +118,25 @@ def test_help_is_printed_from_the_cache_folder_the_second_time(tmp_path: Path) -
     narrow, loaded_narrow = _help(tmp_path, "60")  # another width: laid out again, by the command line
     assert "typer" in loaded_narrow and narrow != first
     assert max(map(len, narrow.splitlines())) <= 60 < max(map(len, first.splitlines()))
+
+
+@pytest.mark.parametrize("package", ["plugnproduce.reasoning", "plugnproduce.reasoning.asp", "plugnproduce.reasoning.checks",
+                                     "plugnproduce.reasoning.repairs", "plugnproduce.reasoning.explanation",
+                                     "plugnproduce.batch"])
+def test_importing_the_reasoning_layer_loads_neither_a_reasoner_nor_its_other_parts(package: str) -> None:
+    loaded = _loaded_after(f"import {package}")
+    parts = ("plugnproduce.reasoning.", "plugnproduce.batch.")
+    assert sorted(m for m in loaded if m in ("clingo", "owlready2", "rdflib", "pint", "distributed")
+                  or (m.startswith(parts) and m != package)) == []
+
+
+def test_the_reasoning_layer_loads_what_is_used_on_first_use() -> None:
+    code = ("import sys\nimport plugnproduce.reasoning as r\nimport plugnproduce.reasoning.checks\n"
+            "print('clingo' in sys.modules, r.check.__module__, r.repair.__module__, 'capabilities' in dir(r))\n"
+            "from plugnproduce.reasoning import Repair, explain_offered\n"
+            "print('clingo' in sys.modules, Repair.__name__, explain_offered.__module__)\n"
+            "import plugnproduce.batch as b\n"
+            "print([n for p in (r, b) for n in p.__all__ if getattr(p, n, None) is None] == [])")
+    assert _run(code).split() == ["False", "plugnproduce.reasoning.checks.plausibility",
+                                  "plugnproduce.reasoning.repairs.windows", "True",
+                                  "True", "Repair", "plugnproduce.reasoning.explanation.why", "True"]

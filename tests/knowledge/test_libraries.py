@@ -202,3 +202,20 @@ def test_an_inconsistent_extension_is_named(tmp_path: Path) -> None:
     result = runner.invoke(app, ["--library", str(tmp_path / "bad"), "vocab"])
     assert result.exit_code == 2
     assert result.output == f"error: the ontology is inconsistent (HermiT) with the extension(s) {bad}\n"
+
+
+def test_the_reasoning_layer_takes_one_knowledge_with_the_processes_indexed_once() -> None:
+    glue = Path(__file__).parents[1] / "data" / "libraries" / "glue-dispensing"
+    k = service.knowledge((str(glue),))
+    assert k.processes_by_id is k.processes_by_id and k.process("lay-bead") is k.processes_by_id["lay-bead"]
+    with pytest.raises(KeyError):
+        k.process("lay-beads")
+    from plugnproduce import reasoning  # the layer itself, as an integration builds on it
+    from plugnproduce.knowledge import Knowledge
+
+    cell, task = service.cell(glue / "cells" / "glue-cell.yaml", k), service.task(glue / "tasks" / "glue.yaml")
+    result = reasoning.check(task, cell, k)
+    assert result.plausible and [s.command for s in result.steps] == [s.command for s in task.steps]
+    own = Knowledge((), k.taxonomy, k.processes)  # processes of one's own, no library: no catalogue
+    assert reasoning.check(task, cell, own) == result and own.devices == ()
+    assert "lay-bead" in reasoning.capabilities(cell, own).commands()

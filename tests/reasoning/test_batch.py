@@ -225,7 +225,7 @@ def test_shipped_tasks_with_loops_branches_and_links_are_answered_as_check_answe
 
 def test_purchases_are_the_cheapest_sets_an_exhaustive_search_finds() -> None:
     catalogue = service.catalogue()
-    e = engine(catalogue, tasks(), service.knowledge().taxonomy, service.knowledge().processes, top=3)
+    e = engine(catalogue, tasks(), service.knowledge(), top=3)
     devices = e.feasibility.abilities.devices
     costs = e.feasibility.abilities.costs
     rng = random.Random(5)
@@ -251,7 +251,7 @@ def test_purchases_are_the_cheapest_sets_an_exhaustive_search_finds() -> None:
 def test_two_workers_give_the_same_rows_as_one() -> None:
     configs = list(generate(service.catalogue(), 5000, (2, 5), seed=3))
     k = service.knowledge()
-    by_workers = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+    by_workers = list(batches.batch(configs, service.catalogue(), tasks(), k, workers=2,
                                     chunk=500, solo=1000))
     assert by_workers == rows(configs, workers=1)
 
@@ -267,10 +267,10 @@ def test_workers_start_only_for_work_large_enough_to_repay_them(monkeypatch: pyt
     monkeypatch.setattr(batches, "ProcessPoolExecutor", Counted)
     k = service.knowledge()
     configs = list(generate(service.catalogue(), 3000, (2, 5), seed=4))
-    small = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+    small = list(batches.batch(configs, service.catalogue(), tasks(), k, workers=2,
                                chunk=500, solo=3000))
     assert started == [] and len(small) == 3000
-    large = list(batches.batch(configs, service.catalogue(), tasks(), k.taxonomy, k.processes, workers=2,
+    large = list(batches.batch(configs, service.catalogue(), tasks(), k, workers=2,
                                chunk=500, solo=2000))
     assert started == [2] and large == small
 

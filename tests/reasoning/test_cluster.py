@@ -39,7 +39,7 @@ def test_a_worker_killed_mid_batch_loses_no_configuration(cluster: LocalCluster)
     configs = list(generate(list(k.devices), 20_000, (0, 7), seed=9))
 
     def run(mapper: object = None) -> Iterator[BatchRow]:
-        return batch(configs, list(k.devices), tasks, k.taxonomy, k.processes, workers=1, chunk=100,
+        return batch(configs, list(k.devices), tasks, k, workers=1, chunk=100,
                      mapper=mapper)  # type: ignore[arg-type]
 
     with Client(cluster) as client:

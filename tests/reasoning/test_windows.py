@@ -19,12 +19,12 @@ KNOWLEDGE = service.knowledge()
 
 
 def whole(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None = None, top: int = 1) -> list:
-    return repairs.repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, catalogue, top=top)
+    return repairs.repair(task, cell, KNOWLEDGE, catalogue, top=top)
 
 
 def windowed(task: Task, cell: Cell, catalogue: list[DeviceDescription] | None = None, top: int = 1,
              margin: int = windows.MARGIN) -> list:
-    return windows.windowed_repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, catalogue, top=top,
+    return windows.windowed_repair(task, cell, KNOWLEDGE, catalogue, top=top,
                                    margin=margin)
 
 
@@ -43,9 +43,9 @@ def test_when_swapping_is_cheaper_than_inserting_the_windows_widen_until_the_cos
     costs = RepairCosts(insert=10, insert_per_role=1, remove=8, swap=1, rebind=1, reset=5)
     assert not windows.edits_stay_local(costs, KNOWLEDGE.processes)
     task = faulty_task(8, 1, 113371)  # with windows of the problem alone: remove a step (8), not swap two (1)
-    best = windows.windowed_repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs, top=1,
+    best = windows.windowed_repair(task, cell, KNOWLEDGE, costs=costs, top=1,
                                    margin=0)[0]
-    assert best.cost == repairs.repair(task, cell, KNOWLEDGE.taxonomy, KNOWLEDGE.processes, costs=costs,
+    assert best.cost == repairs.repair(task, cell, KNOWLEDGE, costs=costs,
                                        top=1)[0].cost == 1
 
 
@@ -107,3 +107,14 @@ def test_a_short_task_is_repaired_whole(cell: Cell) -> None:
 ])
 def test_windows_widen_and_merge(spans: list[Window], margin: int, expected: list[Window]) -> None:
     assert windows.windows(spans, 100, margin) == expected
+
+
+def test_a_long_task_is_repaired_in_a_cell_with_a_device_that_lacks_an_argument(cell: Cell, device) -> None:
+    # the vacuum gripper needs a vacuum no gripping process supplies (missing_arg/5, a shown atom with no step):
+    # the windowed repair took the first number of every shown atom it did not know as a problem's step
+    with_vacuum = cell.with_device(device("vacuum-gripper"))
+    task = faulty_task(30, 2, 7)
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    best = service.repair(task, with_vacuum, top=1)[0]
+    assert best.cost == whole(task, with_vacuum)[0].cost
+    assert service.check(best.task, with_vacuum).plausible

@@ -126,7 +126,7 @@ def test_issue_15_a_shape_pyshacl_cannot_run_is_one_line_not_an_attribute_error(
     # for a nested select it reads in the query's comment; shape_problems took it for a report
     import rdflib
 
-    from plugnproduce.description.knowledge import KnowledgeGraph
+    from plugnproduce.description.datagraph import DataGraph
     from plugnproduce.errors import OntologyError
     from plugnproduce.validation.shapes import shape_problems
 
@@ -136,7 +136,7 @@ def test_issue_15_a_shape_pyshacl_cannot_run_is_one_line_not_an_attribute_error(
         ex:S a sh:NodeShape ; sh:targetNode ex:a ;
             sh:sparql [ sh:select """SELECT $this WHERE { # not { SELECT ?o } here
                 $this ?p ?o . }""" ] .''')
-    kg = KnowledgeGraph()
+    kg = DataGraph()
     kg.graph.add((rdflib.URIRef("urn:ex:a"), rdflib.URIRef("urn:ex:p"), rdflib.Literal(1)))
     with pytest.raises(OntologyError) as info:
         shape_problems(kg, shapes)

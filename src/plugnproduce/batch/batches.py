@@ -19,14 +19,16 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TextIO, cast
+from typing import TYPE_CHECKING, TextIO, cast
 
 from plugnproduce.batch.feasibility import MEMORY, Feasibility, Key
 from plugnproduce.batch.purchases import Purchase, purchase
-from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task
+from plugnproduce.description.model import DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.checks.abilities import Abilities, abilities
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 CHUNK = 2_000
 """Configurations sent to a worker at a time."""
@@ -288,10 +290,10 @@ def task_names(tasks: Sequence[Task]) -> list[tuple[str, Task]]:
     return out
 
 
-def engine(catalogue: Sequence[DeviceDescription], tasks: Sequence[Task], taxonomy: Taxonomy,
-           processes: Sequence[ProcessDescription], top: int = 1) -> Engine:
+def engine(catalogue: Sequence[DeviceDescription], tasks: Sequence[Task], knowledge: Knowledge,
+           top: int = 1) -> Engine:
     """Reason once over the catalogue and tasks; the engine then answers any configuration of them."""
-    return Engine(abilities(catalogue, task_names(tasks), taxonomy, processes), top)
+    return Engine(abilities(catalogue, task_names(tasks), knowledge), top)
 
 
 Part = list[BatchRow] | tuple[str, Tally]
@@ -304,8 +306,7 @@ def batch(
     configurations: Iterable[Configuration],
     catalogue: Sequence[DeviceDescription],
     tasks: Sequence[Task],
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     workers: int = 2,
     chunk: int = CHUNK,
     progress: Callable[[int], None] | None = None,
@@ -315,7 +316,7 @@ def batch(
 ) -> Iterator[BatchRow]:
     """One :class:`BatchRow` per configuration, in order; ``progress(n)`` is told as configurations finish.
     The first ``solo`` configurations are answered in this process; ``workers`` processes answer the rest."""
-    e = engine(catalogue, tasks, taxonomy, processes, top)
+    e = engine(catalogue, tasks, knowledge, top)
     for part, n in _run(e, configurations, "rows", workers, chunk, mapper, solo):
         yield from cast(list[BatchRow], part)
         if progress is not None:
@@ -326,8 +327,7 @@ def report(
     configurations: Iterable[Configuration],
     catalogue: Sequence[DeviceDescription],
     tasks: Sequence[Task],
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     form: str = "jsonl",
     workers: int = 2,
     chunk: int = CHUNK,
@@ -340,7 +340,7 @@ def report(
     """The report of :func:`batch` as text, a chunk at a time: JSONL lines (``BatchRow.to_json``) or CSV rows
     (``form`` "csv", without the header). The text is made where the chunk is answered (in the workers);
     ``tally`` counts the configurations by :data:`OUTCOMES` as their text comes."""
-    e = engine(catalogue, tasks, taxonomy, processes, top)
+    e = engine(catalogue, tasks, knowledge, top)
     return report_from(e, configurations, form, workers, chunk, progress, mapper, tally, solo)
 
 

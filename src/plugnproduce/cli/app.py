@@ -45,6 +45,17 @@ JSON_OPTION = typer.Option(False, "--json", help="Machine-readable output.")
 DISCOVERY_OPTION = typer.Option(None, "--discovery-timeout", metavar="SECONDS", min=0.1, max=3600,
                                 help="Most seconds to wait for the cell's devices on the network (default 10; "
                                      "60 for simulated devices). The wait ends as soon as all have answered.")
+INTERFACE_OPTION = typer.Option(None, "--interface", metavar="NAME|ADDRESS",
+                                help="The network interface the devices are on: a name (eth0) or one of this "
+                                     "machine's IPv4 addresses (default: PNP_INTERFACE, else loopback).")
+
+
+def interface_address(interface: str | None) -> str:
+    """The address ``--interface`` (else ``PNP_INTERFACE``, else loopback) names; an unknown one is exit 2, said
+    before anything is loaded."""
+    from plugnproduce.protocols.interface import chosen_address
+
+    return chosen_address(interface)
 
 
 QUIET_LOGGERS = ("rdflib.term",)

@@ -11,7 +11,16 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
+from plugnproduce.cli.app import (
+    INTERFACE_OPTION,
+    JSON_OPTION,
+    app,
+    boundary,
+    emit_json,
+    fail,
+    interface_address,
+    knowledge,
+)
 from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.lazy import lazy_module
@@ -64,16 +73,19 @@ def discover(
     cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
                                      help="Wait (up to --timeout) for this cell's devices; exit 1 naming those "
                                           "missing."),
+    interface: str | None = INTERFACE_OPTION,
 ) -> None:
-    """List the devices found on the network (SSDP on loopback), with class and skills, and those refused.
+    """List the devices found on the network (SSDP on loopback or --interface), with class and skills, and those
+    refused.
 
     The search ends when no new device answered for --settle seconds, at the latest after --timeout;
     with --expect or --cell it waits for those devices instead. Exit 0 found, 1 some expected device
     missing, 2 bad input.
     """
+    address = interface_address(interface)
     wanted = [d.id for d in service.cell(cell, knowledge(cell)).devices] if cell is not None else []
     try:
-        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted)))
+        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted), address))
     except KeyboardInterrupt:
         return
     if missing:
@@ -113,12 +125,12 @@ class Search:
                 f"(--expect N or --cell CELL waits for them)")
 
 
-async def _discover(json_out: bool, watch: bool, search: Search) -> list[str]:
+async def _discover(json_out: bool, watch: bool, search: Search, address: str) -> list[str]:
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env
 
     began = time.monotonic()
-    async with LiveCell(knowledge().taxonomy, network=network_from_env(), search_timeout=search.timeout,
+    async with LiveCell(knowledge().taxonomy, network=network_from_env(address), search_timeout=search.timeout,
                         expected=search.wanted, expected_count=search.expect,
                         quiet=None if search.waits else search.settle) as live:
         cell, seconds = live.cell, time.monotonic() - began
@@ -232,10 +244,12 @@ def sim_up(
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
                                          help="A simulated bin of N parts at random poses for the devices to work on."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
+    interface: str | None = INTERFACE_OPTION,
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
 
     Plug in more with 'pnp sim plug DEVICE' (a device of the libraries, or a device description file).
+    The devices announce themselves and listen on --interface (default PNP_INTERFACE, else loopback);
     PNP_SSDP_PORT chooses a private SSDP port.
 
     Exit 0 stopped by Ctrl-C or SIGTERM, 2 bad input (a cell that cannot be read or started).
@@ -244,9 +258,10 @@ def sim_up(
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults, run_simulated_cell
 
+    network = network_from_env(interface_address(interface))
     the_cell = service.cell(cell, knowledge())
     k = knowledge(cell)
-    sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=k), network=network_from_env(),
+    sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=k), network=network,
                         faults=parse_faults(faults, the_cell.devices), taxonomy=k.taxonomy,
                         bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None)
     try:

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
+from plugnproduce.cli.app import DISCOVERY_OPTION, INTERFACE_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.cli.reasoning import CELL_OPTION, LIVE_OPTION, _cell
 from plugnproduce.lazy import lazy_module
 
@@ -31,7 +31,7 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
                                           help="Also write the goal as PDDL (domain.pddl, problem.pddl) into DIR, "
                                                "for other planners; not for a goal with until."),
          live: bool = LIVE_OPTION, discovery_timeout: float | None = DISCOVERY_OPTION,
-         json_out: bool = JSON_OPTION) -> None:
+         interface: str | None = INTERFACE_OPTION, json_out: bool = JSON_OPTION) -> None:
     """Plan a task from a goal: which process commands, in which order, on which devices, with which values.
 
     The plan is the shortest that measures what the cell can measure (a pick pose the bin-picking PC
@@ -39,7 +39,7 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
     the goal (why, and the cheapest catalogue device that would make one), 2 bad input.
     """
     k = knowledge(cell)
-    the_cell = _cell(cell, live, discovery_timeout)
+    the_cell = _cell(cell, live, discovery_timeout, interface)
     from plugnproduce.description.model import Link
     from plugnproduce.ontology.vocabulary import local_name
     from plugnproduce.planning import Unreachable  # here, not at the top: `pnp --help` loads none of it

@@ -15,7 +15,18 @@ from typing import TYPE_CHECKING, TextIO
 
 import typer
 
-from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, LIBRARIES, app, boundary, emit_json, fail, knowledge
+from plugnproduce.cli.app import (
+    DISCOVERY_OPTION,
+    INTERFACE_OPTION,
+    JSON_OPTION,
+    LIBRARIES,
+    app,
+    boundary,
+    emit_json,
+    fail,
+    interface_address,
+    knowledge,
+)
 from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.lazy import lazy_module
 
@@ -36,13 +47,17 @@ LIVE_OPTION = typer.Option(False, "--live", help="Find the cell's devices on the
                                                  "each reports, not from its chart's initial state.")
 
 
-def _cell(cell: Path, live: bool, discovery_timeout: float | None) -> Path | Cell:
-    """The cell file, or with ``live`` the cell with each device in the state it reports."""
+def _cell(cell: Path, live: bool, discovery_timeout: float | None, interface: str | None = None) -> Path | Cell:
+    """The cell file, or with ``live`` the cell with each device (found on ``interface``) in the state it reports."""
     if not live:
+        if interface is not None:
+            fail("--interface works with --live: it is where the cell's devices are found")
         return cell
     import asyncio
 
-    return asyncio.run(controller.live_cell(cell, knowledge(cell), discovery_timeout or controller.DISCOVERY_SECONDS))
+    address = interface_address(interface)
+    return asyncio.run(controller.live_cell(cell, knowledge(cell), discovery_timeout or controller.DISCOVERY_SECONDS,
+                                            interface=address))
 VERBOSE_OPTION = typer.Option(False, "--verbose", "-v",
                               help="The engineer's view: ontology terms, rule instances, axioms and file:line.")
 
@@ -97,13 +112,14 @@ def _print_problems(result: reasoning.CheckResult, verbose: bool) -> None:
 @boundary
 def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
           live: bool = LIVE_OPTION, discovery_timeout: float | None = DISCOVERY_OPTION,
-          verbose: bool = VERBOSE_OPTION, json_out: bool = JSON_OPTION) -> None:
+          interface: str | None = INTERFACE_OPTION, verbose: bool = VERBOSE_OPTION,
+          json_out: bool = JSON_OPTION) -> None:
     """Check that a task is plausible: each step finds its devices in the states it starts from.
 
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state),
     2 bad input.
     """
-    result = service.check(task, _cell(cell, live, discovery_timeout), knowledge(cell))
+    result = service.check(task, _cell(cell, live, discovery_timeout, interface), knowledge(cell))
     if json_out:
         emit_json(result.to_json())
     else:
@@ -127,6 +143,7 @@ def repair(
                             help="How many distinct repairs: fewest side effects first, then cheapest."),
     live: bool = LIVE_OPTION,
     discovery_timeout: float | None = DISCOVERY_OPTION,
+    interface: str | None = INTERFACE_OPTION,
     verbose: bool = VERBOSE_OPTION,
     json_out: bool = JSON_OPTION,
 ) -> None:
@@ -137,7 +154,7 @@ def repair(
     A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists, 2 bad input.
     """
-    the_cell = _cell(cell, live, discovery_timeout)
+    the_cell = _cell(cell, live, discovery_timeout, interface)
     the_task = service.task(task)  # read once, checked once: the repairs' assessment starts from this check
     result = service.check(the_task, the_cell, knowledge(cell))
     repairs = [] if result.plausible else service.assessed_repairs(the_task, the_cell, catalogue, top,

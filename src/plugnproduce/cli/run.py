@@ -9,7 +9,16 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
+from plugnproduce.cli.app import (
+    DISCOVERY_OPTION,
+    INTERFACE_OPTION,
+    JSON_OPTION,
+    app,
+    boundary,
+    emit_json,
+    interface_address,
+    knowledge,
+)
 from plugnproduce.cli.generate import refuse
 from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.executor.journal import describe
@@ -29,7 +38,8 @@ def run(
     task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."),
     cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
                                      help="The cell file (default with --sim: the bin-picking cell)."),
-    sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices for this run (on loopback)."),
+    sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices for this run (on loopback, or "
+                                                  "--interface, on a private SSDP port)."),
     faults: str = typer.Option("", "--faults", metavar="SPEC",
                                help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
@@ -43,6 +53,7 @@ def run(
                                              "report."),
     discovery_timeout: float | None = DISCOVERY_OPTION,
     json_out: bool = JSON_OPTION,
+    interface: str | None = INTERFACE_OPTION,
 ) -> None:
     """Find the devices, ask each its state, check and generate the task from there, run it, and journal every
     command and event.
@@ -51,6 +62,7 @@ def run(
     A fault, Ctrl-C or SIGTERM stops the run safely: no further task command; each device is sent the safe-stop
     request its state takes, and the journal ends with each device's answer and state, then the end record.
     """
+    address = interface_address(interface)
     if cell is None:
         if not sim:
             raise typer.BadParameter("give --cell CELL, or --sim to run on the simulated bin-picking cell")
@@ -80,7 +92,7 @@ def run(
                                                   observer=show, started=started, progress=phases,
                                                   knowledge=knowledge(cell), bin_parts=bin_parts, bin_seed=bin_seed,
                                                   assume_initial=assume_initial,
-                                                  discovery_timeout=discovery_timeout))
+                                                  discovery_timeout=discovery_timeout, interface=address))
             phases.close(last_done=True)
     except service.ImplausibleTask as exc:
         refuse(exc, "not run", json_out)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import app, boundary, fail, knowledge
+from plugnproduce.cli.app import INTERFACE_OPTION, app, boundary, fail, interface_address, knowledge
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
@@ -31,14 +31,15 @@ LOOPBACK_NAMES = ("127.0.0.1", "localhost")
 
 
 def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int | None = None,
-                bin_seed: int = 0, discovery_timeout: float | None = None) -> CellSource:
+                bin_seed: int = 0, discovery_timeout: float | None = None, interface: str | None = None) -> CellSource:
     """The cell the HMI shows, as discovery sees it.
 
     With ``sim`` the devices of ``cell`` (default: the built-in bin-picking cell) are simulated
     on a private loopback SSDP network and can be plugged and unplugged from the page, working on
     a simulated bin of ``bin_parts`` parts placed by ``bin_seed`` if given (else, for the runs of tasks that loop
     on a localized pose, a bin of :data:`~plugnproduce.controller.DEFAULT_BIN_PARTS` parts); without, the devices are
-    the ones on the network (``PNP_SSDP_PORT``) and plug in themselves. ``discovery_timeout`` bounds the
+    the ones on the network (``PNP_SSDP_PORT``) and plug in themselves. Both are on ``interface`` (a name or an
+    address; default ``PNP_INTERFACE``, else loopback). ``discovery_timeout`` bounds the
     wait for discovery to see the simulated devices start, plug or unplug (default
     ``controller.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s).
     """
@@ -46,9 +47,11 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int |
         from plugnproduce.controller.livecell import LiveCellSource
         from plugnproduce.protocols.upnp import network_from_env
 
-        return LiveCellSource(network_from_env(), name=service.cell(cell, knowledge()).name if cell else "live",
-                              knowledge=knowledge(cell), search_timeout=discovery_timeout or 1.0)
+        name = service.cell(cell, knowledge()).name if cell else "live"
+        return LiveCellSource(network_from_env(interface), name=name, knowledge=knowledge(cell),
+                              search_timeout=discovery_timeout or 1.0)
     from plugnproduce.controller.simcell import SimulatedCellSource
+    from plugnproduce.protocols.interface import chosen_address
     from plugnproduce.sim.bin import SimulatedBin
 
     cell = cell or service.builtin("cells", "bin-picking.yaml")
@@ -56,7 +59,8 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int |
     parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
     return SimulatedCellSource(service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k,
                                bin=parts, default_bin=SimulatedBin(controller.DEFAULT_BIN_PARTS, bin_seed),
-                               wait=discovery_timeout or controller.SIMULATED_DISCOVERY_SECONDS)
+                               wait=discovery_timeout or controller.SIMULATED_DISCOVERY_SECONDS,
+                               interface=chosen_address(interface))
 
 
 def runner_for(source: CellSource, cell: Path | None = None) -> Runner:
@@ -80,7 +84,8 @@ def serve(
     cell: Path | None = typer.Option(None, "--cell", metavar="CELL",
                                      help="With --sim: the cell to simulate (default: the built-in "
                                           "bin-picking cell); without: only its name is used."),
-    sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices on a private loopback SSDP network; "
+    sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices on a private SSDP network (on "
+                             "loopback or --interface); "
                              "they can be plugged and unplugged from the page."),
     faults: str = typer.Option("", "--faults", metavar="SPEC", help="With --sim: faults to inject, as for pnp run."),
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
@@ -96,6 +101,7 @@ def serve(
         None, "--discovery-timeout", metavar="SECONDS", min=0.1, max=3600,
         help="With --sim: most seconds discovery may take to see the simulated devices start, plug or unplug "
              "(default 60: a busy machine answers late); without: the first search (default 1)."),
+    interface: str | None = INTERFACE_OPTION,
 ) -> None:
     """Serve the Generic HMI: the live cell, offered commands, task editor, check/repair, runs.
 
@@ -113,7 +119,7 @@ def serve(
         fail("--faults needs --sim: faults are injected into simulated devices")
     if bin_parts is not None and not sim:
         fail("--bin-parts works on simulated devices: add --sim")
-    source = cell_source(cell, sim, faults, bin_parts, bin_seed, discovery_timeout)
+    source = cell_source(cell, sim, faults, bin_parts, bin_seed, discovery_timeout, interface_address(interface))
     the_cell = cell or (service.builtin("cells", "bin-picking.yaml") if sim else None)
     allowed = list(LOOPBACK_NAMES) if host in LOOPBACK_NAMES else None
     application = create_app(source, runner_for(source, the_cell), token, allowed_hosts=allowed,

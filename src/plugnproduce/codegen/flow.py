@@ -30,6 +30,7 @@ loop runs or which branches are taken.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from plugnproduce.chartnames import OUTCOME, STEP, branch_variable, rounds
@@ -59,7 +60,7 @@ class Outcomes:
     branches: dict[Branch, tuple[str, ...]] = field(default_factory=dict)
 
 
-def outcome_names(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Outcomes:
+def outcome_names(task: Task, processes: Mapping[str, ProcessDescription], taxonomy: Taxonomy) -> Outcomes:
     """Per loop (1-based) the outcomes that end it or let it go on, per branch the outcomes that take it."""
     out = Outcomes()
     for n, loop in enumerate(task.loops, start=1):

@@ -10,6 +10,7 @@ the executor raises, ends the task in ``failed``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from plugnproduce.chartnames import DONE, FAILED, NEXT, OUTCOME, PLAN, STEP, VALUES, branch_variable, output_variable
@@ -163,7 +164,7 @@ def generate_task(
     task: Task,
     cell: Cell,
     bindings: list[dict[str, str]],
-    processes: dict[str, ProcessDescription],
+    processes: Mapping[str, ProcessDescription],
     taxonomy: Taxonomy,
 ) -> GeneratedTask:
     """Generate the Task State Chart of a task whose steps are bound to devices (``bindings[i]`` for step i+1).
@@ -208,7 +209,7 @@ def _plan(
     task: Task,
     cell: Cell,
     bindings: list[dict[str, str]],
-    processes: dict[str, ProcessDescription],
+    processes: Mapping[str, ProcessDescription],
     taxonomy: Taxonomy,
     consumed: dict[str, set[str]],
 ) -> tuple[list[_Key], list[dict[str, object]]]:

@@ -79,6 +79,7 @@ async def run_task(
     bin_parts: int | None = None,
     bin_seed: int = 0,
     assume_initial: bool = False,
+    interface: str | None = None,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
@@ -89,11 +90,13 @@ async def run_task(
     (default :data:`DISCOVERY_SECONDS`, simulated: :data:`SIMULATED_DISCOVERY_SECONDS`); ``progress`` is told
     each phase as it begins (checking, generating, starting devices, discovering, running). The task is
     checked and generated from the state each device reports once discovered (:func:`reported_states`), or, with
-    ``assume_initial``, from the charts' initial states before discovery. Raises :class:`ImplausibleTask`
-    before any command goes out.
+    ``assume_initial``, from the charts' initial states before discovery. ``interface`` (a name or an address,
+    default ``PNP_INTERFACE``, else loopback) is where the devices are found and spoken to, the simulated ones too.
+    Raises :class:`ImplausibleTask` before any command goes out.
     """
     from plugnproduce.discovery import LiveCell
-    from plugnproduce.protocols.upnp import network_from_env, private_network
+    from plugnproduce.protocols.interface import chosen_address
+    from plugnproduce.protocols.upnp import LOOPBACK, network_from_env, private_network
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
@@ -104,10 +107,11 @@ async def run_task(
         say("checking the task in the cell")
         generated = plan_run(the_task, the_cell, k, progress=say)
     journal = journal or runs_folder() / f"{new_run_id(the_task.name)}.jsonl"
-    network = private_network() if simulate else network_from_env()
+    network = private_network(chosen_address(interface)) if simulate else network_from_env(interface)
     async with contextlib.AsyncExitStack() as stack:
         if simulate:
-            say(f"starting {len(the_cell.devices)} simulated device(s) on loopback")
+            where = "loopback" if network.interface == LOOPBACK.interface else network.interface
+            say(f"starting {len(the_cell.devices)} simulated device(s) on {where}")
             parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
             sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices), bin=parts)
             await stack.enter_async_context(sim)
@@ -157,15 +161,17 @@ async def reported_states(devices: Cell, timeout: float | None = None) -> dict[s
 
 
 async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
-                    discovery_timeout: float = DISCOVERY_SECONDS) -> Cell:
-    """The cell with each device in the state it reports: its devices found by discovery (on the network
-    ``PNP_SSDP_PORT`` names) and asked their states. For ``check``, ``repair`` and ``explain`` on a live cell."""
+                    discovery_timeout: float = DISCOVERY_SECONDS, interface: str | None = None) -> Cell:
+    """The cell with each device in the state it reports: its devices found by discovery (on ``interface``, else
+    ``PNP_INTERFACE`` or loopback, and the SSDP port ``PNP_SSDP_PORT`` names) and asked their states. For ``check``,
+    ``repair`` and ``explain`` on a live cell."""
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.upnp import network_from_env
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     wanted = [d.id for d in the_cell.devices]
-    async with LiveCell(k.taxonomy, network=network_from_env(), name=the_cell.name, expected=wanted) as live:
+    async with LiveCell(k.taxonomy, network=network_from_env(interface), name=the_cell.name,
+                        expected=wanted) as live:
         devices = await find_devices(live, wanted, discovery_timeout)
         return the_cell.reported(await reported_states(devices))
 

@@ -17,6 +17,7 @@ from plugnproduce.controller.run import SIMULATED_DISCOVERY_SECONDS, DevicesMiss
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import ProtocolTimeout, UnknownName
 from plugnproduce.knowledge import Knowledge
+from plugnproduce.protocols.interface import LOOPBACK_ADDRESS
 from plugnproduce.protocols.upnp import private_network
 from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.sim.cell import SimulatedCell, parse_faults
@@ -40,9 +41,12 @@ class SimulatedCellSource(LiveCellSource):
 
     def __init__(self, cell: Cell, catalogue: list[DeviceDescription], faults: str = "",
                  wait: float = SIMULATED_DISCOVERY_SECONDS, knowledge: Knowledge | None = None,
-                 bin: SimulatedBin | None = None, default_bin: SimulatedBin | None = None) -> None:  # noqa: A002
-        """``wait``: seconds a plug, unplug or the start may take until discovery has seen it."""
-        super().__init__(private_network(), name=cell.name, search_timeout=SEARCH_SECONDS, knowledge=knowledge)
+                 bin: SimulatedBin | None = None, default_bin: SimulatedBin | None = None,  # noqa: A002
+                 interface: str = LOOPBACK_ADDRESS) -> None:
+        """``wait``: seconds a plug, unplug or the start may take until discovery has seen it; ``interface``: the
+        address the devices and discovery are on."""
+        super().__init__(private_network(interface), name=cell.name, search_timeout=SEARCH_SECONDS,
+                         knowledge=knowledge)
         self._wanted = [d.id for d in cell.devices]
         self._wait = wait
         self._default_bin = None if bin is not None else default_bin

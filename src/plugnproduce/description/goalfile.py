@@ -7,6 +7,7 @@ left in. Every error names the file and line, as the task reader's do.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -98,7 +99,7 @@ def _item(node: yaml.Node, p: Path) -> GoalItem:
     return GoalItem(command, params, bind, line)
 
 
-def check_terms(goal: Goal, taxonomy: Taxonomy, processes: dict[str, ProcessDescription]) -> None:
+def check_terms(goal: Goal, taxonomy: Taxonomy, processes: Mapping[str, ProcessDescription]) -> None:
     """Refuse, at its line, a command, parameter or role the knowledge does not know, or an unknown concept."""
     path = goal.file
     for item in goal.achieve:

@@ -8,7 +8,7 @@ under its own, and goes on ``while`` one does. The same findings serve ``pnp val
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
 from plugnproduce.description.flow import Branch, Loop
@@ -51,7 +51,7 @@ def _written(task: Task, index: int) -> bool:
     return not any(lp.first <= index <= lp.last for lp in task.loops)
 
 
-def flow_findings(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[FlowFinding]:
+def flow_findings(task: Task, processes: Mapping[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[FlowFinding]:
     """Unknown outcomes, branches that can never run, loops that never end (or never go on) on theirs."""
     for b in task.branches:
         if _written(task, b.step):
@@ -68,7 +68,7 @@ def _unknown(iri: str, taxonomy: Taxonomy) -> str | None:
             + did_you_mean(iri, taxonomy.classes_of_kind("Outcome")))
 
 
-def _branch_findings(task: Task, b: Branch, processes: dict[str, ProcessDescription],
+def _branch_findings(task: Task, b: Branch, processes: Mapping[str, ProcessDescription],
                      taxonomy: Taxonomy) -> Iterator[FlowFinding]:
     step = task.steps[b.step - 1]
     head = f"step {b.step} ({step.command}): branch {local_name(b.outcome)}"
@@ -110,13 +110,13 @@ def ending_loop(task: Task, index: int, outcome: str, taxonomy: Taxonomy) -> str
     return loop.until if loop is not None else None
 
 
-def body_outcomes(task: Task, loop: Loop, processes: dict[str, ProcessDescription]) -> tuple[str, ...]:
+def body_outcomes(task: Task, loop: Loop, processes: Mapping[str, ProcessDescription]) -> tuple[str, ...]:
     """The outcomes the steps of a loop's body can end with."""
     body = task.steps[loop.entry - 1: loop.first - 1]
     return tuple(dict.fromkeys(o for s in body if s.command in processes for o in processes[s.command].outcomes))
 
 
-def _ends_on(task: Task, loop: Loop, until: str, processes: dict[str, ProcessDescription],
+def _ends_on(task: Task, loop: Loop, until: str, processes: Mapping[str, ProcessDescription],
              taxonomy: Taxonomy) -> bool:
     """Whether a step of the loop's body can end with an outcome under ``until`` that no inner loop ends first."""
     return any(taxonomy.is_a(o, until) and loop_ending(task, s.index, o, taxonomy) == loop
@@ -124,7 +124,7 @@ def _ends_on(task: Task, loop: Loop, until: str, processes: dict[str, ProcessDes
                for o in processes[s.command].outcomes)
 
 
-def _loop_findings(task: Task, loop: Loop, processes: dict[str, ProcessDescription],
+def _loop_findings(task: Task, loop: Loop, processes: Mapping[str, ProcessDescription],
                    taxonomy: Taxonomy) -> Iterator[FlowFinding]:
     first = task.steps[loop.entry - 1]
     outcomes = body_outcomes(task, loop, processes)

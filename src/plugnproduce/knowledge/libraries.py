@@ -11,7 +11,7 @@ and the catalogue of devices. Two libraries may not define the same process or d
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -84,7 +84,10 @@ _PREFIX = re.compile(r"^\s*(?:@prefix|PREFIX)\s+([A-Za-z][\w.-]*):\s*<([^<>\s]*)
 
 @dataclass(frozen=True)
 class Knowledge:
-    """The loaded knowledge: taxonomy closure, processes and device catalogue of the libraries."""
+    """The loaded knowledge: taxonomy closure, processes and device catalogue of the libraries.
+
+    What the reasoning layer is given: ``Knowledge((), taxonomy, processes)`` for processes of one's own
+    with no library (and so no catalogue)."""
 
     libraries: tuple[Library, ...]
     taxonomy: Taxonomy
@@ -94,12 +97,17 @@ class Knowledge:
     left_out: tuple[Path, ...] = ()
     """TBox files of the libraries left out (the state before an extension, for ``pnp impact``)."""
 
+    @cached_property
+    def processes_by_id(self) -> Mapping[str, ProcessDescription]:
+        """The processes by id (their process command), indexed once."""
+        return {p.id: p for p in self.processes}
+
     def process(self, command: str) -> ProcessDescription:
         """The process a command names."""
-        for p in self.processes:
-            if p.id == command:
-                return p
-        raise UnknownName("process command", command, (p.id for p in self.processes))
+        found = self.processes_by_id.get(command)
+        if found is None:
+            raise UnknownName("process command", command, self.processes_by_id)
+        return found
 
     @cached_property
     def devices(self) -> tuple[DeviceDescription, ...]:

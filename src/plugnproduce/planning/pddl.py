@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import itertools
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.goalfile import Goal
 from plugnproduce.description.model import Cell, ProcessDescription
@@ -26,6 +27,9 @@ from plugnproduce.planning.planner import check_goal, feeding
 from plugnproduce.reasoning.asp.facts import effects
 from plugnproduce.reasoning.asp.schema import Leaves
 from plugnproduce.reasoning.checks.offers import capabilities
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 PENALTY = 1000
 """Cost of a value left to its default although the cell could measure it, or of a measured value no step takes."""
@@ -48,10 +52,10 @@ def _id(*parts: str) -> str:
     return re.sub(r"[^a-z0-9_-]+", "_", "_".join(parts).lower()).strip("_-") or "x"
 
 
-def actions(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> list[Action]:
+def actions(goal: Goal, cell: Cell, knowledge: Knowledge) -> list[Action]:
     """Every ground action of the goal's domain in this cell."""
-    by_id = {p.id: p for p in processes}
-    caps = capabilities(cell, taxonomy, processes)
+    by_id, taxonomy = knowledge.processes_by_id, knowledge.taxonomy
+    caps = capabilities(cell, knowledge)
     consumable = {k for o in caps.offered for k in feeding(by_id[o.command]).values()}
     measured = {(q.quantity, q.datatype) for o in caps.offered for q in by_id[o.command].outputs} & consumable
     out: list[Action] = []
@@ -112,13 +116,13 @@ def _variants(goal: Goal, p: ProcessDescription, binding: dict[str, str], starts
                 yield Action(name, tuple(pre), tuple(dict.fromkeys(add)), gone, cost)
 
 
-def export(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> tuple[str, str]:
+def export(goal: Goal, cell: Cell, knowledge: Knowledge) -> tuple[str, str]:
     """The goal as a PDDL domain and problem (ground, with action costs)."""
     if goal.until is not None:
         raise DescriptionError("a goal with 'until' plans a loop, which PDDL cannot state; export one without it",
                                goal.file, goal.lines.get("until"))
-    check_goal(goal, cell, taxonomy, {p.id: p for p in processes})
-    acts = actions(goal, cell, taxonomy, processes)
+    check_goal(goal, cell, knowledge)
+    acts = actions(goal, cell, knowledge)
     facts = sorted({f for a in acts for f in (*a.pre, *a.add, *a.delete)} | {"ready"}
                    | {f"done_{g}" for g in range(1, len(goal.achieve) + 1)})
     fresh = sorted(f for f in facts if f.startswith("fresh_"))
@@ -136,7 +140,7 @@ def export(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proce
     initial = ["(ready)", *(f"(at_{_id(d.id, d.initial)})" for d in cell.devices), "(= (total-cost) 0)"]
     wanted = [f"(done_{len(goal.achieve)})", *(f"(not ({f}))" for f in fresh)]
     for d, k in sorted(goal.end.items()):
-        ends = [f"(at_{_id(d, s.id)})" for s in cell.device(d).states if in_concept(s, k, taxonomy)]
+        ends = [f"(at_{_id(d, s.id)})" for s in cell.device(d).states if in_concept(s, k, knowledge.taxonomy)]
         wanted.append(f"(or {' '.join(ends)})" if ends else "(not (ready))")  # no such state: unreachable
     problem = "\n".join(["(define (problem goal)", "  (:domain pnp-cell)", f"  (:init {' '.join(initial)})",
                          f"  (:goal (and {' '.join(wanted)}))", "  (:metric minimize (total-cost)))"]) + "\n"

@@ -11,8 +11,9 @@ so it is checked, verified and run like any task.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import yaml
 
@@ -30,6 +31,9 @@ from plugnproduce.reasoning.asp.facts import fact_book
 from plugnproduce.reasoning.asp.terms import Atom, Model, program
 from plugnproduce.reasoning.checks.offers import capabilities, cell_program
 from plugnproduce.safeio import PlainDumper
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 MAX_STEPS = 12
 """Longest plan searched for, in steps (a loop's body)."""
@@ -61,7 +65,7 @@ class Unreachable:
     purchase: DeviceDescription | None = None
 
 
-def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
+def plan(goal: Goal, cell: Cell, knowledge: Knowledge,
          catalogue: Sequence[DeviceDescription] = (), max_steps: int = MAX_STEPS,
          source: str | None = None) -> Plan | Unreachable:
     """Plan ``goal`` in ``cell`` from its devices' states (their ``initial``: chart or reported).
@@ -69,14 +73,14 @@ def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Process
     ``source`` names the written task file (in messages and ``Task.file``); with a catalogue, an
     unreachable goal names the cheapest device whose purchase makes it reachable.
     """
-    by_id = {p.id: p for p in processes}
-    check_goal(goal, cell, taxonomy, by_id)
-    found = _search(goal, cell, taxonomy, processes, max_steps)
+    by_id = knowledge.processes_by_id
+    check_goal(goal, cell, knowledge)
+    found = _search(goal, cell, knowledge, max_steps)
     if isinstance(found, Model):
         return _written(goal, found, by_id, source or f"{goal.name}.yaml")
     for device in sorted((d for d in catalogue if d.id not in {c.id for c in cell.devices}),
                          key=lambda d: (d.cost, d.id)):
-        if isinstance(_search(goal, cell.with_device(device), taxonomy, processes, max_steps), Model):
+        if isinstance(_search(goal, cell.with_device(device), knowledge, max_steps), Model):
             return Unreachable(goal, found, device)
     return Unreachable(goal, found)
 
@@ -84,9 +88,9 @@ def plan(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Process
 # ------------------------------------------------------------------ the goal against the knowledge
 
 
-def check_goal(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: dict[str, ProcessDescription]) -> None:
+def check_goal(goal: Goal, cell: Cell, knowledge: Knowledge) -> None:
     """Bad input in the goal file: unknown commands, parameters, roles, concepts, and devices not in the cell."""
-    check_terms(goal, taxonomy, processes)
+    check_terms(goal, knowledge.taxonomy, knowledge.processes_by_id)
     for item in goal.achieve:
         for d in item.bind.values():
             _device(d, cell, goal.file, item.line)
@@ -133,14 +137,13 @@ def feeding(process: ProcessDescription) -> dict[str, tuple[str, str]]:
     return {n: k for k, n in first.items()}
 
 
-def _search(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
-            max_steps: int) -> Model | tuple[str, ...]:
+def _search(goal: Goal, cell: Cell, knowledge: Knowledge, max_steps: int) -> Model | tuple[str, ...]:
     """The best plan's model, or why there is none."""
-    why = _cannot(goal, cell, taxonomy, processes)
+    why = _cannot(goal, cell, knowledge)
     if why:
         return why
-    book = fact_book(taxonomy, processes)
-    facts = cell_program(book, cell) + program(goal_facts(goal, processes, taxonomy))
+    book = fact_book(knowledge)
+    facts = cell_program(book, cell) + program(goal_facts(goal, knowledge.processes, knowledge.taxonomy))
     best: tuple[tuple[int, ...], Model] | None = None
     last = max_steps
     for t, model in solver.grow(solver.PLAN, facts, range(1, max_steps + 1)):
@@ -156,14 +159,14 @@ def _search(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proc
     return best[1]
 
 
-def _cannot(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> tuple[str, ...]:
+def _cannot(goal: Goal, cell: Cell, knowledge: Knowledge) -> tuple[str, ...]:
     """Why no plan can exist, whatever its length: commands the cell does not offer, an outcome none reports."""
-    caps = capabilities(cell, taxonomy, processes)
+    caps = capabilities(cell, knowledge)
     offered = {o.command for o in caps.offered}
     why = [f"{n.command} is not offered: {r.plain}" for n in caps.not_offered
            if n.command in {i.command for i in goal.achieve} for r in n.reasons]
-    if goal.until is not None and not any(falling_under(goal.until, p.outcomes, taxonomy)
-                                          for p in processes if p.id in offered):
+    if goal.until is not None and not any(falling_under(goal.until, p.outcomes, knowledge.taxonomy)
+                                          for p in knowledge.processes if p.id in offered):
         why.append(f"no command the cell offers reports {local_name(goal.until)}")
     return tuple(why)
 
@@ -171,7 +174,7 @@ def _cannot(goal: Goal, cell: Cell, taxonomy: Taxonomy, processes: Sequence[Proc
 # ------------------------------------------------------------------ the plan as a task file
 
 
-def _written(goal: Goal, model: Model, processes: dict[str, ProcessDescription], source: str) -> Plan:
+def _written(goal: Goal, model: Model, processes: Mapping[str, ProcessDescription], source: str) -> Plan:
     acts = {a.t: a.p for a in model[ps.Act]}
     binds: dict[int, dict[str, str]] = defaultdict(dict)
     for b in model[ps.Bound]:

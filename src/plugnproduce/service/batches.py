@@ -45,7 +45,7 @@ def batch(
     configs = (batching.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
     mapper = batching.cluster_mapper(cluster) if cluster is not None else None
-    return batching.batch(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+    return batching.batch(configs, devices, [as_task(t) for t in tasks or []], k,
                            workers=workers, progress=progress, top=top, mapper=mapper)
 
 
@@ -69,7 +69,7 @@ def batch_report(
     configs = (batching.read_configurations(configurations) if isinstance(configurations, str | Path)
                else configurations)
     mapper = batching.cluster_mapper(cluster) if cluster is not None else None
-    return batching.report(configs, devices, [as_task(t) for t in tasks or []], k.taxonomy, k.processes,
+    return batching.report(configs, devices, [as_task(t) for t in tasks or []], k,
                             form=form, workers=workers, progress=progress, top=top, mapper=mapper, tally=tally)
 
 
@@ -90,7 +90,7 @@ def batch_engine(
 
     def build() -> batching.Engine:
         k = knowledge(libraries, builtin)
-        return batching.engine(catalogue(folder, k), [task(p) for p in tasks], k.taxonomy, k.processes, top)
+        return batching.engine(catalogue(folder, k), [task(p) for p in tasks], k, top)
 
     key = enginecache.digest(libs, folder, [Path(p) for p in tasks], top)
     found = enginecache.cached(key, build)

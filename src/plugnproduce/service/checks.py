@@ -23,7 +23,7 @@ def capabilities(cell_or_path: CellArg, knowledge: Knowledge | None = None,
     """The process commands a cell offers, each with one valid role binding, how many there are and the
     devices that can fill each role (every binding listed if ``all_bindings``); the others with reasons."""
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
-    return reasoning.capabilities(the_cell, k.taxonomy, k.processes, all_bindings)
+    return reasoning.capabilities(the_cell, k, all_bindings)
 
 
 def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None) -> reasoning.CheckResult:
@@ -32,8 +32,8 @@ def check(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | N
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     task = as_task(task_or_path)
-    result = reasoning.check(task, the_cell, k.taxonomy, k.processes)
-    return dataclasses.replace(result, links=link_safety(task, the_cell, result, k.processes))
+    result = reasoning.check(task, the_cell, k)
+    return dataclasses.replace(result, links=link_safety(task, the_cell, result, k))
 
 
 def repair(
@@ -50,7 +50,7 @@ def repair(
     """
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
-    return reasoning.repair(as_task(task_or_path), the_cell, k.taxonomy, k.processes,
+    return reasoning.repair(as_task(task_or_path), the_cell, k,
                             catalogue=devices, top=top, costs=costs)
 
 
@@ -90,7 +90,7 @@ def assessed_repairs(
     asked = top
     for _ in range(MORE_REPAIRS):
         repairs = repair(the_task, the_cell, devices, asked, knowledge=k)
-        assessed = reasoning.assess(repairs, the_task, the_cell, k.taxonomy, k.processes, devices or (), checked)
+        assessed = reasoning.assess(repairs, the_task, the_cell, k, devices or (), checked)
         if len(assessed) >= top or len(repairs) < asked:
             break
         asked += top

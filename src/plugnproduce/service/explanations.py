@@ -22,14 +22,14 @@ def explain_process(cell_or_path: CellArg, command: str,
                     knowledge: Knowledge | None = None) -> reasoning.ProcessExplanation:
     """Why a process command is (not) offered in a cell."""
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
-    return reasoning.explain_process(the_cell, command, k.taxonomy, k.processes)
+    return reasoning.explain_process(the_cell, command, k)
 
 
 def explain_step(task_or_path: TaskArg, cell_or_path: CellArg, n: int,
                  knowledge: Knowledge | None = None) -> reasoning.StepExplanation:
     """Why step ``n`` (1-based) of a task is (not) plausible in a cell."""
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
-    return reasoning.explain_step(as_task(task_or_path), the_cell, n, k.taxonomy, k.processes)
+    return reasoning.explain_step(as_task(task_or_path), the_cell, n, k)
 
 
 def explain_offered(cell_or_path: CellArg, command: str, knowledge: Knowledge | None = None,
@@ -40,7 +40,7 @@ def explain_offered(cell_or_path: CellArg, command: str, knowledge: Knowledge | 
     devices it rests on)."""
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
-    return reasoning.explain_offered(command, the_cell, k.taxonomy, ontology, k.processes,
+    return reasoning.explain_offered(command, the_cell, k, ontology,
                                      _devices(catalogue_or_folder, k), language)
 
 
@@ -52,7 +52,7 @@ def explain_plausible(task_or_path: TaskArg, cell_or_path: CellArg, n: int, know
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     the_task = as_task(task_or_path)
     ontology = reasoning.ontology_of(k.ontology_files(), k.taxonomy)
-    ex = reasoning.explain_plausible(the_task, n, the_cell, k.taxonomy, ontology, k.processes, language)
+    ex = reasoning.explain_plausible(the_task, n, the_cell, k, ontology, language)
     if ex.answer:
         return ex
     edits = reasoning.counterfactuals_from_repairs(assessed_repairs(the_task, the_cell, None, 3, k))

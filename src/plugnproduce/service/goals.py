@@ -26,7 +26,7 @@ def plan(goal_or_path: Goal | str | Path, cell_or_path: CellArg, knowledge: Know
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     goal = goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path)
     devices = list(k.devices) if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
-    return make_plan(goal, the_cell, k.taxonomy, k.processes, devices, source=source)
+    return make_plan(goal, the_cell, k, devices, source=source)
 
 
 def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,
@@ -36,8 +36,7 @@ def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,
     from plugnproduce.planning.pddl import export
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
-    return export(goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path), the_cell, k.taxonomy,
-                  k.processes)
+    return export(goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path), the_cell, k)
 
 
 def goal_from_text(data: bytes | str, name: str) -> Goal:

@@ -60,7 +60,7 @@ def _generate_task(the_task: Task, the_cell: Cell, result: reasoning.CheckResult
     from plugnproduce.codegen import generate_task
 
     in_units, _ = reasoning.normalised(the_task, k.processes)  # the values in their parameters' units
-    return generate_task(in_units, the_cell, result.bindings(), {p.id: p for p in k.processes}, k.taxonomy)
+    return generate_task(in_units, the_cell, result.bindings(), k.processes_by_id, k.taxonomy)
 
 
 def generation(task_or_path: TaskArg, cell_or_path: CellArg, per_device: bool = False,

@@ -124,7 +124,8 @@ class SimulatedDevice:
         requests, events = requests_and_events(d)
         if d.protocol == "xirp":
             self._xirp = xirp.XirpServer(d.id, device_class, self._on_xirp_request, label=d.label,
-                                         files=self._files(d.endpoint), faults=self.faults)
+                                         files=self._files(d.endpoint), faults=self.faults,
+                                         host=self.network.interface)
             await self._xirp.start()
             spec = upnp.service_spec_from_chart_events({}, [])
             files = self._xirp.files = self._files(self._xirp.endpoint)

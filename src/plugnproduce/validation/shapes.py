@@ -1,4 +1,4 @@
-"""The SHACL shapes run by pySHACL over the knowledge graph."""
+"""The SHACL shapes run by pySHACL over the data graph."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from rdflib.plugins.sparql import prepareQuery
 from rdflib.plugins.sparql.operators import register_custom_function
 from rdflib.plugins.sparql.sparql import Query
 
-from plugnproduce.description.knowledge import KnowledgeGraph
+from plugnproduce.description.datagraph import DataGraph
 from plugnproduce.errors import OntologyError, tidy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.resources import ontology_path
@@ -64,8 +64,8 @@ def shapes_graph(path: Path | None = None) -> rdflib.Graph:
     return parse_turtle(path or ontology_path() / "shapes.ttl")[0]
 
 
-def shape_problems(kg: KnowledgeGraph, shapes: rdflib.Graph | None = None) -> list[Finding]:
-    """Run the shapes over the knowledge graph; one problem per violation, at its node's place.
+def shape_problems(kg: DataGraph, shapes: rdflib.Graph | None = None) -> list[Finding]:
+    """Run the shapes over the data graph; one problem per violation, at its node's place.
 
     A shape pySHACL cannot run (a SPARQL constraint it refuses, say ``{ SELECT ?x }`` in a
     query's comment, read as a nested select) raises :class:`OntologyError` in one line.

@@ -10,8 +10,8 @@ import rdflib
 from rdflib.namespace import OWL, RDF
 
 from plugnproduce.description.charts import device_chart
+from plugnproduce.description.datagraph import DataGraph
 from plugnproduce.description.goalfile import Goal, check_terms, load_goal
-from plugnproduce.description.knowledge import KnowledgeGraph
 from plugnproduce.description.loader import (
     ContractError,
     Loaded,
@@ -70,7 +70,7 @@ def validate_paths(paths: Iterable[str | Path], knowledge: Knowledge | None = No
     report = Report(files=[str(f) for f in files])
     knowledge = _with_extensions(knowledge or load_knowledge(), files, report)
     taxonomy = knowledge.taxonomy
-    kg = KnowledgeGraph()
+    kg = DataGraph()
     kg.add_tbox(knowledge.tbox(), taxonomy)
     processes: dict[str, ProcessDescription] = {}
     tasks = []
@@ -135,7 +135,7 @@ def validate_tasks(tasks: Iterable[Task], knowledge: Knowledge | None = None) ->
     tasks = list(tasks)
     knowledge = knowledge or load_knowledge()
     report = Report(files=[t.file for t in tasks])
-    kg = KnowledgeGraph()
+    kg = DataGraph()
     kg.add_tbox(knowledge.tbox(), knowledge.taxonomy)
     _tasks(tasks, knowledge, {}, kg, report)
     for p in shape_problems(kg):
@@ -182,7 +182,7 @@ def _same_iri(loaded: Loaded, described: dict[str, Where], report: Report) -> No
                                "each IRI may be described by one file only"))
 
 
-def _tasks(tasks: list[Task], knowledge: Knowledge, processes: dict[str, ProcessDescription], kg: KnowledgeGraph,
+def _tasks(tasks: list[Task], knowledge: Knowledge, processes: dict[str, ProcessDescription], kg: DataGraph,
            report: Report) -> None:
     if not tasks:
         return
@@ -198,7 +198,7 @@ def _tasks(tasks: list[Task], knowledge: Knowledge, processes: dict[str, Process
 
 
 def _turtle(
-    loaded: Loaded, taxonomy: Taxonomy, kg: KnowledgeGraph, processes: dict[str, ProcessDescription], report: Report
+    loaded: Loaded, taxonomy: Taxonomy, kg: DataGraph, processes: dict[str, ProcessDescription], report: Report
 ) -> None:
     g = loaded.graph
     if (None, RDF.type, OWL.Ontology) in g or loaded.path.name == "shapes.ttl":

@@ -13,6 +13,7 @@ See ``docs/upnp.md``.
 from __future__ import annotations
 
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.protocols.upnp.advertisements import AdvertisementListener
 from plugnproduce.protocols.upnp.boundary import (
     LOOPBACK,
     SsdpNetwork,
@@ -25,12 +26,9 @@ from plugnproduce.protocols.upnp.device import (
     ARGUMENT_VALUE_INVALID,
     NOT_ACCEPTED_NOW,
     ActionFailed,
-    ActionHandler,
     UpnpDeviceServer,
 )
 from plugnproduce.protocols.upnp.discovery import (
-    Advertisement,
-    AdvertisementListener,
     DeviceSearch,
     Discovery,
     FoundDevice,
@@ -39,6 +37,7 @@ from plugnproduce.protocols.upnp.discovery import (
     describe,
     discover,
 )
+from plugnproduce.protocols.upnp.serverclasses import ActionHandler
 from plugnproduce.protocols.upnp.spec import (
     EVENT_PREFIX,
     REQUEST_PREFIX,
@@ -58,6 +57,7 @@ from plugnproduce.protocols.upnp.spec import (
     udn_for,
     with_state_query,
 )
+from plugnproduce.protocols.upnp.ssdp import Advertisement
 from plugnproduce.protocols.upnp.values import lexical, parse_lexical
 
 __all__ = [

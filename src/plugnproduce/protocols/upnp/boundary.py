@@ -15,6 +15,7 @@ import asyncio
 import ipaddress
 import os
 import socket
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -44,6 +45,7 @@ from plugnproduce.errors import (
     shorten_words,
     tidy,
 )
+from plugnproduce.protocols.interface import LOOPBACK_ADDRESS, chosen_address
 
 T = TypeVar("T")
 
@@ -52,12 +54,14 @@ T = TypeVar("T")
 class SsdpNetwork:
     """Where SSDP runs: the local address all sockets use, and the multicast group and port.
 
-    The default, :data:`LOOPBACK`, keeps everything on ``127.0.0.1`` with the standard
-    group ``239.255.255.250:1900``. A different ``port`` gives a private SSDP
+    ``interface`` is an IPv4 address of this machine: SSDP sends its multicast out of that
+    interface and joins the group on it, and the devices' servers listen on it. The default,
+    :data:`LOOPBACK`, keeps everything on ``127.0.0.1`` with the standard group
+    ``239.255.255.250:1900``. A different ``port`` gives a private SSDP
     "network" (tests use a free port so that parallel runs do not see each other).
     """
 
-    interface: str = "127.0.0.1"
+    interface: str = LOOPBACK_ADDRESS
     group: str = SSDP_IP_V4
     port: int = SSDP_PORT
 
@@ -79,22 +83,48 @@ SSDP_PORT_VARIABLE = "PNP_SSDP_PORT"
 """Environment variable naming another SSDP port, for a private simulated cell (see :func:`network_from_env`)."""
 
 
-def private_network() -> SsdpNetwork:
-    """Loopback SSDP on a free port: a network only the devices and controller told about it share."""
+def private_network(interface: str = LOOPBACK_ADDRESS) -> SsdpNetwork:
+    """SSDP on a free port of ``interface`` (an address): a network only the devices and controller told about it
+    share."""
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        sock.bind((LOOPBACK.interface, 0))
-        return SsdpNetwork(port=int(sock.getsockname()[1]))
+        sock.bind((interface, 0))
+        return SsdpNetwork(interface=interface, port=int(sock.getsockname()[1]))
 
 
-def network_from_env() -> SsdpNetwork:
-    """:data:`LOOPBACK`, or loopback on the port ``PNP_SSDP_PORT`` names, so that ``pnp sim up`` and
-    ``pnp discover`` started with the same value see each other and nobody else."""
+def network_from_env(interface: str | None = None) -> SsdpNetwork:
+    """SSDP on the interface the command line chose and on the standard port, or the one ``PNP_SSDP_PORT`` names,
+    so that ``pnp sim up`` and ``pnp discover`` started with the same values see each other and nobody else.
+
+    ``interface``: the ``--interface`` option, a name or an address; without it ``PNP_INTERFACE``, else loopback
+    (see :func:`~plugnproduce.protocols.interface.chosen_address`).
+    """
+    address = chosen_address(interface)
     value = os.environ.get(SSDP_PORT_VARIABLE, "")
     if not value:
-        return LOOPBACK
+        return SsdpNetwork(interface=address)
     if not value.isdigit() or not 0 < int(value) < 65536:
         raise ProtocolError(f"{SSDP_PORT_VARIABLE}={value!r}: expected a UDP port number (1-65535)")
-    return SsdpNetwork(port=int(value))
+    return SsdpNetwork(interface=address, port=int(value))
+
+
+IP_MULTICAST_ALL = getattr(socket, "IP_MULTICAST_ALL", 49)
+"""Linux's socket option (``<linux/in.h>``; Python 3.11 does not name it): 0 keeps a socket to its own memberships."""
+
+
+def hear_only_the_interface(transport: object) -> None:
+    """Have an SSDP socket bound to the group's port receive the group's datagrams only from its own interface.
+
+    async-upnp-client joins the group on the chosen interface, but binds the socket to every address; Linux then
+    hands it the group's datagrams arriving on *any* interface some other socket joined it on (a device on loopback
+    would be heard by a controller on ``eth0``). ``IP_MULTICAST_ALL`` 0 limits it to its own membership.
+
+    Only the controller's listeners are so limited. A device's search responder is not: with two such limited
+    sockets on the group's port of one host, Linux was seen to drop announcements arriving on the chosen
+    interface, and a device that hears a search from elsewhere only answers it with its own address.
+    """
+    sock = getattr(transport, "get_extra_info", lambda _name: None)("socket")
+    if sock is not None and sys.platform.startswith("linux") and sock.family == socket.AF_INET:
+        sock.setsockopt(socket.IPPROTO_IP, IP_MULTICAST_ALL, 0)
 
 
 class UntrustedUrlError(ProtocolError):

@@ -1,8 +1,7 @@
 """The device side: publish a Plug'n'Produce device as a UPnP root device.
 
-:class:`UpnpDeviceServer` builds async-upnp-client server classes
-(``UpnpServerDevice``/``UpnpServerService``, ``callable_action``,
-``create_event_var``) from a :class:`~plugnproduce.protocols.upnp.spec.ServiceSpec`,
+:class:`UpnpDeviceServer` takes async-upnp-client server classes built from a
+:class:`~plugnproduce.protocols.upnp.spec.ServiceSpec` (:mod:`plugnproduce.protocols.upnp.serverclasses`),
 serves them over HTTP with the library's own SOAP and GENA handlers, answers SSDP
 searches and announces ``ssdp:alive`` on start and ``ssdp:byebye`` on stop.
 
@@ -21,26 +20,19 @@ import json
 import logging
 import socket
 import xml.etree.ElementTree as ET
-from collections.abc import Awaitable, Callable, Mapping
-from contextvars import ContextVar
+from collections.abc import Mapping
 from functools import partial
 from typing import Any, cast
 
 from aiohttp import web
 from async_upnp_client.aiohttp import AiohttpRequester
 from async_upnp_client.client import UpnpStateVariable
-from async_upnp_client.const import STATE_VARIABLE_TYPE_MAPPING, DeviceInfo, ServiceInfo
 from async_upnp_client.exceptions import UpnpActionError, UpnpActionErrorCode, UpnpError, UpnpValueError
 from async_upnp_client.server import (
     SsdpAdvertisementAnnouncer,
-    SsdpSearchResponder,
     UpnpServerDevice,
     UpnpServerService,
     UpnpXmlSerializer,
-    action_handler,
-    callable_action,
-    create_event_var,
-    create_state_var,
     subscribe_handler,
     to_xml,
     unsubscribe_handler,
@@ -49,29 +41,29 @@ from async_upnp_client.server import (
 from plugnproduce.errors import PlugNProduceError, ProtocolConnectionError, ProtocolError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.upnp.boundary import LOOPBACK, SsdpNetwork, reason
+from plugnproduce.protocols.upnp.serverclasses import (
+    CONTENT_TYPES,
+    CONTROL_PATH,
+    DESCRIPTION_PATH,
+    EVENT_PATH,
+    FILES_PATH,
+    REFUSAL,
+    SCPD_PATH,
+    ActionHandler,
+    SearchResponder,
+    control_route,
+    device_class,
+    service_class,
+)
 from plugnproduce.protocols.upnp.spec import (
-    ARG_TYPE_PREFIX,
     PNP_XML_NS,
-    SERVICE_ID,
     SERVICE_TYPE,
-    ActionSpec,
-    ArgumentSpec,
     ServiceSpec,
     payload_variable,
     udn_for,
 )
 
 _LOGGER = logging.getLogger(__name__)
-
-ActionHandler = Callable[[str, Mapping[str, Any]], Awaitable[Mapping[str, Any]]]
-"""``async handler(action_name, arguments) -> out-arguments``: what the device does when an action is invoked."""
-
-DESCRIPTION_PATH = "/device.xml"
-FILES_PATH = "/pnp/"
-CONTROL_PATH = "/upnp/control/DeviceControl"
-EVENT_PATH = "/upnp/event/DeviceControl"
-SCPD_PATH = "/DeviceControl.xml"
-_CONTENT_TYPES = {".ttl": "text/turtle", ".scxml": "application/scxml+xml"}
 
 
 class ActionFailed(PlugNProduceError):
@@ -80,7 +72,8 @@ class ActionFailed(PlugNProduceError):
     Use 501 (Action Failed) for a failure, a code from 700 to 799 for an
     action-specific refusal, e.g. :data:`NOT_ACCEPTED_NOW` when the device's state
     chart does not wait for this request in its current state. The message goes to the
-    caller as the error's description (at most :data:`DESCRIPTION_CHARS` characters).
+    caller as the error's description (at most
+    :data:`~plugnproduce.protocols.upnp.serverclasses.DESCRIPTION_CHARS` characters).
     """
 
     def __init__(self, message: str, code: int = UpnpActionErrorCode.ACTION_FAILED.value) -> None:
@@ -92,109 +85,6 @@ NOT_ACCEPTED_NOW = 701
 """UPnP error code: the request is not accepted in the device's current state."""
 ARGUMENT_VALUE_INVALID = 600
 """UPnP error code (Argument Value Invalid): an argument is not its datatype's lexical form."""
-DESCRIPTION_CHARS = 200
-"""Most characters of a refusal's message sent as its UPnP error description."""
-
-_REFUSAL: ContextVar[str | None] = ContextVar("refusal", default=None)
-"""The message of the refusal the action being answered ended with (set by the handler, read by the control route)."""
-
-
-async def _control(service: UpnpServerService, request: web.Request) -> web.StreamResponse:
-    """The library's control route, with a refusal's own message as the error description.
-
-    async-upnp-client always describes an action error as "Action Failed"; the caller would
-    never learn why the device refused.
-    """
-    _REFUSAL.set(None)
-    response = await action_handler(service, request)
-    message = _REFUSAL.get()
-    if message is None or not isinstance(response, web.Response) or response.body is None:
-        return response
-    root = ET.fromstring(cast(bytes, response.body))  # the library's own answer, not a peer's
-    for element in root.iter("{urn:schemas-upnp-org:control-1-0}errorDescription"):
-        element.text = message[:DESCRIPTION_CHARS]
-    return web.Response(status=response.status, content_type="text/xml", charset="utf-8",
-                        body=ET.tostring(root, encoding="utf-8", xml_declaration=True))
-
-
-def _arg_var_name(action: ActionSpec, argument: ArgumentSpec) -> str:
-    return f"{ARG_TYPE_PREFIX}{action.name}_{argument.name}"
-
-
-def _action_method(action: ActionSpec, dispatch: ActionHandler) -> Callable[..., Any]:
-    """A service method for ``action``, in the form ``callable_action`` expects (real-type annotations)."""
-
-    async def invoke(self: UpnpServerService, **arguments: Any) -> Mapping[str, Any]:
-        return await dispatch(action.name, arguments)
-
-    invoke.__annotations__ = {a.name: STATE_VARIABLE_TYPE_MAPPING[a.data_type]["type"] for a in action.inputs}
-    invoke.__name__ = f"action_{action.name}"
-    method: Callable[..., Any] = callable_action(
-        name=action.name,
-        in_args={a.name: _arg_var_name(action, a) for a in action.inputs},
-        out_args={a.name: _arg_var_name(action, a) for a in action.outputs},
-    )(invoke)
-    return method
-
-
-def _service_class(spec: ServiceSpec, dispatch: ActionHandler) -> type[UpnpServerService]:
-    """Build the ``UpnpServerService`` subclass of one device's service."""
-    variables: dict[str, Any] = {}
-    for action in spec.actions:
-        for argument in (*action.inputs, *action.outputs):
-            allowed = list(argument.allowed_values) or None
-            variables[_arg_var_name(action, argument)] = create_state_var(argument.data_type, allowed=allowed)
-    for var in spec.variables:
-        allowed = list(var.allowed_values) or None
-        variables[var.name] = create_event_var(var.data_type, allowed=allowed, default=var.default)
-    namespace: dict[str, Any] = {
-        "SERVICE_DEFINITION": ServiceInfo(
-            service_id=SERVICE_ID,
-            service_type=SERVICE_TYPE,
-            control_url=CONTROL_PATH,
-            event_sub_url=EVENT_PATH,
-            scpd_url=SCPD_PATH,
-            xml=ET.Element("server_service"),
-        ),
-        "STATE_VARIABLE_DEFINITIONS": variables,
-    }
-    for action in spec.actions:
-        namespace[f"action_{action.name}"] = _action_method(action, dispatch)
-    return type("DeviceControlService", (UpnpServerService,), namespace)
-
-
-def _device_class(udn: str, device_type: str, friendly_name: str, service: type) -> type[UpnpServerDevice]:
-    """Build the ``UpnpServerDevice`` subclass of one device."""
-    info = DeviceInfo(
-        device_type=device_type,
-        friendly_name=friendly_name,
-        manufacturer="Plug'n'Produce",
-        manufacturer_url=None,
-        model_description=None,
-        model_name=friendly_name,
-        model_number=None,
-        model_url=None,
-        serial_number=None,
-        udn=udn,
-        upc=None,
-        presentation_url=None,
-        url=DESCRIPTION_PATH,
-        icons=[],
-        xml=ET.Element("server_device"),
-    )
-    namespace = {"DEVICE_DEFINITION": info, "EMBEDDED_DEVICES": [], "SERVICES": [service]}
-    return type("PnpDevice", (UpnpServerDevice,), namespace)
-
-
-class _SearchResponder(SsdpSearchResponder):
-    """The library's search responder, also closing its reply socket on stop (0.49 leaves it open)."""
-
-    async def async_stop(self) -> None:
-        await super().async_stop()
-        reply = getattr(self, "_response_transport", None)
-        if reply is not None:
-            reply.close()
-
 
 class UpnpDeviceServer:
     """One device published over UPnP: description, SOAP actions, GENA events, SSDP, own files.
@@ -229,7 +119,7 @@ class UpnpDeviceServer:
         self._handler = handler
         self._device: UpnpServerDevice | None = None
         self._runner: web.AppRunner | None = None
-        self._responder: _SearchResponder | None = None
+        self._responder: SearchResponder | None = None
         self._announcer: SsdpAdvertisementAnnouncer | None = None
         self._send_lock = asyncio.Lock()
         self.location: str | None = None
@@ -261,9 +151,9 @@ class UpnpDeviceServer:
                 f"device {self.device_id!r}: cannot bind HTTP to {self.network.interface} ({exc.strerror})"
             ) from exc
         base_uri = f"http://{self.network.interface}:{sock.getsockname()[1]}"
-        service_class = _service_class(self.spec, self._dispatch)
-        device_class = _device_class(self.udn, self.device_type, self.friendly_name, service_class)
-        device = self._device = device_class(AiohttpRequester(), base_uri)
+        service = service_class(self.spec, self._dispatch)
+        device = self._device = device_class(self.udn, self.device_type, self.friendly_name, service)(
+            AiohttpRequester(), base_uri)
         self.location = base_uri + DESCRIPTION_PATH
         self._runner = web.AppRunner(self._app(), shutdown_timeout=2.0)
         await self._runner.setup()
@@ -281,7 +171,7 @@ class UpnpDeviceServer:
 
     async def _start_ssdp(self, device: UpnpServerDevice) -> None:
         source, target = self.network.source, self.network.target
-        responder = _SearchResponder(device, source=source, target=target)
+        responder = SearchResponder(device, source=source, target=target)
         await responder.async_start()
         self._responder = responder
         announcer = SsdpAdvertisementAnnouncer(device, source=source, target=target)
@@ -306,7 +196,7 @@ class UpnpDeviceServer:
         app = web.Application()
         app.router.add_get(DESCRIPTION_PATH, self._description)
         app.router.add_get(SCPD_PATH, partial(to_xml, service))
-        app.router.add_post(CONTROL_PATH, partial(_control, service))
+        app.router.add_post(CONTROL_PATH, partial(control_route, service))
         app.router.add_route("SUBSCRIBE", EVENT_PATH, partial(self._subscribe, service))
         app.router.add_route("UNSUBSCRIBE", EVENT_PATH, partial(unsubscribe_handler, service))
         if self.files is not None:
@@ -342,7 +232,7 @@ class UpnpDeviceServer:
         if name not in texts:
             raise web.HTTPNotFound()
         suffix = name[name.rfind(".") :]
-        return web.Response(text=texts[name], content_type=_CONTENT_TYPES.get(suffix, "text/plain"), charset="utf-8")
+        return web.Response(text=texts[name], content_type=CONTENT_TYPES.get(suffix, "text/plain"), charset="utf-8")
 
     async def _dispatch(self, action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
         """Run the handler; turn its refusal or failure into a UPnP error the library can answer."""
@@ -351,7 +241,7 @@ class UpnpDeviceServer:
             result = dict(await self._handler(action, dict(arguments)))
         except ActionFailed as exc:
             _LOGGER.info("device %s: action %s failed (%s): %s", self.device_id, action, exc.code, exc)
-            _REFUSAL.set(str(exc))
+            REFUSAL.set(str(exc))
             raise UpnpActionError(error_code=exc.code, error_desc=str(exc)) from exc
         except Exception as exc:  # a handler bug must not become a bare HTTP 500
             _LOGGER.exception("device %s: handler of action %s raised", self.device_id, action)

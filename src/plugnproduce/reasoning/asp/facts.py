@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.contracts import KINDS
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
@@ -22,6 +23,9 @@ from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.terms import Atom, program
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 DATATYPES = KINDS
 """Declared parameter datatypes → the short names the encodings compare (the contracts' kinds of value)."""
@@ -184,17 +188,26 @@ def config_facts(config: str, devices: Iterable[str]) -> list[Atom]:
     return [s.Config(config)] + [s.Member(config, d) for d in devices]
 
 
-# ------------------------------------------------------------------ a cache per knowledge base
+# ------------------------------------------------------------------ a cache per knowledge
 
 
 @dataclass
 class FactBook:
-    """Facts of a taxonomy and a set of processes; device facts are made once per device."""
+    """Facts of the knowledge's taxonomy and processes; device facts are made once per device."""
 
-    taxonomy: Taxonomy
-    processes: tuple[ProcessDescription, ...]
+    knowledge: Knowledge
     _devices: dict[DeviceDescription, str] = field(default_factory=dict)
     _processes: str = ""
+
+    @property
+    def taxonomy(self) -> Taxonomy:
+        """The knowledge's taxonomy closure."""
+        return self.knowledge.taxonomy
+
+    @property
+    def processes(self) -> tuple[ProcessDescription, ...]:
+        """The knowledge's processes."""
+        return self.knowledge.processes
 
     def process_text(self) -> str:
         """ASP facts of every process."""
@@ -217,22 +230,22 @@ class FactBook:
 
     def process(self, command: str) -> ProcessDescription:
         """The process a command names."""
-        for p in self.processes:
-            if p.id == command:
-                return p
-        raise UnknownName("process command", command, (p.id for p in self.processes))
+        found = self.knowledge.processes_by_id.get(command)
+        if found is None:
+            raise UnknownName("process command", command, self.knowledge.processes_by_id)
+        return found
 
 
 _BOOKS: dict[tuple[str, int], FactBook] = {}
 
 
-def fact_book(taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> FactBook:
-    """The fact cache for this taxonomy and these processes (kept for the few most recent)."""
-    procs = tuple(processes)
+def fact_book(knowledge: Knowledge) -> FactBook:
+    """The fact cache for the knowledge's taxonomy and processes (kept for the few most recent)."""
+    taxonomy, procs = knowledge.taxonomy, knowledge.processes
     key = (taxonomy.digest or str(id(taxonomy)), hash(procs))
     book = _BOOKS.get(key)
     if book is None or book.processes != procs:
-        book = FactBook(taxonomy, procs)
+        book = FactBook(knowledge)
         if len(_BOOKS) >= 8:
             _BOOKS.pop(next(iter(_BOOKS)))
         _BOOKS[key] = book

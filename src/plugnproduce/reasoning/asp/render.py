@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import difflib
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task, Where
@@ -18,7 +19,7 @@ class Context:
     """Everything a sentence may name: labels from the taxonomy, and where each thing is described."""
 
     taxonomy: Taxonomy
-    processes: dict[str, ProcessDescription]
+    processes: Mapping[str, ProcessDescription]
     devices: dict[str, DeviceDescription]
     cell: str
     task: Task | None = None

@@ -45,6 +45,11 @@ class Atom:
         args = symbol.arguments
         if symbol.name != cls.asp or len(args) != len(cls._decoders):
             raise EncodingError(f"expected {cls.asp}/{len(cls._decoders)}; found {symbol}")
+        return cls._of(symbol, args)
+
+    @classmethod
+    def _of(cls: type[A], symbol: clingo.Symbol, args: Sequence[clingo.Symbol]) -> A:
+        """The typed atom of a symbol of this predicate and its arguments (read once by the caller)."""
         try:
             return cls(*(dec(a) for dec, a in zip(cls._decoders, args, strict=True)))
         except (RuntimeError, TypeError) as exc:
@@ -72,6 +77,12 @@ _CODECS: dict[object, tuple[Callable[[Any], str], Callable[[clingo.Symbol], Any]
     "clingo.Symbol": (_symbol_text, lambda s: s),
 }
 _CODECS.update({str: _CODECS["str"], int: _CODECS["int"], clingo.Symbol: _CODECS["clingo.Symbol"]})
+
+
+def codec(type_name: str, encode: Callable[[Any], str], decode: Callable[[clingo.Symbol], Any]) -> None:
+    """Let a predicate's field be of the type named ``type_name`` (as annotated): written by ``encode``, read by
+    ``decode`` (which raises :class:`EncodingError` for a symbol that does not fit)."""
+    _CODECS[type_name] = (encode, decode)
 
 
 @dataclass_transform(frozen_default=True)
@@ -105,25 +116,31 @@ def program(atoms: Iterable[Atom]) -> str:
 
 
 class Model:
-    """The typed atoms of one answer set, by predicate class."""
+    """The typed atoms of one answer set, by predicate class; each predicate's atoms are decoded when first asked
+    for (a long task's check shows an ``at/5`` atom per step and device, which not every reader needs)."""
 
-    def __init__(self, atoms: dict[type[Atom], list[Atom]], cost: Sequence[int] = ()):
+    def __init__(self, atoms: dict[type[Atom], list[Atom]], cost: Sequence[int] = (),
+                 shown: dict[type[Atom], list[tuple[clingo.Symbol, Sequence[clingo.Symbol]]]] | None = None):
         self._atoms = atoms
+        self._shown = shown or {}
         self.cost = tuple(cost)
 
     def __getitem__(self, cls: type[A]) -> list[A]:
+        if cls not in self._atoms and cls in self._shown:
+            self._atoms[cls] = [cls._of(symbol, args) for symbol, args in self._shown.pop(cls)]
         return self._atoms.get(cls, [])  # type: ignore[return-value]
 
 
 def decode(symbols: Iterable[clingo.Symbol], cost: Sequence[int] = ()) -> Model:
-    """Sort a model's symbols into typed atoms; a shown atom of no known predicate is an error."""
-    out: dict[type[Atom], list[Atom]] = defaultdict(list)
+    """Sort a model's symbols by typed predicate; a shown atom of no known predicate is an error."""
+    shown: dict[type[Atom], list[tuple[clingo.Symbol, Sequence[clingo.Symbol]]]] = defaultdict(list)
     for s in symbols:
-        cls = _REGISTRY.get((s.name, len(s.arguments)))
+        args = s.arguments
+        cls = _REGISTRY.get((s.name, len(args)))
         if cls is None:
-            raise EncodingError(f"the encodings show {s.name}/{len(s.arguments)}, which no typed predicate declares")
-        out[cls].append(cls.from_symbol(s))
-    return Model(dict(out), cost)
+            raise EncodingError(f"the encodings show {s.name}/{len(args)}, which no typed predicate declares")
+        shown[cls].append((s, args))
+    return Model({}, cost, dict(shown))
 
 
 def strings(term: clingo.Symbol) -> list[str]:

@@ -15,6 +15,7 @@ import re
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, Parameter, ProcessDescription, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -25,6 +26,9 @@ from plugnproduce.reasoning.asp.terms import Atom, program
 from plugnproduce.reasoning.checks.accepts import accepts
 from plugnproduce.reasoning.checks.contracts import normalised, refusal
 from plugnproduce.reasoning.checks.plausibility import check
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 _STEP = re.compile(r"step \d+ \([^)]*\): ")
 """Where a check's problem text names its step, before it says what is wrong."""
@@ -71,20 +75,20 @@ class FullCheck:
 
     catalogue: tuple[DeviceDescription, ...]
     """The catalogue devices, in bit order."""
-    taxonomy: Taxonomy
-    processes: tuple[ProcessDescription, ...]
+    knowledge: Knowledge
+    """The taxonomy and processes alone (no libraries, no catalogue): shipped to workers."""
 
     def findings(self, task: Task, mask: int) -> tuple[tuple[str, int, str, str], ...]:
         """Why ``task`` is not plausible in the configuration ``mask`` (empty: it is), as the check says."""
         devices = tuple(d for n, d in enumerate(self.catalogue) if mask >> n & 1)
-        result = check(task, Cell("configuration", devices), self.taxonomy, self.processes)
+        result = check(task, Cell("configuration", devices), self.knowledge)
         return tuple(sorted({(p.kind, p.step, p.role or "", p.device or "") for p in result.problems},
                             key=lambda f: (f[1], f)))
 
     def limit(self, task: Task, mask: int, finding: tuple[str, int, str, str]) -> str:
         """The check's words for one ``device_limit`` finding of ``task`` in the configuration ``mask``."""
         devices = tuple(d for n, d in enumerate(self.catalogue) if mask >> n & 1)
-        result = check(task, Cell("configuration", devices), self.taxonomy, self.processes)
+        result = check(task, Cell("configuration", devices), self.knowledge)
         return "; ".join(_STEP.split(p.text, 1)[-1] for p in result.problems
                          if (p.kind, p.step, p.role or "", p.device or "") == finding)
 
@@ -121,9 +125,10 @@ class Abilities:
         return self.bits.get(device, 0)
 
 
-def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]], taxonomy: Taxonomy,
-              processes: Sequence[ProcessDescription]) -> Abilities:
+def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str, Task]],
+              knowledge: Knowledge) -> Abilities:
     """Reason once over every catalogue device and task; compile the answers into :class:`Abilities`."""
+    taxonomy, processes = knowledge.taxonomy, knowledge.processes
     devices = sorted({d.id: d for d in catalogue}.values(), key=lambda d: d.id)
     index = {d.id: n for n, d in enumerate(devices)}
     proc_atoms = [a for p in processes for a in process_facts(p)]
@@ -145,10 +150,10 @@ def abilities(catalogue: Sequence[DeviceDescription], tasks: Sequence[tuple[str,
         concepts=_concepts(dev_atoms, index),
         leaves=_leaves(dev_atoms, index),
         recovers=_recovers(dev_atoms, index),
-        tasks=tuple(_task(name, t, processes, bad, _refusing(devices, processes, taxonomy), devices)
+        tasks=tuple(_task(name, t, knowledge, bad, _refusing(devices, processes, taxonomy), devices)
                     for name, t in tasks),
         bits={d.id: 1 << n for n, d in enumerate(devices)},
-        full=FullCheck(tuple(devices), taxonomy, tuple(processes)),
+        full=FullCheck(tuple(devices), type(knowledge)((), taxonomy, processes)),
     )
 
 
@@ -195,10 +200,10 @@ def _refusing(devices: Sequence[DeviceDescription], processes: Sequence[ProcessD
             for p in processes for par in p.parameters}
 
 
-def _task(name: str, written: Task, processes: Sequence[ProcessDescription], bad: set[tuple[str, int]],
+def _task(name: str, written: Task, knowledge: Knowledge, bad: set[tuple[str, int]],
           refusing: dict[tuple[str, str], int], devices: Sequence[DeviceDescription]) -> TaskSpec:
-    task = normalised(written, processes)[0]
-    by_id = {p.id: p for p in processes}
+    task = normalised(written, knowledge.processes)[0]
+    by_id = knowledge.processes_by_id
     steps = []
     for step in task.steps:
         p = by_id.get(step.command)

@@ -23,12 +23,15 @@ import dataclasses
 import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.flow import Branch
-from plugnproduce.description.model import ProcessDescription, Task, Where
+from plugnproduce.description.model import Task, Where
 from plugnproduce.description.outcomes import branch_of, ending_loop
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp.results import CheckResult, Problem, Reason, StepCheck
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 MAX_PATHS = 100
 """Most paths a task's check runs (one per branch, and the default one)."""
@@ -53,11 +56,10 @@ class Path:
         return f"{named}, {after}" if named else after
 
 
-def ways_on(task: Task, index: int, processes: dict[str, ProcessDescription],
-            taxonomy: Taxonomy) -> tuple[tuple[Branch, ...], bool]:
+def ways_on(task: Task, index: int, knowledge: Knowledge) -> tuple[tuple[Branch, ...], bool]:
     """The branches of the step at ``index`` that an outcome going on in the task takes, and whether the
     task may also go on without one."""
-    process = processes.get(task.steps[index - 1].command)
+    process, taxonomy = knowledge.processes_by_id.get(task.steps[index - 1].command), knowledge.taxonomy
     siblings = task.branches_of(index)
     if process is None or not process.outcomes:
         return (), True
@@ -81,12 +83,12 @@ def _positions(task: Task, choices: dict[int, Branch | None]) -> tuple[int, ...]
     return tuple(out)
 
 
-def task_paths(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> list[Path]:
+def task_paths(task: Task, knowledge: Knowledge) -> list[Path]:
     """The default path, then one path for each branch it does not take (a branch no outcome takes too:
     it is refused on its own, and its steps still get their bindings)."""
     default: dict[int, Branch | None] = {}
     for index in sorted({b.step for b in task.branches}):
-        reachable, without = ways_on(task, index, processes, taxonomy)
+        reachable, without = ways_on(task, index, knowledge)
         default[index] = None if without or not reachable else reachable[0]
     paths = [Path(None, _positions(task, default))]
     on_default = set(paths[0].positions)
@@ -107,14 +109,13 @@ def covering(paths: list[Path], index: int) -> Path:
     return next((p for p in paths if index in p.positions), paths[0])
 
 
-def join_problems(task: Task, checks: PathChecks, processes: dict[str, ProcessDescription],
-                  taxonomy: Taxonomy) -> Iterator[Problem]:
+def join_problems(task: Task, checks: PathChecks, knowledge: Knowledge) -> Iterator[Problem]:
     """A reachable branch that leaves a device otherwise than the other ways on from its step."""
     paths = checks.paths
     for index in sorted({b.step for b in task.branches}):
         if not any(index in p.positions for p in paths):
             continue
-        reachable, without = ways_on(task, index, processes, taxonomy)
+        reachable, without = ways_on(task, index, knowledge)
         if not reachable:
             continue
         block = max(b.last for b in task.branches_of(index))
@@ -206,11 +207,11 @@ def renumbered_text(text: str, positions: tuple[int, ...]) -> str:
     return _STEP.sub(position, text)
 
 
-def on_a_path(task: Task, index: int, processes: dict[str, ProcessDescription], taxonomy: Taxonomy,
+def on_a_path(task: Task, index: int, knowledge: Knowledge,
               check: Check | None = None) -> tuple[Task, tuple[int, ...]]:
     """A path through the task's branches that runs position ``index``, as a straight task, and its positions:
     the first on which ``check`` finds a problem at the step (the first that runs it, without ``check``)."""
-    paths = [p for p in task_paths(task, processes, taxonomy) if index in p.positions]
+    paths = [p for p in task_paths(task, knowledge) if index in p.positions]
     for path in paths if check is not None else ():
         straight = _straight(task, path.positions)
         assert check is not None

@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Iterator, Sequence
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.contracts import breach
 from plugnproduce.description.model import (
@@ -31,6 +32,9 @@ from plugnproduce.description.units import Amount, UnitError, convert, read_amou
 from plugnproduce.errors import QuantityError, excerpt
 from plugnproduce.reasoning.asp.facts import DATATYPES
 from plugnproduce.reasoning.asp.results import Problem, Reason, StepCheck
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 NUMERIC = ("decimal", "integer")
 
@@ -104,11 +108,10 @@ def contracts_for(device: DeviceDescription, quantity: str) -> list[Argument]:
     return [device.argument(r, quantity) for r in requests]
 
 
-def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
-                  processes: Sequence[ProcessDescription]) -> Iterator[Problem]:
+def beyond_limits(task: Task, cell: Cell, steps: tuple[StepCheck, ...], knowledge: Knowledge) -> Iterator[Problem]:
     """One problem per value (given or default) outside the limits of the device it goes to."""
     devices = {d.id: d for d in cell.devices}
-    procs = {p.id: p for p in processes}
+    procs = knowledge.processes_by_id
     for check, step in zip(steps, task.one_round(), strict=False):
         proc = procs.get(step.command)
         for par in proc.parameters if proc else ():

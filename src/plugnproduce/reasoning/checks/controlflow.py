@@ -18,13 +18,16 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING
 
-from plugnproduce.description.model import Loop, ProcessDescription, Task, Where
+from plugnproduce.description.model import Loop, Task, Where
 from plugnproduce.description.outcomes import loop_ending
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.asp.results import CheckResult, Problem, Reason
 from plugnproduce.reasoning.checks.branches import Path, covering, renumbered
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 Check = Callable[[Task], CheckResult]
 """The chained check of a straight task (no loops) in the same cell."""
@@ -41,7 +44,7 @@ def _named(problem: Problem, path: str) -> Problem:
     return dataclasses.replace(problem, reason=reason)
 
 
-def loop_problems(task: Task, result: CheckResult, processes: dict[str, ProcessDescription], taxonomy: Taxonomy,
+def loop_problems(task: Task, result: CheckResult, knowledge: Knowledge,
                   check: Check, paths: list[Path] | None = None) -> Iterator[Problem]:
     """Problems of the task's loops: an iteration that does not return the devices, an exit that strands them.
 
@@ -51,7 +54,7 @@ def loop_problems(task: Task, result: CheckResult, processes: dict[str, ProcessD
     for loop in task.loops:
         yield from _fixpoint(task, loop, result)
         if loop.until is not None:
-            yield from _exits(task, loop, processes, taxonomy, check, every)
+            yield from _exits(task, loop, knowledge, check, every)
 
 
 def _states_before(result: CheckResult, index: int) -> dict[str, str]:
@@ -72,7 +75,7 @@ def _fixpoint(task: Task, loop: Loop, result: CheckResult) -> Iterator[Problem]:
                           where, device=device, state=after[device])
 
 
-def _exits(task: Task, loop: Loop, processes: dict[str, ProcessDescription], taxonomy: Taxonomy, check: Check,
+def _exits(task: Task, loop: Loop, knowledge: Knowledge, check: Check,
            paths: list[Path]) -> Iterator[Problem]:
     """Check the steps after the loop from where each step that can end the loop leaves the devices."""
     rest = tuple(i for i in paths[0].positions if i > loop.last)
@@ -81,8 +84,9 @@ def _exits(task: Task, loop: Loop, processes: dict[str, ProcessDescription], tax
     assert loop.until is not None
     until = loop.until
     for step in task.steps[loop.entry - 1 : loop.last]:
-        process = processes.get(step.command)
-        if process is None or not any(loop_ending(task, step.index, o, taxonomy) == loop for o in process.outcomes):
+        process = knowledge.processes_by_id.get(step.command)
+        if process is None or not any(loop_ending(task, step.index, o, knowledge.taxonomy) == loop
+                                      for o in process.outcomes):
             continue
         route = tuple(i for i in covering(paths, step.index).positions if i <= step.index) + rest
         straight = dataclasses.replace(task, steps=tuple(dataclasses.replace(task.steps[p - 1], index=i + 1)

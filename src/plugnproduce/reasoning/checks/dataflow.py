@@ -11,7 +11,8 @@ event of its chart carries a value of the output's name.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import (
     Cell,
@@ -29,15 +30,18 @@ from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
 from plugnproduce.reasoning.asp.results import Problem, Reason, StepCheck
 from plugnproduce.statechart.model import Send, walk
 
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
+
 POSE = PNP_IRI + "Pose"
 
 
-def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy: Taxonomy) -> Iterator[Problem]:
+def link_problems(task: Task, knowledge: Knowledge) -> Iterator[Problem]:
     """One problem per link of the task's first round (a loop's first iteration) that cannot get its value."""
     one_round = task.steps[: len(task.steps) // max(task.repeat, 1)]
     later = {i for lp in task.loops for i in range(lp.first, lp.last + 1)}  # a loop's body is written once
     for step in one_round:
-        process = processes.get(step.command)
+        process = knowledge.processes_by_id.get(step.command)
         if step.index in later:
             continue
         if process is None:
@@ -46,7 +50,7 @@ def link_problems(task: Task, processes: dict[str, ProcessDescription], taxonomy
             if name not in {p.name for p in process.parameters}:
                 continue  # an unknown parameter is a problem of its own
             named = _named_before(one_round, step)
-            text, iris = _link_text(step, link, named, processes, process.parameter(name), taxonomy)
+            text, iris = _link_text(step, link, named, knowledge, process.parameter(name))
             text = text or _on_every_path(task, step, name, link, named)
             if text:
                 where = task.where(step, name)
@@ -72,8 +76,8 @@ def _on_every_path(task: Task, step: Step, name: str, link: Link, named: dict[st
             "on every path to it")
 
 
-def _link_text(step: Step, link: Link, named: dict[str, Step], processes: dict[str, ProcessDescription],
-               parameter: Parameter, taxonomy: Taxonomy) -> tuple[str, tuple[str, ...]]:
+def _link_text(step: Step, link: Link, named: dict[str, Step], knowledge: Knowledge,
+               parameter: Parameter) -> tuple[str, tuple[str, ...]]:
     """What is wrong with one link ("" if nothing), and the terms it rests on."""
     head = f"step {step.index} ({step.command}): parameter {parameter.name} takes {link.output} from {link.step}"
     source = named.get(link.step)
@@ -82,7 +86,7 @@ def _link_text(step: Step, link: Link, named: dict[str, Step], processes: dict[s
         return f"{head}, but no step is named {link.step!r}; named steps: {known}", ()
     if source.index >= step.index:
         return f"{head}, but step {source.index} ({link.step}) comes after it; a value must be produced first", ()
-    process = processes.get(source.command)
+    process = knowledge.processes_by_id.get(source.command)
     if process is None:
         return "", ()
     if link.output not in {o.name for o in process.outputs}:
@@ -92,7 +96,7 @@ def _link_text(step: Step, link: Link, named: dict[str, Step], processes: dict[s
     if link.offset is not None and output.datatype != POSE:
         return (f"{head} with an offset, but {link.output} is a {local_name(output.datatype)}; only a pose takes an "
                 "offset [x, y, z, rx, ry, rz]", (output.datatype,))
-    return _fit(head, output, parameter, taxonomy)
+    return _fit(head, output, parameter, knowledge.taxonomy)
 
 
 def _fit(head: str, output: Output, parameter: Parameter, taxonomy: Taxonomy) -> tuple[str, tuple[str, ...]]:
@@ -120,7 +124,7 @@ def reports(device: DeviceDescription, value: str) -> bool:
 
 
 def unreported(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
-               processes: dict[str, ProcessDescription]) -> Iterator[Problem]:
+               processes: Mapping[str, ProcessDescription]) -> Iterator[Problem]:
     """One problem per link whose source step's device never reports the output."""
     one_round = task.steps[: len(task.steps) // max(task.repeat, 1)]
     later = {i for lp in task.loops for i in range(lp.first, lp.last + 1)}

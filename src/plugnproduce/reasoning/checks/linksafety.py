@@ -10,7 +10,8 @@ either proven safe or checked at run time, with the reason.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Argument, Cell, Link, ProcessDescription, Step, Task
 from plugnproduce.description.ranges import OutputRange, output_ranges
@@ -18,17 +19,19 @@ from plugnproduce.description.units import UnitError, convert
 from plugnproduce.reasoning.asp.results import CheckResult, LinkSafety
 from plugnproduce.reasoning.checks.contracts import contracts_for
 
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
-def link_safety(task: Task, cell: Cell, result: CheckResult,
-                processes: Sequence[ProcessDescription]) -> tuple[LinkSafety, ...]:
+
+def link_safety(task: Task, cell: Cell, result: CheckResult, knowledge: Knowledge) -> tuple[LinkSafety, ...]:
     """Per link of the task as written (a loop's body once), whether its value is proven within the contract."""
     if len(result.steps) != len(task.steps):
         return ()
-    return tuple(_links(task, cell, result, {p.id: p for p in processes}))
+    return tuple(_links(task, cell, result, knowledge.processes_by_id))
 
 
 def _links(task: Task, cell: Cell, result: CheckResult,
-           processes: dict[str, ProcessDescription]) -> Iterator[LinkSafety]:
+           processes: Mapping[str, ProcessDescription]) -> Iterator[LinkSafety]:
     devices = {d.id: d for d in cell.devices}
     later = {i for lp in task.loops for i in range(lp.first, lp.last + 1)}
     for step in task.one_round():

@@ -4,16 +4,19 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
 from plugnproduce.errors import UnknownName
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import render, solver
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.facts import FactBook, config_facts, fact_book
 from plugnproduce.reasoning.asp.results import Capabilities, NotOffered, Offer, ProcessExplanation, Reason
 from plugnproduce.reasoning.asp.terms import Model, program, strings
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 CELL = "cell"
 """The configuration name a single cell gets in ASP."""
@@ -29,10 +32,10 @@ def context(book: FactBook, cell: Cell, extra: Sequence[DeviceDescription] = (),
             task: Task | None = None) -> render.Context:
     """The rendering context of a cell (and a task)."""
     devices = {d.id: d for d in [*extra, *cell.devices]}
-    return render.Context(book.taxonomy, {p.id: p for p in book.processes}, devices, cell.name, task)
+    return render.Context(book.taxonomy, book.knowledge.processes_by_id, devices, cell.name, task)
 
 
-def _bindings(model: Model, processes: dict[str, ProcessDescription]) -> dict[str, list[dict[str, str]]]:
+def _bindings(model: Model, processes: Mapping[str, ProcessDescription]) -> dict[str, list[dict[str, str]]]:
     out: dict[str, list[dict[str, str]]] = defaultdict(list)
     for b in model[s.Binding]:
         roles = [r.name for r in processes[b.p].roles]
@@ -74,14 +77,13 @@ def _reasons(model: Model, ctx: render.Context) -> dict[str, list[Reason]]:
     return out
 
 
-def capabilities(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription],
-                 all_bindings: bool = False) -> Capabilities:
+def capabilities(cell: Cell, knowledge: Knowledge, all_bindings: bool = False) -> Capabilities:
     """What ``cell`` can do: offered commands, each with the devices that can fill each role, how many
     valid role bindings that makes and one of them (every one if ``all_bindings``); the others with reasons.
 
     Roles may share a device (roles.lp), so the bindings are every choice of one player per role:
     their number is a product, and only ``all_bindings`` lists them (bindings.lp)."""
-    book = fact_book(taxonomy, processes)
+    book = fact_book(knowledge)
     model = solver.solve(solver.BINDINGS if all_bindings else solver.CAPABILITIES, cell_program(book, cell))
     ctx = context(book, cell)
     listed, reasons = _bindings(model, ctx.processes), _reasons(model, ctx)
@@ -101,18 +103,17 @@ def capabilities(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDesc
     )
 
 
-def explain_process(cell: Cell, command: str, taxonomy: Taxonomy,
-                    processes: Sequence[ProcessDescription]) -> ProcessExplanation:
+def explain_process(cell: Cell, command: str, knowledge: Knowledge) -> ProcessExplanation:
     """Why ``command`` is (not) offered in ``cell``: its bindings, or every reason with provenance.
 
     Every binding is listed only for an offered command (on a big cell, why-not stays fast)."""
-    caps = capabilities(cell, taxonomy, processes)
+    caps = capabilities(cell, knowledge)
     if caps.offers(command):
-        caps = capabilities(cell, taxonomy, processes, all_bindings=True)
+        caps = capabilities(cell, knowledge, all_bindings=True)
     for o in caps.offered:
         if o.command == command:
             return ProcessExplanation(o.command, o.label, True, o.bindings, ())
     for n in caps.not_offered:
         if n.command == command:
             return ProcessExplanation(n.command, n.label, False, (), n.reasons)
-    raise UnknownName("process command", command, (p.id for p in processes))
+    raise UnknownName("process command", command, knowledge.processes_by_id)

@@ -13,6 +13,7 @@ its cost, whose text says which limit the value broke).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import DeviceDescription, Parameter, ProcessDescription, Task
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -20,6 +21,9 @@ from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.terms import Atom
 from plugnproduce.reasoning.checks.accepts import accepts
 from plugnproduce.reasoning.checks.contracts import refuses, why_refused
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 
 class Refusals:
@@ -80,18 +84,16 @@ class Refusals:
         return self._defaults[key]
 
 
-def refusal_facts(task: Task, name: str, devices: Sequence[DeviceDescription],
-                  processes: Sequence[ProcessDescription], taxonomy: Taxonomy,
+def refusal_facts(task: Task, name: str, devices: Sequence[DeviceDescription], knowledge: Knowledge,
                   known: Refusals | None = None) -> list[Atom]:
     """``value_refused/4`` for each step's values (``task`` with its quantities in their parameters' units) and
     ``default_refused/3`` for each parameter's default, over ``devices`` (the cell's and the catalogue's);
     ``known``: the answers found so far in the same repair."""
-    known = known or Refusals(taxonomy)
+    known = known or Refusals(knowledge.taxonomy)
     devices = list({d.id: d for d in devices}.values())
-    out = list(known.defaults(devices, processes))
-    by_id = {p.id: p for p in processes}
+    out = list(known.defaults(devices, knowledge.processes))
     for step in task.steps:
-        command = by_id.get(step.command)
+        command = knowledge.processes_by_id.get(step.command)
         if command is None:
             continue
         for par in command.parameters:

@@ -8,10 +8,10 @@ import dataclasses
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task
+from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.description.paths import in_concept
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book
@@ -19,6 +19,9 @@ from plugnproduce.reasoning.asp.results import CheckResult
 from plugnproduce.reasoning.checks.offers import CELL, cell_program
 from plugnproduce.reasoning.checks.plausibility import check
 from plugnproduce.reasoning.repairs.sideeffects import AssessedRepair
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 MAX_PAIRS = 400
 """At most this many pairs of catalogue devices are tried when no single device makes a process offered."""
@@ -65,10 +68,10 @@ def _names(devices: Sequence[DeviceDescription]) -> str:
     return " and ".join(f"'{d.id}' ({d.label})" for d in devices)
 
 
-def make_offered(command: str, cell: Cell, catalogue: Sequence[DeviceDescription], taxonomy: Taxonomy,
-                 processes: Sequence[ProcessDescription]) -> list[Counterfactual]:
+def make_offered(command: str, cell: Cell, catalogue: Sequence[DeviceDescription],
+                 knowledge: Knowledge) -> list[Counterfactual]:
     """Catalogue devices to add (one, else two) or swap in for one of the cell's that make ``command`` offered."""
-    book = fact_book(taxonomy, processes)
+    book = fact_book(knowledge)
     now = offered(book, cell)
     present = {d.id for d in cell.devices}
     spare = [d for d in catalogue if d.id not in present]
@@ -93,10 +96,9 @@ def make_offered(command: str, cell: Cell, catalogue: Sequence[DeviceDescription
     return sorted(out, key=lambda c: (len(c.devices), c.kind != "add_device", len(c.loses), c.text))
 
 
-def make_not_offered(command: str, cell: Cell, taxonomy: Taxonomy,
-                     processes: Sequence[ProcessDescription]) -> list[Counterfactual]:
+def make_not_offered(command: str, cell: Cell, knowledge: Knowledge) -> list[Counterfactual]:
     """The single devices of the cell without which ``command`` would not be offered (why these devices)."""
-    book = fact_book(taxonomy, processes)
+    book = fact_book(knowledge)
     out = []
     for dev in cell.devices:
         if command not in offered(book, _with(cell, [], dev.id)):
@@ -111,8 +113,7 @@ def _from_states(cell: Cell, states: dict[str, str]) -> Cell:
                                                    for d in cell.devices))
 
 
-def needed_states(result: CheckResult, task: Task, n: int, cell: Cell, taxonomy: Taxonomy,
-                  processes: Sequence[ProcessDescription]) -> list[Counterfactual]:
+def needed_states(result: CheckResult, task: Task, n: int, cell: Cell, knowledge: Knowledge) -> list[Counterfactual]:
     """For a step that is not plausible: the chart states its devices would have to be in when it starts, each
     confirmed by checking the step alone from the states the devices are in then, with that one changed."""
     step = result.steps[n - 1]
@@ -124,12 +125,12 @@ def needed_states(result: CheckResult, task: Task, n: int, cell: Cell, taxonomy:
             continue
         dev = next(d for d in cell.devices if d.id == p.device)
         for st in dev.states:
-            if not in_concept(st, p.needed, taxonomy):
+            if not in_concept(st, p.needed, knowledge.taxonomy):
                 continue
             states = {**step.states, p.device: st.id}
-            ok = check(alone, _from_states(cell, states), taxonomy, processes).plausible
+            ok = check(alone, _from_states(cell, states), knowledge).plausible
             if ok:
-                label = taxonomy.label(st.concept or p.needed)
+                label = knowledge.taxonomy.label(st.concept or p.needed)
                 out.append(Counterfactual("state", f"if device '{p.device}' were in state '{st.id}' ({label}) when "
                                                    f"step {n} starts, the step would be plausible", True,
                                           (p.device,), state=st.id, step=n))

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import dataclasses
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task, Where
 from plugnproduce.errors import UnknownName
@@ -26,6 +27,9 @@ from plugnproduce.reasoning.explanation import counterfactuals
 from plugnproduce.reasoning.explanation.axioms import Axiom, Ontology
 from plugnproduce.reasoning.explanation.counterfactuals import Counterfactual
 
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
+
 PROCESS_CHART = "process chart"
 """What a node of a General Process State Chart rests on, in plain words."""
 
@@ -38,7 +42,7 @@ class Words:
 
     taxonomy: Taxonomy
     ontology: Ontology
-    processes: dict[str, ProcessDescription]
+    processes: Mapping[str, ProcessDescription]
     devices: dict[str, DeviceDescription]
     cell: str
     language: str = "en"
@@ -178,9 +182,9 @@ def play_node(w: Words, model: Model, p: str, r: str, d: str) -> Node:
                {"P": p, "R": r, "D": d, "N": len(role.region)}, (skill, walk_node(w, model, p, r, d)))
 
 
-def derivation_model(cell: Cell, taxonomy: Taxonomy, processes: Sequence[ProcessDescription]) -> Model:
+def derivation_model(cell: Cell, knowledge: Knowledge) -> Model:
     """The intermediate facts a derivation reads (roles.lp, offered.lp, explain.lp)."""
-    return solver.solve(DERIVATION, cell_program(fact_book(taxonomy, processes), cell))
+    return solver.solve(DERIVATION, cell_program(fact_book(knowledge), cell))
 
 
 def offered_tree(w: Words, model: Model, p: str) -> Node:
@@ -331,52 +335,49 @@ class Explanation:
                 "counterfactuals": [c.to_json() for c in self.counterfactuals], "none_exists": self.none_exists}
 
 
-def words(cell: Cell, taxonomy: Taxonomy, ontology: Ontology, processes: Sequence[ProcessDescription],
-          language: str = "en") -> Words:
+def words(cell: Cell, knowledge: Knowledge, ontology: Ontology, language: str = "en") -> Words:
     """What sentences about ``cell`` may name."""
-    return Words(taxonomy, ontology, {p.id: p for p in processes}, {d.id: d for d in cell.devices}, cell.name,
+    return Words(knowledge.taxonomy, ontology, knowledge.processes_by_id, {d.id: d for d in cell.devices}, cell.name,
                  language)
 
 
-def explain_offered(command: str, cell: Cell, taxonomy: Taxonomy, ontology: Ontology,
-                    processes: Sequence[ProcessDescription], catalogue: Sequence[DeviceDescription],
-                    language: str = "en") -> Explanation:
+def explain_offered(command: str, cell: Cell, knowledge: Knowledge, ontology: Ontology,
+                    catalogue: Sequence[DeviceDescription], language: str = "en") -> Explanation:
     """Why ``command`` is (not) offered in ``cell``: the derivation, and the confirmed counterfactuals — devices
     to add or swap in for a "no", the devices a "yes" rests on."""
-    if command not in {p.id for p in processes}:
-        raise UnknownName("process command", command, (p.id for p in processes))
-    w = words(cell, taxonomy, ontology, processes, language)
-    model = derivation_model(cell, taxonomy, processes)
+    if command not in knowledge.processes_by_id:
+        raise UnknownName("process command", command, knowledge.processes_by_id)
+    w = words(cell, knowledge, ontology, language)
+    model = derivation_model(cell, knowledge)
     if any(a.p == command for a in model[s.Offered]):
-        flips = counterfactuals.make_not_offered(command, cell, taxonomy, processes)
+        flips = counterfactuals.make_not_offered(command, cell, knowledge)
         return Explanation("offered", command, True, offered_tree(w, model, command), tuple(flips),
                            None if flips else f"no single device of the cell is needed for {command}: "
                                               f"another can stand in for each")
-    fixes = counterfactuals.make_offered(command, cell, catalogue, taxonomy, processes)
+    fixes = counterfactuals.make_offered(command, cell, catalogue, knowledge)
     return Explanation("offered", command, False, not_offered_tree(w, model, command), tuple(fixes),
                        None if fixes else f"no device of the catalogue, added alone or in pairs or swapped in, "
                                           f"makes the cell offer {command}")
 
 
-def explain_plausible(task: Task, n: int, cell: Cell, taxonomy: Taxonomy, ontology: Ontology,
-                      processes: Sequence[ProcessDescription], language: str = "en") -> Explanation:
+def explain_plausible(task: Task, n: int, cell: Cell, knowledge: Knowledge, ontology: Ontology,
+                      language: str = "en") -> Explanation:
     """Why step ``n`` of ``task`` is (not) plausible: the derivation, and for a "no" the confirmed states its
     devices would have to be in (the service adds the repairs, with their side effects, from
     :func:`sideeffects.assess`)."""
     if not 1 <= n <= len(task.steps):
         raise UnknownName("step", n, detail=f"the task has steps 1 to {len(task.steps)}")
     if task.branches:  # along the path that makes the step (not) plausible, numbered as the task numbers it
-        straight, positions = on_a_path(task, n, {p.id: p for p in processes}, taxonomy,
-                                        lambda t: check(t, cell, taxonomy, processes))
-        ex = explain_plausible(straight, positions.index(n) + 1, cell, taxonomy, ontology, processes, language)
+        straight, positions = on_a_path(task, n, knowledge, lambda t: check(t, cell, knowledge))
+        ex = explain_plausible(straight, positions.index(n) + 1, cell, knowledge, ontology, language)
         return _renumbered(ex, positions, task.path(n))
-    result = check(task, cell, taxonomy, processes)
-    w = words(cell, taxonomy, ontology, processes, language)
+    result = check(task, cell, knowledge)
+    w = words(cell, knowledge, ontology, language)
     tree = step_tree(w, result, task, n)
     ok = not any(p.step == n for p in result.problems)
     if ok:
         return Explanation("plausible", f"step {n}", True, tree)
-    states = counterfactuals.needed_states(result, task, n, cell, taxonomy, processes)
+    states = counterfactuals.needed_states(result, task, n, cell, knowledge)
     return Explanation("plausible", f"step {n}", False, tree, tuple(states),
                        None if states else f"no state of its devices alone makes step {n} plausible; "
                                            f"see the repairs")

@@ -99,7 +99,7 @@ def _cell(path: Path, k: Knowledge) -> tuple[Cell | None, Knowledge]:
 def _offers(cell: Cell | None, k: Knowledge) -> Bindings:
     if cell is None:
         return {}
-    caps = offers.capabilities(cell, k.taxonomy, k.processes, all_bindings=True)
+    caps = offers.capabilities(cell, k, all_bindings=True)
     return {o.command: {" ".join(f"{r}={d}" for r, d in sorted(b.items())) for b in o.bindings} for o in caps.offered}
 
 
@@ -135,8 +135,8 @@ def _task_changes(before: Knowledge, pairs: list[tuple[Path, tuple[Cell | None, 
     for task_file in before.task_files():
         task = load_task(task_file)
         for f, (c0, k0), (c1, k1) in pairs:
-            was = c0 is not None and plausibility.check(task, c0, k0.taxonomy, k0.processes).plausible
-            now = c1 is not None and plausibility.check(task, c1, k1.taxonomy, k1.processes).plausible
+            was = c0 is not None and plausibility.check(task, c0, k0).plausible
+            now = c1 is not None and plausibility.check(task, c1, k1).plausible
             if was != now:
                 out.append({"task": str(task_file), "cell": str(f), "plausible_before": was, "plausible_after": now})
     return out

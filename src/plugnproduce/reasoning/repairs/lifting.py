@@ -17,12 +17,15 @@ import dataclasses
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.flow import Branch, Loop
-from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
-from plugnproduce.ontology.taxonomy import Taxonomy
+from plugnproduce.description.model import Cell, DeviceDescription, Step, Task
 from plugnproduce.reasoning.asp.results import Repair
 from plugnproduce.reasoning.checks.plausibility import check
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 Key = tuple[object, ...]
 """A written item (``("step", pos)``, ``("loop", entry)``, ``("new", n)``) or a container of items
@@ -244,8 +247,7 @@ def _placements(w: _Written, repair: Repair) -> list[Task]:
     return out
 
 
-def lift(repair: Repair, task: Task, cell: Cell, taxonomy: Taxonomy,
-         processes: Sequence[ProcessDescription]) -> Repair:
+def lift(repair: Repair, task: Task, cell: Cell, knowledge: Knowledge) -> Repair:
     """The repair with its resulting task written like ``task`` (its loops and branches kept) when that is
     plausible on every path in ``cell``; else with its flat steps and :attr:`Repair.unrolls` saying why."""
     if not (task.loops or task.branches) or len(repair.origins) != len(repair.task.steps):
@@ -260,7 +262,7 @@ def lift(repair: Repair, task: Task, cell: Cell, taxonomy: Taxonomy,
         return dataclasses.replace(repair, task=flat, unrolls=UNROLLS + str(e))
     first_problem = ""
     for written in candidates:
-        result = check(written, cell, taxonomy, processes)
+        result = check(written, cell, knowledge)
         if result.plausible:
             return dataclasses.replace(repair, task=written, origins=())
         first_problem = first_problem or (result.problems[0].text if result.problems else "")
@@ -269,11 +271,11 @@ def lift(repair: Repair, task: Task, cell: Cell, taxonomy: Taxonomy,
     return dataclasses.replace(repair, task=flat, unrolls=UNROLLS + why)
 
 
-def lifted(repairs: Sequence[Repair], task: Task, cell: Cell, taxonomy: Taxonomy,
-           processes: Sequence[ProcessDescription], catalogue: Sequence[DeviceDescription] = ()) -> list[Repair]:
+def lifted(repairs: Sequence[Repair], task: Task, cell: Cell, knowledge: Knowledge,
+           catalogue: Sequence[DeviceDescription] = ()) -> list[Repair]:
     """Each repair lifted onto the written task (:func:`lift`), checked in the cell with the devices it adds."""
     out = []
     for r in repairs:
         added = tuple(d for d in catalogue if d.id in r.added_devices and all(d.id != c.id for c in cell.devices))
-        out.append(lift(r, task, dataclasses.replace(cell, devices=cell.devices + added), taxonomy, processes))
+        out.append(lift(r, task, dataclasses.replace(cell, devices=cell.devices + added), knowledge))
     return out

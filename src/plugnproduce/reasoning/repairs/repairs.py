@@ -11,21 +11,22 @@ program with the catalogue is never grounded.
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable, Sequence
-
-import clingo
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
-from plugnproduce.errors import EncodingError
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.asp.results import Edit, Repair, RepairCosts
-from plugnproduce.reasoning.asp.terms import Atom, Model, program
+from plugnproduce.reasoning.asp.schema import edits
+from plugnproduce.reasoning.asp.terms import Atom, Model, program, quote
 from plugnproduce.reasoning.checks.contracts import normalised
 from plugnproduce.reasoning.checks.offers import CELL, cell_program
 from plugnproduce.reasoning.checks.plausibility import TASK, check
 from plugnproduce.reasoning.checks.refusals import Refusals, refusal_facts, reset_reason
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 PER_GAP = 2
 """Default number of commands that may be inserted before each step."""
@@ -69,18 +70,17 @@ def forbid(model: Model) -> str:
     """An integrity constraint ruling out this repair's edits (and any repair containing them)."""
     lits = []
     for e in model[s.Edit]:
-        t = e.e
-        if t.name == "insert":  # wherever in the same gap: inserting P before step I
-            lits.append(f"inserted({t.arguments[0]},{t.arguments[2]})")
+        if isinstance(e.e, edits.Insert):  # wherever in the same gap: inserting P before step I
+            lits.append(f"inserted({e.e.i},{quote(e.e.p)})")
         else:
-            lits.append(f"edit({t})")
+            lits.append(f"edit({edits.edit_text(e.e)})")
     return ":- " + ", ".join(sorted(set(lits))) + "." if lits else ":- #true."
 
 
 def outcome(model: Model, task: Task) -> Hashable:
     """What a repair leads to: the commands, bindings and parameter values of the repaired task, the cell."""
     steps = repaired_task(model, task).steps
-    added = sorted(e.e.arguments[0].string for e in model[s.Edit] if e.e.name == "add")
+    added = sorted(e.e.a for e in model[s.Edit] if isinstance(e.e, edits.Add))
     commands = tuple((st.command, tuple(sorted(st.bind.items())), repr(sorted(st.params.items()))) for st in steps)
     return commands, tuple(added)
 
@@ -92,7 +92,7 @@ def task_program(task: Task, devices: Sequence[DeviceDescription], book: FactBoo
     cell's and the catalogue's) refuse which of them (:mod:`..checks.refusals`; ``known``: the answers so far)."""
     readable, _ = normalised(task, book.processes, keep_unreadable=True)
     return program(task_facts(readable, TASK)
-                   + refusal_facts(readable, TASK, devices, book.processes, book.taxonomy, known))
+                   + refusal_facts(readable, TASK, devices, book.knowledge, known))
 
 
 def _optimise(book: FactBook, task: Task, cell: Cell, extra: Sequence[DeviceDescription], top: int,
@@ -107,8 +107,7 @@ def _optimise(book: FactBook, task: Task, cell: Cell, extra: Sequence[DeviceDesc
 def repair(
     task: Task,
     cell: Cell,
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     catalogue: Sequence[DeviceDescription] | None = None,
     top: int = 3,
     costs: RepairCosts | None = None,
@@ -117,12 +116,12 @@ def repair(
 ) -> list[Repair]:
     """The ``top`` cheapest distinct repairs of ``task`` in ``cell`` (empty if it is plausible already)."""
     costs = costs or RepairCosts()
-    if top < 1 or check(task, cell, taxonomy, processes).plausible:
+    if top < 1 or check(task, cell, knowledge).plausible:
         return []
-    book = fact_book(taxonomy, processes)
+    book = fact_book(knowledge)
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
-    known = Refusals(taxonomy)
+    known = Refusals(knowledge.taxonomy)
     models = _optimise(book, task, cell, (), top, costs, per_gap, max_inserts, known)
     cheapest_add = min((add_cost(costs, d) for d in extra), default=None)
     if cheapest_add is not None and (len(models) < top or models[-1].cost[0] > cheapest_add):
@@ -140,7 +139,7 @@ def repaired_runs(model: Model, task: Task) -> list[tuple[int, Step]]:
     for p in model[s.Plays]:
         if p.explicit:
             plays.setdefault(p.s, {})[p.r] = p.d
-    resets = {(e.e.arguments[0].number, e.e.arguments[1].string) for e in model[s.Edit] if e.e.name == "reset"}
+    resets = {(e.e.i, e.e.n) for e in model[s.Edit] if isinstance(e.e, edits.Reset)}
     out: list[tuple[int, Step]] = []
     for run in sorted(model[s.Runs], key=lambda r: r.s):
         bind = dict(sorted(plays.get(run.s, {}).items()))
@@ -178,9 +177,9 @@ def read_repair(model: Model, rank: int, task: Task, book: FactBook, devices: di
                 costs: RepairCosts) -> Repair:
     """A model of repair.lp as a :class:`Repair`."""
     reader = _EditReader(task, book, devices, costs, lambda i: bound_at(model, i))
-    edits = sorted((reader.read(e.e) for e in model[s.Edit]), key=lambda e: (e.step or 0, e.kind, e.text))
-    added = tuple(sorted(e.device for e in edits if e.kind == "add" and e.device))
-    return Repair(rank, model.cost[0] / 100 if model.cost else 0.0, tuple(edits),
+    read = sorted((reader.read(e.e) for e in model[s.Edit]), key=lambda e: (e.step or 0, e.kind, e.text))
+    added = tuple(sorted(e.device for e in read if e.kind == "add" and e.device))
+    return Repair(rank, model.cost[0] / 100 if model.cost else 0.0, tuple(read),
                   repaired_task(model, task), added, tuple(i for i, _ in repaired_runs(model, task)))
 
 
@@ -191,7 +190,7 @@ def bound_at(model: Model, i: int) -> dict[str, str]:
 
 
 class _EditReader:
-    """Turns ``edit/1`` terms into :class:`Edit` objects with sentences and costs; ``bound`` tells the devices the
+    """Turns the edits of a model into :class:`Edit` objects with sentences and costs; ``bound`` tells the devices the
     repaired task binds to an original step's roles (to say which device's limit a reset value broke)."""
 
     def __init__(self, task: Task, book: FactBook, devices: dict[str, DeviceDescription], costs: RepairCosts,
@@ -199,13 +198,25 @@ class _EditReader:
         self.task, self.book, self.devices, self.costs = task, book, devices, costs
         self.bound = bound
 
-    def read(self, term: clingo.Symbol) -> Edit:
-        """The edit a term stands for."""
-        args = [a.number if a.type == clingo.SymbolType.Number else a.string for a in term.arguments]
-        method: Callable[..., Edit] | None = getattr(self, "_" + term.name, None)
-        if method is None:
-            raise EncodingError(f"repair.lp shows an unknown edit {term}")
-        return method(*args)
+    def read(self, term: edits.EditTerm) -> Edit:
+        """The edit with its sentence and cost."""
+        match term:
+            case edits.Insert(i, j, p):
+                return self._insert(i, j, p)
+            case edits.Remove(i):
+                return self._remove(i)
+            case edits.Swap(i):
+                return self._swap(i)
+            case edits.Rebind(i, r, d):
+                return self._rebind(i, r, d)
+            case edits.Bind(i, r, d):
+                return self._bind(i, r, d)
+            case edits.Unbind(i, r):
+                return self._unbind(i, r)
+            case edits.Reset(i, n):
+                return self._reset(i, n)
+            case edits.Add(a):
+                return self._add(a)
 
     def cmd(self, i: int) -> str:
         """The command of original step ``i``."""

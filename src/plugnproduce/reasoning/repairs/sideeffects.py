@@ -10,8 +10,9 @@ process, dropped where the robot stands otherwise. The repair solver is not chan
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Hashable, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task, Where
 from plugnproduce.ontology.taxonomy import Taxonomy
@@ -20,6 +21,9 @@ from plugnproduce.reasoning.asp.derivation import Node, asp
 from plugnproduce.reasoning.asp.results import CheckResult, Repair
 from plugnproduce.reasoning.checks.offers import CELL
 from plugnproduce.reasoning.checks.plausibility import TASK, check
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 SEVERITY = {"drops_part": 2, "moves_device": 1, "ends_holding": 1, "default_values": 0}
 """How much each kind of side effect weighs when repairs are ranked (0: worth knowing, harmless)."""
@@ -84,8 +88,15 @@ class AssessedRepair:
 
 @dataclass(frozen=True)
 class _Cell:
-    taxonomy: Taxonomy
-    processes: dict[str, ProcessDescription]
+    knowledge: Knowledge
+
+    @property
+    def taxonomy(self) -> Taxonomy:
+        return self.knowledge.taxonomy
+
+    @property
+    def processes(self) -> Mapping[str, ProcessDescription]:
+        return self.knowledge.processes_by_id
 
     def is_a(self, iri: str | None, local: str) -> bool:
         return iri is not None and self.taxonomy.is_a(iri, PNP_IRI + local)
@@ -251,13 +262,12 @@ def _moves(k: _Cell, result: CheckResult, i: int, task: Task, inserted: bool) ->
     return out
 
 
-def side_effects(original: Task, repaired: Task, result: CheckResult, cell: Cell, taxonomy: Taxonomy,
-                 processes: Sequence[ProcessDescription], before: CheckResult,
-                 origins: Sequence[int] = ()) -> list[SideEffect]:
+def side_effects(original: Task, repaired: Task, result: CheckResult, cell: Cell, knowledge: Knowledge,
+                 before: CheckResult, origins: Sequence[int] = ()) -> list[SideEffect]:
     """What the repaired task changes besides being plausible: parts dropped, devices moved, a part still held
     at the end that the original task released, default values of inserted steps (``origins``: see
     :func:`new_steps`)."""
-    k = _Cell(taxonomy, {p.id: p for p in processes})
+    k = _Cell(knowledge)
     fresh = new_steps(original, repaired, origins)
     out = _holding(k, result, cell, fresh, repaired, original, origins)
     ends = [d for d, x in result.final_states.items() if k.is_a(_concept(cell, d, x), "Closed")
@@ -269,22 +279,21 @@ def side_effects(original: Task, repaired: Task, result: CheckResult, cell: Cell
     return out
 
 
-def assess(repairs: Sequence[Repair], task: Task, cell: Cell, taxonomy: Taxonomy,
-           processes: Sequence[ProcessDescription],
+def assess(repairs: Sequence[Repair], task: Task, cell: Cell, knowledge: Knowledge,
            catalogue: Sequence[DeviceDescription] = (), before: CheckResult | None = None) -> list[AssessedRepair]:
     """Each repair that checking it again (in the cell with the devices it adds from ``catalogue``, with their own
     contracts and limits) confirms, with its side effects: ranked by its worst side effect, then by cost, then by
     the solver's order. A repair the check does not confirm is no repair: it is left out. ``before``: the check
     of ``task`` in ``cell``, when the caller has it already."""
-    before = before if before is not None else check(task, cell, taxonomy, processes)
+    before = before if before is not None else check(task, cell, knowledge)
     out = []
     for r in repairs:
         added = tuple(d for d in catalogue if d.id in r.added_devices)
         the_cell = dataclasses.replace(cell, devices=cell.devices + added)
-        result = check(r.task, the_cell, taxonomy, processes)
+        result = check(r.task, the_cell, knowledge)
         if not result.plausible:
             continue
-        effects = side_effects(task, r.task, result, the_cell, taxonomy, processes, before, r.origins)
+        effects = side_effects(task, r.task, result, the_cell, knowledge, before, r.origins)
         out.append(AssessedRepair(0, r, tuple(effects), True))
     return [dataclasses.replace(a, rank=n) for n, a in enumerate(sorted(out, key=ranking), start=1)]
 

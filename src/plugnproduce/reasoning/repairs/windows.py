@@ -56,21 +56,23 @@ import heapq
 from collections import defaultdict
 from collections.abc import Hashable, Iterable, Sequence
 from dataclasses import dataclass, replace
-
-import clingo
+from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task
-from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.asp.results import Repair, RepairCosts
-from plugnproduce.reasoning.asp.terms import Model, program
+from plugnproduce.reasoning.asp.schema import edits
+from plugnproduce.reasoning.asp.terms import Model, decode, program
 from plugnproduce.reasoning.checks.contracts import normalised
 from plugnproduce.reasoning.checks.offers import CELL, cell_program
 from plugnproduce.reasoning.checks.plausibility import TASK
 from plugnproduce.reasoning.checks.refusals import Refusals
 from plugnproduce.reasoning.repairs import lifting, repairs
+
+if TYPE_CHECKING:
+    from plugnproduce.knowledge import Knowledge
 
 WHOLE_UP_TO = 40
 """Tasks of at most this many steps are repaired whole (:func:`.repairs.repair`): fast enough, and
@@ -94,7 +96,7 @@ class _Part:
 
     window: Window
     cost: int
-    edits: tuple[clingo.Symbol, ...]
+    edits: tuple[edits.EditTerm, ...]
     steps: tuple[Step, ...]
     left_in: tuple[tuple[str, str], ...]
     origins: tuple[int, ...] = ()
@@ -102,14 +104,6 @@ class _Part:
     reset_bound: tuple[tuple[int, tuple[tuple[str, str], ...]], ...] = ()
     """For each original step with a value reset: the devices the repair binds to its roles (to say which
     device's limit the value broke)."""
-
-
-def shifted(term: clingo.Symbol, offset: int) -> clingo.Symbol:
-    """An ``edit/1`` term of a window with its step number made the original step's."""
-    if term.name == "add" or not offset:
-        return term
-    first, *rest = term.arguments
-    return clingo.Function(term.name, [clingo.Number(first.number + offset), *rest])
 
 
 def k_best(options: Sequence[Sequence[_Part]], k: int) -> list[tuple[_Part, ...]]:
@@ -132,27 +126,22 @@ def k_best(options: Sequence[Sequence[_Part]], k: int) -> list[tuple[_Part, ...]
 
 
 class _Chain:
-    """The task as checked (check.lp): device states before each step, its problems, each device's uses.
+    """The task as checked (check.lp): device states before each step, its problems, each device's uses."""
 
-    Read from the check's raw atoms: a long task's model has an ``at/5`` atom per step and device."""
-
-    def __init__(self, task: Task, atoms: Iterable[clingo.Symbol]):
-        self.task, self.n, self.plausible = task, len(task.steps), False
+    def __init__(self, task: Task, model: Model):
+        self.task, self.n, self.plausible = task, len(task.steps), bool(model[s.Plausible])
         self.at: dict[int, dict[str, str]] = defaultdict(dict)
+        for a in model[s.At]:
+            self.at[a.i][a.d] = a.x
         users: dict[int, set[str]] = defaultdict(set)
-        self.problems: list[tuple[int, str | None]] = []
-        for a in atoms:
-            args = a.arguments
-            if a.name == s.At.asp:
-                self.at[args[2].number][args[3].string] = args[4].string
-            elif a.name == s.Bound.asp:
-                users[args[2].number].add(args[4].string)
-            elif a.name == s.Plausible.asp:
-                self.plausible = True
-            elif a.name != s.LeftBy.asp:
-                step = next(x.number for x in args if x.type == clingo.SymbolType.Number)
-                device = args[4].string if a.name in (s.WrongState.asp, s.Stuck.asp) else None
-                self.problems.append((step, device))
+        for b in model[s.Bound]:
+            users[b.i].add(b.d)
+        at_device: list[s.WrongState | s.Stuck] = [*model[s.WrongState], *model[s.Stuck]]
+        at_step: list[s.NoDevice | s.Ambiguous | s.Absent | s.CannotPlay | s.UnknownRole | s.UnknownCommand
+                      | s.BadType | s.TooLow | s.TooHigh | s.UnknownParam] = [
+            *model[s.NoDevice], *model[s.Ambiguous], *model[s.Absent], *model[s.CannotPlay], *model[s.UnknownRole],
+            *model[s.UnknownCommand], *model[s.BadType], *model[s.TooLow], *model[s.TooHigh], *model[s.UnknownParam]]
+        self.problems: list[tuple[int, str | None]] = [(a.i, a.d) for a in at_device] + [(a.i, None) for a in at_step]
         self.last_use: dict[str, int] = {}
         self.used_before: dict[tuple[int, str], int] = {}
         for i in sorted(users):
@@ -198,8 +187,7 @@ def windows(spans: Iterable[Window], n: int, margin: int) -> list[Window]:
 def repair(
     task: Task,
     cell: Cell,
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     catalogue: Sequence[DeviceDescription] | None = None,
     top: int = 3,
     costs: RepairCosts | None = None,
@@ -209,17 +197,16 @@ def repair(
     """The ``top`` cheapest distinct repairs of ``task`` in ``cell``: whole if short, else window by window;
     each lifted onto the written task, its loops and branches kept where that is plausible (:mod:`lifting`)."""
     if len(task.steps) <= WHOLE_UP_TO or max_inserts is not None:
-        found = repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap, max_inserts)
+        found = repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap, max_inserts)
     else:
-        found = windowed_repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
-    return lifting.lifted(found, task, cell, taxonomy, processes, catalogue or ())
+        found = windowed_repair(task, cell, knowledge, catalogue, top, costs, per_gap)
+    return lifting.lifted(found, task, cell, knowledge, catalogue or ())
 
 
 def windowed_repair(
     task: Task,
     cell: Cell,
-    taxonomy: Taxonomy,
-    processes: Sequence[ProcessDescription],
+    knowledge: Knowledge,
     catalogue: Sequence[DeviceDescription] | None = None,
     top: int = 3,
     costs: RepairCosts | None = None,
@@ -231,21 +218,21 @@ def windowed_repair(
     ``margin``: unbroken steps first added on each side of a problem (doubled until doubling it
     changes no cost)."""
     costs = costs or RepairCosts()
-    book = fact_book(taxonomy, processes)
-    readable, _ = normalised(task, processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
+    book = fact_book(knowledge)
+    readable, _ = normalised(task, knowledge.processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
     facts = cell_program(book, cell) + program(task_facts(readable, TASK)) + program([s.Check(CELL, TASK)])
-    chain = _Chain(task, solver.symbols(solver.CHECK, facts))
+    chain = _Chain(task, decode(solver.symbols(solver.CHECK, facts)))
     if top < 1 or chain.plausible:  # plausible to the encodings: whatever else check() finds, repair.lp cannot fix
-        return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap) if top >= 1 else []
+        return repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap) if top >= 1 else []
     present = {d.id for d in cell.devices}
     extra = sorted({d.id: d for d in catalogue or () if d.id not in present}.values(), key=lambda d: d.id)
     narrower: list[Repair] | None = None
     memo: dict[Hashable, list[Model]] = {}
-    local = edits_stay_local(costs, processes)
+    local = edits_stay_local(costs, knowledge.processes)
     while True:
         wins = windows(chain.spans(), chain.n, margin)
         if wins == [Window(1, chain.n)]:
-            return repairs.repair(task, cell, taxonomy, processes, catalogue, top, costs, per_gap)
+            return repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap)
         found = _Solver(book, chain, cell, costs, per_gap, top, memo).best(wins, extra)
         if found is not None and (local or (narrower is not None
                                             and [r.cost for r in found] == [r.cost for r in narrower])):
@@ -295,7 +282,7 @@ class _Solver:
             models = self.solve(w, self.cell, extra, carried, 1, free)
             if not models:
                 return [], 0
-            bought = frozenset(e.e.arguments[0].string for e in models[0][s.Edit] if e.e.name == "add")
+            bought = frozenset(e.e.a for e in models[0][s.Edit] if isinstance(e.e, edits.Add))
             bound += (models[0].cost[0] if models[0].cost else 0) - len(extra)  # at most one hundredth each
             carried.update(self._carried(w, models[0]))
             if bought and bought not in sets:
@@ -354,13 +341,13 @@ class _Solver:
         steps = self.chain.task.steps[w.first - 1:w.last]
         sub = Task(self.chain.task.name, tuple(replace(st, index=k) for k, st in enumerate(steps, start=1)),
                    self.chain.task.file)
-        edits = tuple(shifted(e.e, w.first - 1) for e in model[s.Edit])
+        moved = tuple(e.e.shifted(w.first - 1) for e in model[s.Edit])
         left = tuple(sorted((a.d, a.x) for a in model[s.LeftIn]))
         runs = repairs.repaired_runs(model, sub)
         origins = tuple(i + w.first - 1 if i else 0 for i, _ in runs)
-        resets = sorted({e.e.arguments[0].number for e in model[s.Edit] if e.e.name == "reset"})
+        resets = sorted({e.e.i for e in model[s.Edit] if isinstance(e.e, edits.Reset)})
         bound = tuple((i + w.first - 1, tuple(sorted(repairs.bound_at(model, i).items()))) for i in resets)
-        return _Part(w, model.cost[0] if model.cost else 0, edits, tuple(st for _, st in runs), left, origins,
+        return _Part(w, model.cost[0] if model.cost else 0, moved, tuple(st for _, st in runs), left, origins,
                      bound)
 
     def read(self, rank: int, combo: tuple[int, tuple[_Part, ...], tuple[str, ...]],
@@ -370,8 +357,8 @@ class _Solver:
         bound = {i: dict(b) for p in parts for i, b in p.reset_bound}
         reader = repairs._EditReader(reader.task, reader.book, reader.devices, reader.costs,
                                      lambda i: bound.get(i, {}))
-        terms = [t for p in parts for t in p.edits] + [clingo.Function("add", [clingo.String(a)]) for a in added]
-        edits = sorted((reader.read(t) for t in terms), key=lambda e: (e.step or 0, e.kind, e.text))
+        terms = [t for p in parts for t in p.edits] + [edits.Add(a) for a in added]
+        read = sorted((reader.read(t) for t in terms), key=lambda e: (e.step or 0, e.kind, e.text))
         task = self.chain.task
         steps: list[Step] = []
         origins: list[int] = []
@@ -387,4 +374,4 @@ class _Solver:
         steps = [replace(st, index=k) for k, st in enumerate(steps, start=1)]
         repaired = Task(task.name, tuple(steps), task.file, task.description,
                         repairs.folded_repeat(steps, task.repeat))
-        return Repair(rank, cost / 100, tuple(edits), repaired, added, tuple(origins))
+        return Repair(rank, cost / 100, tuple(read), repaired, added, tuple(origins))

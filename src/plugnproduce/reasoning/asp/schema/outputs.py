@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import clingo
 
+from plugnproduce.reasoning.asp.schema.edits import EditTerm
 from plugnproduce.reasoning.asp.terms import Atom, predicate
 
 # ------------------------------------------------------------------ output: offered processes
@@ -260,9 +261,10 @@ class UnknownParam(Atom):
 
 @predicate("edit")
 class Edit(Atom):
-    """An edit of an optimal repair: ``insert(I,J,P)``, ``remove(I)``, ``swap(I)``, ``rebind(I,R,D)``, ...."""
+    """An edit of an optimal repair: ``insert(I,J,P)``, ``remove(I)``, ``swap(I)``, ``rebind(I,R,D)``, ...
+    (:mod:`.edits`)."""
 
-    e: clingo.Symbol
+    e: EditTerm
 
 
 @predicate("left_in")

@@ -1,4 +1,4 @@
-"""The knowledge graph: descriptions, their charts lifted to RDF, the ontology and its closure.
+"""The data graph: descriptions, their charts lifted to RDF, the ontology and its closure.
 
 This is the data graph the SHACL shapes check. Each node that stands for something in
 a file is indexed to its :class:`~plugnproduce.description.model.Where`, so a shape's
@@ -24,7 +24,7 @@ NUMBERS = frozenset(str(t) for t in (XSD.decimal, XSD.double, XSD.float, XSD.int
 
 
 @dataclass
-class KnowledgeGraph:
+class DataGraph:
     """A data graph for the shapes, and where each of its nodes comes from."""
 
     graph: rdflib.Graph = field(default_factory=rdflib.Graph)
