@@ -157,3 +157,30 @@ def test_pnp_resume_shows_the_plan_asks_and_continues_with_yes(env: dict[str, st
     assert found == ["PartFound"] * 3 + ["BinEmpty"]  # the seeded bin of 3 parts ends empty
     again = pnp(env, "resume", resumed.name.removesuffix(".jsonl"), "--yes")
     assert again.returncode == 2 and again.stderr.strip().endswith("succeeded: nothing to resume")
+
+
+def test_pnp_resume_sim_starts_the_simulated_devices_where_the_run_left_them(tmp_path: Path) -> None:
+    """A `pnp run --sim` cell ends with its run: `pnp resume --sim` simulates it again, each device in the state the
+    journal's end record left it in, on a bin of the parts left (none was taken before the fault)."""
+    env = {**os.environ, "PNP_RUNS": str(tmp_path / "runs")}
+
+    def pnp_sim(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "plugnproduce", *args], capture_output=True, text=True,
+                              timeout=600, env=env)
+
+    first = pnp_sim("run", str(UNTIL_EMPTY), "--sim", "--faults", GRIPPER_FAULT, "--bin-parts", "3", "--bin-seed",
+                    "2", "--journal", str(tmp_path / "first.jsonl"))
+    assert first.returncode == 1, first.stderr
+    left = journal_of(tmp_path / "first.jsonl")[-1]["device_states"]
+    assert left["robot"] == "at_pose"  # not its chart's initial state (home)
+    done = pnp_sim("resume", str(tmp_path / "first.jsonl"), "--sim", "--bin-parts", "3", "--bin-seed", "2", "--yes",
+                   "--journal", str(tmp_path / "resumed.jsonl"))
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr
+    records = journal_of(tmp_path / "resumed.jsonl")
+    assert [r["kind"] for r in records[:4]] == ["start", "stopped", "replan", "continue"]
+    assert records[2]["states"] == left  # the simulated devices report where the run left them
+    found = [r["params"] for r in records if r["kind"] == "event" and r["event"] == "PartLocalized"]
+    assert [f["outcome"] for f in found] == ["PartFound"] * 3 + ["BinEmpty"]
+    assert sorted(f["part_pose"] for f in found[:-1]) == sorted(p.pose for p in SimulatedBin(3, 2).parts)
+    wrong = pnp_sim("resume", str(tmp_path / "first.jsonl"), "--bin-parts", "3")
+    assert wrong.returncode == 2 and "--faults and --bin-parts work on simulated devices: add --sim" in wrong.stderr

@@ -26,7 +26,7 @@ from plugnproduce.controller.interfaces import (
     RunRefused,
 )
 from plugnproduce.controller.livecell import LiveCellSource
-from plugnproduce.controller.resume import NoCell, Resumed, continue_run, replan_live, resume_run
+from plugnproduce.controller.resume import NoCell, Resumed, SimulatedResume, continue_run, replan_live, resume_run
 from plugnproduce.controller.run import (
     DEFAULT_BIN_PARTS,
     DISCOVERY_SECONDS,
@@ -63,6 +63,7 @@ __all__ = [
     "RunRefused",
     "Runner",
     "SimulatedCellSource",
+    "SimulatedResume",
     "StateNotReported",
     "continue_run",
     "default_bin_parts",

@@ -16,7 +16,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from plugnproduce.controller.run import DISCOVERY_SECONDS, _follow_unplugs, find_devices, reported_states, start_run
+from plugnproduce.controller.run import (
+    DISCOVERY_SECONDS,
+    SIMULATED_DISCOVERY_SECONDS,
+    _follow_unplugs,
+    find_devices,
+    reported_states,
+    start_run,
+)
 from plugnproduce.description.model import Cell
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge
@@ -36,6 +43,8 @@ if TYPE_CHECKING:
     from plugnproduce.description.goalfile import Goal
     from plugnproduce.executor.report import RunReport
     from plugnproduce.executor.run import RecordObserver, TaskRun
+    from plugnproduce.protocols.upnp import SsdpNetwork
+    from plugnproduce.sim.cell import SimulatedCell
 
 Confirm = Callable[[Replan], "str | None"]
 """Shown the plan, says who confirmed it (``the operator``, ``--yes``), or None to decline."""
@@ -77,14 +86,26 @@ async def continue_run(plan: Replan, cell: Cell, devices: Cell, knowledge: Knowl
                      preamble)
 
 
+@dataclass(frozen=True)
+class SimulatedResume:
+    """Resume on simulated devices started where the run left them (the end record's states): ``faults`` as
+    ``pnp run --faults``, working on a bin of ``bin_parts`` parts placed by ``bin_seed`` (None: no bin)."""
+
+    faults: str = ""
+    bin_parts: int | None = None
+    bin_seed: int = 0
+
+
 async def resume_run(run: str | Path, cell_or_path: Cell | str | Path | None, confirm: Confirm, *,
                      goal: Goal | str | Path | None = None, journal: Path | None = None,
                      observer: RecordObserver | None = None, started: Callable[[TaskRun], None] | None = None,
-                     discovery_timeout: float | None = None, knowledge: Knowledge | None = None) -> Resumed:
-    """Resume a stopped run (``pnp resume``) on the devices discovery finds (``PNP_SSDP_PORT``): plan the rest from
-    their states, ask ``confirm`` (in a thread, while discovery goes on), and run it."""
+                     discovery_timeout: float | None = None, knowledge: Knowledge | None = None,
+                     simulate: SimulatedResume | None = None) -> Resumed:
+    """Resume a stopped run (``pnp resume``) on the devices discovery finds (``PNP_SSDP_PORT``), or with
+    ``simulate`` on simulated devices started in the states the run left them in: plan the rest from their
+    states, ask ``confirm`` (in a thread, while discovery goes on), and run it."""
     from plugnproduce.discovery import LiveCell
-    from plugnproduce.protocols.upnp import network_from_env
+    from plugnproduce.protocols.upnp import network_from_env, private_network
 
     stopped = stopped_run(run)
     where = cell_or_path if cell_or_path is not None else stopped.cell_file
@@ -92,10 +113,14 @@ async def resume_run(run: str | Path, cell_or_path: Cell | str | Path | None, co
         raise NoCell(f"run {stopped.run}: its journal names no cell file; give --cell CELL")
     the_cell, k = cell_and_knowledge(where, knowledge)
     wanted = [d.id for d in the_cell.devices]
+    network = private_network() if simulate is not None else network_from_env()
     async with contextlib.AsyncExitStack() as stack:
-        live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network_from_env(), name=the_cell.name,
+        if simulate is not None:
+            await stack.enter_async_context(_simulated(the_cell, stopped, simulate, network))
+        live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
                                                         expected=wanted))
-        devices = await find_devices(live, wanted, discovery_timeout or DISCOVERY_SECONDS)
+        devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
+                                                                         else DISCOVERY_SECONDS))
         plan = await replan_live(stopped, the_cell, devices, k, goal)
         who = await asyncio.to_thread(confirm, plan)
         if who is None:
@@ -108,3 +133,14 @@ async def resume_run(run: str | Path, cell_or_path: Cell | str | Path | None, co
             return Resumed(plan, await the_run.run())
         finally:
             follow.cancel()
+
+
+def _simulated(cell: Cell, stopped: Stopped, simulate: SimulatedResume, network: SsdpNetwork) -> SimulatedCell:
+    """The cell's devices simulated, each started in the state the stopped run left it in."""
+    from plugnproduce.sim.bin import SimulatedBin
+    from plugnproduce.sim.cell import SimulatedCell, parse_faults
+
+    left = {d: s for d, s in stopped.left.items() if any(x.id == d for x in cell.devices)}
+    parts = SimulatedBin(simulate.bin_parts, simulate.bin_seed) if simulate.bin_parts is not None else None
+    return SimulatedCell(cell.reported(left), network=network, faults=parse_faults(simulate.faults, cell.devices),
+                         bin=parts)

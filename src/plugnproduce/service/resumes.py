@@ -51,6 +51,8 @@ class Stopped:
     reason: str
     step: int | None
     """The step position it stopped at (its first fault's), None if it stopped before any step began."""
+    left: dict[str, str] = field(default_factory=dict)
+    """The state each device was left in, as the end record says (after the safe stop)."""
 
     def record(self) -> dict[str, Any]:
         """The fields of the resumed run's ``stopped`` record."""
@@ -99,8 +101,10 @@ def stopped_run(run: str | Path) -> Stopped:
     steps = [r.get("step") for r in record.of_kind("step")]
     step = fault.get("step") if fault is not None else (steps[-1] if steps else None)
     cell_file = record.start.get("cell_file")
+    left = record.end.get("device_states")
     return Stopped(run_id, record.path, task, cell_file if isinstance(cell_file, str) else None, record.status,
-                   str(record.end.get("reason", "")), step if isinstance(step, int) else None)
+                   str(record.end.get("reason", "")), step if isinstance(step, int) else None,
+                   {str(d): str(x) for d, x in left.items()} if isinstance(left, dict) else {})
 
 
 def rest_of_task(task: Task, step: int | None) -> tuple[Task, int]:

@@ -12,6 +12,7 @@ chart does not wait for in its current state is refused (XIRP ``not-accepted``, 
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import logging
 import re
 from collections.abc import Mapping
@@ -75,12 +76,16 @@ class SimulatedDevice:
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
                  faults: xirp.Faults | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
-        """``bin``: the simulated bin the device works on, if any."""
+        """``bin``: the simulated bin the device works on, if any. A device in a state it reported
+        (:meth:`DeviceDescription.reported`) starts its chart there."""
         self.description = device
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
         self.bin = bin
-        self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
+        chart = device.chart
+        if device.reported_state and [device.initial] != chart.initial:  # it starts where it was left (a resume)
+            chart = dataclasses.replace(chart, initial=[device.initial])
+        self.interpreter = Interpreter(chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
         self._loop = ChartLoop(self.interpreter)
         self._task: asyncio.Task[None] | None = None
