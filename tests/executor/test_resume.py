@@ -184,3 +184,27 @@ def test_pnp_resume_sim_starts_the_simulated_devices_where_the_run_left_them(tmp
     assert sorted(f["part_pose"] for f in found[:-1]) == sorted(p.pose for p in SimulatedBin(3, 2).parts)
     wrong = pnp_sim("resume", str(tmp_path / "first.jsonl"), "--bin-parts", "3")
     assert wrong.returncode == 2 and "--faults and --bin-parts work on simulated devices: add --sim" in wrong.stderr
+
+
+def stopped_at(task: Any, step: int) -> service.Stopped:
+    return service.Stopped("r1", Path("r1.jsonl"), task, str(CELL), "failed", "refused", step)
+
+
+def test_a_rest_not_plausible_from_the_devices_states_is_repaired_and_says_how() -> None:
+    """The gripper was left closed: the rest of pick-and-place gets the cheapest confirmed repair, opening it."""
+    task = service.task(service.builtin("tasks", "pick-and-place.yaml"))
+    plan = service.replan(stopped_at(task, 1), service.cell(CELL).reported({"gripper": "closed"}))
+    assert plan.plan == "the rest of task pick-and-place from step 1, repaired"
+    assert plan.repairs == ("insert open-gripper before step 1 (pick-and-place)",)
+    assert [s.command for s in plan.task.steps] == ["open-gripper", "pick-and-place", "move-to"]
+    assert plan.states["gripper"] == "closed"
+
+
+def test_resume_with_a_goal_plans_it_afresh_from_the_devices_states() -> None:
+    """Holding a part (gripper closed, robot at a pose), the bin-emptying goal first places it, then loops."""
+    task = service.task(UNTIL_EMPTY)
+    cell = service.cell(CELL).reported({"gripper": "closed", "robot": "at_pose"})
+    plan = service.replan(stopped_at(task, 2), cell, goal=service.builtin("goals", "empty-the-bin.yaml"))
+    assert plan.plan == "goal empty-the-bin" and plan.repairs == ()
+    assert plan.task.steps[0].command == "place" and len(plan.task.loops) == 1
+    assert service.check(plan.task, cell).plausible
