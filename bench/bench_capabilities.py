@@ -34,15 +34,17 @@ def big_cell(n: int) -> Cell:
     return Cell(f"big-{n}", tuple(replace(d, id=f"{d.id}-{k}") for k, d in zip(range(n), devices, strict=False)))
 
 
-def median_time(call: Callable[[], Capabilities], runs: int) -> tuple[float, Capabilities]:
-    """Warm median seconds of ``call`` over ``runs`` runs, and its answer."""
+def median_time(call: Callable[[], Capabilities], runs: int) -> tuple[float, Capabilities, float]:
+    """Warm median seconds of ``call`` over ``runs`` runs, its answer, and its median CPU seconds (user+sys of
+    this process)."""
     answer = call()
-    times = []
+    times, cpus = [], []
     for _ in range(runs):
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         call()
+        cpus.append(time.process_time() - c)
         times.append(time.perf_counter() - t)
-    return statistics.median(times), answer
+    return statistics.median(times), answer, max(statistics.median(cpus), 1e-9)
 
 
 def same(few: Capabilities, every: Capabilities) -> bool:
@@ -58,25 +60,28 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=20)
     args = parser.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
-    per_device = {}
+    per_device, cpu_per_device = {}, {}
     for n in (10, 100, 1000):
         cell = big_cell(n)
-        dt, caps = median_time(lambda c=cell: service.capabilities(c), args.runs if n < 1000 else 5)
+        dt, caps, cpu = median_time(lambda c=cell: service.capabilities(c), args.runs if n < 1000 else 5)
         count = sum(o.binding_count for o in caps.offered)
         size = len(str(caps.to_json()))
-        per_device[n] = dt / n
+        per_device[n], cpu_per_device[n] = dt / n, cpu / n
         target = " (target < 100 ms)" if n == 100 else ""
-        line = (f"offered commands, {n:,} devices: {1e3 * dt:.1f} ms warm{target}; {len(caps.offered)} offered, "
+        line = (f"offered commands, {n:,} devices: {1e3 * dt:.1f} ms warm{target}, CPU {1e3 * cpu:.1f} ms; "
+                f"{len(caps.offered)} offered, "
                 f"{count:,} bindings counted, {size:,} characters of JSON")
         if count <= LISTABLE:
-            old, every = median_time(lambda c=cell: service.capabilities(c, all_bindings=True), 3)
+            old, every, old_cpu = median_time(lambda c=cell: service.capabilities(c, all_bindings=True), 3)
             line += (f"; listing every binding {1e3 * old:.1f} ms ({len(str(every.to_json())):,} characters), "
-                     f"ratio {old / dt:.1f}x, same answers: {same(caps, every)}")
+                     f"ratio {old / dt:.1f}x, CPU {old_cpu / cpu:.1f}x, same answers: {same(caps, every)}")
         else:
             line += "; listing every binding not run (too many)"
         print(line, flush=True)
     print(f"time per device, 1,000 against 100 devices: {per_device[1000] / per_device[100]:.2f}x "
-          f"(no worse than linear: <= 1x); 100 against 10: {per_device[100] / per_device[10]:.2f}x")
+          f"(no worse than linear: <= 1x), CPU {cpu_per_device[1000] / cpu_per_device[100]:.2f}x; 100 against 10: "
+          f"{per_device[100] / per_device[10]:.2f}x, CPU {cpu_per_device[100] / cpu_per_device[10]:.2f}x")
+    print(f"load average after: {os.getloadavg()[0]:.1f}")
 
 
 if __name__ == "__main__":

@@ -48,6 +48,12 @@ def _server() -> tuple[subprocess.Popen[str], str]:
     return proc, line.split()[-1].rstrip("/")
 
 
+def _server_cpu(pid: int) -> float:
+    """User+sys seconds of the server process so far."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def _latencies(client: httpx.Client, rounds: int) -> dict[str, list[float]]:
     out: dict[str, list[float]] = {name: [] for name in CHEAP}
     for _ in range(rounds):
@@ -94,16 +100,23 @@ def main(rounds: int) -> None:
     try:
         with httpx.Client(base_url=url, timeout=600) as client:
             _latencies(client, 2)  # warm: the workers' first jobs
+            before = _server_cpu(proc.pid)
             idle = _latencies(client, rounds)
+            idle_cpu = _server_cpu(proc.pid) - before
             with LongLoad(url) as load:
                 time.sleep(1.0)  # let the long request reach its worker (a benchmark, not a test)
+                before = _server_cpu(proc.pid)
                 loaded = _latencies(client, rounds)
+                loaded_cpu = _server_cpu(proc.pid) - before
         print(f"pnp serve --sim, bin-picking cell; {rounds} rounds of each small request; "
               "load: another client validating a 1,000-step task, one request after another")
         print(f"{'request':37} {'idle ms':>9} {'loaded ms':>10} {'ratio':>7}")
         for name in CHEAP:
             a, b = statistics.median(idle[name]) * 1000, statistics.median(loaded[name]) * 1000
             print(f"{name:37} {a:9.1f} {b:10.1f} {b / a:7.2f}")
+        count = rounds * len(CHEAP)
+        print(f"server process CPU (not its workers) per small request: idle {1000 * idle_cpu / count:.1f} ms, "
+              f"loaded {1000 * loaded_cpu / count:.1f} ms")
         done = ", ".join(f"{d:.1f} s ({s})" for d, s in zip(load.durations, load.statuses, strict=True))
         print(f"long validations completed meanwhile: {done or 'none (still in flight, stopped at the end)'}")
     finally:

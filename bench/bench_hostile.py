@@ -44,29 +44,33 @@ def _files(folder: Path) -> dict[str, Path]:
     return out
 
 
-def _validate(path: Path) -> tuple[float, float, int]:
-    """Seconds, peak MB and exit code of ``pnp validate path``."""
+def _validate(path: Path) -> tuple[float, float, int, float]:
+    """Seconds, peak MB, exit code and CPU seconds (user+sys of the child) of ``pnp validate path``."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (str(ROOT / "src"), os.environ.get("PYTHONPATH"))))}
     start = time.perf_counter()
     proc = subprocess.Popen([sys.executable, "-m", "plugnproduce", "validate", str(path)], env=env,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     _, status, usage = os.wait4(proc.pid, 0)
-    return time.perf_counter() - start, usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status)
+    return (time.perf_counter() - start, usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status),
+            usage.ru_utime + usage.ru_stime)
 
 
 def main(rounds: int) -> None:
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores at the start", flush=True)
     baseline_file = ROOT / "descriptions" / "devices" / "gripper.ttl"
     _validate(baseline_file)  # warm: byte code and the taxonomy cache
     with tempfile.TemporaryDirectory() as folder:
         files = {"valid gripper (baseline)": baseline_file, **_files(Path(folder))}
         results = {name: [_validate(path) for _ in range(rounds)] for name, path in files.items()}
     base = statistics.median(r[0] for r in results["valid gripper (baseline)"])
+    base_cpu = statistics.median(r[3] for r in results["valid gripper (baseline)"])
     print(f"pnp validate, median of {rounds} (load average now {os.getloadavg()[0]:.2f}):")
     for name, runs in results.items():
         seconds = statistics.median(r[0] for r in runs)
-        peak = max(r[1] for r in runs)
-        print(f"  {name:<26} {seconds:6.2f} s = {seconds / base:4.2f}× baseline, peak {peak:5.0f} MB, "
-              f"exit {runs[0][2]}")
+        peak, cpu = max(r[1] for r in runs), statistics.median(r[3] for r in runs)
+        print(f"  {name:<26} {seconds:6.2f} s = {seconds / base:4.2f}× baseline, CPU {cpu:6.2f} s = "
+              f"{cpu / base_cpu:4.2f}× baseline, peak {peak:5.0f} MB, exit {runs[0][2]}")
+    print(f"load average at the end {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

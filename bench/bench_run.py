@@ -17,6 +17,7 @@ import atexit
 import os
 import statistics
 import tempfile
+import time
 from pathlib import Path
 
 from plugnproduce import controller, service
@@ -25,7 +26,8 @@ from plugnproduce.executor.journal import read_journal
 
 def busy_time(records: list[dict[str, object]]) -> float:
     """Length of the union of the intervals in which a device works on a command."""
-    intervals, waiting = [], {}
+    intervals: list[tuple[float, float]] = []
+    waiting: dict[object, float] = {}
     for r in records:
         if r["kind"] == "command":
             waiting.setdefault(r["device"], float(r["t"]))  # type: ignore[arg-type]
@@ -54,6 +56,7 @@ def cycles(records: list[dict[str, object]]) -> list[tuple[float, float]]:
 async def main(runs: int) -> None:
     task, cell = service.builtin("tasks", "bin-picking.yaml"), service.builtin("cells", "bin-picking.yaml")
     walls, devices = [], []
+    started, started_cpu = time.perf_counter(), time.process_time()
     with tempfile.TemporaryDirectory() as folder:
         for i in range(runs):
             report = await controller.run_task(task, cell, simulate=True, journal=Path(folder) / f"run{i}.jsonl")
@@ -61,11 +64,15 @@ async def main(runs: int) -> None:
             for wall, busy in cycles(read_journal(report.journal).records):
                 walls.append(wall)
                 devices.append(busy)
+    wall, cpu = time.perf_counter() - started, time.process_time() - started_cpu
     overhead = [w - d for w, d in zip(walls, devices, strict=True)]
     print(f"bin-pick + place cycle on the simulated cell, {len(walls)} cycles: "
           f"median {1000 * statistics.median(walls):.0f} ms = device time {1000 * statistics.median(devices):.0f} ms"
           f" + controller overhead {1000 * statistics.median(overhead):.1f} ms "
           f"({100 * statistics.median(overhead) / statistics.median(walls):.1f} %)")
+    print(f"{runs} runs (check, generation, devices and controller in this process): wall {wall:.2f} s, "
+          f"CPU {cpu:.2f} s = {100 * cpu / wall:.0f} % of the wall time; the controller's own CPU apart: "
+          "bench/bench_overhead.py")
 
 
 if __name__ == "__main__":

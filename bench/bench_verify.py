@@ -1,6 +1,7 @@
 """Benchmark of verification over every interleaving (prints figures; not a test).
 
     python bench/bench_verify.py [--steps 6 100] [--repeat 3] [--naive-limit 100000]
+    python bench/bench_verify.py --growth [BOUND ...]
 
 Two families of tasks, each of ``--steps`` steps, with the program already generated:
 
@@ -23,6 +24,12 @@ For each:
   stopped after ``--naive-limit`` paths. Its verdict must agree when it finishes.
 
 Each time is the best of ``--repeat`` measurements.
+
+Then **growth** (``--growth``): the bin-picking until-empty task (localise, pick, place in a loop
+until the bin is empty) with its loop bound raised so that verification explores about 10², 10³,
+10⁴ and 10⁵ configurations. Each row prints the states, the wall and CPU time (user+sys of this
+process) of one verification, states per CPU second, and that rate as a ratio to the smallest
+size's, measured in the same run: time per state is constant when the ratio stays near 1.
 """
 
 from __future__ import annotations
@@ -131,6 +138,41 @@ def measure(family: str, steps: int, repeat: int, limit: int, folder: Path) -> N
           f"= {t_verify / t_sim:5.1f}x simulate | naive {t_naive * 1000:8.1f} ms {naive_verdict}, {walked} paths")
 
 
+UNTIL_EMPTY = TASKS / "bin-picking-until-empty.yaml"
+GROWTH = (4, 42, 420, 4_200)
+"""Loop bounds of the until-empty task: about 24 configurations per iteration, so 10² to 10⁵ states."""
+
+
+def _until_empty(text: str, bound: int, folder: Path) -> Path:
+    path = folder / f"until-empty-{bound}.yaml"
+    path.write_text(text.replace("max: 100\n", f"max: {bound}\n"), encoding="utf-8")
+    return path
+
+
+def growth(bounds: tuple[int, ...], folder: Path) -> None:
+    """Print states/s of verification of the until-empty task at each loop bound, and the ratio to the first."""
+    cell_path = FAMILIES["bin-picking"][1]
+    cell, knowledge = service.cell(cell_path), service.knowledge_for_cell(cell_path)
+    text = UNTIL_EMPTY.read_text(encoding="utf-8")
+    if "max: 100\n" not in text:
+        raise SystemExit(f"{UNTIL_EMPTY.name} no longer has 'max: 100': update this benchmark")
+    # once untimed: the first verification of a process pays its warm-up (imports, compiled charts)
+    verify(service.plan_run(_until_empty(text, bounds[0], folder), cell, knowledge), cell, Budget(10_000_000, 3600))
+    first = None
+    for bound in bounds:
+        generated = service.plan_run(_until_empty(text, bound, folder), cell, knowledge)
+        start, start_cpu = time.perf_counter(), time.process_time()
+        result = verify(generated, cell, Budget(10_000_000, 3600))
+        cpu, wall = time.process_time() - start_cpu, time.perf_counter() - start
+        if result.verdict != "proved":
+            raise RuntimeError(f"loop bound {bound}: verification answered {result.verdict!r}")
+        rate = result.states / cpu
+        first = first or rate
+        print(f"until-empty, loop bound {bound:>5}: {result.states:>7} states {result.transitions:>7} transitions | "
+              f"wall {wall:7.2f} s CPU {cpu:7.2f} s | {rate:8,.0f} states per CPU second = {rate / first:4.2f}x "
+              f"the smallest's | load {os.getloadavg()[0]:.2f}", flush=True)
+
+
 def main() -> None:
     """Run the benchmark and print the figures."""
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -138,8 +180,13 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--naive-limit", type=int, default=100_000)
     parser.add_argument("--tasks", nargs="+", choices=sorted(FAMILIES), default=sorted(FAMILIES, reverse=True))
+    parser.add_argument("--growth", type=int, nargs="*", default=None, metavar="BOUND",
+                        help=f"only the growth rows, at these loop bounds (none given: {' '.join(map(str, GROWTH))})")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
+        if args.growth is not None:
+            growth(tuple(args.growth) or GROWTH, Path(tmp))
+            return
         for family in args.tasks:
             for steps in args.steps:
                 measure(family, steps, args.repeat, args.naive_limit, Path(tmp))

@@ -3,6 +3,7 @@
 Run ``python bench/bench_xirp.py [--iterations N] [--rounds R]``. One process, one
 event loop, connections kept open side by side:
 
+* blocking echo (the floor): a blocking-socket echo, the server in a thread, no event loop;
 * callback echo (the baseline): written in XIRP's own style, ``asyncio.Protocol``
   callbacks on both sides. The client writes a payload the size of an XIRP request
   frame and awaits a future; the server's ``data_received`` writes it back; the
@@ -19,7 +20,8 @@ event loop, connections kept open side by side:
 
 They run in alternating blocks (``R`` rounds of ``N / R`` round trips each), so a
 change of machine load hits all alike. Prints the median and the 99th percentile
-of each and the ratios to the callback echo (target ≤ 3).
+of each, the CPU time per round trip (user+sys of this process, which holds both ends), the
+ratios to the callback echo (target ≤ 2.5) and the callback echo's to the floor.
 """
 
 from __future__ import annotations
@@ -28,7 +30,9 @@ import argparse
 import asyncio
 import atexit
 import os
+import socket
 import statistics
+import threading
 import time
 from collections.abc import Awaitable, Callable, Mapping
 
@@ -38,6 +42,9 @@ HOST = "127.0.0.1"
 PARAMS: dict[str, Value] = {"Target": Pose(0.4, 0.1, 0.2, 0.0, 180.0, 0.0), "Speed": 0.25}
 WARM_UP = 200
 BASELINE = "callback echo"
+FLOOR = "blocking echo"
+TARGET = 2.5
+"""Most XIRP round trip (plain handler), as a multiple of the callback echo's."""
 
 
 async def _echo(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
@@ -112,6 +119,45 @@ class CallbackEcho:
         await done
 
 
+class BlockingEcho:
+    """The floor: a blocking-socket echo on loopback, the server in a thread, the client a plain ``socket``
+    (``sendall``, then ``recv`` until the whole payload is back), no event loop on either side."""
+
+    def __init__(self, payload: bytes) -> None:
+        self.payload = payload
+        self._listener = socket.create_server((HOST, 0))
+        self._thread = threading.Thread(target=self._serve, daemon=True)
+        self._client: socket.socket | None = None
+
+    def _serve(self) -> None:
+        connection, _ = self._listener.accept()
+        with connection:
+            connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            while data := connection.recv(65536):
+                connection.sendall(data)
+
+    async def __aenter__(self) -> BlockingEcho:
+        self._thread.start()
+        self._client = socket.create_connection(self._listener.getsockname())
+        self._client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        return self
+
+    async def __aexit__(self, *exc_info: object) -> None:
+        if self._client is not None:
+            self._client.close()
+        self._thread.join(5)
+        self._listener.close()
+
+    async def round_trip(self) -> None:
+        """Write the payload, block until it is all back (the event loop waits meanwhile)."""
+        if self._client is None:
+            raise RuntimeError("echo not started")
+        self._client.sendall(self.payload)
+        left = len(self.payload)
+        while left > 0:
+            left -= len(self._client.recv(65536))
+
+
 class StreamsEcho:
     """An asyncio-streams TCP echo on loopback: one connection, a payload written and read back whole."""
 
@@ -158,14 +204,17 @@ async def _block(call: Callable[[], Awaitable[object]], count: int, into: list[f
         into.append((clock() - start) / 1000)
 
 
-async def measure(iterations: int, rounds: int) -> dict[str, list[float]]:
-    """Round-trip times (µs) of the echoes and of XIRP requests, in alternating blocks."""
+async def measure(iterations: int, rounds: int) -> tuple[dict[str, list[float]], dict[str, float]]:
+    """Round-trip times (µs) of the echoes and of XIRP requests, in alternating blocks, and the CPU time (s,
+    user+sys of this process, both ends of each connection being in it) each kind took in all."""
     payload = encode_frame(Request("1", "MoveTo", PARAMS))
-    times: dict[str, list[float]] = {name: [] for name in (BASELINE, "streams echo", "XIRP, plain handler",
+    times: dict[str, list[float]] = {name: [] for name in (BASELINE, FLOOR, "streams echo", "XIRP, plain handler",
                                                            "XIRP, async handler")}
+    cpu: dict[str, float] = dict.fromkeys(times, 0.0)
     robot = "http://plugnproduce.org/ontology#Robot"
     async with (
         CallbackEcho(payload) as echo,
+        BlockingEcho(payload) as floor,
         StreamsEcho(payload) as streams,
         XirpServer("robot", robot, _plain_handler, host=HOST) as plain,
         XirpServer("robot", robot, _async_handler, host=HOST) as awaited,
@@ -174,6 +223,7 @@ async def measure(iterations: int, rounds: int) -> dict[str, list[float]]:
     ):
         calls: dict[str, Callable[[], Awaitable[object]]] = {
             BASELINE: echo.round_trip,
+            FLOOR: floor.round_trip,
             "streams echo": streams.round_trip,
             "XIRP, plain handler": lambda: plain_client.request("MoveTo", PARAMS),
             "XIRP, async handler": lambda: async_client.request("MoveTo", PARAMS),
@@ -182,8 +232,10 @@ async def measure(iterations: int, rounds: int) -> dict[str, list[float]]:
             await _block(call, WARM_UP, [])
         for _ in range(rounds):
             for name, call in calls.items():
+                began = time.process_time()
                 await _block(call, iterations // rounds, times[name])
-    return times
+                cpu[name] += time.process_time() - began
+    return times, cpu
 
 
 def _summary(times: list[float]) -> tuple[float, float]:
@@ -193,7 +245,7 @@ def _summary(times: list[float]) -> tuple[float, float]:
 
 async def main(iterations: int, rounds: int) -> float:
     """Run the measurements, print them, return the ratio of the medians (plain handler / callback echo)."""
-    times = await measure(iterations, rounds)
+    times, cpu = await measure(iterations, rounds)
     raw_median, raw_p99 = _summary(times[BASELINE])
     size = len(encode_frame(Request("1", "MoveTo", PARAMS)))
     print(f"request frame {size} bytes; {iterations // rounds * rounds} round trips each, {rounds} alternating blocks")
@@ -201,11 +253,14 @@ async def main(iterations: int, rounds: int) -> float:
     for name, samples in times.items():
         median, p99 = _summary(samples)
         ratios[name] = median / raw_median
-        line = f"{name:20} median {median:6.1f} µs   p99 {p99:6.1f} µs"
+        line = f"{name:20} median {median:6.1f} µs   p99 {p99:6.1f} µs   CPU {1e6 * cpu[name] / len(samples):6.1f} µs"
         if name != BASELINE:
-            line += f"   ratio to callback echo: median {median / raw_median:4.2f}, p99 {p99 / raw_p99:4.2f}"
+            line += (f"   ratio to callback echo: median {median / raw_median:4.2f}, p99 {p99 / raw_p99:4.2f}, "
+                     f"CPU {cpu[name] / cpu[BASELINE]:4.2f}")
         print(line)
-    print("target: median ratio ≤ 3")
+    print(f"callback echo / blocking echo: median {raw_median / _summary(times[FLOOR])[0]:4.2f}, "
+          f"CPU {cpu[BASELINE] / cpu[FLOOR]:4.2f}")
+    print(f"target: XIRP (plain handler) ≤ {TARGET}x the callback echo")
     return ratios["XIRP, plain handler"]
 
 

@@ -29,6 +29,11 @@ LAYERS = {
 }
 """Rank of each subpackage or top-level module: a module imports only from lower ranks or its own part."""
 
+FACES = ("cli", "hmi")
+FACES_MAY_IMPORT = {"service", "controller", "errors", "lazy"}
+"""Besides their own presentation code (and the command line the HMI it serves), the faces import only these: the
+concepts' types and helpers they name come through the service or the controller."""
+
 REASONING_PARTS = ("asp", "checks", "repairs", "explanation")
 """The parts of ``reasoning/`` in order: each imports only from itself and the parts before it."""
 
@@ -47,7 +52,8 @@ def _part(module: str) -> str | None:
 
 
 def _imports(path: Path) -> set[str]:
-    """Every module ``path`` imports (``from plugnproduce import service`` counts as ``plugnproduce.service``)."""
+    """Every module ``path`` imports (``from plugnproduce import service`` counts as ``plugnproduce.service``),
+    including those it imports on first use (``lazy_module("plugnproduce.service")``) and for type checkers."""
     out: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.Import):
@@ -55,7 +61,10 @@ def _imports(path: Path) -> set[str]:
         elif isinstance(node, ast.ImportFrom) and node.module:
             out.add(node.module)
             if node.module == "plugnproduce":
-                out |= {f"plugnproduce.{a.name}" for a in node.names}
+                out |= {f"plugnproduce.{a.name}" for a in node.names if a.name != "__version__"}
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "lazy_module"
+              and node.args and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str)):
+            out.add(node.args[0].value)
     return out
 
 
@@ -70,6 +79,22 @@ def test_imports_point_down_the_layers(path: Path) -> None:
     upward = sorted(m for m in _imports(path) if (part := _part(m)) in LAYERS and part != own
                     and LAYERS[part] >= LAYERS[own])
     assert upward == [], f"{own} (rank {LAYERS[own]}) imports {upward}"
+
+
+@pytest.mark.parametrize("face", FACES)
+def test_the_faces_import_only_the_service_and_the_controller(face: str) -> None:
+    allowed = FACES_MAY_IMPORT | set(FACES if face == "cli" else (face,))  # pnp serve starts the HMI
+    reached = sorted(f"{p.relative_to(SRC)}: {m}" for p in (SRC / face).rglob("*.py") for m in _imports(p)
+                     if (part := _part(m)) is not None and part not in allowed)
+    assert reached == []
+
+
+def test_the_faces_check_sees_an_import_on_first_use_and_for_type_checkers(tmp_path: Path) -> None:
+    module = tmp_path / "face.py"
+    module.write_text("from typing import TYPE_CHECKING\nfrom plugnproduce.lazy import lazy_module\n"
+                      "if TYPE_CHECKING:\n    from plugnproduce.discovery import LiveCell\n"
+                      "else:\n    sim = lazy_module('plugnproduce.sim.control')\n", encoding="utf-8")
+    assert {"plugnproduce.discovery", "plugnproduce.sim.control"} <= _imports(module)
 
 
 def test_scxml_is_parsed_written_and_named_only_in_statechart() -> None:

@@ -120,6 +120,16 @@ def test_help_is_printed_from_the_cache_folder_the_second_time(tmp_path: Path) -
     assert max(map(len, narrow.splitlines())) <= 60 < max(map(len, first.splitlines()))
 
 
+def test_plugging_a_simulated_device_loads_only_the_control_channel() -> None:
+    """``pnp sim plug`` talks to a running simulated cell over its control channel: none of the network stack, the
+    service or the executor (the controller's names are imported on first use)."""
+    loaded = _loaded_after(_command("sim", "plug", "gripper", "--control", "127.0.0.1:1"))  # nothing listens there
+    assert "plugnproduce.sim.control" in loaded
+    unneeded = ("aiohttp", "async_upnp_client", "rdflib", "owlready2", "clingo", "plugnproduce.service",
+                "plugnproduce.discovery", "plugnproduce.executor", "plugnproduce.protocols", "plugnproduce.sim.cell")
+    assert sorted(h for h in unneeded if h in loaded) == []
+
+
 @pytest.mark.parametrize("package", ["plugnproduce.reasoning", "plugnproduce.reasoning.asp", "plugnproduce.reasoning.checks",
                                      "plugnproduce.reasoning.repairs", "plugnproduce.reasoning.explanation",
                                      "plugnproduce.batch"])

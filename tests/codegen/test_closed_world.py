@@ -18,6 +18,8 @@ from tests.conftest import edit
 VALID_TASKS = ["bin-picking", "bin-picking-in-rounds", "bin-picking-localized", "bin-picking-then-home",
                "bin-picking-until-empty",
                "pick-and-place"]
+OTHER_CELLS = {"pick-and-screw": "mixed"}
+"""Tasks of a built-in cell other than bin-picking: the task and its cell."""
 
 
 def run(chart: bytes) -> set[str]:
@@ -33,9 +35,16 @@ def test_closed_world_chart_reaches_done(task, bin_picking_cell, processes) -> N
     assert run(closed_world_chart(generated, bin_picking_cell)) == {"done"}
 
 
+@pytest.mark.parametrize("task", OTHER_CELLS)
+def test_closed_world_chart_of_another_cell_reaches_done(task, processes) -> None:
+    """The mixed cell's task (XIRP, UPnP and OPC UA devices): its OPC UA requests are plain events there too."""
+    cell = service.cell(service.builtin("cells", f"{OTHER_CELLS[task]}.yaml"))
+    assert run(closed_world_chart(generate(task, cell, processes), cell)) == {"done"}
+
+
 def test_every_builtin_valid_task_is_covered() -> None:
     names = {p.stem for p in (descriptions_path() / "tasks").glob("*.yaml")}
-    assert names - {"bin-picking-invalid"} == set(VALID_TASKS)
+    assert names - {"bin-picking-invalid"} == set(VALID_TASKS) | set(OTHER_CELLS)
 
 
 def test_broken_device_model_does_not_reach_done(tmp_path: Path, bin_picking_cell, processes) -> None:

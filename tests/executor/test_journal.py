@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -54,3 +55,22 @@ def test_describe_reads_like_a_log() -> None:
         "→ gripper: xirp.request.Close"
     )
     assert describe({"kind": "end", "outcome": "failed", "reason": "timeout"}) == "end: failed (timeout)"
+
+
+def test_what_the_run_observed_is_flushed_at_once_and_fsynced_before_the_next_command(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path, synced, real_fsync = tmp_path / "j.jsonl", list[int](), os.fsync
+
+    def counting(fd: int) -> None:  # how many records were on disk at each fsync
+        synced.append(len(read_journal(path).records))
+        real_fsync(fd)
+
+    monkeypatch.setattr("os.fsync", counting)
+    with Journal(path) as journal:
+        journal.write("start", task="t")
+        journal.write("step", step=1)
+        journal.write("state", step=1, device="robot", state="moving")
+        assert [r["kind"] for r in read_journal(path).records] == ["start", "step", "state"]  # another reader sees them
+        journal.write("command", step=1, device="robot", command="MoveTo", params={})
+        journal.write("event", step=1, device="robot", event="motion_done", params={})
+    assert synced == [1, 4, 5]  # start; the command with what came before it; the event when the journal closes

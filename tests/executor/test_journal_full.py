@@ -48,9 +48,9 @@ def test_a_failed_write_is_raised_with_its_record_and_nothing_more_is_written(tm
 
         monkeypatch.setattr("os.fsync", failing)
         with pytest.raises(JournalWriteError, match="cannot be written: No space left on device") as caught:
-            journal.write("step", step=1)
-        assert caught.value.record["kind"] == "step"
+            journal.write("command", step=1)
+        assert caught.value.record["kind"] == "command"
         monkeypatch.setattr("os.fsync", real_fsync)
         with pytest.raises(JournalWriteError):
             journal.write("end", outcome="failed")  # a torn line stays the last one
-    assert [r["kind"] for r in read_journal(tmp_path / "j.jsonl").records] == ["start", "step"]
+    assert [r["kind"] for r in read_journal(tmp_path / "j.jsonl").records] == ["start", "command"]

@@ -270,9 +270,35 @@ BARE: dict[str, bytes] = {
     "request, bad name": f'<request {NS} id="17" name="9"/>'.encode(),
     "request, other namespace": b'<request xmlns="urn:plugnproduce-org:xirp:2" id="17" name="Open"/>',
 }
+_POSE = '<pose name="Target">0.4 0.1 0.2 0.0 180.0 -90.5</pose>'
+TYPED: dict[str, bytes] = {
+    "request": f'<request {NS} id="17" name="MoveTo">{_POSE}<decimal name="Speed">0.25</decimal>'
+               '<integer name="Repeat">-3</integer><boolean name="Careful">true</boolean></request>'.encode(),
+    "response": f'<response {NS} id="7"><decimal name="Force">39.5</decimal><boolean name="Ok">false</boolean>'
+                '</response>'.encode(),
+    "request, leading zeros and -0": f'<request {NS} id="1" name="A"><decimal name="x">-007.50</decimal>'
+                                     '<integer name="n">-0</integer></request>'.encode(),
+    "request, a name twice": f'<request {NS} id="1" name="A"><decimal name="x">1</decimal>'
+                             '<decimal name="x">2</decimal></request>'.encode(),
+    "response, a name twice": f'<response {NS} id="1"><boolean name="x">true</boolean>'
+                              '<integer name="x">2</integer></response>'.encode(),
+    "request, exponent": f'<request {NS} id="1" name="A"><decimal name="x">1e5</decimal></request>'.encode(),
+    "request, boolean 1": f'<request {NS} id="1" name="A"><boolean name="x">1</boolean></request>'.encode(),
+    "request, pose of five": f'<request {NS} id="1" name="A"><pose name="p">1 2 3 4 5</pose></request>'.encode(),
+    "request, pose of seven": f'<request {NS} id="1" name="A"><pose name="p">1 2 3 4 5 6 7</pose></request>'.encode(),
+    "request, integer as decimal": f'<request {NS} id="1" name="A"><integer name="n">1.5</integer></request>'.encode(),
+    "request, huge integer": f'<request {NS} id="1" name="A"><integer name="n">{"9" * 30}</integer>'
+                             '</request>'.encode(),
+    "request, string": f'<request {NS} id="1" name="A"><string name="s">a &amp; b</string></request>'.encode(),
+    "request, bad value name": f'<request {NS} id="1" name="A"><decimal name="9x">1</decimal></request>'.encode(),
+    "request, unknown element": f'<request {NS} id="1" name="A"><float name="x">1</float></request>'.encode(),
+    "request, spaced": f'<request {NS} id="1" name="A"><decimal name="x"> 1</decimal></request>'.encode(),
+    "request, comment": f'<request {NS} id="1" name="A"><decimal name="x">1<!-- c --></decimal></request>'.encode(),
+    "response, failure": f'<response {NS} id="1"><failure code="busy">no</failure></response>'.encode(),
+}
 
 
-@pytest.mark.parametrize("data", BARE.values(), ids=BARE.keys())
+@pytest.mark.parametrize("data", [*BARE.values(), *TYPED.values()], ids=[*BARE, *(f"typed {k}" for k in TYPED)])
 def test_the_fast_path_for_bare_messages_agrees_with_the_full_path(data: bytes) -> None:
     try:
         full: Message | MessageError = _decode_document(data, "x")
@@ -287,6 +313,18 @@ def test_the_fast_path_for_bare_messages_agrees_with_the_full_path(data: bytes) 
         assert fast.code == full.code
     else:
         assert fast == full
+
+
+def test_requests_and_responses_with_numbers_are_read_without_the_full_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    def full_path(data: bytes, source: str) -> Message:
+        raise AssertionError("took the full path")
+
+    monkeypatch.setattr("plugnproduce.protocols.xirp.decoding._decode_document", full_path)
+    assert decode(TYPED["request"]) == Request("17", "MoveTo", {"Target": POSE, "Speed": 0.25, "Repeat": -3,
+                                                                "Careful": True})
+    assert decode(encode(Response("7", {"Force": 39.5, "Done": True}))) == Response("7", {"Force": 39.5, "Done": True})
+    with pytest.raises(AssertionError, match="full path"):
+        decode(TYPED["request, a name twice"])
 
 
 def test_the_canonical_bare_messages_are_what_encode_writes() -> None:

@@ -22,7 +22,7 @@ CASES = [
     ("DeviceShape/skill", "devices", "cnc", "a pnp:CNCMachine", "a pnp:Machine", 6,
      "no skill, declared or implied by its class"),
     ("DeviceShape/protocol", "devices", "gripper", "pnp:protocol pnp:XIRP", "pnp:protocol pnp:Modbus", 6,
-     "exactly one pnp:protocol, pnp:XIRP or pnp:UPnP"),
+     "exactly one pnp:protocol, pnp:XIRP, pnp:UPnP or pnp:OPCUA"),
     ("DeviceShape/endpoint", "devices", "robot", '"xirp://127.0.0.1:0"', '"127.0.0.1"', 6, "pnp:endpoint"),
     ("DeviceShape/chart", "devices", "gripper", "pnp:stateChart <gripper.scxml> ;", "", 6, "pnp:stateChart"),
     ("DeviceShape/cost", "devices", "gripper", "pnp:cost 1800", "pnp:cost -5", 6, "pnp:cost"),

@@ -194,6 +194,17 @@ EXPECTED = {
     ("bin-picking", "bin-picking"): (True, "proved", set()),
     ("pick-and-place", "assembly"): (False, None, {"device_limit", "no_device"}),
     ("pick-and-place", "bin-picking"): (True, "proved", set()),
+    ("bin-picking-in-rounds", "mixed"): (False, None, {"absent"}),  # binds binpicking-pc, not in the mixed cell
+    ("bin-picking-invalid", "mixed"): (False, None, {"wrong_state"}),
+    ("bin-picking-localized", "mixed"): (False, None, {"absent"}),
+    ("bin-picking-then-home", "mixed"): (False, None, {"absent"}),
+    ("bin-picking-until-empty", "mixed"): (False, None, {"absent"}),
+    ("bin-picking", "mixed"): (False, None, {"absent"}),
+    ("pick-and-place", "mixed"): (True, "proved", set()),
+    ("pick-and-screw", "assembly"): (False, None, {"absent", "device_limit", "wrong_state"}),
+    ("pick-and-screw", "bin-picking"): (False, None, {"absent"}),
+    ("pick-and-screw", "mixed"): (True, "proved", set()),  # XIRP, UPnP and OPC UA devices
+    ("opcua-glue", "opcua-glue-cell"): (True, "proved", set()),
     ("machine-tending", "machine-tending"): (True, "proved", set()),
     ("machining-door-open", "machine-tending"): (False, None, {"wrong_state"}),
     ("close-gripper", "bin-picking-locked"): (False, None, {"stuck"}),

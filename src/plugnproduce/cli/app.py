@@ -17,7 +17,7 @@ from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import DescriptionError, PlugNProduceError, bug_message
 
 if TYPE_CHECKING:  # the knowledge is loaded by the commands that need it
-    from plugnproduce.knowledge import Knowledge
+    from plugnproduce.service import Knowledge
 
 app = PlainTyper(
     no_args_is_help=True,
@@ -53,7 +53,7 @@ INTERFACE_OPTION = typer.Option(None, "--interface", metavar="NAME|ADDRESS",
 def interface_address(interface: str | None) -> str:
     """The address ``--interface`` (else ``PNP_INTERFACE``, else loopback) names; an unknown one is exit 2, said
     before anything is loaded."""
-    from plugnproduce.protocols.interface import chosen_address
+    from plugnproduce.controller import chosen_address
 
     return chosen_address(interface)
 

@@ -27,11 +27,10 @@ from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:  # the network stack is imported by the commands that use it
     from plugnproduce import service
-    from plugnproduce.description.model import Cell
-    from plugnproduce.discovery import CellChange, LiveCell
-    from plugnproduce.sim import control
+    from plugnproduce.controller import CellChange, LiveCell, devices
+    from plugnproduce.service import Cell
 else:
-    control = lazy_module("plugnproduce.sim.control")
+    devices = lazy_module("plugnproduce.controller.devices")
     service = lazy_module("plugnproduce.service")
 
 sim_app = PlainTyper(no_args_is_help=True, rich_markup_mode=None,
@@ -126,13 +125,10 @@ class Search:
 
 
 async def _discover(json_out: bool, watch: bool, search: Search, address: str) -> list[str]:
-    from plugnproduce.discovery import LiveCell
-    from plugnproduce.protocols.upnp import network_from_env
-
     began = time.monotonic()
-    async with LiveCell(knowledge().taxonomy, network=network_from_env(address), search_timeout=search.timeout,
-                        expected=search.wanted, expected_count=search.expect,
-                        quiet=None if search.waits else search.settle) as live:
+    async with devices.discovery(knowledge(), search_timeout=search.timeout, expected=search.wanted,
+                                 expected_count=search.expect, quiet=None if search.waits else search.settle,
+                                 interface=address) as live:
         cell, seconds = live.cell, time.monotonic() - began
         missing = search.missing(cell)
         _show_found(live, cell, json_out, watch, {"searched_seconds": round(seconds, 1), "missing": missing,
@@ -186,7 +182,7 @@ def _address(control_address: str | None) -> tuple[str, int]:
         if not host or not port.isdigit():
             fail(f"--control: expected HOST:PORT; found {control_address!r}")
         return host, int(port)
-    return control.read_state()
+    return devices.control_address()
 
 
 CONTROL = typer.Option(None, "--control", metavar="HOST:PORT",
@@ -224,13 +220,13 @@ def sim_unplug(device: str = typer.Argument(..., metavar="DEVICE", help="The id 
 def _control(op: str, device: str, control_address: str | None) -> None:
     address = _address(control_address)
     try:
-        devices = asyncio.run(control.request(address, op, device))
+        running = asyncio.run(devices.control_request(address, op, device))
     except ProtocolConnectionError as exc:  # the address the cell started last recorded: it may have stopped
         hint = "" if control_address else "; start a cell with 'pnp sim up CELL', or name one with --control HOST:PORT"
         fail(f"error: {exc}{hint}")
     except ProtocolError as exc:
         fail(f"error: {exc}")
-    typer.echo(f"{op}ged {device}; running: {', '.join(devices)}")
+    typer.echo(f"{op}ged {device}; running: {', '.join(running)}")
 
 
 @sim_app.command("up")
@@ -254,17 +250,12 @@ def sim_up(
 
     Exit 0 stopped by Ctrl-C or SIGTERM, 2 bad input (a cell that cannot be read or started).
     """
-    from plugnproduce.protocols.upnp import network_from_env
-    from plugnproduce.sim.bin import SimulatedBin
-    from plugnproduce.sim.cell import SimulatedCell, parse_faults, run_simulated_cell
-
-    network = network_from_env(interface_address(interface))
+    address = interface_address(interface)  # an unknown interface is said before anything is loaded
     the_cell = service.cell(cell, knowledge())
     k = knowledge(cell)
-    sim = SimulatedCell(the_cell, catalogue=service.catalogue(knowledge=k), network=network,
-                        faults=parse_faults(faults, the_cell.devices), taxonomy=k.taxonomy,
-                        bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None)
+    sim = devices.simulated_cell(the_cell, service.catalogue(knowledge=k), k, faults, bin_parts, bin_seed,
+                                 interface=address)
     try:
-        asyncio.run(run_simulated_cell(sim, state_file or control.default_state_file(), echo=typer.echo))
+        asyncio.run(devices.run_simulated(sim, state_file, echo=typer.echo))
     except KeyboardInterrupt:
         typer.echo("stopped")

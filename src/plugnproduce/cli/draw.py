@@ -23,6 +23,6 @@ def draw(
 
     Exit 0 drawn, 2 bad input (an unreadable chart, an unknown picture format).
     """
-    from plugnproduce.drawing import draw_chart
+    from plugnproduce.service.drawings import draw
 
-    typer.echo(f"wrote {draw_chart(chart, output, expand=step)}")
+    typer.echo(f"wrote {draw(chart, output, step)}")

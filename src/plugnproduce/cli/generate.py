@@ -50,14 +50,12 @@ def generate(
     3 verification inconclusive within its budget (nothing is written; see --max-states, --timeout, --no-verify).
     """
     from plugnproduce.cli.verify import budget, exit_code
-    from plugnproduce.codegen import ImplausibleStep
-
     limits = None if no_verify else budget(max_states, timeout)
     try:
         generated = service.generate(task, cell, per_device, knowledge(cell), verify=limits)
     except service.ImplausibleTask as exc:
         refuse(exc, "nothing written", json_out)
-    except ImplausibleStep as exc:  # the check passed it, yet its code cannot be built: a finding, at its line
+    except service.ImplausibleStep as exc:  # the check passed it, yet its code cannot be built: a finding, at its line
         typer.echo(f"{task}:{exc.step.line or 1}: {exc}; nothing written", err=True)
         raise typer.Exit(1) from None
     except service.Unverified as exc:

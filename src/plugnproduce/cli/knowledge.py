@@ -33,7 +33,7 @@ def vocab(json_out: bool = JSON_OPTION,
 
     Exit 0 listed, 2 bad input (a library that cannot be read).
     """
-    from plugnproduce.knowledge.vocab import taxonomy_tree, vocabulary, vocabulary_text, vocabulary_tree
+    from plugnproduce.service import taxonomy_tree, vocabulary, vocabulary_text, vocabulary_tree
 
     if tree and json_out:
         emit_json(taxonomy_tree(knowledge().taxonomy))
@@ -121,7 +121,7 @@ def export(
 
     Exit 0 written, 2 bad input.
     """
-    from plugnproduce.ontology.export import FORMATS
+    from plugnproduce.service import ONTOLOGY_FORMATS as FORMATS
 
     if fmt not in FORMATS:
         fail(f"--format {fmt!r}: expected one of {', '.join(FORMATS)}")

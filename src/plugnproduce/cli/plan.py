@@ -17,7 +17,7 @@ from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
     from plugnproduce import service
-    from plugnproduce.planning import Unreachable
+    from plugnproduce.service import Unreachable
 else:
     service = lazy_module("plugnproduce.service")
 
@@ -40,9 +40,7 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
     """
     k = knowledge(cell)
     the_cell = _cell(cell, live, discovery_timeout, interface)
-    from plugnproduce.description.model import Link
-    from plugnproduce.ontology.vocabulary import local_name
-    from plugnproduce.planning import Unreachable  # here, not at the top: `pnp --help` loads none of it
+    from plugnproduce.service import Link, Unreachable, local_name  # here, not at the top: `pnp --help` loads none
 
     if pddl is not None:
         domain, problem = service.plan_pddl(goal, the_cell, k)

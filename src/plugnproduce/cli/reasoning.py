@@ -31,14 +31,9 @@ from plugnproduce.cli.progress import on_a_terminal
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
-    from plugnproduce import batch as batching
-    from plugnproduce import controller, reasoning, service
-    from plugnproduce.description import loader
-    from plugnproduce.description.model import Cell
+    from plugnproduce import controller, service
+    from plugnproduce.service import Cell
 else:
-    loader = lazy_module("plugnproduce.description.loader")
-    batching = lazy_module("plugnproduce.batch")
-    reasoning = lazy_module("plugnproduce.reasoning")
     controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 
@@ -66,7 +61,7 @@ def _bindings(bindings: tuple[dict[str, str], ...]) -> str:
     return " | ".join(" ".join(f"{r}={d}" for r, d in b.items()) for b in bindings)
 
 
-def _reasons(reasons: tuple[reasoning.Reason, ...], verbose: bool, indent: str = "    ") -> None:
+def _reasons(reasons: tuple[service.Reason, ...], verbose: bool, indent: str = "    ") -> None:
     for r in reasons:
         typer.echo(f"{indent}- {r.text if verbose else r.plain}")
         if r.where and verbose:
@@ -101,7 +96,7 @@ def capabilities(cell: Path = CELL_OPTION, verbose: bool = VERBOSE_OPTION, json_
         _reasons(n.reasons, verbose)
 
 
-def _print_problems(result: reasoning.CheckResult, verbose: bool) -> None:
+def _print_problems(result: service.CheckResult, verbose: bool) -> None:
     for p in result.problems:
         typer.echo(str(p) if verbose else f"{p.where}: {p.reason.plain}")
         if p.reason.where and verbose:
@@ -183,12 +178,12 @@ def repair(
             if r.repair.unrolls:
                 typer.echo(f"  note: {r.repair.unrolls}")
             typer.echo("  resulting task:")
-            typer.echo("".join(f"    {line}\n" for line in loader.task_to_yaml(r.repair.task).splitlines()), nl=False)
+            typer.echo("".join(f"    {line}\n" for line in service.task_text(r.repair.task).splitlines()), nl=False)
     if not result.plausible and not repairs:
         raise typer.Exit(1)
 
 
-def _tree(ex: reasoning.Explanation, depth: int | None, verbose: bool) -> None:
+def _tree(ex: service.Explanation, depth: int | None, verbose: bool) -> None:
     for level, sentence in ex.derivation.sentences(depth, verbose):
         typer.echo(f"{'  ' * level}{'- ' if level else ''}{sentence}")
     if ex.counterfactuals:
@@ -307,9 +302,9 @@ def batch(
         fail("give either CONFIGS (a JSONL or CSV file, or -) or --generate N")
     access = None
     if cluster is not None:
-        access = batching.ClusterAccess(cluster, cluster_timeout, cluster_ca, cluster_cert, cluster_key)
+        access = service.ClusterAccess(cluster, cluster_timeout, cluster_ca, cluster_cert, cluster_key)
         try:
-            batching.check_cluster_address(cluster)
+            service.check_cluster_address(cluster)
             access.check()
         except ValueError as exc:
             fail(f"--cluster: {exc}")
@@ -317,18 +312,18 @@ def batch(
     total: int | None = generate
     if generate is not None:
         try:
-            configurations = batching.generate(engine.devices, generate, _sizes(sizes), seed)
+            configurations = service.random_configurations(engine.devices, generate, _sizes(sizes), seed)
         except ValueError as exc:
             fail(f"--sizes: {exc}")
     elif configs == "-":
-        configurations = batching.configurations_from(batching.bounded_lines(sys.stdin), "<stdin>")
+        configurations = service.configurations_from(service.bounded_lines(sys.stdin), "<stdin>")
     else:
-        configurations = batching.read_configurations(configs)  # type: ignore[arg-type]
+        configurations = service.read_configurations(configs)  # type: ignore[arg-type]
     as_csv = output is not None and output.suffix.lower() == ".csv"
     with contextlib.ExitStack() as stack:
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
         if as_csv:
-            csv.writer(out, lineterminator="\n").writerow(batching.BATCH_CSV_HEADER)
+            csv.writer(out, lineterminator="\n").writerow(service.BATCH_CSV_HEADER)
         tally: dict[str, int] = {}
         written = _write(lambda progress: service.batch_report_from(
             engine, configurations, "csv" if as_csv else "jsonl", workers, progress, cluster=access, tally=tally),

@@ -21,12 +21,11 @@ from plugnproduce.cli.app import (
 )
 from plugnproduce.cli.generate import refuse
 from plugnproduce.cli.progress import Phases, on_a_terminal
-from plugnproduce.executor.journal import describe
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
     from plugnproduce import controller, service
-    from plugnproduce.executor.run import TaskRun
+    from plugnproduce.controller import TaskRun
 else:
     controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
@@ -79,7 +78,7 @@ def run(
         if record["kind"] == "step":
             phases.update(f"step {record.get('step')} ({record.get('command')})")
         if not json_out:
-            phases.echo(describe(record))
+            phases.echo(service.describe(record))
 
     def started(the_run: TaskRun) -> None:
         loop = asyncio.get_running_loop()
@@ -124,5 +123,5 @@ def report(run_id: str | None = typer.Argument(None, metavar="RUN", help="A run 
                    "records": record.records})
         return
     for r in record.records:
-        typer.echo(describe(r))
+        typer.echo(service.describe(r))
     typer.echo(f"status: {record.status}" + (f"; {record.safe_stop}" if record.safe_stop else ""))

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     from fastapi import FastAPI
 
     from plugnproduce import controller, service
-    from plugnproduce.hmi import CellSource, Runner
+    from plugnproduce.controller import CellSource, Runner
 else:
     controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
@@ -44,30 +44,22 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int |
     ``controller.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s).
     """
     if not sim:
-        from plugnproduce.controller.livecell import LiveCellSource
-        from plugnproduce.protocols.upnp import network_from_env
-
         name = service.cell(cell, knowledge()).name if cell else "live"
-        return LiveCellSource(network_from_env(interface), name=name, knowledge=knowledge(cell),
-                              search_timeout=discovery_timeout or 1.0)
-    from plugnproduce.controller.simcell import SimulatedCellSource
-    from plugnproduce.protocols.interface import chosen_address
-    from plugnproduce.sim.bin import SimulatedBin
-
+        return controller.LiveCellSource(controller.network_from_env(interface), name=name, knowledge=knowledge(cell),
+                                         search_timeout=discovery_timeout or 1.0)
     cell = cell or service.builtin("cells", "bin-picking.yaml")
     k = knowledge(cell)
-    parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
-    return SimulatedCellSource(service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k,
-                               bin=parts, default_bin=SimulatedBin(controller.DEFAULT_BIN_PARTS, bin_seed),
-                               wait=discovery_timeout or controller.SIMULATED_DISCOVERY_SECONDS,
-                               interface=chosen_address(interface))
+    parts = controller.SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
+    return controller.SimulatedCellSource(
+        service.cell(cell, k), service.catalogue(knowledge=k), faults=faults, knowledge=k, bin=parts,
+        default_bin=controller.SimulatedBin(controller.DEFAULT_BIN_PARTS, bin_seed),
+        wait=discovery_timeout or controller.SIMULATED_DISCOVERY_SECONDS,
+        interface=controller.chosen_address(interface))
 
 
 def runner_for(source: CellSource, cell: Path | None = None) -> Runner:
     """Who runs tasks: the executor, on the devices of the source's cell, journalling into the runs folder."""
-    from plugnproduce.controller.runner import ExecutorRunner
-
-    return ExecutorRunner(source, service.runs_folder(), knowledge(cell))
+    return controller.ExecutorRunner(source, service.runs_folder(), knowledge(cell))
 
 
 def _listen(host: str, port: int) -> socket.socket:

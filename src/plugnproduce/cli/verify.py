@@ -14,7 +14,7 @@ from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
     from plugnproduce import service
-    from plugnproduce.verification import Budget, Verification
+    from plugnproduce.service import Budget, Verification
 else:
     service = lazy_module("plugnproduce.service")
 
@@ -28,7 +28,7 @@ TIMEOUT_OPTION = typer.Option(60.0, "--timeout", metavar="SECONDS",
 
 def budget(max_states: int, timeout: float) -> Budget:
     """The search budget of the options (a timeout that is not a positive number is bad input)."""
-    from plugnproduce.verification import Budget
+    from plugnproduce.service import Budget
 
     if not math.isfinite(timeout) or timeout <= 0:
         fail(f"error: --timeout {timeout}: expected a positive number of seconds")

@@ -17,7 +17,7 @@ import dataclasses
 
 from plugnproduce.chartnames import DONE, FAILED
 from plugnproduce.codegen.task import GeneratedTask
-from plugnproduce.description.model import Cell, DeviceDescription
+from plugnproduce.description.model import PROTOCOLS, Cell, DeviceDescription
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (
     Cancel,
@@ -43,7 +43,7 @@ def closed_world_chart(generated: GeneratedTask, cell: Cell) -> bytes:
     controller = copy.deepcopy(next(c for c in task.children if isinstance(c, State) and c.id == "task"))
     controller.id = "controller"
     for node in walk(controller, into_charts=False):
-        if isinstance(node, Send) and node.type in ("xirp", "upnp"):
+        if isinstance(node, Send) and node.type in PROTOCOLS:
             node.event, node.type, node.target = f"{node.target}.{node.event}", None, None
         elif isinstance(node, Transition):
             node.targets = [_TARGETS.get(t, t) for t in node.targets]

@@ -14,7 +14,7 @@ from __future__ import annotations
 import copy
 
 from plugnproduce.chartnames import NEXT, PLAN, STEP
-from plugnproduce.codegen.task import GeneratedTask
+from plugnproduce.codegen.task import GeneratedTask, plan_data
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.ontology.vocabulary import concept_value
 from plugnproduce.statechart.io.writer import write_chart
@@ -35,7 +35,7 @@ def device_program(generated: GeneratedTask, device: DeviceDescription) -> bytes
     pick.transitions.append(Transition(cond=f"{PLAN}[{STEP}] == 0", targets=[END]))
     end = Final(id=END, extra_attrs=_visit(device, END, last, entry=False).extra_attrs)
     root = Chart(name=f"{device.id}-program", initial=["p0"], datamodel="python",
-                 data=[Data(id=PLAN, expr="[" + ", ".join(map(str, [*plan, 0])) + "]"), Data(id=STEP, expr="0")],
+                 data=[plan_data([*plan, 0]), Data(id=STEP, expr="0")],
                  extra_attrs={pnp("device"): device.id}, children=[start, pick])
     for path, k in segments.items():
         root.children.extend(_segment(device, k, path))

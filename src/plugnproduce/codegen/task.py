@@ -247,6 +247,12 @@ def values_data(rows: list[dict[str, object]]) -> Data:
         "{" + ", ".join(f"{n!r}: {literal(v)}" for n, v in sorted(r.items())) + "}" for r in rows) + "]")
 
 
+def plan_data(plan: list[int]) -> Data:
+    """The plan of which step chart runs when, as inline content: a literal list, not an expression, so that no
+    length of task meets the bounds the runtime puts on an expression (a 2,000-step plan has over 2,000 parts)."""
+    return Data(id=PLAN, text="[" + ", ".join(map(str, plan)) + "]")
+
+
 def _task_chart(task: Task, steps: list[StepChart], outcomes: Outcomes) -> Chart:
     """The task chart: each distinct step chart once, the plan of which runs when, and the values that vary."""
     bodies = [s for s in steps if s.body == s.step.index]
@@ -256,7 +262,7 @@ def _task_chart(task: Task, steps: list[StepChart], outcomes: Outcomes) -> Chart
     pick.transitions.append(Transition(cond=f"{PLAN}[{STEP}] == 0", targets=[DONE]))
     body = State(id="task", initial=[NEXT], transitions=[Transition(event="timeout error", targets=[FAILED])],
                  children=[pick, *(b.element for b in bodies)])
-    data = [Data(id=PLAN, expr="[" + ", ".join(map(str, plan)) + "]"), Data(id=STEP, expr="0")]
+    data = [plan_data(plan), Data(id=STEP, expr="0")]
     data += [Data(id=v, expr="None") for v in sorted({var for b in bodies for _, _, var in b.produces} - {OUTCOME})]
     data += flow_data(task)
     if any(s.varying for s in steps):

@@ -14,40 +14,90 @@ protocols, executor, sim).
 
 from __future__ import annotations
 
-from plugnproduce.controller.interfaces import (
-    CellChangeRefused,
-    CellListener,
-    CellSource,
-    CellUpdate,
-    JournalRecord,
-    PluggableCellSource,
-    Runner,
-    RunObserver,
-    RunRefused,
-)
-from plugnproduce.controller.livecell import LiveCellSource
-from plugnproduce.controller.resume import NoCell, Resumed, SimulatedResume, continue_run, replan_live, resume_run
-from plugnproduce.controller.run import (
-    DEFAULT_BIN_PARTS,
-    DISCOVERY_SECONDS,
-    SIMULATED_DISCOVERY_SECONDS,
-    DevicesMissing,
-    StateNotReported,
-    default_bin_parts,
-    find_devices,
-    live_cell,
-    reported_states,
-    run_task,
-    start_run,
-)
-from plugnproduce.controller.runner import ExecutorRunner
-from plugnproduce.controller.simcell import SimulatedCellSource
-from plugnproduce.controller.teach import read_taught, teach
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from plugnproduce.controller.interfaces import (
+        CellChangeRefused,
+        CellListener,
+        CellSource,
+        CellUpdate,
+        JournalRecord,
+        PluggableCellSource,
+        Runner,
+        RunObserver,
+        RunRefused,
+    )
+    from plugnproduce.controller.livecell import LiveCellSource
+    from plugnproduce.controller.resume import (
+        NoCell,
+        Resumed,
+        SimulatedResume,
+        continue_run,
+        replan_live,
+        resume_run,
+    )
+    from plugnproduce.controller.run import (
+        DEFAULT_BIN_PARTS,
+        DISCOVERY_SECONDS,
+        SIMULATED_DISCOVERY_SECONDS,
+        DevicesMissing,
+        StateNotReported,
+        default_bin_parts,
+        find_devices,
+        live_cell,
+        planned_run,
+        reported_states,
+        run_task,
+        start_run,
+    )
+    from plugnproduce.controller.runner import ExecutorRunner
+    from plugnproduce.controller.simcell import SimulatedCellSource
+    from plugnproduce.controller.teach import read_taught, teach
+    from plugnproduce.discovery import CellChange, LiveCell
+    from plugnproduce.executor.run import TaskRun
+    from plugnproduce.protocols.interface import chosen_address
+    from plugnproduce.protocols.upnp import network_from_env
+    from plugnproduce.sim.bin import SimulatedBin
+
+_WHERE = {
+    **dict.fromkeys(("CellChangeRefused", "CellListener", "CellSource", "CellUpdate", "JournalRecord",
+                     "PluggableCellSource", "Runner", "RunObserver", "RunRefused"),
+                    "plugnproduce.controller.interfaces"),
+    "LiveCellSource": "plugnproduce.controller.livecell",
+    **dict.fromkeys(("NoCell", "Resumed", "SimulatedResume", "continue_run", "replan_live", "resume_run"),
+                    "plugnproduce.controller.resume"),
+    **dict.fromkeys(("read_taught", "teach"), "plugnproduce.controller.teach"),
+    **dict.fromkeys(("DEFAULT_BIN_PARTS", "DISCOVERY_SECONDS", "SIMULATED_DISCOVERY_SECONDS", "DevicesMissing",
+                     "StateNotReported", "default_bin_parts", "find_devices", "live_cell", "planned_run",
+                     "reported_states", "run_task", "start_run"), "plugnproduce.controller.run"),
+    "ExecutorRunner": "plugnproduce.controller.runner",
+    "SimulatedCellSource": "plugnproduce.controller.simcell",
+    **dict.fromkeys(("CellChange", "LiveCell"), "plugnproduce.discovery"),
+    "TaskRun": "plugnproduce.executor.run",
+    "chosen_address": "plugnproduce.protocols.interface",
+    "network_from_env": "plugnproduce.protocols.upnp",
+    "SimulatedBin": "plugnproduce.sim.bin",
+}
+"""Where each name of the controller lives: it is imported on first use, so that importing one module of the
+controller (``pnp sim plug`` needs :mod:`.devices` alone) loads no network stack."""
+
+
+def __getattr__(name: str) -> object:
+    """A name of :data:`_WHERE`, imported from its module on first use."""
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_WHERE[name]), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "DEFAULT_BIN_PARTS",
     "DISCOVERY_SECONDS",
     "SIMULATED_DISCOVERY_SECONDS",
+    "CellChange",
     "CellChangeRefused",
     "CellListener",
     "CellSource",
@@ -55,6 +105,7 @@ __all__ = [
     "DevicesMissing",
     "ExecutorRunner",
     "JournalRecord",
+    "LiveCell",
     "LiveCellSource",
     "NoCell",
     "PluggableCellSource",
@@ -62,15 +113,20 @@ __all__ = [
     "RunObserver",
     "RunRefused",
     "Runner",
+    "SimulatedBin",
     "SimulatedCellSource",
     "SimulatedResume",
     "StateNotReported",
+    "TaskRun",
+    "chosen_address",
     "continue_run",
     "default_bin_parts",
     "find_devices",
     "live_cell",
-    "replan_live",
+    "network_from_env",
+    "planned_run",
     "read_taught",
+    "replan_live",
     "reported_states",
     "resume_run",
     "run_task",

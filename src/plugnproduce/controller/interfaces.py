@@ -1,4 +1,4 @@
-"""What the HMI needs from the rest of the controller, as small protocols.
+"""What the HMI needs from the controller, as small protocols.
 
 The HMI shows a cell that changes (devices plug in and unplug) and runs tasks on it; it is
 written against these interfaces, which :mod:`plugnproduce.controller.livecell` and

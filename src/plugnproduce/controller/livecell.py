@@ -18,18 +18,19 @@ from plugnproduce.controller.interfaces import CellListener, CellUpdate
 from plugnproduce.description.model import Cell
 from plugnproduce.discovery import LiveCell
 from plugnproduce.knowledge import Knowledge
-from plugnproduce.protocols.upnp import SsdpNetwork
+from plugnproduce.protocols.upnp import SsdpNetwork, network_from_env
 
 log = logging.getLogger(__name__)
 
 
 class LiveCellSource:
-    """The devices discovery finds on ``network``; they plug in and unplug themselves."""
+    """The devices discovery finds on ``network`` (default: the one ``PNP_SSDP_PORT`` names); they plug in and
+    unplug themselves."""
 
-    def __init__(self, network: SsdpNetwork, name: str = "live", search_timeout: float = 1.0,
+    def __init__(self, network: SsdpNetwork | None = None, name: str = "live", search_timeout: float = 1.0,
                  knowledge: Knowledge | None = None) -> None:
-        self.network = network
-        self._live = LiveCell((knowledge or service.knowledge()).taxonomy, network=network, name=name,
+        self.network = network if network is not None else network_from_env()
+        self._live = LiveCell((knowledge or service.knowledge()).taxonomy, network=self.network, name=name,
                               search_timeout=search_timeout)
         self._cell = Cell(name, ())
         self._listeners: list[CellListener] = []

@@ -23,6 +23,8 @@ if TYPE_CHECKING:
     from plugnproduce.discovery import LiveCell
     from plugnproduce.executor.report import RunReport
     from plugnproduce.executor.run import RecordObserver, TaskRun
+    from plugnproduce.protocols.upnp import SsdpNetwork
+    from plugnproduce.sim.cell import SimulatedCell
 
 
 class DevicesMissing(PlugNProduceError):
@@ -97,8 +99,6 @@ async def run_task(
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.interface import chosen_address
     from plugnproduce.protocols.upnp import LOOPBACK, network_from_env, private_network
-    from plugnproduce.sim.bin import SimulatedBin
-    from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     say = progress or (lambda _: None)
     the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
@@ -112,21 +112,15 @@ async def run_task(
         if simulate:
             where = "loopback" if network.interface == LOOPBACK.interface else network.interface
             say(f"starting {len(the_cell.devices)} simulated device(s) on {where}")
-            parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
-            sim = SimulatedCell(the_cell, network=network, faults=parse_faults(faults, the_cell.devices), bin=parts)
-            await stack.enter_async_context(sim)
+            await stack.enter_async_context(_simulated(the_cell, network, faults, bin_parts, bin_seed))
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         wanted = [d.id for d in the_cell.devices]
         live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
                                                         expected=wanted))
         devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
                                                                          else DISCOVERY_SECONDS))
-        devices = Cell(devices.name, devices.devices, the_cell.file)  # journalled, for a resume
-        if generated is None:
-            say("asking each device its state; checking the task from there")
-            generated = plan_run(the_task, the_cell.reported(await reported_states(devices)), k, progress=say)
-        say("running")
-        run = start_run(generated, devices, journal, observer, prefixes=k.prefixes)
+        run = await planned_run(the_task, the_cell, devices, journal, knowledge=k, observer=observer,
+                                progress=say, generated=generated)
         if started is not None:
             started(run)
         follow = asyncio.create_task(_follow_unplugs(live, run))
@@ -134,6 +128,37 @@ async def run_task(
             return await run.run()
         finally:
             follow.cancel()
+
+
+def _simulated(cell: Cell, network: SsdpNetwork, faults: str, bin_parts: int | None, bin_seed: int) -> SimulatedCell:
+    """The devices of ``cell`` simulated on ``network``, with ``faults``, on a bin of ``bin_parts`` parts if given."""
+    from plugnproduce.sim.bin import SimulatedBin
+    from plugnproduce.sim.cell import SimulatedCell, parse_faults
+
+    parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
+    return SimulatedCell(cell, network=network, faults=parse_faults(faults, cell.devices), bin=parts)
+
+
+async def planned_run(task: Task, cell: Cell, devices: Cell, journal: Path, *, knowledge: Knowledge | None = None,
+                      observer: RecordObserver | None = None, progress: Callable[[str], None] | None = None,
+                      generated: GeneratedTask | None = None) -> TaskRun:
+    """The run of ``task`` in ``cell`` on ``devices`` (its devices at the endpoints discovery found), journalling
+    into ``journal``: checked and generated from the state each device reports (:func:`reported_states`), unless
+    ``generated`` is the task planned already; it starts when its ``run()`` is awaited.
+
+    Every run starts here: ``pnp run`` (:func:`run_task`) and the HMI's (:class:`~.runner.ExecutorRunner`).
+    Raises :class:`StateNotReported` or :class:`~plugnproduce.service.ImplausibleTask` before any command goes out.
+    """
+    the_cell, k = cell_and_knowledge(cell, knowledge)
+    if generated is None:
+        if progress is not None:
+            progress("asking each device its state; checking the task from there")
+        reported = the_cell.reported(await reported_states(devices))
+        generated = await asyncio.to_thread(plan_run, task, reported, k, progress)
+    if progress is not None:
+        progress("running")
+    named = Cell(devices.name, devices.devices, devices.file or the_cell.file)  # the cell file is journalled
+    return start_run(generated, named, journal, observer, prefixes=k.prefixes)
 
 
 class StateNotReported(PlugNProduceError):
@@ -182,9 +207,8 @@ def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
     """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
     real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
 
-    ``preamble``: records journalled right after ``start`` (a resumed run's, :mod:`.resume`).
-    Both faces start runs this way: ``pnp run`` after discovering the cell's devices
-    (:func:`run_task`), the HMI with the devices its cell source follows.
+    :func:`planned_run` makes every run this way, once the task is planned. ``preamble``: records journalled
+    right after ``start`` (a resumed run's, :mod:`.resume`).
     """
     from plugnproduce.executor.run import TaskRun
 

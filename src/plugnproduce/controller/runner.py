@@ -1,9 +1,9 @@
 """The executor as the HMI's :class:`~plugnproduce.controller.interfaces.Runner`.
 
-A run takes the service's one path: :func:`plugnproduce.service.plan_run` checks the task for
-the cell as it is now, each device in the state it reports, and generates only its task chart;
-:func:`plugnproduce.controller.run.start_run` runs it against the cell's devices at the endpoints
-discovery found, journalling into the runs folder. A device the cell source sees leave during
+A run takes the one path of every run, :func:`~plugnproduce.controller.run.planned_run` (as ``pnp run``
+does): the task is checked for the cell as it is now, each device in the state it reports, only its
+task chart is generated, and it runs against the cell's devices at the endpoints discovery found,
+journalling into the runs folder. A device the cell source sees leave during
 the run is a lost device: the run stops with a fault.
 One run at a time.
 """
@@ -17,16 +17,16 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from plugnproduce import service
 from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
 from plugnproduce.controller.resume import continue_run, replan_live
-from plugnproduce.controller.run import StateNotReported, reported_states, start_run
+from plugnproduce.controller.run import StateNotReported, planned_run
 from plugnproduce.controller.simcell import SimulatedCellSource
 from plugnproduce.description.model import Cell, Task
 from plugnproduce.errors import UnknownName
 from plugnproduce.executor.journal import read_journal
-from plugnproduce.executor.run import TaskRun  # the type of a run the service starts
+from plugnproduce.executor.run import TaskRun  # the type of a run
 from plugnproduce.knowledge import Knowledge
+from plugnproduce.service import ImplausibleTask, NoWayOn, Replan, knowledge, new_run_id, stopped_run
 
 log = logging.getLogger(__name__)
 
@@ -68,21 +68,19 @@ class ExecutorRunner:
             raise RunRefused(f"run {active} is still running; stop it first")
         if isinstance(self._source, SimulatedCellSource):
             self._source.prepare_run(task)  # its default bin, for a task that loops on a localized pose
+        run_id = new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", task.name))
+        observe, started = self._observer(run_id, observer)
         try:  # planned from the state each device reports, not its chart's initial state
-            reported = cell.reported(await reported_states(cell))
-            generated = await asyncio.to_thread(service.plan_run, task, reported, self._knowledge)
-            prefixes = await asyncio.to_thread(  # how devices may name concepts (pnp:PartFound)
-                lambda: (self._knowledge or service.knowledge()).prefixes)
+            run = await planned_run(task, cell, cell, self._dir / f"{run_id}.jsonl", knowledge=self._knowledge,
+                                    observer=observe)
         except StateNotReported as exc:
             raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
-        except service.ImplausibleTask as exc:
+        except ImplausibleTask as exc:
             first = exc.result.problems[0]
             raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc
-        run_id = service.new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", task.name))
-        return await self._launch(run_id, observer, lambda observe: start_run(
-            generated, cell, self._dir / f"{run_id}.jsonl", observe, prefixes))
+        return await self._launch(run_id, run, started)
 
-    async def replan(self, run_id: str, cell: Cell) -> service.Replan:
+    async def replan(self, run_id: str, cell: Cell) -> Replan:
         """What runs on after run ``run_id`` (failed or stopped), planned from the states ``cell``'s devices report
         now (RunRefused while it runs or when nothing plausible goes on; NotResumable for a run that succeeded)."""
         entry = self._run(run_id)
@@ -90,9 +88,9 @@ class ExecutorRunner:
             raise RunRefused(f"run {run_id} is still running; stop it first")
         k = await self._known()
         try:
-            stopped = await asyncio.to_thread(service.stopped_run, entry.run.journal_path)
+            stopped = await asyncio.to_thread(stopped_run, entry.run.journal_path)
             return await replan_live(stopped, cell, cell, k)
-        except (StateNotReported, service.NoWayOn) as exc:
+        except (StateNotReported, NoWayOn) as exc:
             raise RunRefused(f"run {run_id} cannot be resumed: {exc}") from exc
 
     async def resume(self, run_id: str, cell: Cell, observer: RunObserver, seen: dict[str, str] | None = None) -> str:
@@ -107,30 +105,34 @@ class ExecutorRunner:
             raise RunRefused("the devices changed since the plan was shown; look at the new plan and confirm it")
         if isinstance(self._source, SimulatedCellSource):
             self._source.prepare_run(plan.task)  # the session's bin, as the run it resumes had
-        k = await self._known()
-        new_id = service.new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", plan.task.name))
+        new_id = new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", plan.task.name))
+        observe, started = self._observer(new_id, observer)
         try:
-            run = await continue_run(plan, cell, cell, k, "the operator", self._dir / f"{new_id}.jsonl")
-        except service.NoWayOn as exc:
+            run = await continue_run(plan, cell, cell, await self._known(), "the operator",
+                                     self._dir / f"{new_id}.jsonl", observe)
+        except NoWayOn as exc:
             raise RunRefused(str(exc)) from exc
-        return await self._launch(new_id, observer, lambda observe: run.observed(observe))
+        return await self._launch(new_id, run, started)
 
     async def _known(self) -> Knowledge:
         """The knowledge runs are planned with (the built-in library unless given)."""
         if self._knowledge is None:
-            self._knowledge = await asyncio.to_thread(service.knowledge)
+            self._knowledge = await asyncio.to_thread(knowledge)
         return self._knowledge
 
-    async def _launch(self, run_id: str, observer: RunObserver,
-                      make: Callable[[Callable[[JournalRecord], None]], TaskRun]) -> str:
-        """Start the run ``make`` builds around an observer; return once its journal has its ``start`` record."""
+    @staticmethod
+    def _observer(run_id: str, observer: RunObserver) -> tuple[Callable[[JournalRecord], None], asyncio.Event]:
+        """The run's record observer, passing each record on with the run id; the event it sets on the first."""
         started = asyncio.Event()
 
         def observe(record: JournalRecord) -> None:
             started.set()
             observer(run_id, record)
 
-        run = make(observe)
+        return observe, started
+
+    async def _launch(self, run_id: str, run: TaskRun, started: asyncio.Event) -> str:
+        """Start ``run``; return once its journal has its ``start`` record."""
         self._loop = asyncio.get_running_loop()
         running = asyncio.create_task(run.run(), name=f"run {run_id}")
         running.add_done_callback(self._finished)

@@ -52,7 +52,7 @@ from plugnproduce.statechart.io.reader import parse_chart, read_chart
 SAFE_STOP = str(PNP.SafeStop)
 """A device state chart's transition annotated with this concept (or one below it) is its safe-stop request."""
 
-PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp"}
+PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp", str(PNP.OPCUA): "opcua"}
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")
 _OUTPUT_NAME = re.compile(r"[a-z][a-z0-9_]{0,63}")
 
@@ -154,7 +154,8 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
     protocol = str(_one(loaded, s, PNP.protocol, "protocol"))
     if protocol not in PROTOCOL_NAMES:
         raise DescriptionError(
-            f"unknown protocol {local_name(protocol)}; expected pnp:XIRP or pnp:UPnP", loaded.path, loaded.line(str(s))
+            f"unknown protocol {local_name(protocol)}; expected pnp:XIRP, pnp:UPnP or pnp:OPCUA", loaded.path,
+            loaded.line(str(s))
         )
     chart_file = file_of(_one(loaded, s, PNP.stateChart, "state chart"))
     if charts is None:

@@ -18,8 +18,8 @@ from plugnproduce.description.flow import enclosing, outermost_first, path_name
 from plugnproduce.errors import UnknownName
 from plugnproduce.statechart.model import Chart
 
-Protocol = Literal["xirp", "upnp"]
-PROTOCOLS: tuple[Protocol, ...] = ("xirp", "upnp")
+Protocol = Literal["xirp", "upnp", "opcua"]
+PROTOCOLS: tuple[Protocol, ...] = ("xirp", "upnp", "opcua")
 
 
 @dataclass(frozen=True)
@@ -171,6 +171,13 @@ class DeviceDescription:
         return dataclasses.replace(self, initial=state_id, reported_state=True)
     arguments: tuple[Argument, ...] = ()
     """Declared contracts of its requests' arguments (``pnp:hasArgument``)."""
+
+    def answer_to(self, request: str) -> str | None:
+        """The event the device answers ``request`` with at once: the one protocol event every transition taking
+        the request sends (in the transition or the target's onentry), or None."""
+        sent = {tuple(c.name for c in t.sends if c.kind == "event")
+                for t in (*self.transitions, *self.stops) if t.request is not None and t.request.name == request}
+        return next(iter(sent))[0] if len(sent) == 1 and len(next(iter(sent))) == 1 else None
 
     def argument(self, request: str, quantity: str) -> Argument:
         """The contract of a request's argument: the declared one, else required with no limits."""

@@ -40,6 +40,7 @@ from plugnproduce.description.model import Cell, DeviceDescription
 from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout, excerpt
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP
+from plugnproduce.protocols.opcua import spec as opcua_spec
 from plugnproduce.protocols.upnp import (
     LOOPBACK,
     Advertisement,
@@ -372,11 +373,26 @@ def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> D
     if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
         return replace(device, endpoint=found.location)
     host = urlparse(found.location).hostname  # None: found at no host, so no endpoint is on its host
-    named_host, port = parse_endpoint(device.endpoint)
+    named_host, port, path = _endpoint_parts(device.protocol, device.endpoint)
     if host is None or (named_host != host and not (named_host.lower() == "localhost" and _is_loopback(host))):
         raise UntrustedUrlError(f"device {excerpt(device.id)} found at {host or excerpt(found.location)} "
-                                f"names XIRP endpoint {excerpt(device.endpoint)} on another host; refused")
-    return replace(device, endpoint=format_endpoint(host, port))  # reached where it was found, never by name
+                                f"names {_NAMES[device.protocol]} endpoint {excerpt(device.endpoint)} on another "
+                                "host; refused")
+    # reached where it was found, never by name
+    if device.protocol == "opcua":
+        return replace(device, endpoint=opcua_spec.format_endpoint(host, port, path))
+    return replace(device, endpoint=format_endpoint(host, port))
+
+
+_NAMES = {"xirp": "XIRP", "opcua": "OPC UA"}
+
+
+def _endpoint_parts(protocol: str, endpoint: str) -> tuple[str, int, str]:
+    """Host, port and path of an XIRP or OPC UA endpoint (a ProtocolError for any other)."""
+    if protocol == "opcua":
+        return opcua_spec.parse_endpoint(endpoint)
+    host, port = parse_endpoint(endpoint)
+    return host, port, ""
 
 
 def _is_loopback(host: str) -> bool:

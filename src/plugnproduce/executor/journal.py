@@ -6,9 +6,14 @@ steps), then ``command`` (sent to a device), ``event`` (from a device or the cha
 one ``stop`` per device (the safe-stop request sent, its answer, the state the device reports) and finally
 ``end`` (outcome). A run that resumes a stopped one (``pnp resume``) writes, right after its ``start``,
 ``stopped`` (the run it resumes and how that one stopped), ``replan`` (the states the devices reported and the
-rest planned from them) and ``continue`` (who confirmed it). A line is flushed and fsynced before the run goes
-on, so after a crash the journal holds everything up to the crash, and a run without ``end`` is
-told apart from a finished one. Nothing is ever rewritten.
+rest planned from them) and ``continue`` (who confirmed it). A line is flushed to the operating system
+before the run goes on, so after a crash of the controller the journal holds everything up to the crash,
+and a run without ``end`` is told apart from a finished one. It is made durable on disk (fsynced) before the run
+acts on the world: with each ``command`` (the command goes out after it), and with ``start``,
+``fault``, ``stop`` and ``end``; what the run observed in between (``step``, ``state``, ``event``,
+``value``, ``branch``) is fsynced with the next of these. One fsync per record held up the
+event loop for milliseconds each, several times per command, while the devices' events waited.
+Nothing is ever rewritten.
 """
 
 from __future__ import annotations
@@ -25,6 +30,8 @@ from plugnproduce.errors import DescriptionError, PlugNProduceError
 
 KINDS = ("start", "stopped", "replan", "continue", "step", "command", "event", "value", "state", "branch", "fault",
          "stop", "end")
+OBSERVED = frozenset({"step", "event", "value", "state", "branch"})
+"""Kinds that record what the run saw, not what it did: flushed at once, fsynced with the next other record."""
 
 
 class JournalInUse(PlugNProduceError):
@@ -55,11 +62,13 @@ class Journal:
         except FileExistsError as exc:
             raise JournalInUse(f"journal {self.path} already exists (another run's); give each run its own") from exc
         self._seq = 0
+        self._unsynced = False
         self.failure: str | None = None
         """Why the journal could not be written (None: every record so far was)."""
 
     def write(self, kind: str, **data: Any) -> dict[str, Any]:
-        """Append one record, make it durable, and return it (:class:`JournalWriteError` if it cannot be)."""
+        """Append one record, make it durable (see the module's description: a record of what the run observed
+        with the next one of what it did), and return it (:class:`JournalWriteError` if it cannot be)."""
         if kind not in KINDS:
             raise ValueError(f"unknown journal record kind {kind!r}")
         if self._file is None:
@@ -71,7 +80,11 @@ class Journal:
         try:
             self._file.write(json.dumps(record, sort_keys=True, default=str) + "\n")
             self._file.flush()
-            os.fsync(self._file.fileno())
+            if kind in OBSERVED:
+                self._unsynced = True
+            else:
+                os.fsync(self._file.fileno())
+                self._unsynced = False
         except OSError as exc:
             self.failure = f"journal {self.path} cannot be written: {exc.strerror or exc}"
             raise JournalWriteError(self.failure, record) from exc
@@ -82,6 +95,8 @@ class Journal:
         if self._file is not None:
             file, self._file = self._file, None
             try:
+                if self._unsynced and self.failure is None:
+                    os.fsync(file.fileno())
                 file.close()
             except OSError:  # the buffer of a failed write: it cannot be written now either
                 pass

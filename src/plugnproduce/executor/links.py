@@ -110,6 +110,48 @@ class UpnpLink:
         await self._client.close()
 
 
+class OpcUaLink:
+    """A device driven over OPC UA: requests are method calls, events are OPC UA events of the device object.
+
+    A method's output arguments are the values of the event the device answers the request with at once
+    (:meth:`DeviceDescription.answer_to`): they reach the chart as that event, as any produced value does.
+    """
+
+    def __init__(self, device: DeviceDescription, client: Any, on_event: EventCallback) -> None:
+        self.device = device.id
+        self._description = device
+        self._client = client
+        self._on_event = on_event
+
+    @classmethod
+    async def open(cls, device: DeviceDescription, on_event: EventCallback, on_lost: ProblemCallback,
+                   on_anomaly: ProblemCallback) -> OpcUaLink:
+        """Open a session with the device's server and subscribe to the events its chart sends."""
+        from plugnproduce.protocols.opcua import OpcUaDeviceClient  # asyncua loads only for an OPC UA cell
+
+        client = await OpcUaDeviceClient.connect(device.endpoint, device.id, device.command_timeout)
+        events = sorted({c.name for t in (*device.transitions, *device.stops) for c in t.sends if c.kind == "event"})
+        try:
+            await client.subscribe(events, lambda name, values: on_event(device.id, name, values),
+                                   lambda reason: on_lost(device.id, reason),
+                                   lambda what: on_anomaly(device.id, what), device.command_timeout)
+        except BaseException:
+            await client.close()
+            raise
+        return cls(device, client, on_event)
+
+    async def request(self, name: str, params: Mapping[str, Any], timeout: float) -> None:
+        outputs = await self._client.call(name, params, timeout)
+        answer = self._description.answer_to(name)
+        if answer is not None:
+            self._on_event(self.device, answer, outputs)
+
+    async def state(self, timeout: float) -> str:
+        state: str = await self._client.state(timeout)
+        return state
+
+    async def close(self) -> None:
+        await self._client.close()
 
 
 async def query_report(device: DeviceDescription, timeout: float) -> tuple[str, dict[str, Any]]:
@@ -138,9 +180,9 @@ async def query_state(device: DeviceDescription, timeout: float) -> str:
 async def open_link(device: DeviceDescription, on_event: EventCallback, on_lost: ProblemCallback,
                     on_anomaly: ProblemCallback) -> DeviceLink:
     """Connect to a device over its protocol."""
-    kinds: dict[str, Any] = {"xirp": XirpLink, "upnp": UpnpLink}
+    kinds: dict[str, Any] = {"xirp": XirpLink, "upnp": UpnpLink, "opcua": OpcUaLink}
     if device.protocol not in kinds:
         raise ProtocolError(f"device {device.id}: protocol {device.protocol!r} is not supported; "
-                            "expected xirp or upnp")
+                            "expected xirp, upnp or opcua")
     link: DeviceLink = await kinds[device.protocol].open(device, on_event, on_lost, on_anomaly)
     return link

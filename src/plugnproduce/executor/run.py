@@ -1,6 +1,6 @@
 """Running a Task State Chart against the devices of a cell (paper section 6.3).
 
-The task chart runs in the project's SCXML runtime. Its ``<send type="xirp|upnp">``
+The task chart runs in the project's SCXML runtime. Its ``<send type="xirp|upnp|opcua">``
 commands go out over the device links; device events come back as
 ``DEVICE.PROTOCOL.event.NAME``. Every command, event, device state and step is written
 to the run's journal before the run goes on.
@@ -33,7 +33,7 @@ from typing import Any
 
 from plugnproduce.chartnames import DONE, STEP, branch_variable
 from plugnproduce.codegen import GeneratedTask
-from plugnproduce.description.model import Cell, Command
+from plugnproduce.description.model import PROTOCOLS, Cell, Command
 from plugnproduce.description.taskfile import task_to_yaml
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import outcomes, values
@@ -105,7 +105,7 @@ class TaskRun:
         chart = parse_chart(data, f"{generated.task.name}.task.scxml")
         self._states = _chart_map(chart)
         self._bindings = {s.step.index: dict(s.binding) for s in generated.steps}
-        self.interpreter = Interpreter(chart, io_processors={"xirp": self, "upnp": self})
+        self.interpreter = Interpreter(chart, io_processors={p: self for p in PROTOCOLS})
         self.interpreter.attach(self._on_meta)
         self._loop = ChartLoop(self.interpreter, self._on_step)
         self._journal: Journal | None = None

@@ -14,15 +14,13 @@ from starlette.middleware.trustedhost import TrustedHostMiddleware
 
 from plugnproduce import service
 from plugnproduce.controller.interfaces import CellSource, Runner
-from plugnproduce.description.model import DeviceDescription
 from plugnproduce.hmi import errors
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
 from plugnproduce.hmi.routes import cell, charts, goal, runs, sources, task, teach
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders
 from plugnproduce.hmi.work import WAITING, WORK_MEMORY, WORK_SECONDS, WORKERS, Work, WorkLimits
-from plugnproduce.knowledge import Knowledge
-from plugnproduce.safeio import MAX_BYTES
+from plugnproduce.service import MAX_BYTES, DeviceDescription, Knowledge
 
 DESCRIPTION = f"""\
 The Generic HMI of a Plug'n'Produce cell: the live cell, the process commands it offers,

@@ -16,10 +16,8 @@ from typing import Any
 
 from plugnproduce import service
 from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, Runner
-from plugnproduce.description.model import Cell, DeviceDescription, Task
-from plugnproduce.executor.journal import describe
 from plugnproduce.hmi.views import cell_json
-from plugnproduce.knowledge import Knowledge
+from plugnproduce.service import Cell, DeviceDescription, Knowledge, Task, describe
 
 QUEUE_SIZE = 512
 """Events kept for a page that is slow to read; a page further behind is dropped (its browser reconnects)."""

@@ -17,14 +17,11 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from plugnproduce import service
-from plugnproduce.codegen.outputs import GeneratedChart
-from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.hmi import taskfiles
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.views import editor_rows, task_json
-from plugnproduce.knowledge import Knowledge
-from plugnproduce.verification import Budget
+from plugnproduce.service import Budget, Cell, DeviceDescription, GeneratedChart, Knowledge, Task
 
 T = TypeVar("T")
 

@@ -1,5 +1,5 @@
-"""Pictures of charts for the page (SVG drawn by :func:`plugnproduce.drawing.render_chart`, in memory), and the
-charts generated for recent tasks, kept in memory so the page can fetch them by id."""
+"""Pictures of charts for the page (SVG drawn by :mod:`plugnproduce.service.drawings`, in memory), and the charts
+generated for recent tasks, kept in memory so the page can fetch them by id."""
 
 from __future__ import annotations
 
@@ -8,12 +8,13 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from plugnproduce.codegen.outputs import GeneratedChart
-from plugnproduce.description.model import DeviceDescription
-from plugnproduce.drawing import PlanStep, find_plan, render_chart
 from plugnproduce.errors import UnknownName
-from plugnproduce.statechart import parse_chart, write_chart
+from plugnproduce.service import drawings
+
+if TYPE_CHECKING:
+    from plugnproduce.service import DeviceDescription, GeneratedChart
 
 
 class _Bounded(OrderedDict[str, object]):
@@ -39,20 +40,17 @@ class Pictures:
         """The picture of a chart file (redrawn when the file changes)."""
         p = Path(path)
         key = f"file:{p}:{p.stat().st_mtime_ns}"
-        return self._cached(key, lambda: render_chart(p, "svg", p))
+        return self._cached(key, lambda: drawings.picture_of_file(p))
 
     def of_device(self, device: DeviceDescription) -> bytes:
         """The picture of the Device State Chart a device carries (a discovered device's has no file on disk)."""
-        key = "device:" + hashlib.sha256(write_chart(device.chart)).hexdigest()
-        return self._cached(key, lambda: render_chart(device.chart, "svg", device.chart_file,
-                                                      name=Path(device.chart_file).stem))
+        key = "device:" + hashlib.sha256(drawings.device_chart(device)).hexdigest()
+        return self._cached(key, lambda: drawings.picture_of_device(device))
 
     def of_chart(self, chart: GeneratedChart, step: int | None = None) -> bytes:
         """The picture of a generated chart; of a task chart, with ``step`` (from 1) expanded."""
         key = f"chart:{step}:" + hashlib.sha256(chart.data).hexdigest()
-
-        return self._cached(key, lambda: render_chart(parse_chart(chart.data, chart.name), "svg", chart.name,
-                                                      name="chart", expand=step))
+        return self._cached(key, lambda: drawings.picture_of_chart(chart, step))
 
     def _cached(self, key: str, draw: Callable[[], bytes]) -> bytes:
         with self._lock:
@@ -65,11 +63,9 @@ class Pictures:
         return data
 
 
+steps_of = drawings.task_steps
+"""The steps a generated task chart runs, in order (none for a chart without a plan of processes)."""
 
-def steps_of(chart: GeneratedChart) -> tuple[PlanStep, ...]:
-    """The steps a generated task chart runs, in order (none for a chart without a plan of processes)."""
-    plan = find_plan(parse_chart(chart.data, chart.name))
-    return plan.steps if plan and plan.is_task else ()
 
 class GeneratedCharts:
     """The charts generated for the last few tasks, by generation id."""

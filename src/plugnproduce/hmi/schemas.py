@@ -30,9 +30,8 @@ from pydantic import (
 )
 
 from plugnproduce import service
-from plugnproduce.description.model import Task
 from plugnproduce.errors import DescriptionError
-from plugnproduce.safeio import MAX_DIGITS
+from plugnproduce.service import MAX_DIGITS, Task
 
 TASK_SOURCE = "task"
 """The ``file`` of a task that came as JSON: problems name its steps, not a file."""

@@ -15,11 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from plugnproduce import service
-from plugnproduce.description.model import Task
 from plugnproduce.hmi.schemas import TaskIn
 from plugnproduce.hmi.views import editor_rows
-from plugnproduce.knowledge import Knowledge
-from plugnproduce.ontology.vocabulary import concept_value
+from plugnproduce.service import Knowledge, Task, concept_value
 
 _validating = threading.Lock()
 """One validation at a time: the shapes engine is not meant to share its graphs between threads."""

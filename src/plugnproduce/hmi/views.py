@@ -5,20 +5,21 @@ from __future__ import annotations
 from typing import Any
 
 from plugnproduce import service
-from plugnproduce.description.flow import Loop
-from plugnproduce.description.model import (
+from plugnproduce.service import (
     Cell,
     DeviceDescription,
+    Loop,
     Output,
     Parameter,
     ProcessDescription,
     Step,
     Task,
+    Taxonomy,
+    concept_value,
+    describe,
+    local_name,
     plain_value,
 )
-from plugnproduce.executor.journal import describe
-from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_value, local_name
 
 DATATYPES = {"decimal": "decimal", "integer": "integer", "boolean": "boolean", "string": "string", "Pose": "pose"}
 """Local name of a parameter's ``pnp:datatype`` → the kind of field the parameter dialog shows."""

@@ -34,9 +34,8 @@ from typing import Any, TypeVar
 from fastapi import HTTPException, Request, status
 from pebble import ProcessExpired, ProcessPool
 
-from plugnproduce.description.model import DeviceDescription
 from plugnproduce.hmi import jobs
-from plugnproduce.knowledge import Knowledge
+from plugnproduce.service import DeviceDescription, Knowledge
 
 log = logging.getLogger(__name__)
 

@@ -31,6 +31,7 @@ class PNP(DefinedNamespace):
     Pose: URIRef
     XIRP: URIRef
     UPnP: URIRef
+    OPCUA: URIRef
     hasSkill: URIRef
     protocol: URIRef
     endpoint: URIRef

@@ -14,15 +14,34 @@ group of use cases, every name here:
 - :mod:`.resumes`: what runs on after a stopped run, planned from the devices' states;
 - :mod:`.teaching`: teach-in, a value a device reports held to its contracts.
 
+- :mod:`.drawings`: pictures of state charts.
+
 Running a task on devices (discovery, the executor) is the controller's
 (:mod:`plugnproduce.controller`).
+
+The faces import the service and the controller, never a concept package: the concepts' types and
+helpers they name (a task, a cell, a check's result, a verification budget ...) are named here too,
+the heavy ones imported on first use (:data:`_ELSEWHERE`), so that ``pnp --help`` loads none of them.
 """
 
 from __future__ import annotations
 
+import importlib
 from typing import TYPE_CHECKING
 
-from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.description.flow import Loop
+from plugnproduce.description.model import (
+    Cell,
+    DeviceDescription,
+    Link,
+    Output,
+    Parameter,
+    ProcessDescription,
+    Step,
+    Task,
+    plain_value,
+)
+from plugnproduce.executor.journal import describe
 from plugnproduce.knowledge import Knowledge, Library
 from plugnproduce.lazy import lazy_module
 from plugnproduce.service.batches import (
@@ -78,17 +97,78 @@ from plugnproduce.service.teaching import ReportsNothing, Taught, judge_taught, 
 
 if TYPE_CHECKING:
     from plugnproduce import reasoning
+    from plugnproduce.batch import (
+        BATCH_CSV_HEADER,
+        ClusterAccess,
+        bounded_lines,
+        check_cluster_address,
+        configurations_from,
+        read_configurations,
+    )
+    from plugnproduce.batch import generate as random_configurations
+    from plugnproduce.codegen import GeneratedTask, ImplausibleStep
+    from plugnproduce.codegen.outputs import GeneratedChart
+    from plugnproduce.knowledge.vocab import taxonomy_tree, vocabulary, vocabulary_text, vocabulary_tree
+    from plugnproduce.ontology.export import FORMATS as ONTOLOGY_FORMATS
+    from plugnproduce.ontology.taxonomy import Taxonomy
+    from plugnproduce.ontology.vocabulary import concept_value, local_name
+    from plugnproduce.planning import Plan, Unreachable
+    from plugnproduce.reasoning import CheckResult, Explanation, Reason
+    from plugnproduce.resources import rules_path
+    from plugnproduce.safeio import MAX_BYTES, MAX_DIGITS
+    from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
 
+_ELSEWHERE = {
+    **dict.fromkeys(("GeneratedTask", "ImplausibleStep"), "plugnproduce.codegen"),
+    "GeneratedChart": "plugnproduce.codegen.outputs",
+    **dict.fromkeys(("taxonomy_tree", "vocabulary", "vocabulary_text", "vocabulary_tree"),
+                    "plugnproduce.knowledge.vocab"),
+    "ONTOLOGY_FORMATS": "plugnproduce.ontology.export:FORMATS",
+    "Taxonomy": "plugnproduce.ontology.taxonomy",
+    **dict.fromkeys(("concept_value", "local_name"), "plugnproduce.ontology.vocabulary"),
+    **dict.fromkeys(("Plan", "Unreachable"), "plugnproduce.planning"),
+    **dict.fromkeys(("BATCH_CSV_HEADER", "ClusterAccess", "bounded_lines", "check_cluster_address",
+                     "configurations_from", "read_configurations"), "plugnproduce.batch"),
+    "random_configurations": "plugnproduce.batch:generate",
+    **dict.fromkeys(("CheckResult", "Explanation", "Reason"), "plugnproduce.reasoning"),
+    "rules_path": "plugnproduce.resources",
+    **dict.fromkeys(("MAX_BYTES", "MAX_DIGITS"), "plugnproduce.safeio"),
+    **dict.fromkeys(("Budget", "Verification"), "plugnproduce.verification"),
+}
+"""The concepts' names the faces use that the service imports on first use: name → module (``module:name`` when
+the service names it otherwise)."""
+
+
+def __getattr__(name: str) -> object:
+    """A name of :data:`_ELSEWHERE`, imported from its module on first use."""
+    if name not in _ELSEWHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module, _, original = _ELSEWHERE[name].partition(":")
+    value = getattr(importlib.import_module(module), original or name)
+    globals()[name] = value
+    return value
+
 __all__ = [
+    "BATCH_CSV_HEADER",
+    "MAX_BYTES",
+    "MAX_DIGITS",
     "MORE_REPAIRS",
+    "ONTOLOGY_FORMATS",
+    "Budget",
     "Cell",
     "CellArg",
+    "CheckResult",
+    "ClusterAccess",
     "DeviceDescription",
     "DeviceView",
+    "Explanation",
     "Generated",
+    "GeneratedChart",
+    "GeneratedTask",
     "Generation",
+    "ImplausibleStep",
     "ImplausibleTask",
     "NoWayOn",
     "NotResumable",
@@ -98,15 +178,27 @@ __all__ = [
     "Taught",
     "Knowledge",
     "Library",
+    "Link",
+    "Loop",
+    "Output",
+    "Parameter",
+    "Plan",
+    "ProcessDescription",
+    "Reason",
+    "Step",
     "Task",
     "TaskArg",
+    "Taxonomy",
+    "Unreachable",
     "Unverified",
+    "Verification",
     "as_task",
     "assessed_repairs",
     "batch",
     "batch_engine",
     "batch_report",
     "batch_report_from",
+    "bounded_lines",
     "builtin",
     "capabilities",
     "catalogue",
@@ -114,6 +206,10 @@ __all__ = [
     "cell",
     "cell_and_knowledge",
     "check",
+    "check_cluster_address",
+    "concept_value",
+    "configurations_from",
+    "describe",
     "device_view",
     "explain_offered",
     "explain_plausible",
@@ -128,10 +224,14 @@ __all__ = [
     "judge_taught",
     "knowledge",
     "knowledge_for_cell",
+    "local_name",
     "new_run_id",
+    "plain_value",
     "plan",
     "plan_pddl",
     "plan_run",
+    "random_configurations",
+    "read_configurations",
     "reasoning",
     "repair",
     "replan",
@@ -139,13 +239,18 @@ __all__ = [
     "reported_quantities",
     "reported_value",
     "rest_of_task",
+    "rules_path",
     "runs",
     "runs_folder",
     "stopped_run",
     "task",
     "task_from_text",
     "task_text",
+    "taxonomy_tree",
     "validate",
     "validate_tasks",
     "verify",
+    "vocabulary",
+    "vocabulary_text",
+    "vocabulary_tree",
 ]

@@ -1,12 +1,13 @@
 """A simulated device: its own Device State Chart is its program.
 
 A request the chart waits for moves it; an event the chart sends goes out over the
-device's protocol. The device is driven over XIRP (an :class:`XirpServer`) or UPnP
+device's protocol. The device is driven over XIRP (an :class:`XirpServer`), UPnP
 (an :class:`UpnpDeviceServer` whose actions and evented variables come from the
-chart) and, whatever its protocol, announces itself by SSDP and serves its own
+chart) or OPC UA (an :class:`OpcUaDeviceServer` whose methods and event types come
+from the chart) and, whatever its protocol, announces itself by SSDP and serves its own
 Turtle and chart, the Turtle naming the endpoint it really listens on. A request the
 chart does not wait for in its current state is refused (XIRP ``not-accepted``, UPnP
-701) and does not move the chart.
+701, OPC UA ``BadInvalidState``) and does not move the chart.
 """
 
 from __future__ import annotations
@@ -15,9 +16,9 @@ import asyncio
 import dataclasses
 import logging
 import re
-from collections.abc import Mapping
+from collections.abc import Coroutine, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.description.reports import reported_values
@@ -25,10 +26,13 @@ from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.sim.bin import SimulatedBin
-from plugnproduce.statechart.model import Send, walk
+from plugnproduce.sim.payloads import event_payloads
 from plugnproduce.statechart.runtime.events import Event, EventData
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
+
+if TYPE_CHECKING:
+    from plugnproduce.protocols.opcua import OpcUaDeviceServer
 
 _ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
 _CHART = re.compile(r"(pnp:stateChart\s+)<[^>]*>")
@@ -43,18 +47,6 @@ def served_description(device: DeviceDescription, endpoint: str) -> tuple[str, s
     # The chart is served beside the Turtle whatever folder it sits in, so the reference is its name.
     turtle = _CHART.sub(lambda m: f"{m.group(1)}<{Path(device.chart_file).name}>", turtle, count=1)
     return turtle, Path(device.chart_file).read_text(encoding="utf-8")
-
-
-def event_payloads(device: DeviceDescription) -> dict[str, list[str]]:
-    """The values each protocol event of the chart carries (the names of its ``<param>`` elements)."""
-    out: dict[str, list[str]] = {}
-    for node in walk(device.chart):
-        if isinstance(node, Send) and node.event is not None and node.params:
-            command = Command.parse(node.event)
-            if command is not None and command.kind == "event":
-                names = out.setdefault(command.name, [])
-                names.extend(p.name for p in node.params if p.name not in names)
-    return out
 
 
 def requests_and_events(device: DeviceDescription) -> tuple[dict[str, list[str]], list[str]]:
@@ -75,10 +67,13 @@ class SimulatedDevice:
     """One device running its chart behind its protocol; ``async with`` starts and stops it."""
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
-                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
-        """``bin``: the simulated bin the device works on, if any. A device in a state it reported
-        (:meth:`DeviceDescription.reported`) starts its chart there."""
+                 faults: xirp.Faults | None = None, bin: SimulatedBin | None = None,  # noqa: A002
+                 lds: str | None = None) -> None:
+        """``bin``: the simulated bin the device works on, if any; ``lds``: the Local Discovery Server an OPC UA
+        device registers with, if any. A device in a state it reported (:meth:`DeviceDescription.reported`)
+        starts its chart there."""
         self.description = device
+        self.lds = lds
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
         self.bin = bin
@@ -91,6 +86,9 @@ class SimulatedDevice:
         self._task: asyncio.Task[None] | None = None
         self._xirp: xirp.XirpServer | None = None
         self._upnp: upnp.UpnpDeviceServer | None = None
+        self._opcua: OpcUaDeviceServer | None = None
+        self._answers: dict[str, asyncio.Future[dict[str, Any]]] = {}
+        """Per event a request is answered with at once (an OPC UA method's output arguments), its caller."""
         self._pending: set[asyncio.Task[Any]] = set()
         self._reports = reported_values(device)
 
@@ -109,6 +107,8 @@ class SimulatedDevice:
         """Where a controller reaches the device: ``xirp://host:port`` or the UPnP description URL."""
         if self._xirp is not None:
             return self._xirp.endpoint
+        if self._opcua is not None and self._opcua.endpoint is not None:
+            return self._opcua.endpoint
         if self._upnp is not None and self._upnp.location is not None:
             return self._upnp.location
         raise RuntimeError(f"device {self.id} is not started")
@@ -134,6 +134,18 @@ class SimulatedDevice:
             await self._xirp.start()
             spec = upnp.service_spec_from_chart_events({}, [])
             files = self._xirp.files = self._files(self._xirp.endpoint)
+        elif d.protocol == "opcua":
+            from plugnproduce.protocols.opcua import OpcUaDeviceServer  # asyncua loads only for an OPC UA device
+            from plugnproduce.sim.opcua import node_spec
+
+            self._opcua = OpcUaDeviceServer(node_spec(d), self._on_opcua_call, lambda: self.state,
+                                            host=self.network.interface, files=self._files)
+            await self._opcua.start()
+            if self.lds is not None:
+                await self._opcua.register(self.lds)
+            assert self._opcua.endpoint is not None
+            spec = upnp.service_spec_from_chart_events({}, [])
+            files = self._files(self._opcua.endpoint)
         else:
             spec = upnp.with_state_query(upnp.service_spec_from_chart_events(requests, events,
                                                                               payloads=event_payloads(d)))
@@ -153,10 +165,12 @@ class SimulatedDevice:
             await self._upnp.stop()
         if self._xirp is not None:
             await self._xirp.stop()
+        if self._opcua is not None:
+            await self._opcua.stop()
         if self._task is not None:
             self._task.cancel()
             await asyncio.gather(self._task, *self._pending, return_exceptions=True)
-        self._upnp = self._xirp = self._task = None
+        self._upnp = self._xirp = self._task = self._opcua = None
 
     async def drop_connections(self) -> int:
         """Abort every XIRP connection (a cable pulled); the device stays announced."""
@@ -178,7 +192,7 @@ class SimulatedDevice:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
         if self.bin is not None:
             self.bin.on_request(self.description, params, self.interpreter.dm)
-        self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too
+        self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too, as in any interpreter
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
         if request.name == xirp.STATE:  # with the values its chart says it reports (teach-in reads them)
@@ -190,6 +204,26 @@ class SimulatedDevice:
         except LookupError as exc:
             raise xirp.RequestFailed(str(exc), xirp.NOT_ACCEPTED) from None
         return None
+
+    async def _on_opcua_call(self, request: str, values: Mapping[str, Any]) -> Mapping[str, Any] | None:
+        """A method call: the request goes to the chart; the answer's values, if it has one, come back."""
+        from plugnproduce.protocols.opcua import RequestRefused
+
+        answer = self.description.answer_to(request)
+        waiter = asyncio.get_running_loop().create_future() if answer is not None else None
+        if answer is not None and waiter is not None:
+            self._answers[answer] = waiter
+        try:
+            self._accept(request, values)
+        except LookupError as exc:
+            self._answers.pop(answer or "", None)
+            raise RequestRefused(str(exc)) from None
+        if waiter is None:
+            return None
+        try:
+            return await asyncio.wait_for(waiter, self.description.command_timeout)
+        finally:
+            self._answers.pop(answer or "", None)
 
     async def _on_upnp_action(self, action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
         if action == upnp.STATE_ACTION:
@@ -225,7 +259,16 @@ class SimulatedDevice:
             raise ValueError(f"device {self.id} cannot send {event.name!r}; expected {type}.event.NAME")
         if self._xirp is not None:
             self._xirp.emit(command.name, dict(event.data or {}))
+        elif self._opcua is not None:
+            waiter = self._answers.pop(command.name, None)
+            if waiter is not None and not waiter.done():
+                waiter.set_result(dict(event.data or {}))  # the method's output arguments
+                return
+            self._schedule(self._opcua.emit(command.name, dict(event.data or {})))
         elif self._upnp is not None:
-            task = asyncio.get_running_loop().create_task(self._upnp.emit(command.name, dict(event.data or {})))
-            self._pending.add(task)
-            task.add_done_callback(self._pending.discard)
+            self._schedule(self._upnp.emit(command.name, dict(event.data or {})))
+
+    def _schedule(self, sending: Coroutine[Any, Any, object]) -> None:
+        task = asyncio.get_running_loop().create_task(sending)
+        self._pending.add(task)
+        task.add_done_callback(self._pending.discard)

@@ -27,7 +27,7 @@ from typing import Any, Literal
 
 from plugnproduce.chartnames import DONE, STEP
 from plugnproduce.codegen.task import GeneratedTask
-from plugnproduce.description.model import Cell, ChartTransition, DeviceDescription
+from plugnproduce.description.model import PROTOCOLS, Cell, ChartTransition, DeviceDescription
 from plugnproduce.errors import ExecutionError
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.runtime.clock import ManualClock
@@ -110,7 +110,7 @@ class ClosedWorld:
         self._index = {d.id: i for i, d in enumerate(self.devices)}
         self._outbox = _Outbox()
         self.controller = Interpreter(generated.chart, clock=ManualClock(),
-                                      io_processors={"xirp": self._outbox, "upnp": self._outbox})
+                                      io_processors={p: self._outbox for p in PROTOCOLS})
         self.sessions = [Interpreter(d.chart, clock=ManualClock(), io_processors={d.protocol: self._outbox})
                          for d in self.devices]
         self._vars = assigned_variables(self.controller)

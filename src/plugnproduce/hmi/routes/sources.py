@@ -14,7 +14,7 @@ from fastapi import APIRouter, Depends, HTTPException, Query, status
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.routes import hub_of
 from plugnproduce.hmi.security import allow_read
-from plugnproduce.resources import rules_path
+from plugnproduce.service import rules_path
 
 router = APIRouter(prefix="/api", tags=["sources"], dependencies=[Depends(allow_read)])
 

@@ -84,6 +84,48 @@ _BARE_REQUEST = re.compile(
 )
 _BARE_MAX = 300
 
+# Requests and responses carrying decimals, integers, booleans and poses (every command with
+# parameters, most results) are recognised the same way: in the exact form encode() writes them,
+# each number in a plain decimal form that is valid for the schema's type and means the same to
+# float() and int() as to the full path. Strings (which may need escapes) and documents take the
+# full path, and so does a value named twice (the schema refuses it).
+_NAME_BYTES = NAME_PATTERN.pattern.encode()
+_DECIMAL = rb"-?[0-9]{1,40}(?:\.[0-9]{1,40})?"
+_TYPED_VALUE = (rb'<(?:decimal name="' + _NAME_BYTES + rb'">' + _DECIMAL + rb"</decimal>"
+                rb'|integer name="' + _NAME_BYTES + rb'">-?[0-9]{1,18}</integer>'
+                rb'|boolean name="' + _NAME_BYTES + rb'">(?:true|false)</boolean>'
+                rb'|pose name="' + _NAME_BYTES + rb'">' + _DECIMAL + rb"(?: " + _DECIMAL + rb"){5}</pose>)")
+_TYPED_REQUEST = re.compile(rb'<request xmlns="' + _NS_BYTES + rb'" id="(' + _ID_BYTES + rb')" name="('
+                            + _NAME_BYTES + rb')">((?:' + _TYPED_VALUE + rb")+)</request>")
+_TYPED_RESPONSE = re.compile(rb'<response xmlns="' + _NS_BYTES + rb'" id="(' + _ID_BYTES + rb')">((?:'
+                             + _TYPED_VALUE + rb")+)</response>")
+_ONE_VALUE = re.compile(rb'<([a-z]+) name="([^"]+)">([^<]*)<')
+_TYPED_MAX = 4096
+
+
+def _typed_values(content: bytes) -> dict[str, Value] | None:
+    """The values of content :data:`_TYPED_VALUE` matched; None when a name comes twice."""
+    values: dict[str, Value] = {}
+    for tag, name, text in _ONE_VALUE.findall(content):
+        key = name.decode("ascii")
+        if key in values:
+            return None
+        values[key] = _VALUE_READERS[_NS + tag.decode("ascii")](text.decode("ascii"))
+    return values
+
+
+def _typed(data: bytes) -> Message | None:
+    match = _TYPED_REQUEST.fullmatch(data)
+    if match is not None:
+        values = _typed_values(match.group(3))
+        return None if values is None else Request(match.group(1).decode("ascii"), match.group(2).decode("ascii"),
+                                                   values)
+    match = _TYPED_RESPONSE.fullmatch(data)
+    if match is not None:
+        values = _typed_values(match.group(2))
+        return None if values is None else Response(match.group(1).decode("ascii"), values)
+    return None
+
 
 def _bare(data: bytes) -> Message | None:
     match = _BARE_RESPONSE.fullmatch(data)
@@ -104,6 +146,13 @@ def decode(data: bytes, source: str = "peer") -> Message:
         bare = _bare(data)
         if bare is not None:
             return bare
+    if len(data) <= _TYPED_MAX:
+        try:
+            typed = _typed(data)
+        except MessageError:  # a number too large: the full path says so in its words
+            typed = None
+        if typed is not None:
+            return typed
     return _decode_document(data, source)
 
 

@@ -45,6 +45,9 @@ function stateCell(device) {
   return h("td", { class: "state", dataset: { device: device.id } }, h("span", { class: "badge" }, device.state || "?"), concept);
 }
 
+/** How each protocol is written: its own spelling, not upper case (OPC UA, UPnP). */
+const PROTOCOL_NAMES = { xirp: "XIRP", upnp: "UPnP", opcua: "OPC UA" };
+
 function deviceRow(device) {
   const actions = h("td", { class: "actions" },
     h("button", { type: "button", class: "quiet", "aria-label": `Show the state chart of ${device.id}`,
@@ -55,7 +58,8 @@ function deviceRow(device) {
     h("th", { scope: "row" }, h("span", { class: "device-id" }, device.id), h("span", { class: "device-label" }, device.label)),
     h("td", {}, device.classes.join(", ")),
     h("td", { class: "skills" }, device.skills.join(", ")),
-    h("td", {}, h("span", { class: `proto proto-${device.protocol}` }, device.protocol.toUpperCase())),
+    h("td", { class: "protocol" }, h("span", { class: `proto proto-${device.protocol}` }, PROTOCOL_NAMES[device.protocol] || device.protocol),
+      device.endpoint ? h("code", { class: "endpoint" }, device.endpoint) : null),
     stateCell(device),
     actions);
 }
