@@ -11,12 +11,11 @@ import click
 import typer
 
 from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
-from plugnproduce.executor.journal import describe
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
     from plugnproduce import controller, service
-    from plugnproduce.executor.run import TaskRun
+    from plugnproduce.controller import TaskRun
 else:
     controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
@@ -68,7 +67,7 @@ def resume(
 
     def show(record: dict[str, object]) -> None:
         if not json_out:
-            typer.echo(describe(record))
+            typer.echo(service.describe(record))
 
     def started(the_run: TaskRun) -> None:
         loop = asyncio.get_running_loop()

@@ -157,12 +157,10 @@ def explain_command(cell: Cell, command: str) -> dict[str, Any]:
 def plan_goal(data: bytes, filename: str, cell: Cell) -> dict[str, Any]:
     """``service.plan`` of a goal given as YAML: the plan's steps and task (as the editor's JSON, and as a task
     file) with the check's verdict, or why no plan reaches the goal and what to buy."""
-    from plugnproduce.planning import Unreachable
-
     k = _knowledge()
     goal = service.goal_from_text(data, filename)
     found = service.plan(goal, cell, k, _catalogue())
-    if isinstance(found, Unreachable):
+    if isinstance(found, service.Unreachable):
         buy = found.purchase
         return {"goal": goal.name, "reachable": False, "reasons": list(found.reasons),
                 "purchase": None if buy is None else {"device": buy.id, "label": buy.label, "cost": buy.cost}}
