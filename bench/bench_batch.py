@@ -12,9 +12,10 @@
    against the naive reference timed on a sample of the same sets, whose answers are checked equal;
 3. end to end: ``pnp batch`` as a process against the brute-force script (``naive_batch.py``, a
    straightforward per-configuration script) as a process, on the same 10^3, 10^4 and 10^5 distinct
-   configurations of that catalogue, JSONL in and out, with the three tasks: CPU time (user+sys of
-   each process and the workers it started) and wall time, their ratios, the load, and the answers
-   (offered, plausible) checked equal on every line; the batch also computes purchases;
+   configurations of that catalogue (10^6 too with ``--end-to-end 1000000 --rounds 1``: minutes), JSONL in
+   and out, with the three tasks: CPU time (user+sys of each process and the workers it started) and wall
+   time, their ratios, the load, and the answers (offered, plausible) checked equal on every line; the batch
+   also computes purchases;
 4. tasks with loops, branches and links (the three shipped ones), which the batch answers with the full
    check once per way their roles are bound: on ``--flow`` random configurations around the paper's
    cell, against the plain way (``pnp check``'s check of every task in every configuration), answers

@@ -5,7 +5,8 @@
 CPU time (user+sys of the child, ``resource.getrusage(RUSAGE_CHILDREN)``) and wall time of
 ``pnp --help``, importing the reasoning layer (which loads none of its parts until used), ``pnp validate`` of a
 device, a warm ``pnp capabilities`` on the bin-picking
-cell and ``pnp check`` of the bin-picking task, each against a bare ``python -c pass``
+cell and ``pnp check`` of the bin-picking task (warm: the help, units, taxonomy and loaded knowledge kept in the
+user's cache folder by a first run), each against a bare ``python -c pass``
 measured in the same run, interleaved (so a burst of load hits every command alike). Targets,
 in CPU time: ``--help`` ≤ 3×, warm ``capabilities`` ≤ 10×, ``check`` ≤ 15× ``python -c pass``.
 The commands run as ``python -m plugnproduce`` with the interpreter running this script, so no

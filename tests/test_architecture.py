@@ -1,9 +1,15 @@
-"""The layers of ``docs/architecture.md``, checked on the source: imports point one way, and SCXML
-is read, written and named only in ``statechart/``."""
+"""The layers of ``docs/architecture.md``, checked on the source: imports point one way, SCXML is read,
+written and named only in ``statechart/``, and the doc's package graph is the one the imports draw.
+
+``python -m tests.test_architecture`` prints the package graph as the doc's mermaid block;
+``python -m tests.test_architecture --write`` redraws the block in ``docs/architecture.md``."""
 
 from __future__ import annotations
 
 import ast
+import re
+import sys
+from collections import defaultdict
 from pathlib import Path
 
 import pytest
@@ -11,6 +17,7 @@ import pytest
 SRC = Path(__file__).parent.parent / "src" / "plugnproduce"
 
 LAYERS = {
+    "__main__": 8,  # ``python -m plugnproduce``: the kept help, else the command line
     "cli": 7,  # the command line may also start the web HMI (pnp serve)
     "hmi": 6,
     "controller": 5.5,  # runs a cell: the cell sources, the runs (discovery, executor, sim) over the service
@@ -20,11 +27,12 @@ LAYERS = {
     "batch": 3.5,  # checks a product family in many cells with the reasoning layer; not part of it
     "codegen": 3, "reasoning": 3, "validation": 3, "drawing": 3,
     "planning": 3.2,  # plans from goals with the reasoning layer
+    "timing": 3.1,  # cycle time: times the generated charts (codegen) with the devices' durations
     "knowledge": 2.5,  # the loaded libraries: their taxonomy, descriptions and catalogue
     "description": 2,
     "ontology": 1, "statechart": 1, "protocols": 1,
     "chartnames": 0.5,  # the generated task chart's variable names: codegen writes them, the executor reads them
-    "resources": 0, "safeio": 0,
+    "resources": 0, "safeio": 0, "folders": 0, "lazy": 0, "helpcache": 0,
     "errors": -1,
 }
 """Rank of each subpackage or top-level module: a module imports only from lower ranks or its own part."""
@@ -41,8 +49,7 @@ SCXML_NAMESPACE = "http://www.w3.org/2005/07/scxml"
 
 
 def _modules() -> list[Path]:
-    return sorted(p for p in SRC.rglob("*.py")
-                  if (p.parent != SRC and p.name != "__main__.py") or (p.parent == SRC and p.stem in LAYERS))
+    return sorted(p for p in SRC.rglob("*.py") if p.parent != SRC or p.stem in LAYERS)
 
 
 def _part(module: str) -> str | None:
@@ -142,3 +149,112 @@ def test_the_reasoning_layer_and_the_batch_hold_at_most_15_modules_flat() -> Non
     crowded = {str(d.relative_to(SRC)): n for d in folders
                if (n := len([m for m in d.glob("*.py") if m.name != "__init__.py"])) > 15}
     assert crowded == {}
+
+
+# ---------------------------------------------------------------- the doc's package graph
+
+DOC = Path(__file__).parent.parent / "docs" / "architecture.md"
+_GRAPH = re.compile(r"```mermaid\n(graph TD\n.*?)```", re.S)
+
+
+def parts() -> list[str]:
+    """Every package of ``src/plugnproduce`` and every top-level module but ``__init__``."""
+    packages = {p.parent.name for p in SRC.glob("*/*.py")}
+    modules = {p.stem for p in SRC.glob("*.py") if p.stem != "__init__"}
+    return sorted(packages | modules)
+
+
+def package_graph() -> set[tuple[str, str]]:
+    """``(a, b)`` for each part ``a`` with a module that imports a module of another part ``b``."""
+    known = set(parts())
+    edges = set()
+    for path in SRC.rglob("*.py"):
+        if path == SRC / "__init__.py":
+            continue
+        own = _own_part(path)
+        edges |= {(own, part) for m in _imports(path) if (part := _part(m)) in known and part != own}
+    return edges
+
+
+def _rank(part: str) -> float:
+    return LAYERS.get(part, -2)
+
+
+def mermaid(edges: set[tuple[str, str]]) -> str:
+    """The graph as the doc draws it: one line per part, its imports after ``-->``, the highest layers first;
+    a part that imports nothing of the package and is imported by nothing stands on a line of its own."""
+    out: dict[str, list[str]] = defaultdict(list)
+    for a, b in edges:
+        out[a].append(b)
+    order = sorted(parts(), key=lambda p: (-_rank(p), p))
+    lines = ["graph TD"]
+    for part in order:
+        targets = sorted(out.get(part, []), key=lambda p: (-_rank(p), p))
+        if targets:
+            lines.append(f"  {part} --> {' & '.join(targets)}")
+        elif not any(part in ts for ts in out.values()):
+            lines.append(f"  {part}")
+    return "\n".join(lines) + "\n"
+
+
+def doc_graph(text: str) -> tuple[set[tuple[str, str]], set[str]]:
+    """The edges and the nodes of the doc's mermaid package graph (``a --> b & c`` lines, lone ``a`` lines)."""
+    found = _GRAPH.search(text)
+    assert found is not None, f"{DOC.name} has no ```mermaid graph TD block"
+    edges, nodes = set(), set()
+    for line in found.group(1).splitlines()[1:]:
+        line = line.split("%%")[0].strip()
+        if not line:
+            continue
+        sources, _, targets = line.partition("-->")
+        left = [n.strip() for n in sources.split("&")]
+        right = [n.strip() for n in targets.split("&")] if targets else []
+        nodes |= {*left, *right}
+        edges |= {(a, b) for a in left for b in right}
+    return edges, nodes
+
+
+def test_the_docs_package_graph_is_the_one_the_imports_draw() -> None:
+    drawn, _ = doc_graph(DOC.read_text(encoding="utf-8"))
+    actual = package_graph()
+    missing, extra = sorted(actual - drawn), sorted(drawn - actual)
+    if missing or extra:
+        pytest.fail(f"{DOC.name} lacks the imports {', '.join(f'{a} --> {b}' for a, b in missing) or '(none)'} "
+                    f"and draws {', '.join(f'{a} --> {b}' for a, b in extra) or '(none)'}, which do not exist; "
+                    "redraw it with: python -m tests.test_architecture --write", pytrace=False)
+
+
+def test_the_doc_names_every_package_and_top_level_module() -> None:
+    text = DOC.read_text(encoding="utf-8")
+    _, nodes = doc_graph(text)
+    unnamed, unknown = sorted(set(parts()) - nodes), sorted(nodes - set(parts()))
+    if unnamed or unknown:
+        pytest.fail(f"{DOC.name}'s graph leaves out {', '.join(unnamed) or '(none)'} and names "
+                    f"{', '.join(unknown) or '(none)'}, which is no package or top-level module", pytrace=False)
+
+
+def test_every_part_has_a_layer() -> None:
+    assert sorted(p for p in parts() if p not in LAYERS) == []
+
+
+def _redraw() -> None:
+    text = DOC.read_text(encoding="utf-8")
+    found = _GRAPH.search(text)
+    assert found is not None
+    DOC.write_text(text[:found.start(1)] + mermaid(package_graph()) + text[found.end(1):], encoding="utf-8")
+
+
+
+def test_no_runtime_part_escapes_the_type_checker_through_any() -> None:
+    """The runtime's parts reach one another through the Protocols of ``statechart/runtime/session.py``."""
+    escapes = re.compile(r":\s*Any\s*=\s*self\b|type:\s*ignore\[arg-type\]")
+    offenders = [f"{p.relative_to(SRC)}:{n}" for p in (SRC / "statechart" / "runtime").glob("*.py")
+                 for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), start=1) if escapes.search(line)]
+    assert offenders == []
+
+
+if __name__ == "__main__":
+    if sys.argv[1:] == ["--write"]:
+        _redraw()
+    else:
+        print(mermaid(package_graph()), end="")

@@ -77,6 +77,16 @@ def test_a_lazy_module_loads_on_first_use() -> None:
     assert _run(code).split() == ["False", "False", "True", "True", "True"]
 
 
+def test_a_name_the_module_binds_anew_after_first_use_is_seen_through_its_stand_in() -> None:
+    code = ("from plugnproduce.lazy import lazy_module\n"
+            "m = lazy_module('plugnproduce.drawing')\n"
+            "m.draw_chart\n"  # first use
+            "import plugnproduce.drawing as real\n"
+            "real.draw_chart = 'patched'\n"  # as a test's monkeypatch or a module replacing a global does
+            "print(m.draw_chart)")
+    assert _run(code).split() == ["patched"]
+
+
 def test_a_missing_module_is_an_error_at_once() -> None:
     with pytest.raises(ModuleNotFoundError, match="plugnproduce.nowhere"):
         lazy_module("plugnproduce.nowhere")
@@ -150,3 +160,24 @@ def test_the_reasoning_layer_loads_what_is_used_on_first_use() -> None:
     assert _run(code).split() == ["False", "plugnproduce.reasoning.checks.plausibility",
                                   "plugnproduce.reasoning.repairs.windows", "True",
                                   "True", "Repair", "plugnproduce.reasoning.explanation.why", "True"]
+
+
+NOT_FOR_A_WARM_ANSWER = ("pydantic", "asyncio", "owlready2", "pyshacl", "xmlschema", "aiohttp", "fastapi", "uvicorn",
+                         "async_upnp_client", "graphviz", "pint", "numpy", "distributed", "plugnproduce.codegen",
+                         "plugnproduce.hmi", "plugnproduce.verification")
+"""What answering ``pnp capabilities`` and ``pnp check`` from files seen before has no use for (typer turns the
+file names into paths without pydantic; the event loop is started only by the commands that talk to devices;
+the taxonomy comes reasoned from the cache folder)."""
+
+
+@pytest.mark.parametrize("args", [("capabilities", "--cell", "descriptions/cells/bin-picking.yaml"),
+                                  ("check", "descriptions/tasks/bin-picking.yaml", "--cell",
+                                   "descriptions/cells/bin-picking.yaml")])
+def test_a_warm_capabilities_or_check_loads_nothing_it_has_no_use_for(tmp_path: Path, args: tuple[str, ...]) -> None:
+    code = _command(*args).replace("pass", "print('exit', sys.exc_info()[1].code)")
+    _run(code, tmp_path)  # the first answer keeps the units and the reasoned taxonomy in the cache folder
+    out = _run(code + "\nprint('loaded: ' + ' '.join(sorted(sys.modules)))", tmp_path)
+    answer = "9 of 12 process commands offered" if args[0] == "capabilities" else "bin-picking: plausible"
+    assert answer in out and "exit 0" in out
+    loaded = set(out.rsplit("loaded: ", 1)[1].split())
+    assert sorted(h for h in NOT_FOR_A_WARM_ANSWER if h in loaded) == []

@@ -34,6 +34,22 @@ def _width() -> int:
         return 80
 
 
+def _cache_folder() -> str:
+    """The user's cache folder, as :func:`plugnproduce.folders.cache_folder` names it.
+
+    On Linux platformdirs names it from ``XDG_CACHE_HOME`` or ``~/.cache``; that rule is followed here
+    without importing platformdirs, which imports ``pathlib`` and ``re`` and would double the start-up this
+    module saves (``tests/test_folders.py`` holds the two to the same answer). Elsewhere, platformdirs answers.
+    """
+    if sys.platform.startswith("linux"):
+        xdg = os.environ.get("XDG_CACHE_HOME", "")
+        base = xdg if os.path.isabs(xdg) else os.path.expanduser("~/.cache")
+        return os.path.join(base, "plugnproduce")
+    import platformdirs
+
+    return platformdirs.user_cache_dir("plugnproduce")
+
+
 def help_file(folder: str | None = None) -> str:
     """The file of the help text for this command line's code, version, width and environment."""
     here = os.path.dirname(__file__)
@@ -45,7 +61,7 @@ def help_file(folder: str | None = None) -> str:
     for f in sorted(files):
         stat = os.stat(f)
         h.update(f"{os.path.basename(f)}\0{stat.st_size}\0{stat.st_mtime_ns}\0".encode())
-    folder = folder or os.path.join(os.path.expanduser("~"), ".cache", "plugnproduce")
+    folder = folder or _cache_folder()
     return os.path.join(folder, f"help-{h.hexdigest()[:24]}.txt")
 
 

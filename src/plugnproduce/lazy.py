@@ -25,9 +25,9 @@ class _LazyModule(ModuleType):
     """Stands for a module not imported yet; the first attribute it is asked for imports it."""
 
     def __getattr__(self, attr: str) -> object:  # only for what the stand-in itself does not have
-        module = importlib.import_module(self.__name__)
-        self.__dict__.update(module.__dict__)
-        return getattr(module, attr)
+        # asked of the module every time, not copied: a name the module binds anew later (a patched function,
+        # a global it replaces) is seen through the stand-in too
+        return getattr(importlib.import_module(self.__name__), attr)
 
 
 def lazy_module(name: str) -> ModuleType:

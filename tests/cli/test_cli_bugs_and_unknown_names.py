@@ -28,7 +28,7 @@ def _raise_key_error() -> list[object]:
     return {}["wrong-key"]  # type: ignore[no-any-return]
 
 
-def test_a_key_error_raised_by_a_bug_is_exit_3_with_the_traceback_logged(
+def test_a_key_error_raised_by_a_bug_is_exit_4_with_the_traceback_logged(
         home: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(service, "runs", _raise_key_error)
     result = runner.invoke(app, ["runs"])
@@ -44,7 +44,7 @@ def test_a_key_error_raised_by_a_bug_is_exit_3_with_the_traceback_logged(
     assert "in _raise_key_error" in logged and "KeyError: 'wrong-key'" in logged
 
 
-def test_any_other_exception_of_a_bug_is_exit_3_too(home: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_any_other_exception_of_a_bug_is_exit_4_too(home: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     def broken() -> list[object]:
         raise AttributeError("'NoneType' object has no attribute 'id'")
 

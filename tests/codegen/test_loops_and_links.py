@@ -101,3 +101,17 @@ def test_a_loop_goes_on_while_an_outcome_under_its_while_is_reported(bin_picking
     assert rule_taken(chart, {**iterated, "pnp_outcome": "BinEmpty"}) == [
         ("pnp_rounds_1", "pnp_rounds_1 + 1"), ("pnp_step", "3")]
     assert rule_taken(chart, {**iterated, "pnp_outcome": "PartFound"}) == [("pnp_outcome", "None"), ("pnp_rounds_1", "-1")]
+
+
+def test_a_loop_of_at_most_one_iteration_skips_its_later_iterations_copy(bin_picking_cell, processes) -> None:
+    # the body is localize, pick, place: its first iteration is positions 1-3, the later iterations' copy 4-6
+    chart = chart_of(UNTIL_EMPTY.replace("max: 100", "max: 1"), bin_picking_cell, processes)
+    assert rule_taken(chart, {"pnp_step": 3, "pnp_rounds_1": 0, "pnp_outcome": "PartFound"}) == [
+        ("pnp_step", "6"), ("pnp_rounds_1", "-1")]
+
+
+def test_the_outcome_of_the_loops_first_step_ends_it(bin_picking_cell, processes) -> None:
+    chart = chart_of(UNTIL_EMPTY, bin_picking_cell, processes)
+    assert rule_taken(chart, {"pnp_step": 1, "pnp_rounds_1": 0, "pnp_outcome": "BinEmpty"}) == [
+        ("pnp_step", "6"), ("pnp_outcome", "None"), ("pnp_rounds_1", "-1")]
+    assert rule_taken(chart, {"pnp_step": 0, "pnp_rounds_1": 0, "pnp_outcome": "BinEmpty"}) == []

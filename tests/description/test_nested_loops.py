@@ -82,3 +82,31 @@ def test_loops_nested_beyond_the_step_limit_are_refused_at_the_loop_that_passes_
     with pytest.raises(DescriptionError, match="the task makes more than 10000 steps") as err:
         parse_task(text.encode(), "deep.yaml")
     assert err.value.line == 4  # the outermost loop (its first key): its second copy of the body would pass the limit
+
+
+INNER_FIRST = b"""task: inner-first
+steps:
+  - loop:
+      max: 2
+      steps:
+        - loop:
+            until: BinEmpty
+            max: 3
+            steps:
+              - command: localize-part
+              - command: pick
+        - command: place
+"""
+
+
+def test_a_loop_starting_where_its_outer_loop_starts_comes_after_it() -> None:
+    task = parse_task(INNER_FIRST, "inner-first.yaml")
+    assert [(lp.entry, lp.first, lp.last) for lp in task.loops] == [(1, 6, 10), (1, 3, 4), (6, 8, 9)]
+    assert [(lp.entry, lp.last) for lp in task.loops_at(1)] == [(1, 10), (1, 4)]  # its first step: both loops
+    assert [(lp.entry, lp.last) for lp in task.loops_at(4)] == [(1, 10), (1, 4)]  # the inner loop's last step
+    assert [(lp.entry, lp.last) for lp in task.loops_at(5)] == [(1, 10)]
+    assert [(lp.entry, lp.last) for lp in task.loops_at(10)] == [(1, 10)]  # the outer loop's last step
+    assert task.loops_at(11) == ()
+    loop = task.loop_at(1)
+    assert loop is not None and (loop.entry, loop.last) == (1, 10)
+    assert task.path(1) == "loop iteration 1, loop iteration 1"

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from plugnproduce.description.flow import Branch
 from plugnproduce.description.loader import load_task, parse_task, task_to_yaml
 from plugnproduce.description.model import Task
 from plugnproduce.errors import DescriptionError
@@ -108,3 +109,9 @@ def test_a_loop_inside_a_branch_runs_once_and_is_written_back() -> None:
     assert (task.branches[0].first, task.branches[0].last) == (2, 5)
     assert (task.loops[0].entry, task.loops[0].first, task.loops[0].last) == (2, 4, 5)
     assert _shape(parse_task(task_to_yaml(task).encode(), "t.yaml")) == _shape(task)
+
+
+@pytest.mark.parametrize("outcome", ["https://example.org/cell/outcomes#NoPartFound",
+                                     "https://example.org/cell/outcomes/NoPartFound", "NoPartFound"])
+def test_a_branch_is_named_by_its_outcomes_local_name_however_the_iri_ends(outcome: str) -> None:
+    assert Branch(3, outcome, 4, 5).path == "branch NoPartFound at step 3"

@@ -72,6 +72,15 @@ def test_the_next_best_repairs_are_distinct_and_no_cheaper(cell: Cell) -> None:
     assert all(service.check(r.task, cell).plausible for r in found)
 
 
+def test_a_step_rebound_in_a_window_names_its_new_device_in_the_repaired_task(cell: Cell) -> None:
+    task = faulty_task(25, 2, 5, kinds=("absent",))  # places 20 and 42 bound to a SCARA the cell does not have
+    best = windowed(task, cell)[0]
+    assert [(e.kind, e.step, e.role, e.device) for e in best.edits] == [("rebind", 20, "robot", "robot"),
+                                                                         ("rebind", 42, "robot", "robot")]
+    assert [(n, st.bind) for n, st in enumerate(best.task.steps, start=1) if st.bind] == [
+        (20, {"robot": "robot"}), (42, {"robot": "robot"})]
+
+
 def _screws(task: Task, at: tuple[int, ...]) -> Task:
     steps = list(task.steps)
     for i in sorted(at, reverse=True):
@@ -85,6 +94,19 @@ def test_one_device_bought_for_two_distant_windows_is_paid_once(cell: Cell, devi
     assert best.added_devices == ("screwdriver",)
     assert best.cost == whole(task, cell, devices)[0].cost
     assert service.check(best.task, cell.with_device(_by_id(devices, best.added_devices[0]))).plausible
+
+
+def test_a_device_bought_in_one_window_enters_the_next_in_the_state_the_first_left_it(
+        cell: Cell, devices: list[DeviceDescription]) -> None:
+    """No gripper in the cell: a pick and, 25 robot moves later, a place. The gripper bought for both leaves the
+    pick holding the part, so the place needs nothing more (no close-gripper inserted before it)."""
+    pick, place = (replace(st, bind={}) for st in service.task(service.builtin("tasks", "bin-picking.yaml")).steps[:2])
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    steps = [move] * 10 + [pick] + [move] * 25 + [place] + [move] * 10
+    task = Task("far", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "far.yaml")
+    best = windowed(task, cell.without("gripper"), devices)[0]
+    assert [e.kind for e in best.edits] == ["add"] and best.added_devices == ("gripper",)
+    assert best.cost == whole(task, cell.without("gripper"), devices)[0].cost == 5.18
 
 
 def _by_id(devices: list[DeviceDescription], name: str) -> DeviceDescription:

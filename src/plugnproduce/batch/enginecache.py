@@ -21,6 +21,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import plugnproduce
+from plugnproduce import folders
 from plugnproduce.knowledge.libraries import Library, tbox_files
 from plugnproduce.resources import rules_path
 
@@ -30,7 +31,7 @@ KEEP = 8
 
 def cache_folder() -> Path:
     """Where the engines are kept: the user's cache folder, beside the taxonomy's closures."""
-    return Path.home() / ".cache" / "plugnproduce"
+    return folders.cache_folder()
 
 
 def _files(root: Path, pattern: str = "*") -> list[Path]:

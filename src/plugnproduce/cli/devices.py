@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import json
 import time
 from dataclasses import dataclass
@@ -25,11 +24,14 @@ from plugnproduce.cli.helptext import PlainTyper
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.lazy import lazy_module
 
-if TYPE_CHECKING:  # the network stack is imported by the commands that use it
+if TYPE_CHECKING:
+    import asyncio  # the network stack is imported by the commands that use it
+
     from plugnproduce import service
     from plugnproduce.controller import CellChange, LiveCell, devices
     from plugnproduce.service import Cell
 else:
+    asyncio = lazy_module("asyncio")  # the event loop is started by the commands that use it
     devices = lazy_module("plugnproduce.controller.devices")
     service = lazy_module("plugnproduce.service")
 
@@ -240,6 +242,9 @@ def sim_up(
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,
                                          help="A simulated bin of N parts at random poses for the devices to work on."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
+    speed: float = typer.Option(1.0, "--speed", metavar="F", min=0.01, max=1000.0,
+                                help="The devices work F times faster than real time (their durations divided by F; "
+                                     "default 1)."),
     interface: str | None = INTERFACE_OPTION,
 ) -> None:
     """Start the cell's simulated devices; Ctrl-C stops them cleanly.
@@ -254,7 +259,7 @@ def sim_up(
     the_cell = service.cell(cell, knowledge())
     k = knowledge(cell)
     sim = devices.simulated_cell(the_cell, service.catalogue(knowledge=k), k, faults, bin_parts, bin_seed,
-                                 interface=address)
+                                 interface=address, speed=speed)
     try:
         asyncio.run(devices.run_simulated(sim, state_file, echo=typer.echo))
     except KeyboardInterrupt:

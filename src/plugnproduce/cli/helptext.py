@@ -9,7 +9,9 @@ from typing import Any, TypeVar
 
 import typer
 from typer import _click as click  # typer vendors its own click: its commands take these types
-from typer.core import TyperCommand
+from typer.core import TyperCommand, TyperGroup
+
+from plugnproduce.cli.coercion import plain_values
 
 
 def is_argument(param: click.Parameter) -> bool:
@@ -27,7 +29,13 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 class PlainCommand(TyperCommand):
-    """A command whose usage line and help name its arguments plainly."""
+    """A command whose usage line and help name its arguments plainly, and whose texts and paths are taken
+    without pydantic (:mod:`plugnproduce.cli.coercion`)."""
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        """As typer parses them, texts and paths turned plainly."""
+        plain_values(self.get_params(ctx))
+        return super().parse_args(ctx, args)
 
     def collect_usage_pieces(self, ctx: click.Context) -> list[str]:
         """``[OPTIONS] TASK``, an optional argument in brackets: ``[OPTIONS] [RUN]``."""
@@ -58,8 +66,21 @@ class PlainCommand(TyperCommand):
                     formatter.write_dl(rows)
 
 
+class PlainGroup(TyperGroup):
+    """The command group, whose own options' texts and paths are taken without pydantic."""
+
+    def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
+        """As typer parses them, texts and paths turned plainly."""
+        plain_values(self.get_params(ctx))
+        return super().parse_args(ctx, args)
+
+
 class PlainTyper(typer.Typer):
-    """A typer application whose commands are :class:`PlainCommand` unless told otherwise."""
+    """A typer application whose commands are :class:`PlainCommand` (and group :class:`PlainGroup`) unless told
+    otherwise."""
+
+    def __init__(self, *args: Any, cls: type[TyperGroup] | None = None, **kwargs: Any) -> None:
+        super().__init__(*args, cls=cls or PlainGroup, **kwargs)
 
     def command(self, *args: Any, cls: type[TyperCommand] | None = None, **kwargs: Any) -> Callable[[F], F]:
         """As :meth:`typer.Typer.command`, with plain help."""

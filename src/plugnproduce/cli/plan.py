@@ -31,13 +31,20 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
                                           help="Also write the goal as PDDL (domain.pddl, problem.pddl) into DIR, "
                                                "for other planners; not for a goal with until."),
          live: bool = LIVE_OPTION, discovery_timeout: float | None = DISCOVERY_OPTION,
-         interface: str | None = INTERFACE_OPTION, json_out: bool = JSON_OPTION) -> None:
+         interface: str | None = INTERFACE_OPTION,
+         minimize: str = typer.Option("steps", "--minimize", metavar="steps|cycle-time",
+                                      help="After measuring what the cell can measure: the fewest steps (default), "
+                                           "or the least estimated cycle time."),
+         json_out: bool = JSON_OPTION) -> None:
     """Plan a task from a goal: which process commands, in which order, on which devices, with which values.
 
     The plan is the shortest that measures what the cell can measure (a pick pose the bin-picking PC
-    reports rather than a default); it is checked like a written task. Exit 0 planned, 1 no plan reaches
-    the goal (why, and the cheapest catalogue device that would make one), 2 bad input.
+    reports rather than a default), or with --minimize cycle-time the one of least estimated cycle time;
+    it is checked like a written task. Exit 0 planned, 1 no plan reaches the goal (why, and the cheapest
+    catalogue device that would make one), 2 bad input.
     """
+    if minimize not in ("steps", "cycle-time"):
+        raise typer.BadParameter(f"--minimize {minimize!r}: expected steps or cycle-time")
     k = knowledge(cell)
     the_cell = _cell(cell, live, discovery_timeout, interface)
     from plugnproduce.service import Link, Unreachable, local_name  # here, not at the top: `pnp --help` loads none
@@ -47,18 +54,20 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
         pddl.mkdir(parents=True, exist_ok=True)
         (pddl / "domain.pddl").write_text(domain, encoding="utf-8")
         (pddl / "problem.pddl").write_text(problem, encoding="utf-8")
-    found = service.plan(goal, the_cell, k, source=str(output) if output else None)
+    found = service.plan(goal, the_cell, k, source=str(output) if output else None, minimize=minimize)
     if isinstance(found, Unreachable):
         _unreachable(found, json_out)
         raise typer.Exit(1)
     checked = service.check(found.task, the_cell, k)
+    estimate = service.cycle_time(found.task, the_cell, k, checked)
     if output is not None:
         output.write_text(found.text, encoding="utf-8")
     if json_out:
         emit_json({"goal": found.goal.name, "reachable": True, "steps": found.steps, "task": found.text,
                    "written_to": str(output) if output else None,
                    "defaults_not_measured": [{"step": t, "parameter": n} for t, n in found.blind],
-                   "check": checked.to_json()})
+                   "check": checked.to_json(), "minimize": minimize,
+                   "cycle_time": estimate.to_json() if estimate is not None else None})
         return
     loop = f", repeated until {local_name(found.goal.until)}" if found.goal.until else ""
     typer.echo(f"goal {found.goal.name} in cell {checked.cell}: planned, {found.steps} steps{loop}; "
@@ -70,6 +79,9 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
         typer.echo(f"  {step.index}. {step.command:<16} {binding}" + (f"  ({values})" if values else ""))
     for t, n in found.blind:
         typer.echo(f"  step {t}'s {n} takes its default, though the cell could measure it")
+    if estimate is not None:
+        typer.echo(f"  estimated cycle time: {estimate.total:.2f} s"
+                   + (" per iteration of the loop" if found.goal.until else ""))
     if output is not None:
         typer.echo(f"written to {output}")
     else:

@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import dataclasses
+import json
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -103,6 +105,14 @@ def _print_problems(result: service.CheckResult, verbose: bool) -> None:
             typer.echo(f"    rests on: {', '.join(str(w) for w in p.reason.where)}")
 
 
+def _cycle_line(estimate: service.CycleTime) -> str:
+    """The text output's total line: the estimated cycle time, and what it counts once."""
+    line = f"estimated cycle time: {estimate.total:.2f} s"
+    per = [f"{lp.later_iteration:.2f} s per further iteration of steps {lp.entry}-{lp.last}"
+           for lp in estimate.loops if lp.count is None]
+    return line + (f" (loops ended by an outcome counted once; {', '.join(per)})" if per else "")
+
+
 @app.command()
 @boundary
 def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (YAML)."), cell: Path = CELL_OPTION,
@@ -114,15 +124,19 @@ def check(task: Path = typer.Argument(..., metavar="TASK", help="The task file (
     Exit 0 plausible, 1 implausible (each problem names the step, device, its state and the needed state),
     2 bad input.
     """
-    result = service.check(task, _cell(cell, live, discovery_timeout, interface), knowledge(cell))
+    the_cell, k = _cell(cell, live, discovery_timeout, interface), knowledge(cell)
+    result = service.check(task, the_cell, k)
+    estimate = service.cycle_time(task, the_cell, k, result) if result.plausible else None
     if json_out:
-        emit_json(result.to_json())
+        emit_json({**result.to_json(), "cycle_time": estimate.to_json() if estimate is not None else None})
     else:
         verdict = "plausible" if result.plausible else f"implausible ({len(result.problems)} problem(s))"
         typer.echo(f"task {result.task} in cell {result.cell}: {verdict}")
         _print_problems(result, verbose)
         for link in result.links:  # what a device reports is proven here or held to the contract when it comes
             typer.echo(f"  {link}")
+        if estimate is not None:
+            typer.echo(_cycle_line(estimate))
     if not result.plausible:
         raise typer.Exit(1)
 
@@ -140,24 +154,36 @@ def repair(
     discovery_timeout: float | None = DISCOVERY_OPTION,
     interface: str | None = INTERFACE_OPTION,
     verbose: bool = VERBOSE_OPTION,
+    rank: str = typer.Option("side-effects", "--rank", metavar="side-effects|time",
+                             help="Order the repairs by their side effects, then cost (default), or by the cycle "
+                                  "time they add (the repaired task's estimate), fastest first."),
     json_out: bool = JSON_OPTION,
 ) -> None:
     """Propose minimal-cost repairs of an implausible task: ranked edit lists and the resulting tasks.
 
-    Ranked by their worst side effect (none first, a dropped part last), then by cost, cheapest first; each one
+    Ranked by their worst side effect (none first, a dropped part last), then by cost, cheapest first (or with
+    --rank time by the estimated cycle time of the repaired task); each one
     checked again, with the devices it buys and their own limits.
     A task of more than 40 steps is repaired window by window around its problems (same optimal cost).
     Exit 0 when the task is plausible or repairs were found, 1 when no repair exists, 2 bad input.
     """
+    if rank not in ("side-effects", "time"):
+        raise typer.BadParameter(f"--rank {rank!r}: expected side-effects or time")
     the_cell = _cell(cell, live, discovery_timeout, interface)
     the_task = service.task(task)  # read once, checked once: the repairs' assessment starts from this check
     result = service.check(the_task, the_cell, knowledge(cell))
     repairs = [] if result.plausible else service.assessed_repairs(the_task, the_cell, catalogue, top,
                                                                    knowledge(cell), checked=result)
+    times = service.repair_cycle_times(repairs, the_cell, catalogue, knowledge(cell))
+    if rank == "time":
+        order = sorted(range(len(repairs)), key=lambda i: (_seconds(times[i]), repairs[i].rank))
+        repairs = [dataclasses.replace(repairs[i], rank=n) for n, i in enumerate(order, start=1)]
+        times = [times[i] for i in order]
     players = service.catalogue_players(result, knowledge(cell))
     if json_out:
         emit_json({"task": result.task, "cell": result.cell, "plausible": result.plausible,
-                   "repairs": [r.to_json() for r in repairs],
+                   "repairs": [{**r.to_json(), "cycle_time": _seconds(t, None)} for r, t in zip(repairs, times,
+                                                                                            strict=True)],
                    "catalogue_players": [{"step": i, "role": r, "devices": ds} for (i, r), ds in players.items()]})
     elif result.plausible:
         typer.echo(f"task {result.task} in cell {result.cell}: plausible; nothing to repair")
@@ -169,7 +195,7 @@ def repair(
                                                        + ("" if catalogue else " (repair with --catalogue to add one)")
                                                        if devices else "no catalogue device (built-in or library) "
                                                        "can play it"))
-        for r in repairs:
+        for r, t in zip(repairs, times, strict=True):
             typer.echo(f"\nrepair {r.rank} (cost {r.repair.cost:g}):")
             for e in r.repair.edits:
                 typer.echo(f"  - {e.text} [cost {e.cost:g}]")
@@ -177,10 +203,17 @@ def repair(
                 typer.echo(f"  side effect: {x.text}")
             if r.repair.unrolls:
                 typer.echo(f"  note: {r.repair.unrolls}")
+            if t is not None:
+                typer.echo(f"  estimated cycle time: {t.total:.2f} s")
             typer.echo("  resulting task:")
             typer.echo("".join(f"    {line}\n" for line in service.task_text(r.repair.task).splitlines()), nl=False)
     if not result.plausible and not repairs:
         raise typer.Exit(1)
+
+
+def _seconds(estimate: service.CycleTime | None, missing: float | None = float("inf")) -> float | None:
+    """A repaired task's estimated seconds (``missing`` when it has none)."""
+    return round(estimate.total, 3) if estimate is not None else missing
 
 
 def _tree(ex: service.Explanation, depth: int | None, verbose: bool) -> None:
@@ -260,6 +293,8 @@ plausible; {"options": [], "ambiguous": "..."} when several devices of the confi
 play a step's role (bind it in the task: no purchase cures that); {"options": [], "impossible":
 "why"} when no set from the catalogue helps. A .csv output file gets the same columns as CSV.
 With -o, or on a terminal, a last line on stderr counts the configurations of each kind.
+--cycle-time adds "cost" and per task its estimated "cycle_time" (seconds, null where not plausible);
+--pareto prints only the front of cost x cycle time: {"config", "devices", "cost", "cycle_time"}.
 
 Exit 0 answered (whatever is feasible), 2 bad input.
 """
@@ -297,6 +332,12 @@ def batch(
                                              help="With tls://: this client's certificate."),
     cluster_key: Path | None = typer.Option(None, "--cluster-key", metavar="FILE",
                                             help="With tls://: this client's private key."),
+    cycle_time: bool = typer.Option(False, "--cycle-time",
+                                    help="Add each configuration's cost and per task its estimated cycle time "
+                                         "(seconds), answered in this process (JSONL)."),
+    pareto: bool = typer.Option(False, "--pareto",
+                                help="Print only the configurations on the front of cost x cycle time (every task "
+                                     "plausible; the time summed over the tasks), cheapest first (JSONL)."),
 ) -> None:
     if (configs is None) == (generate is None):
         fail("give either CONFIGS (a JSONL or CSV file, or -) or --generate N")
@@ -320,6 +361,11 @@ def batch(
     else:
         configurations = service.read_configurations(configs)  # type: ignore[arg-type]
     as_csv = output is not None and output.suffix.lower() == ".csv"
+    if cycle_time or pareto:
+        if as_csv or cluster is not None:
+            fail("--cycle-time and --pareto write JSONL in this process: no .csv output, no --cluster")
+        _timed(engine, configurations, catalogue, list(tasks), output, pareto)
+        return
     with contextlib.ExitStack() as stack:
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
         if as_csv:
@@ -331,6 +377,21 @@ def batch(
     if output is not None or on_a_terminal():
         where = f" to {output}" if output is not None else ""
         typer.echo(f"wrote {written} configurations{where}: {_tally(tally)}", err=True)
+
+
+def _timed(engine: service.Engine, configurations: Iterable[service.Configuration], catalogue: Path | None,
+           tasks: list[Path], output: Path | None, pareto: bool) -> None:
+    """``pnp batch --cycle-time`` (every row with its cost and cycle times) or ``--pareto`` (the front only)."""
+    rows = service.batch_cycle_times(engine, configurations, catalogue, list(tasks), tuple(LIBRARIES["folders"]),
+                                     LIBRARIES["builtin"])
+    with contextlib.ExitStack() as stack:
+        out = stack.enter_context(output.open("w", encoding="utf-8")) if output else sys.stdout
+        if not pareto:
+            for row in rows:
+                out.write(json.dumps(row) + "\n")
+            return
+        for point in service.pareto_front(rows):
+            out.write(json.dumps(point) + "\n")
 
 
 def _tally(tally: dict[str, int]) -> str:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import signal
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -24,9 +23,12 @@ from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
+    import asyncio
+
     from plugnproduce import controller, service
     from plugnproduce.controller import TaskRun
 else:
+    asyncio = lazy_module("asyncio")  # the event loop is started by the commands that use it
     controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 
@@ -45,6 +47,9 @@ def run(
                                          help="With --sim: a simulated bin of N parts at random poses (default "
                                               "5 for a task that loops on a localized pose, else none)."),
     bin_seed: int = typer.Option(0, "--bin-seed", metavar="S", help="With --bin-parts: the seed that places them."),
+    speed: float = typer.Option(1.0, "--speed", metavar="F", min=0.01, max=1000.0,
+                                help="With --sim: the devices work F times faster than real time (their durations "
+                                     "divided by F; default 1, real time)."),
     journal: Path | None = typer.Option(None, "--journal", metavar="FILE",
                                         help="Journal file (default: a new file in PNP_RUNS)."),
     assume_initial: bool = typer.Option(False, "--assume-initial",
@@ -68,6 +73,8 @@ def run(
         cell = service.builtin("cells", "bin-picking.yaml")
     if bin_parts is not None and not sim:
         raise typer.BadParameter("--bin-parts works on simulated devices: add --sim")
+    if speed != 1.0 and not sim:
+        raise typer.BadParameter("--speed works on simulated devices: add --sim")
     if sim and bin_parts is None and (bin_parts := controller.default_bin_parts(task)) is not None:
         typer.echo(f"simulated bin: {bin_parts} parts at random poses (seed {bin_seed}); --bin-parts N for another",
                    err=json_out)
@@ -90,7 +97,7 @@ def run(
             report = asyncio.run(controller.run_task(task, cell, simulate=sim, faults=faults, journal=journal,
                                                   observer=show, started=started, progress=phases,
                                                   knowledge=knowledge(cell), bin_parts=bin_parts, bin_seed=bin_seed,
-                                                  assume_initial=assume_initial,
+                                                  assume_initial=assume_initial, speed=speed,
                                                   discovery_timeout=discovery_timeout, interface=address))
             phases.close(last_done=True)
     except service.ImplausibleTask as exc:

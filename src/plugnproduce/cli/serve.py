@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import os
 import signal
 import socket
@@ -18,12 +17,15 @@ from plugnproduce.cli.app import INTERFACE_OPTION, app, boundary, fail, interfac
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:
+    import asyncio
+
     import uvicorn
     from fastapi import FastAPI
 
     from plugnproduce import controller, service
     from plugnproduce.controller import CellSource, Runner
 else:
+    asyncio = lazy_module("asyncio")  # the event loop is started by the commands that use it
     controller = lazy_module("plugnproduce.controller")
     service = lazy_module("plugnproduce.service")
 

@@ -63,6 +63,8 @@ class RegionResult:
     """(controller state id, command) in order: what the controller sends and waits for."""
     path: list[ChartTransition] = field(default_factory=list)
     """The transitions the device takes in its own chart, in order."""
+    legs: list[int] = field(default_factory=list)
+    """How many of :attr:`path`'s transitions each transition of the role's region takes, in order."""
 
 
 def state_id(step: int, device: str, general_id: str, role: str) -> str:
@@ -101,6 +103,7 @@ def specific_region(
         values = {p: params[p] for p in general.params if p in params}
         _insert_path(states, path.steps, ids[general.id], device, values, process, cond, result)
         result.path.extend(path.steps)
+        result.legs.append(len(path.steps))
         current = path.target
         kind = Final if general is role.region[-1] else State
         states.append(kind(id=ids[general.id], extra_attrs=_annotation(general.concept, current)))

@@ -30,17 +30,18 @@ def discovery(knowledge: Knowledge, *, search_timeout: float, expected: Collecti
 
 
 def simulated_cell(cell: Cell, catalogue: list[DeviceDescription], knowledge: Knowledge, faults: str = "",
-                   bin_parts: int | None = None, bin_seed: int = 0, interface: str | None = None) -> SimulatedCell:
+                   bin_parts: int | None = None, bin_seed: int = 0, interface: str | None = None,
+                   speed: float = 1.0) -> SimulatedCell:
     """The devices of ``cell`` simulated on ``interface`` (an address) and the SSDP port ``PNP_SSDP_PORT`` names,
     ``catalogue`` the devices that may be plugged in later, with ``faults`` (``pnp run --faults``), on a bin of
-    ``bin_parts`` parts if given."""
+    ``bin_parts`` parts if given, ``speed`` times faster than real time."""
     from plugnproduce.protocols.upnp import network_from_env
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     return SimulatedCell(cell, catalogue=catalogue, network=network_from_env(interface),
                          faults=parse_faults(faults, cell.devices), taxonomy=knowledge.taxonomy,
-                         bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None)
+                         bin=SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None, speed=speed)
 
 
 async def run_simulated(sim: SimulatedCell, state_file: Path | None, echo: Callable[[str], None]) -> None:

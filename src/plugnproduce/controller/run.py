@@ -82,6 +82,7 @@ async def run_task(
     bin_seed: int = 0,
     assume_initial: bool = False,
     interface: str | None = None,
+    speed: float = 1.0,
 ) -> RunReport:
     """Check and generate a task, find the cell's devices by discovery, run the task chart against them.
 
@@ -94,6 +95,7 @@ async def run_task(
     checked and generated from the state each device reports once discovered (:func:`reported_states`), or, with
     ``assume_initial``, from the charts' initial states before discovery. ``interface`` (a name or an address,
     default ``PNP_INTERFACE``, else loopback) is where the devices are found and spoken to, the simulated ones too.
+    Simulated devices work ``speed`` times faster than real time (their durations divided by it).
     Raises :class:`ImplausibleTask` before any command goes out.
     """
     from plugnproduce.discovery import LiveCell
@@ -112,7 +114,7 @@ async def run_task(
         if simulate:
             where = "loopback" if network.interface == LOOPBACK.interface else network.interface
             say(f"starting {len(the_cell.devices)} simulated device(s) on {where}")
-            await stack.enter_async_context(_simulated(the_cell, network, faults, bin_parts, bin_seed))
+            await stack.enter_async_context(_simulated(the_cell, network, faults, bin_parts, bin_seed, speed))
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         wanted = [d.id for d in the_cell.devices]
         live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
@@ -130,13 +132,15 @@ async def run_task(
             follow.cancel()
 
 
-def _simulated(cell: Cell, network: SsdpNetwork, faults: str, bin_parts: int | None, bin_seed: int) -> SimulatedCell:
-    """The devices of ``cell`` simulated on ``network``, with ``faults``, on a bin of ``bin_parts`` parts if given."""
+def _simulated(cell: Cell, network: SsdpNetwork, faults: str, bin_parts: int | None, bin_seed: int,
+               speed: float = 1.0) -> SimulatedCell:
+    """The devices of ``cell`` simulated on ``network``, with ``faults``, on a bin of ``bin_parts`` parts if given,
+    ``speed`` times faster than real time."""
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     parts = SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
-    return SimulatedCell(cell, network=network, faults=parse_faults(faults, cell.devices), bin=parts)
+    return SimulatedCell(cell, network=network, faults=parse_faults(faults, cell.devices), bin=parts, speed=speed)
 
 
 async def planned_run(task: Task, cell: Cell, devices: Cell, journal: Path, *, knowledge: Knowledge | None = None,

@@ -1,52 +1,54 @@
-"""Description files → :mod:`plugnproduce.description.model` objects.
+"""Description files → :mod:`plugnproduce.description.model` objects: devices and cells here, processes in
+:mod:`~plugnproduce.description.processfile`, tasks in :mod:`~plugnproduce.description.taskfile` (all named
+here).
 
 Every error names the file and line. The RDF graph each description came from is
-kept (:class:`Loaded`) so the SHACL shapes can check the same data.
+kept (:class:`~plugnproduce.description.rdf.Loaded`) so the SHACL shapes can check the same data.
 """
 
 from __future__ import annotations
 
-import keyword
-import math
 import re
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from decimal import Decimal
 from pathlib import Path
-from urllib.parse import unquote, urlparse
 
 import rdflib
 import yaml
 from rdflib.namespace import RDF, RDFS, XSD
 
-from plugnproduce.description.charts import device_chart, process_regions
+from plugnproduce.description.charts import device_chart
+from plugnproduce.description.durations import RequestDuration
 from plugnproduce.description.model import (
     Argument,
     Cell,
     ChartTransition,
     DeviceDescription,
-    Output,
-    Parameter,
     ProcessDescription,
-    Role,
-    Where,
 )
+from plugnproduce.description.processfile import load_process as load_process
+from plugnproduce.description.processfile import process_from as process_from
 from plugnproduce.description.ranges import output_ranges
-from plugnproduce.description.rdf import term_line
+from plugnproduce.description.rdf import Loaded as Loaded
+from plugnproduce.description.rdf import file_of as file_of
+from plugnproduce.description.rdf import (
+    finite_number,
+    one_value,
+    optional_value,
+    or_default,
+    plain_default,
+)
+from plugnproduce.description.rdf import parse_description as parse_description
+from plugnproduce.description.rdf import read_description as read_description
 from plugnproduce.description.taskfile import _mapping, _plain, _unknown_keys
 from plugnproduce.description.taskfile import load_task as load_task
 from plugnproduce.description.taskfile import parse_task as parse_task
 from plugnproduce.description.taskfile import task_to_yaml as task_to_yaml
 from plugnproduce.description.units import unit_known
-from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
+from plugnproduce.errors import DescriptionError, excerpt
 from plugnproduce.ontology.names import turtle_spelling, unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import (
-    parse_turtle,
-    parse_turtle_bytes,
-    parse_yaml_node,
-)
+from plugnproduce.safeio import parse_yaml_node
 from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
 SAFE_STOP = str(PNP.SafeStop)
@@ -54,64 +56,10 @@ SAFE_STOP = str(PNP.SafeStop)
 
 PROTOCOL_NAMES = {str(PNP.XIRP): "xirp", str(PNP.UPnP): "upnp", str(PNP.OPCUA): "opcua"}
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")
-_OUTPUT_NAME = re.compile(r"[a-z][a-z0-9_]{0,63}")
 
 
 class ContractError(DescriptionError):
     """A device's argument contract that does not fit its chart, or names a unit there is not."""
-
-
-@dataclass(frozen=True)
-class Loaded:
-    """A parsed Turtle description: its graph, text and path."""
-
-    path: Path
-    graph: rdflib.Graph
-    text: str
-
-    def line(self, iri: str) -> int | None:
-        """The line where ``iri`` is described in the file."""
-        return term_line(self.text, self.graph, iri)
-
-    def where(self, iri: str) -> Where:
-        """The place where ``iri`` is described."""
-        return Where(str(self.path), self.line(iri))
-
-
-def read_description(path: str | Path) -> Loaded:
-    """Parse a Turtle description file."""
-    p = Path(path)
-    g, text = parse_turtle(p)
-    return Loaded(p, g, text)
-
-
-def parse_description(data: bytes, path: str | Path) -> Loaded:
-    """Parse a Turtle description from bytes as if it were the file at ``path`` (relative IRIs resolve
-    against it, messages name it); nothing is read from disk."""
-    p = Path(path)
-    g, text = parse_turtle_bytes(data, p)
-    return Loaded(p, g, text)
-
-
-def _one(loaded: Loaded, subject: rdflib.term.Node, prop: rdflib.URIRef, what: str) -> rdflib.term.Node:
-    values = list(loaded.graph.objects(subject, prop))
-    if len(values) != 1:
-        found = "none" if not values else f"{len(values)} values"
-        raise DescriptionError(
-            f"{local_name(str(subject))} needs exactly one {what} ({local_name(str(prop))}); found {found}",
-            loaded.path,
-            loaded.line(str(subject)),
-        )
-    return values[0]
-
-
-def _opt(loaded: Loaded, subject: rdflib.term.Node, prop: rdflib.URIRef) -> rdflib.term.Node | None:
-    return next(iter(loaded.graph.objects(subject, prop)), None)
-
-
-def file_of(iri: rdflib.term.Node) -> Path:
-    """The local path a ``file:`` IRI (a relative reference in a description) names."""
-    return Path(unquote(urlparse(str(iri)).path))
 
 
 def device_subject(loaded: Loaded, taxonomy: Taxonomy) -> rdflib.URIRef:
@@ -151,13 +99,13 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
     s = device_subject(loaded, taxonomy)
     classes = tuple(sorted(str(c) for c in loaded.graph.objects(s, RDF.type) if taxonomy.is_kind(str(c), "Device")))
     declared = tuple(sorted(str(k) for k in loaded.graph.objects(s, PNP.hasSkill)))
-    protocol = str(_one(loaded, s, PNP.protocol, "protocol"))
+    protocol = str(one_value(loaded, s, PNP.protocol, "protocol"))
     if protocol not in PROTOCOL_NAMES:
         raise DescriptionError(
             f"unknown protocol {local_name(protocol)}; expected pnp:XIRP, pnp:UPnP or pnp:OPCUA", loaded.path,
             loaded.line(str(s))
         )
-    chart_file = file_of(_one(loaded, s, PNP.stateChart, "state chart"))
+    chart_file = file_of(one_value(loaded, s, PNP.stateChart, "state chart"))
     if charts is None:
         chart = read_chart(chart_file)
     elif chart_file in charts:
@@ -170,12 +118,15 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
     every = lifted.transitions
     stops = tuple(t for t in every if t.concept is not None and taxonomy.is_a(t.concept, SAFE_STOP))
     transitions = tuple(t for t in every if t not in stops)
-    timeout = _opt(loaded, s, PNP.commandTimeout)
-    cost = _opt(loaded, s, PNP.cost)
-    label = _opt(loaded, s, RDFS.label)
+    timeout = optional_value(loaded, s, PNP.commandTimeout)
+    cost = optional_value(loaded, s, PNP.cost)
+    label = optional_value(loaded, s, RDFS.label)
     arguments = tuple(sorted((_argument(loaded, a) for a in loaded.graph.objects(s, PNP.hasArgument)),
                              key=lambda a: (a.request, a.quantity)))
     _check_arguments(arguments, transitions, loaded.path)
+    durations = tuple(sorted((_duration(loaded, d) for d in loaded.graph.objects(s, PNP.hasDuration)),
+                             key=lambda d: d.request))
+    _check_durations(durations, transitions, loaded.path)
     device = DeviceDescription(
         id=local_name(str(s)),
         iri=str(s),
@@ -183,19 +134,20 @@ def device_from(loaded: Loaded, taxonomy: Taxonomy, charts: Mapping[Path, bytes]
         classes=classes,
         declared_skills=declared,
         protocol=PROTOCOL_NAMES[protocol],
-        endpoint=str(_one(loaded, s, PNP.endpoint, "endpoint")),
+        endpoint=str(one_value(loaded, s, PNP.endpoint, "endpoint")),
         chart_file=str(chart_file),
         initial=lifted.initial,
         states=lifted.states,
         transitions=transitions,
         compounds=lifted.compounds,
         where=loaded.where(str(s)),
-        command_timeout=_or(_finite(loaded, s, timeout, "command timeout"), 10.0),
-        cost=_or(_finite(loaded, s, cost, "cost"), 0.0),
+        command_timeout=or_default(finite_number(loaded, s, timeout, "command timeout"), 10.0),
+        cost=or_default(finite_number(loaded, s, cost, "cost"), 0.0),
         skills=tuple(sorted(taxonomy.device_skills(classes, declared))),
         chart=chart,
         stops=stops,
         arguments=arguments,
+        durations=durations,
     )
     try:  # a range its chart declares for a value it reports is a number, at its line
         output_ranges(device)
@@ -220,20 +172,56 @@ def _check_arguments(arguments: tuple[Argument, ...], transitions: tuple[ChartTr
                                    path, line)
 
 
+def _duration(loaded: Loaded, d: rdflib.term.Node) -> RequestDuration:
+    """One ``pnp:hasDuration`` of a device (the shapes check its terms; the numbers must be finite)."""
+    motion, share = optional_value(loaded, d, PNP.motionOf), optional_value(loaded, d, PNP.speedShare)
+    return RequestDuration(
+        request=str(one_value(loaded, d, PNP.forRequest, "request")),
+        seconds=finite_number(loaded, d, optional_value(loaded, d, PNP.seconds), "duration"),
+        motion_of=str(motion) if motion is not None else None,
+        top_speed=finite_number(loaded, d, optional_value(loaded, d, PNP.topSpeed), "top speed"),
+        speed_share=str(share) if share is not None else None,
+        where=loaded.where(str(d)),
+    )
+
+
+def _check_durations(durations: tuple[RequestDuration, ...], transitions: tuple[ChartTransition, ...],
+                     path: Path) -> None:
+    """Each duration belongs to a request of the chart, once, and a motion to a quantity the request takes."""
+    accepts = {t.request.name: set(t.accepts) for t in transitions if t.request}
+    seen: set[str] = set()
+    for d in durations:
+        line = d.where.line if d.where else None
+        request = excerpt(d.request)
+        if d.request not in accepts:
+            raise ContractError(f"duration of request {request}: no transition of the chart waits for request "
+                                f"{request}", path, line)
+        if d.request in seen:
+            raise ContractError(f"request {request} has more than one duration", path, line)
+        seen.add(d.request)
+        if d.seconds is None and (d.motion_of is None or d.top_speed is None):
+            raise ContractError(f"duration of request {request}: expected pnp:seconds, or pnp:motionOf with "
+                                "pnp:topSpeed", path, line)
+        for quantity in (d.motion_of, d.speed_share):
+            if quantity is not None and quantity not in accepts[d.request]:
+                raise ContractError(f"duration of request {request}: the request does not take "
+                                    f"{excerpt(local_name(quantity))} (its pnp:accepts)", path, line)
+
+
 def _argument(loaded: Loaded, a: rdflib.term.Node) -> Argument:
     """One ``pnp:RequestArgument`` of a device (the shapes check its terms; the limits must be finite)."""
-    required = _opt(loaded, a, PNP.required)
-    datatype = _opt(loaded, a, PNP.datatype)
+    required = optional_value(loaded, a, PNP.required)
+    datatype = optional_value(loaded, a, PNP.datatype)
     return Argument(
-        request=str(_one(loaded, a, PNP.request, "request")),
-        quantity=str(_one(loaded, a, PNP.quantity, "quantity")),
+        request=str(one_value(loaded, a, PNP.request, "request")),
+        quantity=str(one_value(loaded, a, PNP.quantity, "quantity")),
         required=not (isinstance(required, rdflib.Literal) and required.toPython() is False),
         datatype=str(datatype) if datatype is not None else "",
-        unit=str(_opt(loaded, a, PNP.unit) or ""),
-        minimum=_finite(loaded, a, _opt(loaded, a, PNP.minValue), "minimum"),
-        maximum=_finite(loaded, a, _opt(loaded, a, PNP.maxValue), "maximum"),
-        reach=_finite(loaded, a, _opt(loaded, a, PNP.maxReach), "maximum reach"),
-        default=_default(_opt(loaded, a, PNP.defaultValue)),
+        unit=str(optional_value(loaded, a, PNP.unit) or ""),
+        minimum=finite_number(loaded, a, optional_value(loaded, a, PNP.minValue), "minimum"),
+        maximum=finite_number(loaded, a, optional_value(loaded, a, PNP.maxValue), "maximum"),
+        reach=finite_number(loaded, a, optional_value(loaded, a, PNP.maxReach), "maximum reach"),
+        default=plain_default(optional_value(loaded, a, PNP.defaultValue)),
         where=loaded.where(str(a)),
     )
 
@@ -241,123 +229,6 @@ def _argument(loaded: Loaded, a: rdflib.term.Node) -> Argument:
 def load_device(path: str | Path, taxonomy: Taxonomy) -> DeviceDescription:
     """Read a device description (Turtle + its Device State Chart)."""
     return device_from(read_description(path), taxonomy)
-
-
-def process_from(loaded: Loaded) -> ProcessDescription:
-    """Build the process of a parsed description, with its chart's regions."""
-    subjects = sorted({s for s in loaded.graph.subjects(PNP.generalChart) if isinstance(s, rdflib.URIRef)})
-    if len(subjects) != 1:
-        raise DescriptionError(
-            f"a process description describes exactly one process (with pnp:generalChart); found {len(subjects)}",
-            loaded.path,
-            1,
-        )
-    s = subjects[0]
-    chart_file = file_of(_one(loaded, s, PNP.generalChart, "general process state chart"))
-    chart = read_chart(chart_file)
-    regions = process_regions(chart, chart_file)
-    roles: list[Role] = []
-    for r in sorted(loaded.graph.objects(s, PNP.hasRole), key=str):
-        name = str(_one(loaded, r, PNP.roleName, "role name"))
-        if name not in regions:
-            raise DescriptionError(
-                f"role {name!r} has no region in {chart_file.name}; expected a region with pnp:role=\"{name}\"",
-                loaded.path,
-                loaded.line(str(r)),
-            )
-        skill = str(_one(loaded, r, PNP.requiresSkill, "required skill"))
-        roles.append(Role(name, str(r), skill, regions[name], loaded.where(str(r))))
-    missing = sorted(set(regions) - {r.name for r in roles})
-    if missing:
-        raise DescriptionError(
-            f"chart region(s) {', '.join(missing)} have no pnp:Role in the metadata", loaded.path, loaded.line(str(s))
-        )
-    params = tuple(
-        sorted((_parameter(loaded, p) for p in loaded.graph.objects(s, PNP.hasParameter)), key=lambda p: p.name)
-    )
-    outputs = tuple(sorted((_output(loaded, o) for o in loaded.graph.objects(s, PNP.hasOutput)), key=lambda o: o.name))
-    label = _opt(loaded, s, RDFS.label)
-    comment = _opt(loaded, s, RDFS.comment)
-    return ProcessDescription(
-        id=local_name(str(s)),
-        iri=str(s),
-        label=str(label) if label is not None else local_name(str(s)),
-        comment=str(comment) if comment is not None else "",
-        classes=tuple(sorted(str(c) for c in loaded.graph.objects(s, RDF.type))),
-        roles=tuple(sorted(roles, key=lambda r: r.name)),
-        parameters=params,
-        chart_file=str(chart_file),
-        where=loaded.where(str(s)),
-        chart=chart,
-        outputs=outputs,
-    )
-
-
-def _finite(loaded: Loaded, subject: rdflib.term.Node, node: rdflib.term.Node | None, what: str) -> float | None:
-    """A literal read as a finite number (None if absent); an ill-typed, huge or NaN one is refused at its line."""
-    if not isinstance(node, rdflib.Literal):
-        return None
-    try:
-        value = float(node.toPython())
-    except (TypeError, ValueError, OverflowError):
-        value = math.nan
-    if not math.isfinite(value):
-        raise UnreadableError(f"{local_name(str(subject))}: {what} {excerpt(str(node))!r} is not a finite number; "
-                              "expected a decimal such as 2.5", loaded.path, loaded.line(str(subject)))
-    return value
-
-
-def _or(value: float | None, default: float) -> float:
-    return default if value is None else value
-
-
-def _default(node: rdflib.term.Node | None) -> object:
-    """A default value as a plain Python value (a decimal as a float, never ``Decimal``)."""
-    if not isinstance(node, rdflib.Literal):
-        return None
-    value = node.toPython()
-    return float(value) if isinstance(value, Decimal) else value
-
-
-def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
-    role = _one(loaded, p, PNP.forRole, "role")
-    role_name = _opt(loaded, role, PNP.roleName)
-    default = _opt(loaded, p, PNP.defaultValue)
-    return Parameter(
-        name=str(_one(loaded, p, PNP.parameterName, "parameter name")),
-        iri=str(p),
-        role=str(role_name) if role_name is not None else local_name(str(role)),
-        quantity=str(_one(loaded, p, PNP.quantity, "quantity")),
-        datatype=str(_one(loaded, p, PNP.datatype, "datatype")),
-        unit=str(_opt(loaded, p, PNP.unit) or ""),
-        minimum=_finite(loaded, p, _opt(loaded, p, PNP.minValue), "minimum"),
-        maximum=_finite(loaded, p, _opt(loaded, p, PNP.maxValue), "maximum"),
-        default=_default(default),
-        where=loaded.where(str(p)),
-    )
-
-
-def _output(loaded: Loaded, o: rdflib.term.Node) -> Output:
-    role = _one(loaded, o, PNP.forRole, "role")
-    role_name = _opt(loaded, role, PNP.roleName)
-    name = str(_one(loaded, o, PNP.outputName, "output name"))
-    if not _OUTPUT_NAME.fullmatch(name) or keyword.iskeyword(name):
-        raise DescriptionError(f"output name {excerpt(repr(name))} must be a lower_snake_case name such as part_pose",
-                               loaded.path, loaded.line(str(o)))
-    return Output(
-        name=name,
-        iri=str(o),
-        role=str(role_name) if role_name is not None else local_name(str(role)),
-        quantity=str(_one(loaded, o, PNP.quantity, "quantity")),
-        datatype=str(_one(loaded, o, PNP.datatype, "datatype")),
-        unit=str(_opt(loaded, o, PNP.unit) or ""),
-        where=loaded.where(str(o)),
-    )
-
-
-def load_process(path: str | Path) -> ProcessDescription:
-    """Read a process description (Turtle + its General Process State Chart)."""
-    return process_from(read_description(path))
 
 
 # ------------------------------------------------------------------ YAML: cells (tasks: taskfile.py)

@@ -24,6 +24,7 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from plugnproduce import folders
 from plugnproduce.errors import PlugNProduceError
 
 if TYPE_CHECKING:
@@ -41,7 +42,7 @@ class Incompatible(PlugNProduceError, ValueError):
 
 def cache_folder() -> Path:
     """The user's cache folder for plugnproduce, where the taxonomy's closure is cached too."""
-    return Path.home() / ".cache" / "plugnproduce"
+    return folders.cache_folder()
 
 
 class Quantity:

@@ -24,10 +24,9 @@ each answer is journalled (``stop`` records) before the ``end`` record.
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import hashlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -37,13 +36,14 @@ from plugnproduce.description.model import PROTOCOLS, Cell, Command
 from plugnproduce.description.taskfile import task_to_yaml
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import outcomes, values
+from plugnproduce.executor.chartmap import chart_map
 from plugnproduce.executor.journal import Journal, JournalWriteError
 from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.executor.monitor import Breach, Monitor
 from plugnproduce.executor.report import Fault, RunReport
+from plugnproduce.executor.safestop import stop_safely
 from plugnproduce.ontology.vocabulary import local_name
-from plugnproduce.statechart import PNP_NS, Chart, Parallel, parse_chart
-from plugnproduce.statechart.model import StateNode
+from plugnproduce.statechart import parse_chart
 from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, EventData, MacroStep, MetaEvent
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
@@ -52,39 +52,6 @@ RecordObserver = Callable[[dict[str, Any]], None]
 """Called with each journal record as soon as it is written."""
 
 FAULT_EVENT = "error.fault"
-
-STOP_TIMEOUT = 5.0
-"""The longest wait, in seconds, for each answer of the safe stop (a device's command timeout if shorter)."""
-
-_COMMAND, _DEVICE, _DEVICE_STATE = (f"{{{PNP_NS}}}{n}" for n in ("command", "device", "deviceState"))
-
-
-@dataclass(frozen=True)
-class _StateInfo:
-    device: str | None
-    device_state: str | None
-    command: str | None
-    starts_step: bool
-    """The state is a step's chart: entering it starts the step the plan's counter names."""
-
-
-def _chart_map(chart: Chart) -> dict[str, _StateInfo]:
-    """Per controller state: the device region it belongs to, the device state it stands for, its process."""
-    out: dict[str, _StateInfo] = {}
-
-    def walk(node: StateNode, device: str | None, command: str | None) -> None:
-        attrs = node.extra_attrs
-        starts = isinstance(node, Parallel) and _COMMAND in attrs
-        command = attrs[_COMMAND] if starts else command
-        device = attrs.get(_DEVICE, device)
-        if node.id:
-            out[node.id] = _StateInfo(device, attrs.get(_DEVICE_STATE), command, starts)
-        for child in getattr(node, "children", ()):
-            walk(child, device, command)
-
-    for top in chart.children:
-        walk(top, None, None)
-    return out
 
 
 class TaskRun:
@@ -103,7 +70,7 @@ class TaskRun:
         data = generated.task_chart()
         self._digest = hashlib.sha256(data).hexdigest()
         chart = parse_chart(data, f"{generated.task.name}.task.scxml")
-        self._states = _chart_map(chart)
+        self._states = chart_map(chart)
         self._bindings = {s.step.index: dict(s.binding) for s in generated.steps}
         self.interpreter = Interpreter(chart, io_processors={p: self for p in PROTOCOLS})
         self.interpreter.attach(self._on_meta)
@@ -150,7 +117,7 @@ class TaskRun:
             finally:
                 self._journal_held()
                 if self.fault is not None or self.interpreter.final_state != DONE:
-                    await self._safe_stop()
+                    await stop_safely(self.cell, self._links, self.device_states, self._record)
                 for task in self._commands:
                     task.cancel()
                 await asyncio.gather(*self._commands, return_exceptions=True)
@@ -258,36 +225,6 @@ class TaskRun:
         await asyncio.wait({answered, faulted}, return_when=asyncio.FIRST_COMPLETED)
         faulted.cancel()
         answered.cancel()
-
-    async def _safe_stop(self) -> None:
-        """Stop every connected device safely, at once, each answer bounded in time."""
-        await asyncio.gather(*(self._stop_device(d) for d in self._links))
-
-    async def _stop_device(self, device_id: str) -> None:
-        device, link = self.cell.device(device_id), self._links[device_id]
-        timeout = min(device.command_timeout, STOP_TIMEOUT)
-        seen = self.device_states.get(device_id, device.initial)
-        try:
-            state = await link.state(timeout)
-        except PlugNProduceError as exc:
-            self._record("stop", device=device_id, state=seen, request=None, answer=f"no state reported: {exc}")
-            return
-        stop = device.stop_from(state)
-        if stop is None or stop.request is None:
-            self._record("stop", device=device_id, state=state, request=None, answer=None)
-        else:
-            request = stop.request.name
-            try:
-                await link.request(request, {}, timeout)
-                answer = "accepted"
-            except ProtocolTimeout:
-                answer = f"no answer within {timeout:g} s"
-            except PlugNProduceError as exc:
-                answer = f"refused: {exc}"
-            with contextlib.suppress(PlugNProduceError):
-                state = await link.state(timeout)
-            self._record("stop", device=device_id, state=state, request=request, answer=answer)
-        self.device_states[device_id] = state
 
     def _on_event(self, device: str, name: str, params: Mapping[str, Any]) -> None:
         if self.fault is not None:

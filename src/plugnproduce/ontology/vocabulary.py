@@ -66,6 +66,12 @@ class PNP(DefinedNamespace):
     request: URIRef
     required: URIRef
     maxReach: URIRef
+    hasDuration: URIRef
+    forRequest: URIRef
+    seconds: URIRef
+    motionOf: URIRef
+    topSpeed: URIRef
+    speedShare: URIRef
     # task description lifted to RDF (for the task shapes)
     hasStep: URIRef
     stepIndex: URIRef

@@ -4,12 +4,15 @@ The horizon grows one step at a time (rules/plan.lp, incremental). The first hor
 gives the fewest steps; the search then looks :data:`LOOK_FURTHER` steps beyond it for a plan that
 measures more of its values (a pick pose the bin-picking PC reports rather than a default), and
 keeps the best: fewest values left to defaults that the cell could measure, then fewest steps,
-then fewest device roles. The plan is written as a task file and read back by the task reader,
+then fewest device roles. With ``minimize="cycle-time"`` it compares, at each horizon searched, up to
+:data:`MOST_PLANS` plans that are best by those criteria, and keeps the one of least estimated cycle time
+(:mod:`plugnproduce.timing`) before fewest steps. The plan is written as a task file and read back by the task reader,
 so it is checked, verified and run like any task.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -39,6 +42,11 @@ MAX_STEPS = 12
 """Longest plan searched for, in steps (a loop's body)."""
 LOOK_FURTHER = 3
 """Steps beyond the shortest plan searched for one that measures more of its values."""
+MOST_PLANS = 16
+"""With ``minimize="cycle-time"``: the optimal plans per horizon whose cycle times are compared."""
+MINIMIZE = ("steps", "cycle-time")
+"""What a plan minimises after the values it measures: its steps (then its device roles), or its estimated
+cycle time (then its steps, then its roles)."""
 
 
 @dataclass(frozen=True)
@@ -54,6 +62,8 @@ class Plan:
     """(step, parameter) left to its default although the cell could measure it."""
     wasted: tuple[tuple[int, str], ...] = ()
     """(step, output) that another command could take, which no later step takes."""
+    cycle_time: float | None = None
+    """The estimated cycle time it was chosen by (``minimize="cycle-time"``; None otherwise)."""
 
 
 @dataclass(frozen=True)
@@ -67,17 +77,25 @@ class Unreachable:
 
 def plan(goal: Goal, cell: Cell, knowledge: Knowledge,
          catalogue: Sequence[DeviceDescription] = (), max_steps: int = MAX_STEPS,
-         source: str | None = None) -> Plan | Unreachable:
+         source: str | None = None, minimize: str = "steps") -> Plan | Unreachable:
     """Plan ``goal`` in ``cell`` from its devices' states (their ``initial``: chart or reported).
 
     ``source`` names the written task file (in messages and ``Task.file``); with a catalogue, an
-    unreachable goal names the cheapest device whose purchase makes it reachable.
+    unreachable goal names the cheapest device whose purchase makes it reachable. ``minimize``: one of
+    :data:`MINIMIZE`.
     """
+    if minimize not in MINIMIZE:
+        raise ValueError(f"minimize {minimize!r}: expected one of {', '.join(MINIMIZE)}")
     by_id = knowledge.processes_by_id
     check_goal(goal, cell, knowledge)
+    name = source or f"{goal.name}.yaml"
+    if minimize == "cycle-time":
+        fastest = _fastest(goal, cell, knowledge, max_steps, name)
+        if isinstance(fastest, Plan):
+            return fastest
     found = _search(goal, cell, knowledge, max_steps)
     if isinstance(found, Model):
-        return _written(goal, found, by_id, source or f"{goal.name}.yaml")
+        return _written(goal, found, by_id, name)
     for device in sorted((d for d in catalogue if d.id not in {c.id for c in cell.devices}),
                          key=lambda d: (d.cost, d.id)):
         if isinstance(_search(goal, cell.with_device(device), knowledge, max_steps), Model):
@@ -152,6 +170,35 @@ def _search(goal: Goal, cell: Cell, knowledge: Knowledge, max_steps: int) -> Mod
             if best is None or key < best[0]:
                 best = (key, model)
             last = min(last, t + LOOK_FURTHER) if best[0][0] else t
+        if t >= last:
+            break
+    if best is None:
+        return (f"no plan of at most {max_steps} steps reaches the goal from the devices' states",)
+    return best[1]
+
+
+def _fastest(goal: Goal, cell: Cell, knowledge: Knowledge, max_steps: int, source: str) -> Plan | tuple[str, ...]:
+    """The plan of least estimated cycle time among the best of each horizon searched, or why there is none."""
+    from plugnproduce.timing.tasks import task_cycle_time
+
+    why = _cannot(goal, cell, knowledge)
+    if why:
+        return why
+    by_id = knowledge.processes_by_id
+    facts = cell_program(fact_book(knowledge), cell) + program(goal_facts(goal, knowledge.processes,
+                                                                           knowledge.taxonomy))
+    best: tuple[tuple[float, ...], Plan] | None = None
+    last = max_steps
+    for t, models in solver.grow_optima(solver.PLAN, facts, range(1, max_steps + 1), MOST_PLANS):
+        for model in models:
+            written = _written(goal, model, by_id, source)
+            estimate = task_cycle_time(written.task, cell, knowledge)
+            seconds = estimate.total if estimate is not None else float("inf")
+            key = (len(model[ps.Blind]) + sum(w.h == t for w in model[ps.Wasted]), seconds, t, len(model[ps.Bound]))
+            if best is None or key < best[0]:
+                best = (key, dataclasses.replace(written, cycle_time=estimate.total if estimate else None))
+        if models:
+            last = min(last, t + LOOK_FURTHER)
         if t >= last:
             break
     if best is None:

@@ -46,10 +46,12 @@ from plugnproduce.knowledge import Knowledge, Library
 from plugnproduce.lazy import lazy_module
 from plugnproduce.service.batches import (
     batch,
+    batch_cycle_times,
     batch_engine,
     batch_report,
     batch_report_from,
     generate_configurations,
+    pareto_front,
 )
 from plugnproduce.service.checks import (
     MORE_REPAIRS,
@@ -87,9 +89,11 @@ from plugnproduce.service.programs import (
     Generation,
     ImplausibleTask,
     Unverified,
+    cycle_time,
     generate,
     generation,
     plan_run,
+    repair_cycle_times,
     verify,
 )
 from plugnproduce.service.resumes import NotResumable, NoWayOn, Replan, Stopped, replan, rest_of_task, stopped_run
@@ -100,6 +104,8 @@ if TYPE_CHECKING:
     from plugnproduce.batch import (
         BATCH_CSV_HEADER,
         ClusterAccess,
+        Configuration,
+        Engine,
         bounded_lines,
         check_cluster_address,
         configurations_from,
@@ -116,6 +122,7 @@ if TYPE_CHECKING:
     from plugnproduce.reasoning import CheckResult, Explanation, Reason
     from plugnproduce.resources import rules_path
     from plugnproduce.safeio import MAX_BYTES, MAX_DIGITS
+    from plugnproduce.timing.estimate import CycleTime
     from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
@@ -129,7 +136,9 @@ _ELSEWHERE = {
     "Taxonomy": "plugnproduce.ontology.taxonomy",
     **dict.fromkeys(("concept_value", "local_name"), "plugnproduce.ontology.vocabulary"),
     **dict.fromkeys(("Plan", "Unreachable"), "plugnproduce.planning"),
-    **dict.fromkeys(("BATCH_CSV_HEADER", "ClusterAccess", "bounded_lines", "check_cluster_address",
+    "CycleTime": "plugnproduce.timing.estimate",
+    **dict.fromkeys(("BATCH_CSV_HEADER", "ClusterAccess", "Configuration", "Engine", "bounded_lines",
+                     "check_cluster_address",
                      "configurations_from", "read_configurations"), "plugnproduce.batch"),
     "random_configurations": "plugnproduce.batch:generate",
     **dict.fromkeys(("CheckResult", "Explanation", "Reason"), "plugnproduce.reasoning"),
@@ -154,6 +163,10 @@ __all__ = [
     "BATCH_CSV_HEADER",
     "MAX_BYTES",
     "MAX_DIGITS",
+    "repair_cycle_times",
+    "batch_cycle_times",
+    "pareto_front",
+    "cycle_time",
     "MORE_REPAIRS",
     "ONTOLOGY_FORMATS",
     "Budget",
@@ -161,6 +174,9 @@ __all__ = [
     "CellArg",
     "CheckResult",
     "ClusterAccess",
+    "Configuration",
+    "CycleTime",
+    "Engine",
     "DeviceDescription",
     "DeviceView",
     "Explanation",

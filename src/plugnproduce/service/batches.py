@@ -123,3 +123,34 @@ def generate_configurations(
 ) -> Iterator[batching.Configuration]:
     """``count`` random configurations of ``sizes[0]``-``sizes[1]`` distinct catalogue devices, generated lazily."""
     return batching.generate(_devices(catalogue_or_folder, _k(knowledge)), count, sizes, seed)
+
+
+def batch_cycle_times(
+    engine: batching.Engine,
+    configurations: Iterable[batching.Configuration],
+    catalogue_folder: str | Path | None,
+    tasks: list[str | Path],
+    libraries: tuple[str | Path, ...] = (),
+    builtin: bool = True,
+) -> Iterator[dict[str, object]]:
+    """:func:`batch_report_from`'s JSONL rows in this process, each with the configuration's ``cost`` and per task
+    its estimated ``cycle_time`` (seconds; null where it is not plausible), estimated once per set of devices the
+    tasks bind (:class:`~plugnproduce.batch.timings.CycleTimes`)."""
+    from plugnproduce.batch.timings import CycleTimes
+
+    k = knowledge(libraries, builtin)
+    folder = Path(catalogue_folder) if catalogue_folder is not None else None
+    times = CycleTimes(engine, catalogue(folder, k), [task(p) for p in tasks], k)
+    for config in configurations:
+        yield times.annotate(engine.line(config), config)
+
+
+def pareto_front(rows: Iterable[dict[str, object]]) -> list[dict[str, object]]:
+    """Of :func:`batch_cycle_times`'s rows, the configurations in which every task is plausible that no other beats
+    in both cost and cycle time (summed over the tasks), cheapest first: ``{config, devices, cost, cycle_time}``."""
+    from plugnproduce.batch.timings import ParetoFront
+
+    front = ParetoFront()
+    for row in rows:
+        front.add(row)
+    return [p.to_json() for p in front.front()]

@@ -32,14 +32,17 @@ else:
 
 @lru_cache(maxsize=8)
 def _loaded(libraries: tuple[Library, ...]) -> Knowledge:
-    return load_knowledge(libraries)
+    from plugnproduce.knowledge.cache import cached_knowledge
+
+    return cached_knowledge(libraries, lambda: load_knowledge(libraries))
 
 
 def knowledge(libraries: tuple[str | Path, ...] = (), builtin: bool = True) -> Knowledge:
     """Load the knowledge of the built-in library (unless ``builtin`` is false) and ``libraries``.
 
-    Loading the same libraries again returns the same object; every use case takes the result as
-    its ``knowledge`` argument (default: the built-in library alone).
+    Loading the same libraries again returns the same object, and a later process reads it back from the user's
+    cache folder while the files are unchanged (:mod:`plugnproduce.knowledge.cache`); every use case takes the
+    result as its ``knowledge`` argument (default: the built-in library alone).
     """
     libs = ((builtin_library(),) if builtin else ()) + library_folders(libraries)
     return _loaded(libs)

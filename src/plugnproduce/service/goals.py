@@ -16,17 +16,18 @@ if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
 
 def plan(goal_or_path: Goal | str | Path, cell_or_path: CellArg, knowledge: Knowledge | None = None,
          catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
-         source: str | None = None) -> Plan | Unreachable:
+         source: str | None = None, minimize: str = "steps") -> Plan | Unreachable:
     """A task that reaches a goal in a cell, from its devices' states (a cell with reported states plans from
     those), or why none does, with the cheapest catalogue device (built-in and library) that would make one.
-    ``source`` names the written task file."""
+    ``source`` names the written task file; ``minimize``: ``steps`` (the shortest plan) or ``cycle-time`` (the
+    one of least estimated cycle time)."""
     from plugnproduce.description.goalfile import Goal, load_goal
     from plugnproduce.planning import plan as make_plan
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     goal = goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path)
     devices = list(k.devices) if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
-    return make_plan(goal, the_cell, k, devices, source=source)
+    return make_plan(goal, the_cell, k, devices, source=source, minimize=minimize)
 
 
 def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import os
 import secrets
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from plugnproduce import folders
 from plugnproduce.errors import PlugNProduceError, UnknownName
 
 if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
@@ -16,8 +16,9 @@ if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
 
 
 def runs_folder() -> Path:
-    """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``~/.local/state/plugnproduce/runs``."""
-    return Path(os.environ.get("PNP_RUNS") or Path.home() / ".local" / "state" / "plugnproduce" / "runs")
+    """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``runs`` in the user's state folder
+    (:func:`plugnproduce.folders.runs_folder`)."""
+    return folders.runs_folder()
 
 
 def new_run_id(task_name: str) -> str:

@@ -2,21 +2,23 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
-from plugnproduce.description.model import Cell, Task
+from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge
 from plugnproduce.lazy import lazy_module
 from plugnproduce.service import checks
-from plugnproduce.service.descriptions import CellArg, TaskArg, as_task, cell_and_knowledge
+from plugnproduce.service.descriptions import CellArg, TaskArg, _devices, as_task, cell_and_knowledge
 
 if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
     from plugnproduce import reasoning
     from plugnproduce.codegen import GeneratedTask
     from plugnproduce.codegen.outputs import GeneratedChart
+    from plugnproduce.timing.estimate import CycleTime
     from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
@@ -130,3 +132,32 @@ def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge 
     if progress is not None:
         progress(f"generating the charts of {len(the_task.steps)} step(s)")
     return _generate_task(the_task, the_cell, result, k)
+
+
+def cycle_time(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None,
+               result: reasoning.CheckResult | None = None) -> CycleTime | None:
+    """The estimated cycle time of a task in a cell, step by step (None: the task is not plausible there, or
+    its program cannot be generated). ``result``: the task's check, when it was checked already."""
+    from plugnproduce.timing.tasks import task_cycle_time
+
+    the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
+    result = result if result is not None else checks.check(the_task, the_cell, k)
+    return task_cycle_time(the_task, the_cell, k, result)
+
+
+def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path: CellArg,
+                       catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
+                       knowledge: Knowledge | None = None) -> list[CycleTime | None]:
+    """Each repaired task's estimated cycle time in the cell with the devices its repair buys (None: no estimate).
+    Every repair starts from the same task, so their order by it is their order by the time they add."""
+    from plugnproduce.timing.tasks import task_cycle_time
+
+    the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
+    bought = {d.id: d for d in (k.devices if catalogue_or_folder is None else _devices(catalogue_or_folder, k))}
+    out: list[CycleTime | None] = []
+    for r in repairs:
+        cell = the_cell
+        for device in r.repair.added_devices:
+            cell = cell.with_device(bought[device])
+        out.append(task_cycle_time(r.repair.task, cell, k))
+    return out

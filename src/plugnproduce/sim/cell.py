@@ -72,9 +72,12 @@ class SimulatedCell:
 
     def __init__(self, cell: Cell, *, catalogue: Iterable[DeviceDescription] = (),
                  network: upnp.SsdpNetwork = upnp.LOOPBACK, faults: dict[str, xirp.Faults] | None = None,
-                 taxonomy: Taxonomy | None = None, bin: SimulatedBin | None = None) -> None:  # noqa: A002
+                 taxonomy: Taxonomy | None = None, bin: SimulatedBin | None = None,  # noqa: A002
+                 speed: float = 1.0) -> None:
         """``taxonomy`` reads device description files plugged in by path (default: the built-in ontology);
-        ``bin`` is the simulated bin the devices work on (none: they report their charts' fixed values)."""
+        ``bin`` is the simulated bin the devices work on (none: they report their charts' fixed values);
+        ``speed`` how much faster than real time the devices work (their durations divided by it)."""
+        self.speed = speed
         self.cell = cell
         self.bin = bin
         self.taxonomy = taxonomy
@@ -118,7 +121,7 @@ class SimulatedCell:
                                 "a library's device needs the cell started with it: "
                                 "pnp --library LIBRARY sim up CELL")
         device = SimulatedDevice(self.catalogue[device_id], network=self.network, faults=self.faults.get(device_id),
-                                 bin=self.bin)
+                                 bin=self.bin, speed=self.speed)
         await device.start()
         self.devices[device_id] = device
         return sorted(self.devices)

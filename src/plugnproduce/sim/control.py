@@ -16,6 +16,7 @@ from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
+from plugnproduce import folders
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 
 Handler = Callable[[str, str], Awaitable[list[str]]]
@@ -26,7 +27,7 @@ MAX_LINE = 4096
 
 def default_state_file() -> Path:
     """Where a running simulated cell says where its control channel listens."""
-    return Path.home() / ".cache" / "plugnproduce" / "sim-control.json"
+    return folders.cache_folder() / "sim-control.json"
 
 
 class ControlServer:

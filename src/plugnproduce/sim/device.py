@@ -15,38 +15,60 @@ from __future__ import annotations
 import asyncio
 import dataclasses
 import logging
-import re
+import math
 from collections.abc import Coroutine, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import rdflib
+
 from plugnproduce.description.model import Command, DeviceDescription
 from plugnproduce.description.reports import reported_values
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.safeio import parse_turtle
 from plugnproduce.sim.bin import SimulatedBin
 from plugnproduce.sim.payloads import event_payloads
 from plugnproduce.statechart.runtime.events import Event, EventData
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 from plugnproduce.statechart.runtime.loop import ChartLoop
+from plugnproduce.timing.requests import DeviceTimer
 
 if TYPE_CHECKING:
     from plugnproduce.protocols.opcua import OpcUaDeviceServer
 
-_ENDPOINT = re.compile(r'(pnp:endpoint\s+)"[^"]*"')
-_CHART = re.compile(r"(pnp:stateChart\s+)<[^>]*>")
-
 
 def served_description(device: DeviceDescription, endpoint: str) -> tuple[str, str]:
-    """The device's Turtle with its real endpoint, and its chart, as text."""
-    turtle = Path(device.where.file).read_text(encoding="utf-8")
-    turtle, found = _ENDPOINT.subn(lambda m: f'{m.group(1)}"{endpoint}"', turtle, count=1)
-    if not found:
-        raise ValueError(f"{device.where.file}: no pnp:endpoint literal to fill in")
-    # The chart is served beside the Turtle whatever folder it sits in, so the reference is its name.
-    turtle = _CHART.sub(lambda m: f"{m.group(1)}<{Path(device.chart_file).name}>", turtle, count=1)
-    return turtle, Path(device.chart_file).read_text(encoding="utf-8")
+    """The device's Turtle with its real endpoint, and its chart, as text.
+
+    The Turtle is edited as RDF: the device's ``pnp:endpoint`` becomes ``endpoint`` and its ``pnp:stateChart``
+    the chart's name, since the chart is served beside the Turtle whatever folder it sits in. Other IRIs the
+    file gave relative to its folder stay relative, so they name the served files, not the simulator's.
+    """
+    path = Path(device.where.file)
+    graph, _ = parse_turtle(path)
+    subject = rdflib.URIRef(device.iri)
+    if graph.value(subject, PNP.endpoint) is None:
+        raise ValueError(f"{device.where.file}: {device.id} has no pnp:endpoint to fill in")
+    served = _relative_to(graph, path.parent.resolve().as_uri() + "/")
+    served.set((subject, PNP.endpoint, rdflib.Literal(endpoint)))
+    served.set((subject, PNP.stateChart, rdflib.URIRef(Path(device.chart_file).name)))
+    return served.serialize(format="turtle"), Path(device.chart_file).read_text(encoding="utf-8")
+
+
+def _relative_to(graph: rdflib.Graph, folder: str) -> rdflib.Graph:
+    """A copy of ``graph`` whose IRIs inside ``folder`` are written relative to it."""
+    def relative(node: Any) -> Any:
+        return rdflib.URIRef(node[len(folder):]) if isinstance(node, rdflib.URIRef) and node.startswith(folder) \
+            else node
+
+    out = rdflib.Graph()
+    for prefix, namespace in graph.namespaces():
+        out.bind(prefix, namespace, override=True, replace=True)
+    for s, p, o in graph:
+        out.add((relative(s), relative(p), relative(o)))
+    return out
 
 
 def requests_and_events(device: DeviceDescription) -> tuple[dict[str, list[str]], list[str]]:
@@ -68,10 +90,13 @@ class SimulatedDevice:
 
     def __init__(self, device: DeviceDescription, *, network: upnp.SsdpNetwork = upnp.LOOPBACK,
                  faults: xirp.Faults | None = None, bin: SimulatedBin | None = None,  # noqa: A002
-                 lds: str | None = None) -> None:
+                 lds: str | None = None, speed: float = 1.0) -> None:
         """``bin``: the simulated bin the device works on, if any; ``lds``: the Local Discovery Server an OPC UA
-        device registers with, if any. A device in a state it reported (:meth:`DeviceDescription.reported`)
-        starts its chart there."""
+        device registers with, if any; ``speed``: how much faster than real time the device works (its chart's
+        delays and declared durations divided by it). A device in a state it reported
+        (:meth:`DeviceDescription.reported`) starts its chart there."""
+        if not (math.isfinite(speed) and speed > 0):
+            raise ValueError(f"speed factor {speed!r}: expected a positive number")
         self.description = device
         self.lds = lds
         self.network = network
@@ -82,6 +107,9 @@ class SimulatedDevice:
             chart = dataclasses.replace(chart, initial=[device.initial])
         self.interpreter = Interpreter(chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
+        self.speed = speed
+        self.timer = DeviceTimer(device)
+        self.interpreter.delay_policy = self._delay
         self._loop = ChartLoop(self.interpreter)
         self._task: asyncio.Task[None] | None = None
         self._xirp: xirp.XirpServer | None = None
@@ -136,10 +164,12 @@ class SimulatedDevice:
             files = self._xirp.files = self._files(self._xirp.endpoint)
         elif d.protocol == "opcua":
             from plugnproduce.protocols.opcua import OpcUaDeviceServer  # asyncua loads only for an OPC UA device
+            from plugnproduce.protocols.opcua.security import device_security
             from plugnproduce.sim.opcua import node_spec
 
+            security = await device_security(d.id)  # PNP_OPCUA_PKI: the folder's missing certificates are made
             self._opcua = OpcUaDeviceServer(node_spec(d), self._on_opcua_call, lambda: self.state,
-                                            host=self.network.interface, files=self._files)
+                                            host=self.network.interface, files=self._files, security=security)
             await self._opcua.start()
             if self.lds is not None:
                 await self._opcua.register(self.lds)
@@ -192,7 +222,13 @@ class SimulatedDevice:
             raise LookupError(f"device {self.id} is {self.state}; it does not accept {request} now")
         if self.bin is not None:
             self.bin.on_request(self.description, params, self.interpreter.dm)
+        self.timer.request(request, params)
         self._loop.queue(event, EventData(params))  # its values read as _event.data.NAME too, as in any interpreter
+
+    def _delay(self, nominal: float) -> float:
+        """A delayed send of the chart: the declared duration of the request just taken (once) or the chart's
+        delay, scaled by the speed factor."""
+        return self.timer.delay(nominal) / self.speed
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
         if request.name == xirp.STATE:  # with the values its chart says it reports (teach-in reads them)

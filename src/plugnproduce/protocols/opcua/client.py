@@ -14,14 +14,17 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from asyncua import Client, Node, ua
+from asyncua.common.connection import TransportLimits
 from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.protocols.opcua.security import PeerRefused, Security, check_plain, from_environment, secure_client
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
     MAX_ARGUMENTS,
+    MAX_CHUNK,
     MAX_CHUNKS,
     MAX_MESSAGE,
     MAX_STRING,
@@ -64,20 +67,32 @@ class OpcUaDeviceClient:
         self.lost: str | None = None
 
     @classmethod
-    async def connect(cls, endpoint: str, device: str, timeout: float) -> OpcUaDeviceClient:
-        """Open a session (security mode None) and find the device's object by its browse path."""
-        parse_endpoint(endpoint)
+    async def connect(cls, endpoint: str, device: str, timeout: float,
+                      security: Security | None = None) -> OpcUaDeviceClient:
+        """Open a session and find the device's object by its browse path.
+
+        ``security`` (default: from the environment, :func:`.security.from_environment`): mode None only on
+        loopback, Sign or SignAndEncrypt with the PKI folder's certificates.
+        """
+        host = parse_endpoint(endpoint)[0]
+        security = from_environment() if security is None else security
+        check_plain(security, device, endpoint, host)
         client = Client(endpoint, timeout=timeout)
         client.max_messagesize, client.max_chunkcount = MAX_MESSAGE, MAX_CHUNKS
+        _bound_transport(client)
         try:
-            await asyncio.wait_for(client.connect(), timeout)
+            await asyncio.wait_for(_secure_and_connect(client, security, device), timeout)
         except TimeoutError as exc:
             await _quietly_close(client)
             raise ProtocolTimeout(f"device {device}: {endpoint} did not open a session within {timeout:g} s") \
                 from exc
+        except ProtocolError:
+            await _quietly_close(client)
+            raise
         except Exception as exc:  # any failure of a foreign server is a refused connection, never a crash
             await _quietly_close(client)
-            raise ProtocolConnectionError(f"device {device}: cannot connect to {endpoint}: {_said(exc)}") from exc
+            raise ProtocolConnectionError(f"device {device}: cannot connect to {endpoint} "
+                                          f"(security mode {security.mode}): {_refusal(exc, security.mode)}") from exc
         try:
             ns, node = await asyncio.wait_for(_device_node(client, device), timeout)
         except ProtocolError:
@@ -252,6 +267,66 @@ def _on_close(client: Client, then: Callable[[], None]) -> None:
         then()
 
     protocol.connection_lost = connection_lost
+
+
+class _Limits(TransportLimits):  # type: ignore[misc]
+    """The transport limits of one connection, held to ours whatever the server's Acknowledge says (asyncua
+    takes the server's limits as its own, and 0 from the server would mean none)."""
+
+    def update_client_limits(self, msg: ua.Acknowledge) -> None:
+        super().update_client_limits(msg)
+        _cap(self)
+
+
+def _cap(limits: Any) -> None:
+    limits.max_recv_buffer = _capped(limits.max_recv_buffer, MAX_CHUNK)
+    limits.max_chunk_count = _capped(limits.max_chunk_count, MAX_CHUNKS)
+    limits.max_message_size = _capped(limits.max_message_size, MAX_MESSAGE)
+
+
+def _capped(value: int, limit: int) -> int:
+    return limit if value <= 0 else min(value, limit)
+
+
+def _bound_transport(client: Client) -> None:
+    """Every connection the client opens (for its endpoints and its session) receives at most ``MAX_CHUNKS``
+    chunks of ``MAX_CHUNK`` bytes per message: a server's larger answer ends the connection."""
+    uaclient = client.uaclient
+    make = uaclient._make_protocol
+
+    def bounded() -> Any:
+        protocol = make()
+        protocol._connection._limits = _Limits(MAX_CHUNK, MAX_CHUNK, MAX_CHUNKS, MAX_MESSAGE)
+        return protocol
+
+    uaclient._make_protocol = bounded
+
+
+async def _secure_and_connect(client: Client, security: Security, device: str) -> None:
+    await secure_client(client, security, device)
+    await client.connect()
+
+
+_CERTIFICATE_REFUSALS = {
+    "BadCertificateUntrusted": "its certificate is not among the trusted ones (PKI/trusted)",
+    "BadCertificateUriInvalid": "its certificate does not name its application URI",
+    "BadCertificateTimeInvalid": "its certificate has expired or is not valid yet",
+}
+
+
+def _refusal(exc: BaseException, mode: str) -> str:
+    """What a failed connection says, a refused certificate in words: refused by the controller (its own
+    validator) or by the device."""
+    if isinstance(exc, ua.UaStatusCodeError):
+        name = type(exc).__name__
+        if isinstance(exc.__cause__, PeerRefused):
+            return f"{name}: {_CERTIFICATE_REFUSALS.get(name, 'its certificate is refused')}"
+        if name.startswith("BadCertificate") or name == "BadSecurityChecksFailed":
+            return f"{name}: the device refused the controller's certificate (PKI/own/cert.der is not among " \
+                   "the certificates it trusts)"
+    if str(exc).startswith("No matching endpoints"):
+        return f"the device offers no endpoint with security mode {mode} ({_said(exc)})"
+    return _said(exc)
 
 
 async def _device_node(client: Client, device: str) -> tuple[int, Node]:

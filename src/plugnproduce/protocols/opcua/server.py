@@ -1,6 +1,7 @@
 """The device side of OPC UA: an asyncua server publishing one device after the naming rule of :mod:`.spec`.
 
-The server listens on loopback (or the host it is given) with security mode None, answers each method call
+The server listens on loopback (or the host it is given) with the one security mode it is given (None by
+default), answers each method call
 through a handler (the simulated device's chart), serves the chart state it is in as the ``State``
 variable (read when asked, never stale) and sends the chart's events as OPC UA events of the device object.
 """
@@ -16,6 +17,7 @@ from asyncua import Node, Server, ua
 
 from plugnproduce.errors import ProtocolError
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.protocols.opcua.security import Security, secure_server
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
@@ -57,9 +59,11 @@ class OpcUaDeviceServer:
 
     def __init__(self, spec: NodeSpec, handler: RequestHandler, state: Callable[[], str], *,
                  host: str = "127.0.0.1", port: int = 0,
-                 files: Callable[[str], DeviceFiles] | None = None) -> None:
+                 files: Callable[[str], DeviceFiles] | None = None, security: Security | None = None) -> None:
         """``files``: the device's own description for the endpoint it listens on, served as the String
-        variables of ``ns:Description``."""
+        variables of ``ns:Description``; ``security``: the one mode it offers (default None) and its PKI
+        folder."""
+        self.security = security or Security()
         self.spec = spec
         self.files = files
         self._handler = handler
@@ -78,7 +82,7 @@ class OpcUaDeviceServer:
         await server.init()
         server.set_server_name(f"Plug'n'Produce {self.spec.device}")
         server.set_endpoint(format_endpoint(self._host, self._port, f"/pnp/{self.spec.device}"))
-        server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        await secure_server(server, self.security, self.spec.device)
         await server.set_application_uri(application_uri_for(self.spec.device))
         idx = await server.register_namespace(self.spec.namespace)
         self._device = await server.nodes.objects.add_object(idx, self.spec.device)

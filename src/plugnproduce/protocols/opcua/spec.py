@@ -45,8 +45,10 @@ MAX_ARGUMENTS = 64
 """Most arguments (of a method, or fields of an event) the controller reads."""
 MAX_MESSAGE = 1 << 20
 """Largest OPC UA message (bytes) the controller accepts; larger ones end the connection."""
-MAX_CHUNKS = 64
-"""Most chunks one OPC UA message may come in."""
+MAX_CHUNK = 65535
+"""Largest chunk (bytes) of an OPC UA message the controller receives."""
+MAX_CHUNKS = 16
+"""Most chunks one OPC UA message may come in: with :data:`MAX_CHUNK`, at most :data:`MAX_MESSAGE` bytes."""
 MAX_BROWSE = 256
 """Most references the controller reads when it browses one node (the event types, the device object)."""
 

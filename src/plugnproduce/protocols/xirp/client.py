@@ -14,9 +14,8 @@ from __future__ import annotations
 
 import asyncio
 import logging
-import math
 from collections.abc import AsyncIterator
-from typing import Any, NamedTuple
+from typing import Any
 
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.files import DeviceFiles
@@ -43,21 +42,10 @@ from plugnproduce.protocols.xirp.messages import (
     format_endpoint,
     parse_endpoint,
 )
+from plugnproduce.protocols.xirp.pending import PendingRequests
 from plugnproduce.protocols.xirp.stream import ConnectionLost, FrameLink
 
 _LOGGER = logging.getLogger(__name__)
-
-_SLACK = 0.001  # seconds: a request whose deadline is this close when the watchdog fires counts as overdue
-
-
-class _Waiting(NamedTuple):
-    """A request waiting for its response."""
-
-    future: asyncio.Future[Response]
-    name: str
-    limit: float
-    deadline: float
-
 
 class RemoteFailure(RemoteError):
     """The device answered a request with a failure (or a protocol error naming it)."""
@@ -90,10 +78,7 @@ class XirpClient:
         self._hello: Hello | None = None
         self._greeted: asyncio.Future[Hello] = asyncio.get_running_loop().create_future()
         self._inbox = EventInbox(what, on_event, event_buffer, self.stats)
-        self._pending: dict[str, _Waiting] = {}
-        self._watchdog: asyncio.TimerHandle | None = None
-        self._watchdog_at = math.inf
-        self._next_id = 0
+        self._pending = PendingRequests(what)
         self._closing = False
         self._ended = False
         self._lost: ProtocolConnectionError | None = None
@@ -227,53 +212,19 @@ class XirpClient:
     async def _exchange(self, name: str, params: Params, timeout: float | None) -> Response:
         if self._lost is not None or self._closing:
             raise ProtocolConnectionError(f"request {name} to {self._what}: {self._lost or 'the connection is closed'}")
-        self._next_id += 1
-        request_id = str(self._next_id)
+        request_id = self._pending.next_id()
         data = encode_frame(Request(request_id, name, params))
         if len(data) - 4 > self._link.max_frame:
             size, most = len(data) - 4, self._link.max_frame
             raise MessageError(f"request {name} to {self._what} takes {size} bytes; at most {most} fit", TOO_LARGE)
-        loop = asyncio.get_running_loop()
-        future: asyncio.Future[Response] = loop.create_future()
-        limit = self.timeout if timeout is None else timeout
-        deadline = loop.time() + limit
-        self._pending[request_id] = _Waiting(future, name, limit, deadline)
-        if deadline < self._watchdog_at:
-            self._arm_watchdog(loop, deadline)
+        future = self._pending.wait(request_id, name, self.timeout if timeout is None else timeout)
         try:
             self._link.send(data)
             return await future
         except ConnectionLost as exc:
             raise ProtocolConnectionError(f"request {name}: {exc}") from exc
         finally:
-            del self._pending[request_id]
-
-    # One timer for all waiting requests, set for the earliest deadline, rather than
-    # a timer per request: scheduling and cancelling a timer per request costs more
-    # than the rest of a round trip's bookkeeping together.
-
-    def _arm_watchdog(self, loop: asyncio.AbstractEventLoop, deadline: float) -> None:
-        if self._watchdog is not None:
-            self._watchdog.cancel()
-        self._watchdog = loop.call_at(deadline, self._expire_overdue)
-        self._watchdog_at = deadline
-
-    def _expire_overdue(self) -> None:
-        """Fail every request past its deadline with ProtocolTimeout; set the timer for the next deadline."""
-        self._watchdog, self._watchdog_at = None, math.inf
-        loop = asyncio.get_running_loop()
-        now = loop.time() + _SLACK
-        upcoming = math.inf
-        for waiting in self._pending.values():
-            if waiting.future.done():
-                continue
-            if waiting.deadline <= now:
-                message = f"request {waiting.name} to {self._what}: no response within {waiting.limit:g} s"
-                waiting.future.set_exception(ProtocolTimeout(message))
-            else:
-                upcoming = min(upcoming, waiting.deadline)
-        if upcoming < math.inf:
-            self._arm_watchdog(loop, upcoming)
+            self._pending.done(request_id)
 
     # ------------------------------------------------------------ events
 
@@ -338,7 +289,7 @@ class XirpClient:
             self._link.abort()
             return
         self._hello = message
-        self._what = self._inbox.what = f"device {message.device!r} at {self._link.peer}"
+        self._what = self._inbox.what = self._pending.what = f"device {message.device!r} at {self._link.peer}"
         self._source = f"message from {self._what}"
         if not self._greeted.done():
             self._greeted.set_result(message)
@@ -351,12 +302,7 @@ class XirpClient:
             self._lost = reason
             _LOGGER.info("%s", reason)
         lost = ConnectionLost(str(self._lost or "the connection was closed by the controller"))
-        for waiting in self._pending.values():
-            if not waiting.future.done():
-                waiting.future.set_exception(lost)
-        if self._watchdog is not None:
-            self._watchdog.cancel()
-            self._watchdog, self._watchdog_at = None, math.inf
+        self._pending.fail_all(lost)
         if not self._greeted.done():
             self._greeted.set_exception(reason)
         self._inbox.end(str(self._lost or "the connection is closed"))

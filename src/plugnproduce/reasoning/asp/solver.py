@@ -150,6 +150,34 @@ def grow(rules: Sequence[str], facts: str, horizons: Iterable[int],
         yield t, _optimum(ctl)
 
 
+def grow_optima(rules: Sequence[str], facts: str, horizons: Iterable[int], most: int,
+                arguments: Sequence[str] = OPTIMISE) -> Iterator[tuple[int, list[Model]]]:
+    """:func:`grow`, but for each horizon up to ``most`` of its optimal models (clingo's ``optN``), in the order
+    clingo finds them: the plans a further criterion (their cycle time) chooses among."""
+    ctl, messages = _control(["--warn=none", "--opt-mode=optN", f"--models={most}", *arguments])
+    _ground(ctl, messages, rules, facts)
+    before = None
+    for t in horizons:
+        ctl.ground([("step", [clingo.Number(t)]), ("check", [clingo.Number(t)])])
+        if before is not None:
+            ctl.release_external(before)
+        before = clingo.Function("query", [clingo.Number(t)])
+        ctl.assign_external(before, True)
+        yield t, _optima(ctl)
+
+
+def _optima(ctl: clingo.Control) -> list[Model]:
+    """The models of an ``optN`` solve that are proven optimal."""
+    found: list[Model] = []
+
+    def keep(m: clingo.Model) -> None:
+        if m.optimality_proven:
+            found.append(decode(m.symbols(shown=True), m.cost))
+
+    ctl.solve(on_model=keep)
+    return found
+
+
 def _optimum(ctl: clingo.Control) -> Model | None:
     """The last (optimal) model of an optimising solve, or None if there is none."""
     found: list[Model] = []

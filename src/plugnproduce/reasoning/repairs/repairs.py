@@ -58,6 +58,8 @@ def cost_facts(costs: RepairCosts, processes: Sequence[ProcessDescription],
                        for p in processes]
     out += [s.EditCost(k, "", _hundredths(getattr(costs, k))) for k in ("remove", "swap", "rebind", "reset")]
     out += [s.EditCost("add", d.id, add_cost(costs, d)) for d in catalogue]
+    if not costs.add_device_per_price:
+        out += [s.TiePrice(d.id, _hundredths(d.cost)) for d in catalogue]
     return out
 
 

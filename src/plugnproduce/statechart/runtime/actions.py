@@ -1,8 +1,8 @@
 """Executable content compiled to actions: small objects whose ``run(rt)`` does the work.
 
-``rt`` is the running session (:class:`~plugnproduce.statechart.runtime.interpreter.Interpreter`);
-actions use only its datamodel namespace ``rt.dm`` and a few methods (``raise_internal``,
-``send``, ``cancel``, ``log``). A failing action raises :class:`EvaluationError` or
+``rt`` is the running session, as :class:`~plugnproduce.statechart.runtime.session.ActionSession`
+names it: actions use only its datamodel namespace ``rt.dm`` and a few methods (``holds``,
+``raise_internal``, ``send``, ``cancel``, ``log``, ``new_sendid``). A failing action raises :class:`EvaluationError` or
 :class:`ActionError`; the interpreter then stops the block and raises the error event.
 """
 
@@ -37,7 +37,7 @@ from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator
 from plugnproduce.statechart.runtime.events import EventData
 
 if TYPE_CHECKING:
-    from plugnproduce.statechart.runtime.interpreter import Interpreter
+    from plugnproduce.statechart.runtime.session import ActionSession
 
 
 class ActionError(ExecutionError):
@@ -56,7 +56,7 @@ class Action:
     __slots__ = ("line",)
     line: int | None  # the element's line in the chart
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         """Do the action in the session ``rt``."""
         raise NotImplementedError
 
@@ -65,7 +65,7 @@ Block = tuple[Action, ...]
 """A sequence of actions that runs as a unit (an error stops the rest of it)."""
 
 
-def run_actions(rt: Interpreter, block: Block) -> None:
+def run_actions(rt: ActionSession, block: Block) -> None:
     """Run a block's actions in order; errors propagate to the caller."""
     for action in block:
         action.run(rt)
@@ -108,7 +108,7 @@ class ValueSource:
         self.value: Any = chart if chart is not None else (
             markup_value(markup) if markup is not None else (literal(text) if text is not None else None))
 
-    def get(self, rt: Interpreter) -> Any:
+    def get(self, rt: ActionSession) -> Any:
         """The value now."""
         if self.expr is not None:
             return self.expr.evaluate(rt.dm)
@@ -139,7 +139,7 @@ class EventPayload:
                     for p in params],
                    content_source(evaluator, content))
 
-    def evaluate(self, rt: Interpreter) -> Any:
+    def evaluate(self, rt: ActionSession) -> Any:
         """The event data: the content's value, or a dict of names and params (None when empty)."""
         if self.content is not None:
             return self.content.get(rt)
@@ -176,7 +176,7 @@ class RaiseAction(Action):
     def __init__(self, node: Raise):
         self.event = node.event
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         rt.raise_internal(self.event)
 
 
@@ -192,7 +192,7 @@ class SendAction(Action):
         self.idlocation = ev.location(node.idlocation) if node.idlocation is not None else None
         self.payload = EventPayload.build(ev, node.namelist, node.params, node.content)
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         sendid = self.id or rt.new_sendid()
         if self.idlocation is not None:
             self.idlocation.assign(rt.dm, sendid)
@@ -215,7 +215,7 @@ class AssignAction(Action):
         self.location = ev.location(node.location)
         self.value = ValueSource(ev, node.expr, node.text, node.markup)
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         self.location.assign(rt.dm, self.value.get(rt))
 
 
@@ -226,7 +226,7 @@ class LogAction(Action):
         self.label = node.label
         self.expr = ev.expr(node.expr) if node.expr is not None else None
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         rt.log(self.label, self.expr.evaluate(rt.dm) if self.expr is not None else None)
 
 
@@ -240,7 +240,7 @@ class IfAction(Action):
         if node.orelse is not None:
             self.branches.append((None, compile_block(ev, node.orelse.actions, where)))
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         for cond, block in self.branches:
             if cond is None or rt.holds(cond):
                 run_actions(rt, block)
@@ -256,7 +256,7 @@ class ForeachAction(Action):
         self.index = node.index
         self.block = compile_block(ev, node.actions, where)
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         array = self.array.evaluate(rt.dm)
         if not isinstance(array, list | tuple | dict | str | range):
             raise EvaluationError(f"foreach array {self.array.source!r} is a {type(array).__name__}; "
@@ -279,7 +279,7 @@ class ScriptAction(Action):
             raise ExecutionError(f"{where}:{node.line}: <script src> is not supported; expected inline code")
         self.script = ev.script(node.text or "", f"{where}:{node.line}")
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         self.script(rt.dm)
 
 
@@ -289,7 +289,7 @@ class CancelAction(Action):
     def __init__(self, ev: Evaluator, node: Cancel):
         self.sendid = _attr(ev, node.sendid, node.sendidexpr)
 
-    def run(self, rt: Interpreter) -> None:
+    def run(self, rt: ActionSession) -> None:
         rt.cancel(str(value_of(rt, self.sendid)))
 
 
@@ -297,7 +297,7 @@ def _attr(ev: Evaluator, literal_value: str | None, expr: str | None) -> str | E
     return ev.expr(expr) if expr is not None else literal_value
 
 
-def value_of(rt: Interpreter, source: str | Expr | None) -> Any:
+def value_of(rt: ActionSession, source: str | Expr | None) -> Any:
     """The value of a literal-or-expression attribute."""
     return source.evaluate(rt.dm) if isinstance(source, Expr) else source
 

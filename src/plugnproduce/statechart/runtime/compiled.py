@@ -6,7 +6,7 @@ transition domains and event matchers), executable content compiled to actions.
 from __future__ import annotations
 
 import logging
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from plugnproduce.statechart.model import (
     Chart,
@@ -20,6 +20,9 @@ from plugnproduce.statechart.model import (
 )
 from plugnproduce.statechart.runtime.actions import Block, compile_block, compile_donedata, compile_invoke
 from plugnproduce.statechart.runtime.evaluator import Evaluator, Expr
+
+if TYPE_CHECKING:
+    from plugnproduce.statechart.runtime.session import EntrySet
 
 log = logging.getLogger(__name__)
 
@@ -80,14 +83,14 @@ class CTransition:
         self.wildcard = "*" in descriptors
         self.exact = frozenset(descriptors)
         self.prefixes = tuple(d + "." for d in descriptors)
-        blank = node.cond is None or not node.cond.strip()  # an empty cond is read as no cond
-        self.cond: Expr | None = None if blank else evaluator.expr(node.cond)  # type: ignore[arg-type]
+        cond = node.cond if node.cond is not None and node.cond.strip() else None  # an empty cond is no cond
+        self.cond: Expr | None = None if cond is None else evaluator.expr(cond)
         self.targets: list[CState] = []
         self.internal = node.type == "internal"
         self.actions = actions
         self.has_history = False
         self.domain: CState | None = None
-        self.entry_cache: Any = None
+        self.entry_cache: EntrySet | None = None
 
     def matches(self, name: str) -> bool:
         """True when the event ``name`` matches one of the transition's descriptors."""

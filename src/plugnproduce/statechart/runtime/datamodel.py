@@ -24,6 +24,7 @@ from plugnproduce.statechart.runtime.invoke import resolve_src, value_from_file
 if TYPE_CHECKING:
     from plugnproduce.statechart.model import Chart, Data
     from plugnproduce.statechart.runtime.compiled import CompiledChart, CState
+    from plugnproduce.statechart.runtime.session import DatamodelSession, ErrorSession
 
 log = logging.getLogger("plugnproduce.statechart")
 
@@ -43,12 +44,11 @@ class Datamodel:
     _late: bool
     _observers: list[Callable[[MetaEvent], None]]
 
-    def _init_datamodel(self) -> None:
-        rt: Any = self
+    def _init_datamodel(self: DatamodelSession) -> None:
         self.dm.clear()
         self.dm["__builtins__"] = self.compiled.evaluator.builtins()
-        self.dm.update(_sessionid=self.session_id, _name=self.chart.name, _ioprocessors=rt.io_locations(),
-                       _event=None, In=rt.is_active)
+        self.dm.update(_sessionid=self.session_id, _name=self.chart.name, _ioprocessors=self.io_locations(),
+                       _event=None, In=self.is_active)
         if self._late:
             self._bind(self.compiled.root)
             return
@@ -80,10 +80,10 @@ class Datamodel:
             return literal(data.text)
         return None
 
-    def _run(self, block: Block) -> None:
+    def _run(self: ErrorSession, block: Block) -> None:
         """Run a block of executable content; its first error stops it and is raised as an error event."""
         try:
-            run_actions(self, block)  # type: ignore[arg-type]
+            run_actions(self, block)
         except ActionError as exc:
             self._error(exc.kind, exc.message, exc.sendid)
         except EvaluationError as exc:

@@ -8,7 +8,7 @@ import heapq
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from plugnproduce.statechart.runtime.actions import ActionError
 from plugnproduce.statechart.runtime.clock import Clock
@@ -23,7 +23,7 @@ from plugnproduce.statechart.runtime.events import (
 )
 
 if TYPE_CHECKING:
-    from plugnproduce.statechart.runtime.events import MacroStep
+    from plugnproduce.statechart.runtime.events import MacroStep, MetaEvent
     from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 _SCXML_PREFIX = "#_scxml_"
@@ -40,6 +40,39 @@ class _Delayed:
     cancelled: bool = field(default=False, compare=False)
 
 
+class DispatchSession(Protocol):
+    """What the dispatcher needs of its session: its own state, and the errors, meta events and invoked
+    sessions the other parts keep."""
+
+    session_id: str
+    clock: Clock
+    io_processors: dict[str, IOProcessor]
+    internal: deque[Event]
+    external: deque[Event]
+    invokeid: str | None
+    _parent: Interpreter | None
+    _sessions: dict[str, Interpreter]
+    _step: MacroStep | None
+    _observers: list[Callable[[MetaEvent], None]]
+    _delayed: list[_Delayed]
+    _pending: dict[str, list[_Delayed]]
+    delay_policy: Callable[[float], float] | None
+
+    def _error(self, name: str, message: str, sendid: str | None = None) -> None: ...
+
+    def _notify(self, name: str, **data: Any) -> None: ...
+
+    def _children(self) -> list[Interpreter]: ...
+
+    def _child(self, invokeid: str) -> Interpreter | None: ...
+
+    def _deliver(self: DispatchSession, event: Event, target: str | None, kind: str) -> str | None: ...
+
+    def _forget(self, entry: _Delayed) -> None: ...
+
+    def _next_seq(self) -> int: ...
+
+
 class Dispatcher:
     """The sending half of a session (mixed into the interpreter)."""
 
@@ -52,9 +85,12 @@ class Dispatcher:
     _parent: Interpreter | None
     _sessions: dict[str, Interpreter]
     _step: MacroStep | None
-    _observers: list[Callable[..., None]]
+    _observers: list[Callable[[MetaEvent], None]]
 
     def _init_dispatch(self) -> None:
+        self.delay_policy: Callable[[float], float] | None = None
+        """Maps a delayed send's delay (seconds, as the chart says) to the one it takes (a simulated device
+        scaled by a speed factor, or timed by its declared durations); None: as the chart says."""
         self._delayed: list[_Delayed] = []
         self._pending: dict[str, list[_Delayed]] = {}
         self._counter = 0
@@ -72,11 +108,13 @@ class Dispatcher:
             out[kind] = EventData(location=getattr(processor, "location", None))
         return out
 
-    def send(self, name: str, target: str | None, kind: str | None, delay: float, data: Any, sendid: str,
-             visible_sendid: str | None) -> None:
+    def send(self: DispatchSession, name: str, target: str | None, kind: str | None, delay: float, data: Any,
+             sendid: str, visible_sendid: str | None) -> None:
         """Execute a ``<send>``: check it, record it, then deliver it now or after ``delay`` seconds."""
         kind = str(kind) if kind is not None else SCXML_IO
         target = str(target) if target is not None else None
+        if delay > 0 and self.delay_policy is not None:
+            delay = self.delay_policy(delay)
         if kind in SCXML_TYPES:
             if target is not None and not target.startswith("#_"):
                 raise ActionError(f"send target {target!r} is not supported by the SCXML processor; expected "
@@ -105,7 +143,7 @@ class Dispatcher:
         for entry in self._pending.pop(sendid, ()):
             entry.cancelled = True
 
-    def next_due(self) -> float | None:
+    def next_due(self: DispatchSession) -> float | None:
         """Clock time of the next delayed send of this session or its invoked sessions (None: none)."""
         while self._delayed and self._delayed[0].cancelled:
             heapq.heappop(self._delayed)
@@ -116,7 +154,7 @@ class Dispatcher:
                 times.append(due)
         return min(times) if times else None
 
-    def _release_due(self) -> None:
+    def _release_due(self: DispatchSession) -> None:
         """Deliver every delayed send whose time has come, in due order."""
         if not self._delayed:
             return
@@ -130,7 +168,7 @@ class Dispatcher:
             if problem is not None:
                 self._error("error.communication", problem, entry.sendid)
 
-    def _deliver(self, event: Event, target: str | None, kind: str) -> str | None:
+    def _deliver(self: DispatchSession, event: Event, target: str | None, kind: str) -> str | None:
         """Hand the event over; the problem as text when it cannot be delivered."""
         if kind not in SCXML_TYPES:
             try:
@@ -169,13 +207,3 @@ class Dispatcher:
     def _next_seq(self) -> int:
         self._counter += 1
         return self._counter
-
-    if TYPE_CHECKING:  # provided by the interpreter and the invoker
-
-        def _error(self, name: str, message: str, sendid: str | None = None) -> None: ...
-
-        def _notify(self, name: str, **data: Any) -> None: ...
-
-        def _children(self) -> list[Interpreter]: ...
-
-        def _child(self, invokeid: str) -> Interpreter | None: ...

@@ -61,25 +61,20 @@ from plugnproduce.statechart.io.checks import check_structure
 from plugnproduce.statechart.io.reader import parse_chart
 from plugnproduce.statechart.model import Chart
 from plugnproduce.statechart.runtime import gcpause
-from plugnproduce.statechart.runtime.actions import Block
 from plugnproduce.statechart.runtime.clock import Clock, MonotonicClock
-from plugnproduce.statechart.runtime.compiled import ROOT, CompiledChart, CState, CTransition
+from plugnproduce.statechart.runtime.compiled import CompiledChart, CState, CTransition
 from plugnproduce.statechart.runtime.datamodel import Datamodel
 from plugnproduce.statechart.runtime.dispatch import Dispatcher
-from plugnproduce.statechart.runtime.entry import EntryBuilder, domain_of
 from plugnproduce.statechart.runtime.evaluator import EvaluationError, Evaluator, Expr
 from plugnproduce.statechart.runtime.events import (
     EVENT_CONSUMED,
-    STATE_ENTERED,
-    STATE_EXITED,
-    TRANSITION_TAKEN,
     Event,
     IOProcessor,
     MacroStep,
     MetaEvent,
-    TakenTransition,
 )
 from plugnproduce.statechart.runtime.invoke import Invocation, Invoker
+from plugnproduce.statechart.runtime.microstep import Microstep, doc_order
 
 log = logging.getLogger("plugnproduce.statechart")
 
@@ -89,10 +84,7 @@ MAX_MICROSTEPS = 100_000
 Observer = Callable[[MetaEvent], None]
 """Something that receives meta events."""
 
-_EntrySet = tuple[list[CState], set[CState], dict[CState, Block]]
-
-
-class Interpreter(Datamodel, Dispatcher, Invoker):
+class Interpreter(Datamodel, Dispatcher, Invoker, Microstep):
     """Runs one SCXML session. ``trusted=False`` (default) restricts expressions and refuses ``<script>``.
 
     ``io_processors`` maps ``<send type>`` values (``"xirp"``, ``"upnp"``) to objects with
@@ -158,7 +150,7 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
     @property
     def configuration(self) -> list[str]:
         """Ids of the active states in document order."""
-        return [s.id for s in sorted(self._config, key=_doc_order)]
+        return [s.id for s in sorted(self._config, key=doc_order)]
 
     def is_active(self, state_id: str) -> bool:
         """True when the state with this id is active."""
@@ -286,7 +278,7 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
             self._notify(EVENT_CONSUMED, event=event)
 
     def _start_invokes(self) -> None:
-        states = sorted(self._to_invoke, key=_doc_order)
+        states = sorted(self._to_invoke, key=doc_order)
         self._to_invoke.clear()
         for state in states:
             for inv in state.invokes:
@@ -296,7 +288,7 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
 
     def _atomic_states(self) -> list[CState]:
         if self._atomic is None:
-            self._atomic = sorted((s for s in self._config if s.is_atomic), key=_doc_order)
+            self._atomic = sorted((s for s in self._config if s.is_atomic), key=doc_order)
         return self._atomic
 
     def _select(self, name: str | None) -> list[CTransition]:
@@ -349,122 +341,11 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
                 filtered.append(t1)
         return filtered
 
-    # --- microstep --------------------------------------------------------------------
-
-    def _microstep(self, enabled: list[CTransition]) -> None:
-        self._exit_states(enabled)
-        for t in enabled:
-            if self._step is not None:
-                self._step.transitions.append(TakenTransition(t.source.id, tuple(s.id for s in t.targets), t.events))
-            if self._observers:
-                self._notify(TRANSITION_TAKEN, transition=t.node, source=t.source.id)
-            if t.actions:
-                self._run(t.actions)
-        self._enter(enabled)
-
-    def _exits(self, t: CTransition) -> set[CState]:
-        """The active states that taking ``t`` exits."""
-        domain = domain_of(t, self._history)
-        return self._config & domain.descendants if domain is not None else set()
-
-    def _exit_set(self, transitions: list[CTransition]) -> list[CState]:
-        """The states the transitions exit, in exit order (reverse document order)."""
-        return sorted(set().union(*map(self._exits, transitions)), key=_doc_order, reverse=True)
-
-    def _exit_states(self, enabled: list[CTransition]) -> None:
-        to_exit = self._exit_set(enabled)
-        if not to_exit:
-            return
-        self._to_invoke.difference_update(to_exit)
-        for s in to_exit:
-            for h in s.histories:
-                if h.deep:
-                    self._history[h] = [x for x in self._config if x.is_atomic and x in s.descendants]
-                else:
-                    self._history[h] = [x for x in self._config if x.parent is s]
-        for s in to_exit:
-            self._exit_one(s)
-        self._atomic = None
-
-    def _exit_one(self, s: CState) -> None:
-        for block in s.onexit:
-            self._run(block)
-        if self._invocations:
-            self._cancel_invokes(s)
-        self._config.discard(s)
-        if self._step is not None:
-            self._step.exited.append(s.id)
-        if self._observers:
-            self._notify(STATE_EXITED, state=s.id)
-
-    def _enter(self, enabled: list[CTransition]) -> None:
-        states, default_entry, history_content = self._entry_set(enabled)
-        for s in states:
-            self._config.add(s)
-            self._atomic = None
-            self._to_invoke.add(s)
-            if self._step is not None:
-                self._step.entered.append(s.id)
-            if self._observers:
-                self._notify(STATE_ENTERED, state=s.id)
-            if self._late and s not in self._data_ready:
-                self._bind(s)
-            for block in s.onentry:
-                self._run(block)
-            if s in default_entry and s.initial is not None and s.initial.actions:
-                self._run(s.initial.actions)
-            if s in history_content:
-                self._run(history_content[s])
-            if s.is_final:
-                self._entered_final(s)
-
-    def _entered_final(self, s: CState) -> None:
-        parent = s.parent
-        assert parent is not None  # a final state is never the root
-        if parent.kind == ROOT:
-            self.running = False
-            self.final_state = s.id
-            return
-        self.internal.append(Event("done.state." + parent.id, self._donedata(s), "internal"))
-        grand = parent.parent
-        if grand is not None and grand.is_parallel and all(self._in_final(c) for c in grand.substates):
-            self.internal.append(Event("done.state." + grand.id, None, "internal"))
-
-    def _in_final(self, s: CState) -> bool:
-        if s.is_compound:
-            return any(c.is_final and c in self._config for c in s.substates)
-        if s.is_parallel:
-            return all(self._in_final(c) for c in s.substates)
-        return False
-
-    def _donedata(self, s: CState) -> Any:
-        if s.donedata is None:
-            return None
-        try:
-            return self._done_data(s.donedata.evaluate(self))
-        except EvaluationError as exc:
-            self._error("error.execution", str(exc))
-            return None
-
-    # --- entry set --------------------------------------------------------------------
-
-    def _entry_set(self, enabled: list[CTransition]) -> _EntrySet:
-        single = enabled[0] if len(enabled) == 1 else None
-        if single is not None and single.entry_cache is not None:
-            return single.entry_cache  # type: ignore[no-any-return]
-        builder = EntryBuilder(self._history)
-        for t in enabled:
-            builder.add(t)
-        result = (sorted(builder.states, key=_doc_order), builder.default_entry, builder.history_content)
-        if single is not None and not builder.saw_history:
-            single.entry_cache = result
-        return result
-
     def _exit_interpreter(self) -> None:
         """Leave every state (onexit runs), cancel invocations, and tell the parent if it was a final state."""
         final = self.compiled.by_id.get(self.final_state) if self.final_state is not None else None
         done = self._donedata(final) if final is not None and self._parent is not None else None
-        for s in sorted(self._config, key=_doc_order, reverse=True):
+        for s in sorted(self._config, key=doc_order, reverse=True):
             self._exit_one(s)
         self._atomic = None
         self._sessions.pop(self.session_id, None)
@@ -488,6 +369,3 @@ class Interpreter(Datamodel, Dispatcher, Invoker):
             self.final_state = None
             self._exit_interpreter()
 
-
-def _doc_order(state: CState) -> int:
-    return state.idx

@@ -25,6 +25,7 @@ from plugnproduce.statechart.runtime.events import SCXML_TYPES, Event, EventData
 if TYPE_CHECKING:
     from plugnproduce.statechart.runtime.compiled import CState
     from plugnproduce.statechart.runtime.interpreter import Interpreter
+    from plugnproduce.statechart.runtime.session import InvokerSession
 
 MAX_CHILD_STEPS = 10_000
 """Most macrosteps an invoked session makes before its parent takes its next event."""
@@ -77,37 +78,35 @@ class Invoker:
     external: deque[Event]
     _invocations: dict[str, Invocation]
 
-    def _start_invoke(self, state: CState, inv: CInvoke) -> None:
+    def _start_invoke(self: InvokerSession, state: CState, inv: CInvoke) -> None:
         """Start one ``<invoke>`` of ``state``; failures become ``error.execution``."""
-        rt: Any = self
-        invokeid = inv.node.id or f"{state.id}.{rt.new_sendid().rsplit('.', 1)[-1]}"
+        invokeid = inv.node.id or f"{state.id}.{self.new_sendid().rsplit('.', 1)[-1]}"
         try:
             if inv.idlocation is not None:
                 inv.idlocation.assign(self.dm, invokeid)
-            kind = value_of(rt, inv.type) or "scxml"
+            kind = value_of(self, inv.type) or "scxml"
             if kind not in SCXML_TYPES:
                 raise ActionError(f"invoke type {kind!r} is not supported; expected scxml")
             chart, base = self._child_chart(inv)
-            values = inv.payload.evaluate(rt) or {}
-            child = rt._spawn(chart, invokeid, dict(values), base)
+            values = inv.payload.evaluate(self) or {}
+            child = self._spawn(chart, invokeid, dict(values), base)
         except ActionError as exc:  # before its base class: the action's own kind of error
-            rt._error(exc.kind, f"invoke {invokeid!r} failed: {exc.message}")
+            self._error(exc.kind, f"invoke {invokeid!r} failed: {exc.message}")
             return
         except PlugNProduceError as exc:
-            rt._error("error.execution", f"invoke {invokeid!r} failed: {exc}")
+            self._error("error.execution", f"invoke {invokeid!r} failed: {exc}")
             return
         except Exception as exc:  # an expression error while evaluating the invoke's attributes
-            rt._error("error.execution", f"invoke {invokeid!r} failed: {exc}")
+            self._error("error.execution", f"invoke {invokeid!r} failed: {exc}")
             return
         self._invocations[invokeid] = Invocation(invokeid, state, child, inv.finalize, inv.node.autoforward)
         child.start()
 
-    def _child_chart(self, inv: CInvoke) -> tuple[Chart, Path | None]:
+    def _child_chart(self: InvokerSession, inv: CInvoke) -> tuple[Chart, Path | None]:
         from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
-        rt: Any = self
         if inv.content is not None:
-            value = inv.content.get(rt)
+            value = inv.content.get(self)
             if isinstance(value, Chart):
                 return value, self.base_dir
             if isinstance(value, etree._Element):
@@ -117,7 +116,7 @@ class Invoker:
             if isinstance(value, bytes):
                 return parse_chart(value, "<invoke content>"), self.base_dir
             raise ActionError(f"invoke content is a {type(value).__name__}; expected an SCXML document")
-        src = value_of(rt, inv.src)
+        src = value_of(self, inv.src)
         if src is None:
             raise ActionError("invoke has neither content nor src; expected one of them")
         path = resolve_src(str(src), self.base_dir, self.trusted)
@@ -129,13 +128,12 @@ class Invoker:
             event.invokeid = invokeid
             self.external.append(event)
 
-    def _before_event(self, event: Event) -> None:
+    def _before_event(self: InvokerSession, event: Event) -> None:
         """Run ``<finalize>`` for an event from a child; forward the event to autoforwarding children."""
-        rt: Any = self
         if event.invokeid is not None:
             invocation = self._invocations.get(event.invokeid)
             if invocation is not None and invocation.finalize:
-                rt._run(invocation.finalize)
+                self._run(invocation.finalize)
         for invocation in self._invocations.values():
             if invocation.autoforward and invocation.child.running:
                 copy = Event(event.name, event.data, event.type, event.sendid, event.origin, event.origintype,

@@ -5,15 +5,6 @@ from __future__ import annotations
 from plugnproduce.reasoning.asp.terms import Atom, predicate
 
 
-@predicate("skilled")
-class Skilled(Atom):
-    """Device ``d``'s skills subsume the skill role ``r`` of ``p`` requires."""
-
-    p: str
-    r: str
-    d: str
-
-
 @predicate("walk")
 class Walk(Atom):
     """Device ``d`` can be in chart state ``x`` when role ``r``'s region of ``p`` visits its ``i``-th state."""

@@ -339,6 +339,15 @@ class EditCost(Atom):
     k: int
 
 
+@predicate("tie_price")
+class TiePrice(Atom):
+    """A catalogue device's price in hundredths, to prefer the cheaper of two purchases of equal cost when the
+    costs leave prices out."""
+
+    a: str
+    price: int
+
+
 @predicate("max_inserts")
 class MaxInserts(Atom):
     """At most ``m`` commands may be inserted."""

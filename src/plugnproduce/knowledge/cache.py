@@ -1,0 +1,116 @@
+"""The parsed knowledge, kept in the user's cache folder so that a command over unchanged libraries reads it back.
+
+Every command that reasons first loads its libraries: the taxonomy's closure (itself cached by the TBox's
+content) and every process description, Turtle and general process state chart, parsed again each time,
+though they rarely change between two commands. The loaded :class:`~.libraries.Knowledge` is kept as a pickle
+named by the digest of everything it was read from: the package's code (each module's name, size and time of
+change, as the kept help is named), the ontology files and every file of every library, by content. A process
+whose chart lies outside its library has that file's content checked when the pickle is read. A change to any
+of them names another file, or fails the check; a file that cannot be read or unpickled is loaded again. The
+folder is the user's own (as for the taxonomy's closure and the batch's engines), so the pickle is as trusted
+as the user's files.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import pickle
+import sys
+import tempfile
+from collections.abc import Callable, Iterable, Sequence
+from pathlib import Path
+
+import plugnproduce
+from plugnproduce import folders
+from plugnproduce.knowledge.libraries import Knowledge, Library, tbox_files
+
+FORMAT = 1
+"""The layout of what is kept; another layout is another file name."""
+KEEP = 8
+"""Knowledge files kept in the cache folder; older ones are removed when a new one is written."""
+
+
+def cache_folder() -> Path:
+    """The user's cache folder, beside the taxonomy's closures and the batch's engines."""
+    return folders.cache_folder()
+
+
+def _files(root: Path) -> list[Path]:
+    return sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts)
+
+
+def _code(h: hashlib._Hash) -> None:
+    """The package's code, by each module's name, size and time of change (reading it all would cost more than
+    it saves)."""
+    here = Path(plugnproduce.__file__).parent
+    for folder, dirs, names in os.walk(here):
+        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        for name in sorted(n for n in names if n.endswith(".py")):
+            stat = os.stat(os.path.join(folder, name))
+            h.update(f"{os.path.relpath(os.path.join(folder, name), here)}\0{stat.st_size}\0{stat.st_mtime_ns}\0"
+                     .encode())
+
+
+def digest(libraries: Sequence[Library]) -> str | None:
+    """The digest of what the knowledge of ``libraries`` is loaded from; None when a file cannot be read (it is
+    then loaded, and what is wrong said, as without a cache)."""
+    h = hashlib.sha256(f"{FORMAT}\0{sys.version}\0".encode())
+    _code(h)
+    try:
+        for f in [*tbox_files(libraries), *(f for lib in libraries for f in _files(lib.root))]:
+            h.update(f"{f}\0".encode() + Path(f).read_bytes() + b"\0")
+    except OSError:
+        return None
+    h.update("\0".join(f"{lib.root}\0{lib.builtin}" for lib in libraries).encode())
+    return h.hexdigest()[:32]
+
+
+def _outside(knowledge: Knowledge) -> dict[str, bytes]:
+    """The content of each process's chart file that lies outside every library (read again when kept)."""
+    roots = [lib.root.resolve() for lib in knowledge.libraries]
+    charts = {Path(p.chart_file).resolve() for p in knowledge.processes if p.chart_file}
+    return {str(c): c.read_bytes() for c in sorted(charts) if not any(c.is_relative_to(r) for r in roots)}
+
+
+def _unchanged(outside: dict[str, bytes]) -> bool:
+    try:
+        return all(Path(f).read_bytes() == data for f, data in outside.items())
+    except OSError:
+        return False
+
+
+def cached_knowledge(libraries: Sequence[Library], load: Callable[[], Knowledge],
+                     folder: Path | None = None) -> Knowledge:
+    """The knowledge of ``libraries``, read from the cache folder when kept there, else ``load()``'s, then kept."""
+    key = digest(libraries)
+    if key is None:
+        return load()
+    path = (folder or cache_folder()) / f"knowledge-{key}.pickle"
+    with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError,
+                             ValueError, IndexError):
+        kept, outside = pickle.loads(path.read_bytes())  # noqa: S301 - the user's own cache folder, by content
+        if isinstance(kept, Knowledge) and _unchanged(outside):
+            return kept
+    knowledge = load()
+    with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
+        _keep(path, pickle.dumps((knowledge, _outside(knowledge)), protocol=pickle.HIGHEST_PROTOCOL))
+    return knowledge
+
+
+def _keep(path: Path, data: bytes) -> None:
+    """Write whole and at once (a concurrent reader sees no half file); keep only the newest :data:`KEEP`."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".knowledge-", dir=path.parent)
+    with os.fdopen(fd, "wb") as f:
+        f.write(data)
+    os.replace(tmp, path)
+    old = sorted(path.parent.glob("knowledge-*.pickle"), key=lambda p: p.stat().st_mtime, reverse=True)[KEEP:]
+    for p in old:
+        p.unlink(missing_ok=True)
+
+
+def kept_files(folder: Path | None = None) -> Iterable[Path]:
+    """The knowledge files kept in the cache folder."""
+    return sorted((folder or cache_folder()).glob("knowledge-*.pickle"))
