@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
-import signal
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -53,6 +51,9 @@ def resume(
     Exit 0 the continuation succeeded, 1 it failed, was declined or nothing plausible goes on from the devices'
     states, 2 bad input (no such run, a run that succeeded, devices not found).
     """
+    import asyncio  # here, not at the top: the other commands need no event loop
+    import signal
+
     k = knowledge(cell)
     simulate = _simulation(run_id, sim, faults, bin_parts, bin_seed, json_out)
 

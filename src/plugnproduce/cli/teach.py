@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -32,6 +31,8 @@ def teach(
     Exit 0 read and within the contracts, 1 a contract refuses it (which and why), 2 bad input (an unknown
     device or quantity, a device not found).
     """
+    import asyncio  # here, not at the top: the other commands need no event loop
+
     k = knowledge(cell)
     taught = asyncio.run(controller.teach(device, quantity, cell, k, discovery_timeout or controller.DISCOVERY_SECONDS))
     if json_out:
