@@ -71,10 +71,13 @@ def served(tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[Served]:
     """The HMI served by uvicorn on a free loopback port (listening before the thread starts: no waiting).
 
     Parametrize it indirectly with a ``--faults`` spec to inject faults into the simulated devices,
-    or with a :class:`SimulatedBin` for the simulated devices to work on.
+    with a :class:`SimulatedBin` for the simulated devices to work on, or with both as a pair.
     """
     param = getattr(request, "param", "")
-    hmi = make_hmi(tmp_path, faults=param, bin=None) if isinstance(param, str) else make_hmi(tmp_path, bin=param)
+    if isinstance(param, tuple):  # both: faults injected into devices working on a bin
+        hmi = make_hmi(tmp_path, faults=param[0], bin=param[1])
+    else:
+        hmi = make_hmi(tmp_path, faults=param, bin=None) if isinstance(param, str) else make_hmi(tmp_path, bin=param)
     sock = socket.create_server(("127.0.0.1", 0))
     port = sock.getsockname()[1]
     config = uvicorn.Config(hmi.app, log_level="warning", lifespan="on", ws="none", timeout_graceful_shutdown=1)

@@ -29,6 +29,8 @@ CHANGES = {
     ("DELETE", "/api/cell/devices/{device_id}"),
     ("POST", "/api/runs"),
     ("POST", "/api/runs/{run_id}/stop"),
+    ("POST", "/api/runs/{run_id}/replan"),  # asks the devices their states: an operator's step towards a resume
+    ("POST", "/api/runs/{run_id}/resume"),
 }
 """Requests that change the cell or a run: the token always."""
 
@@ -40,6 +42,7 @@ CHECKS = {
     ("POST", "/api/task/generate"),
     ("POST", "/api/task/export"),
     ("POST", "/api/task/import"),
+    ("POST", "/api/goal/plan"),
 }
 """Requests sent with a body that change nothing (a task checked, converted): read rules."""
 

@@ -16,6 +16,6 @@ from plugnproduce.cli import draw, validate  # noqa: E402,F401  isort: skip
 from plugnproduce.cli import generate, reasoning  # noqa: E402,F401  isort: skip
 from plugnproduce.cli import devices, run, serve  # noqa: E402,F401  isort: skip
 from plugnproduce.cli import runs, verify  # noqa: E402,F401  isort: skip
-from plugnproduce.cli import knowledge, plan  # noqa: E402,F401  isort: skip
+from plugnproduce.cli import knowledge, plan, resume, teach  # noqa: E402,F401  isort: skip
 
 __all__ = ["app", "main"]

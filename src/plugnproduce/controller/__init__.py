@@ -4,6 +4,8 @@
   simulated cell through discovery and plugs its devices (:mod:`.interfaces` says what a source is);
 - the runs: :func:`run_task` finds a cell's devices and runs a task on them (``pnp run``), and
   :class:`ExecutorRunner` runs tasks on a cell source's devices, one at a time (the HMI);
+- resume: :func:`resume_run` re-plans a stopped run from the devices' states and continues it (``pnp resume``);
+- teach-in: :func:`teach` reads a value a device reports and holds it to its contracts (``pnp teach``);
 - the live cell: :func:`live_cell` asks each device its state (``pnp check --live``).
 
 The faces (``cli``, ``hmi``) use it and the service; it uses the service and the concepts (discovery,
@@ -28,6 +30,14 @@ if TYPE_CHECKING:
         RunRefused,
     )
     from plugnproduce.controller.livecell import LiveCellSource
+    from plugnproduce.controller.resume import (
+        NoCell,
+        Resumed,
+        SimulatedResume,
+        continue_run,
+        replan_live,
+        resume_run,
+    )
     from plugnproduce.controller.run import (
         DEFAULT_BIN_PARTS,
         DISCOVERY_SECONDS,
@@ -44,6 +54,7 @@ if TYPE_CHECKING:
     )
     from plugnproduce.controller.runner import ExecutorRunner
     from plugnproduce.controller.simcell import SimulatedCellSource
+    from plugnproduce.controller.teach import read_taught, teach
     from plugnproduce.discovery import CellChange, LiveCell
     from plugnproduce.executor.run import TaskRun
     from plugnproduce.protocols.interface import chosen_address
@@ -55,6 +66,9 @@ _WHERE = {
                      "PluggableCellSource", "Runner", "RunObserver", "RunRefused"),
                     "plugnproduce.controller.interfaces"),
     "LiveCellSource": "plugnproduce.controller.livecell",
+    **dict.fromkeys(("NoCell", "Resumed", "SimulatedResume", "continue_run", "replan_live", "resume_run"),
+                    "plugnproduce.controller.resume"),
+    **dict.fromkeys(("read_taught", "teach"), "plugnproduce.controller.teach"),
     **dict.fromkeys(("DEFAULT_BIN_PARTS", "DISCOVERY_SECONDS", "SIMULATED_DISCOVERY_SECONDS", "DevicesMissing",
                      "StateNotReported", "default_bin_parts", "find_devices", "live_cell", "planned_run",
                      "reported_states", "run_task", "start_run"), "plugnproduce.controller.run"),
@@ -93,21 +107,29 @@ __all__ = [
     "JournalRecord",
     "LiveCell",
     "LiveCellSource",
+    "NoCell",
     "PluggableCellSource",
+    "Resumed",
     "RunObserver",
     "RunRefused",
     "Runner",
     "SimulatedBin",
     "SimulatedCellSource",
+    "SimulatedResume",
     "StateNotReported",
     "TaskRun",
     "chosen_address",
+    "continue_run",
     "default_bin_parts",
     "find_devices",
     "live_cell",
     "network_from_env",
     "planned_run",
+    "read_taught",
+    "replan_live",
     "reported_states",
+    "resume_run",
     "run_task",
     "start_run",
+    "teach",
 ]

@@ -16,10 +16,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Literal, Protocol, runtime_checkable
 
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
+
+if TYPE_CHECKING:
+    from plugnproduce.service import Replan
 
 
 @dataclass(frozen=True)
@@ -117,6 +120,15 @@ class Runner(Protocol):
 
     async def stop(self, run_id: str) -> None:
         """Stop a run, leaving every device in a safe state (UnknownName if the run is unknown)."""
+        ...
+
+    async def replan(self, run_id: str, cell: Cell) -> Replan:
+        """What runs on after a failed or stopped run, planned from the states ``cell``'s devices report now."""
+        ...
+
+    async def resume(self, run_id: str, cell: Cell, observer: RunObserver, seen: dict[str, str] | None = None) -> str:
+        """Re-plan a failed or stopped run and start the plan (``seen``: the states of the plan the operator
+        confirmed; RunRefused if they changed); return the new run's id."""
         ...
 
     def active(self) -> str | None:

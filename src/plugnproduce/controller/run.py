@@ -11,7 +11,7 @@ import asyncio
 import contextlib
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from plugnproduce.description.model import Cell, DeviceDescription, Link, Task
 from plugnproduce.errors import PlugNProduceError
@@ -162,7 +162,8 @@ async def planned_run(task: Task, cell: Cell, devices: Cell, journal: Path, *, k
         generated = await asyncio.to_thread(plan_run, task, reported, k, progress)
     if progress is not None:
         progress("running")
-    return start_run(generated, devices, journal, observer, prefixes=k.prefixes)
+    named = Cell(devices.name, devices.devices, devices.file or the_cell.file)  # the cell file is journalled
+    return start_run(generated, named, journal, observer, prefixes=k.prefixes)
 
 
 class StateNotReported(PlugNProduceError):
@@ -207,15 +208,17 @@ async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
 
 
 def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
-              observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> TaskRun:
+              observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None,
+              preamble: tuple[tuple[str, dict[str, Any]], ...] = ()) -> TaskRun:
     """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
     real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
 
-    :func:`planned_run` makes every run this way, once the task is planned.
+    :func:`planned_run` makes every run this way, once the task is planned. ``preamble``: records journalled
+    right after ``start`` (a resumed run's, :mod:`.resume`).
     """
     from plugnproduce.executor.run import TaskRun
 
-    return TaskRun(generated, devices, journal, observer, prefixes)
+    return TaskRun(generated, devices, journal, observer, prefixes, preamble)
 
 
 async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:

@@ -13,10 +13,12 @@ from __future__ import annotations
 import asyncio
 import logging
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from plugnproduce.controller.interfaces import CellSource, CellUpdate, JournalRecord, RunObserver, RunRefused
+from plugnproduce.controller.resume import continue_run, replan_live
 from plugnproduce.controller.run import StateNotReported, planned_run
 from plugnproduce.controller.simcell import SimulatedCellSource
 from plugnproduce.description.model import Cell, Task
@@ -24,7 +26,7 @@ from plugnproduce.errors import UnknownName
 from plugnproduce.executor.journal import read_journal
 from plugnproduce.executor.run import TaskRun  # the type of a run
 from plugnproduce.knowledge import Knowledge
-from plugnproduce.service import ImplausibleTask, new_run_id
+from plugnproduce.service import ImplausibleTask, NoWayOn, Replan, knowledge, new_run_id, stopped_run
 
 log = logging.getLogger(__name__)
 
@@ -67,12 +69,7 @@ class ExecutorRunner:
         if isinstance(self._source, SimulatedCellSource):
             self._source.prepare_run(task)  # its default bin, for a task that loops on a localized pose
         run_id = new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", task.name))
-        started = asyncio.Event()
-
-        def observe(record: JournalRecord) -> None:
-            started.set()
-            observer(run_id, record)
-
+        observe, started = self._observer(run_id, observer)
         try:  # planned from the state each device reports, not its chart's initial state
             run = await planned_run(task, cell, cell, self._dir / f"{run_id}.jsonl", knowledge=self._knowledge,
                                     observer=observe)
@@ -81,6 +78,61 @@ class ExecutorRunner:
         except ImplausibleTask as exc:
             first = exc.result.problems[0]
             raise RunRefused(f"task {task.name!r} cannot run in cell {cell.name!r}: {first.text}") from exc
+        return await self._launch(run_id, run, started)
+
+    async def replan(self, run_id: str, cell: Cell) -> Replan:
+        """What runs on after run ``run_id`` (failed or stopped), planned from the states ``cell``'s devices report
+        now (RunRefused while it runs or when nothing plausible goes on; NotResumable for a run that succeeded)."""
+        entry = self._run(run_id)
+        if not entry.task.done():
+            raise RunRefused(f"run {run_id} is still running; stop it first")
+        k = await self._known()
+        try:
+            stopped = await asyncio.to_thread(stopped_run, entry.run.journal_path)
+            return await replan_live(stopped, cell, cell, k)
+        except (StateNotReported, NoWayOn) as exc:
+            raise RunRefused(f"run {run_id} cannot be resumed: {exc}") from exc
+
+    async def resume(self, run_id: str, cell: Cell, observer: RunObserver, seen: dict[str, str] | None = None) -> str:
+        """Resume run ``run_id``: re-plan it (:meth:`replan`) and start the plan, its journal beginning with the
+        stop, the re-plan and the operator's confirmation; ``seen``: the devices' states of the plan the operator
+        confirmed (RunRefused when they have changed since). Returns the new run's id."""
+        active = self.active()
+        if active is not None:
+            raise RunRefused(f"run {active} is still running; stop it first")
+        plan = await self.replan(run_id, cell)
+        if seen is not None and seen != plan.states:
+            raise RunRefused("the devices changed since the plan was shown; look at the new plan and confirm it")
+        if isinstance(self._source, SimulatedCellSource):
+            self._source.prepare_run(plan.task)  # the session's bin, as the run it resumes had
+        new_id = new_run_id(re.sub(r"[^A-Za-z0-9_-]", "_", plan.task.name))
+        observe, started = self._observer(new_id, observer)
+        try:
+            run = await continue_run(plan, cell, cell, await self._known(), "the operator",
+                                     self._dir / f"{new_id}.jsonl", observe)
+        except NoWayOn as exc:
+            raise RunRefused(str(exc)) from exc
+        return await self._launch(new_id, run, started)
+
+    async def _known(self) -> Knowledge:
+        """The knowledge runs are planned with (the built-in library unless given)."""
+        if self._knowledge is None:
+            self._knowledge = await asyncio.to_thread(knowledge)
+        return self._knowledge
+
+    @staticmethod
+    def _observer(run_id: str, observer: RunObserver) -> tuple[Callable[[JournalRecord], None], asyncio.Event]:
+        """The run's record observer, passing each record on with the run id; the event it sets on the first."""
+        started = asyncio.Event()
+
+        def observe(record: JournalRecord) -> None:
+            started.set()
+            observer(run_id, record)
+
+        return observe, started
+
+    async def _launch(self, run_id: str, run: TaskRun, started: asyncio.Event) -> str:
+        """Start ``run``; return once its journal has its ``start`` record."""
         self._loop = asyncio.get_running_loop()
         running = asyncio.create_task(run.run(), name=f"run {run_id}")
         running.add_done_callback(self._finished)

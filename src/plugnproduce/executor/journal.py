@@ -4,9 +4,11 @@ Every run writes one record per line: ``start`` (task, cell, chart digest, numbe
 steps), then ``command`` (sent to a device), ``event`` (from a device or the chart), ``state``
 (a device region entered a state), ``step`` (a step began, with its role bindings), ``fault``, after a fault
 one ``stop`` per device (the safe-stop request sent, its answer, the state the device reports) and finally
-``end`` (outcome). A line is flushed to the operating system before the run goes on, so after
-a crash of the controller the journal holds everything up to the crash, and a run without
-``end`` is told apart from a finished one. It is made durable on disk (fsynced) before the run
+``end`` (outcome). A run that resumes a stopped one (``pnp resume``) writes, right after its ``start``,
+``stopped`` (the run it resumes and how that one stopped), ``replan`` (the states the devices reported and the
+rest planned from them) and ``continue`` (who confirmed it). A line is flushed to the operating system
+before the run goes on, so after a crash of the controller the journal holds everything up to the crash,
+and a run without ``end`` is told apart from a finished one. It is made durable on disk (fsynced) before the run
 acts on the world: with each ``command`` (the command goes out after it), and with ``start``,
 ``fault``, ``stop`` and ``end``; what the run observed in between (``step``, ``state``, ``event``,
 ``value``, ``branch``) is fsynced with the next of these. One fsync per record held up the
@@ -26,7 +28,8 @@ from typing import Any, TextIO
 
 from plugnproduce.errors import DescriptionError, PlugNProduceError
 
-KINDS = ("start", "step", "command", "event", "value", "state", "branch", "fault", "stop", "end")
+KINDS = ("start", "stopped", "replan", "continue", "step", "command", "event", "value", "state", "branch", "fault",
+         "stop", "end")
 OBSERVED = frozenset({"step", "event", "value", "state", "branch"})
 """Kinds that record what the run saw, not what it did: flushed at once, fsynced with the next other record."""
 
@@ -179,6 +182,8 @@ def describe(record: dict[str, Any]) -> str:
     kind = record["kind"]
     if kind == "start":
         return f"start task {record.get('task')} on cell {record.get('cell')}"
+    if kind in ("stopped", "replan", "continue"):
+        return _resumed(record)
     if kind == "step":
         return f"step {record.get('step')}: {record.get('command')}"
     if kind == "command":
@@ -207,3 +212,15 @@ def describe(record: dict[str, Any]) -> str:
         return (f"stop {record.get('device')}: {record.get('request')} {record.get('answer')}; "
                 f"now in state {record.get('state')}")
     return f"end: {record.get('outcome')}" + (f" ({record.get('reason')})" if record.get("reason") else "")
+
+
+def _resumed(record: dict[str, Any]) -> str:
+    """The line of a ``stopped``, ``replan`` or ``continue`` record."""
+    kind = record["kind"]
+    if kind == "stopped":
+        at = f" at step {record['step']}" if record.get("step") is not None else ""
+        return f"resumes run {record.get('run')}, which {record.get('outcome')}{at}: {record.get('reason')}"
+    if kind == "replan":
+        states = ", ".join(f"{d} {s}" for d, s in sorted((record.get("states") or {}).items()))
+        return f"re-planned {record.get('plan')} from the devices' states ({states}): {record.get('steps')} step(s)"
+    return f"continues, confirmed by {record.get('confirmed_by')}"

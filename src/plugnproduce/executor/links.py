@@ -154,6 +154,20 @@ class OpcUaLink:
         await self._client.close()
 
 
+async def query_report(device: DeviceDescription, timeout: float) -> tuple[str, dict[str, Any]]:
+    """Connect to a device, ask its state and the values it reports with it (teach-in), disconnect.
+
+    Over XIRP the ``state`` response carries them; a UPnP device's state query reports its state only."""
+    if device.protocol != "xirp":
+        raise ProtocolError(f"device {device.id} speaks {device.protocol}, whose state query reports its state "
+                            "only; values are read with it over XIRP")
+    client = await xirp.XirpClient.connect_endpoint(device.endpoint, timeout=timeout)
+    try:
+        return await client.report(timeout=timeout)
+    finally:
+        await client.close()
+
+
 async def query_state(device: DeviceDescription, timeout: float) -> str:
     """Connect to a device, ask its current state (the id of its device state chart's state), disconnect."""
     link = await open_link(device, lambda *_: None, lambda *_: None, lambda *_: None)

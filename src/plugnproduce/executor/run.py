@@ -33,6 +33,7 @@ from typing import Any
 from plugnproduce.chartnames import DONE, STEP, branch_variable
 from plugnproduce.codegen import GeneratedTask
 from plugnproduce.description.model import PROTOCOLS, Cell, Command
+from plugnproduce.description.taskfile import task_to_yaml
 from plugnproduce.errors import ExecutionError, PlugNProduceError, ProtocolConnectionError, ProtocolTimeout
 from plugnproduce.executor import outcomes, values
 from plugnproduce.executor.chartmap import chart_map
@@ -57,8 +58,12 @@ class TaskRun:
     """One run of a generated task in a cell whose devices carry their real endpoints."""
 
     def __init__(self, generated: GeneratedTask, cell: Cell, journal_path: Path,
-                 observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None) -> None:
+                 observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None,
+                 preamble: tuple[tuple[str, dict[str, Any]], ...] = ()) -> None:
+        """``preamble``: records (kind, fields) journalled right after ``start``, before anything goes out (a
+        resumed run's ``stopped``, ``replan`` and ``continue``)."""
         self.generated = generated
+        self._preamble = preamble
         self.cell = cell
         self.journal_path = journal_path
         self._observer = observer
@@ -95,7 +100,10 @@ class TaskRun:
         """Connect to the devices, run the chart to its end, close everything; the report says how it went."""
         with Journal(self.journal_path) as self._journal:
             self._record("start", task=self.generated.task.name, cell=self.cell.name, chart_sha256=self._digest,
-                         steps=len(self.generated.steps), devices={d.id: d.endpoint for d in self.cell.devices})
+                         steps=len(self.generated.steps), devices={d.id: d.endpoint for d in self.cell.devices},
+                         task_file=task_to_yaml(self.generated.task), cell_file=self.cell.file)
+            for kind, fields in self._preamble:
+                self._record(kind, **fields)
             try:
                 await self._connect()
                 if self.fault is None:
@@ -120,6 +128,11 @@ class TaskRun:
                 end["reason"] = str(self.fault)
             self._record("end", **end)
         return RunReport(outcome, self.journal_path, self.fault, dict(self.device_states))
+
+    def observed(self, observer: RecordObserver) -> TaskRun:
+        """The run, its records passed to ``observer`` from now on (before it starts)."""
+        self._observer = observer
+        return self
 
     def stop(self, reason: str = "stopped by the operator") -> None:
         """Stop the run as a fault of kind ``stopped``: no further command goes out."""

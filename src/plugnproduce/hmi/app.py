@@ -17,7 +17,7 @@ from plugnproduce.controller.interfaces import CellSource, Runner
 from plugnproduce.hmi import errors
 from plugnproduce.hmi.hub import Hub
 from plugnproduce.hmi.pictures import GeneratedCharts, Pictures
-from plugnproduce.hmi.routes import cell, charts, runs, sources, task
+from plugnproduce.hmi.routes import cell, charts, goal, runs, sources, task, teach
 from plugnproduce.hmi.security import BodyLimit, SecurityHeaders
 from plugnproduce.hmi.work import WAITING, WORK_MEMORY, WORK_SECONDS, WORKERS, Work, WorkLimits
 from plugnproduce.service import MAX_BYTES, DeviceDescription, Knowledge
@@ -84,7 +84,8 @@ def create_app(
     app.state.pictures = Pictures()
     app.state.generated = GeneratedCharts()
     errors.install(app)
-    for router in (cell.router, task.router, charts.router, runs.router, sources.router):
+    for router in (cell.router, task.router, goal.router, charts.router, runs.router, sources.router,
+                   teach.router):
         app.include_router(router)
     folder = static_folder()
     app.mount("/static", StaticFiles(directory=folder), name="static")

@@ -29,6 +29,7 @@ from plugnproduce.errors import (
     tidy,
 )
 from plugnproduce.hmi.schemas import LOOP_TAG, STEP_TAG
+from plugnproduce.service import NotResumable
 
 
 def field_name(loc: Sequence[int | str]) -> str:
@@ -98,6 +99,7 @@ def install(app: FastAPI) -> None:
     app.add_exception_handler(UnknownName, _unknown)
     app.add_exception_handler(RunRefused, _conflict)
     app.add_exception_handler(CellChangeRefused, _conflict)
+    app.add_exception_handler(NotResumable, _conflict)
     app.add_exception_handler(PlugNProduceError, _other)
     app.add_middleware(BugBoundary)  # added first: inside the others, so that a 500 has the security headers too
 

@@ -124,6 +124,15 @@ class Hub:
         """Start a run of ``task`` in the current cell (RunRefused when it cannot start)."""
         return await self.runner.start(task, self.cell, self.on_run_record)
 
+    async def replan_run(self, run_id: str) -> dict[str, Any]:
+        """What would run on after a failed or stopped run, from the states the cell's devices report now."""
+        plan = await self.runner.replan(run_id, self.cell)
+        return {"run": run_id, "stopped": plan.stopped.record(), **plan.record()}
+
+    async def resume_run(self, run_id: str, seen: dict[str, str] | None) -> str:
+        """Resume a failed or stopped run with the plan the operator confirmed; the new run's id."""
+        return await self.runner.resume(run_id, self.cell, self.on_run_record, seen)
+
     def on_run_record(self, run_id: str, record: JournalRecord) -> None:
         """Take in one journal record of a run: device states follow it, and every page hears of it."""
         if record.get("kind") in ("state", "stop") and record.get("device"):  # a stop record: the state reported

@@ -194,3 +194,11 @@ class RunIn(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     task: TaskIn
+
+
+class ResumeIn(BaseModel):
+    """The plan the operator confirmed: the devices' states it was planned from (none: plan and go on)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    states: dict[str, str] | None = None

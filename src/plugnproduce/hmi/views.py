@@ -72,6 +72,7 @@ def parameter_json(p: Parameter, taxonomy: Taxonomy) -> dict[str, Any]:
         "default": _pose(p.default) if kind == "pose" else p.default,
         "role": p.role,
         "quantity": taxonomy.label(p.quantity),
+        "quantity_name": local_name(p.quantity),
     }
 
 

@@ -10,7 +10,9 @@ group of use cases, every name here:
 - :mod:`.goals`: planning from a goal;
 - :mod:`.batches`: the feasibility of many configurations;
 - :mod:`.programs`: generate and verify, and what a run needs (:func:`plan_run`);
-- :mod:`.journals`: the runs folder and past runs' journals.
+- :mod:`.journals`: the runs folder and past runs' journals;
+- :mod:`.resumes`: what runs on after a stopped run, planned from the devices' states;
+- :mod:`.teaching`: teach-in, a value a device reports held to its contracts.
 
 - :mod:`.drawings`: pictures of state charts.
 
@@ -80,7 +82,7 @@ from plugnproduce.service.descriptions import (
     validate_tasks,
 )
 from plugnproduce.service.explanations import explain_offered, explain_plausible, explain_process, explain_step
-from plugnproduce.service.goals import plan, plan_pddl
+from plugnproduce.service.goals import goal_from_text, plan, plan_pddl
 from plugnproduce.service.journals import new_run_id, report, runs, runs_folder
 from plugnproduce.service.programs import (
     Generated,
@@ -94,6 +96,8 @@ from plugnproduce.service.programs import (
     repair_cycle_times,
     verify,
 )
+from plugnproduce.service.resumes import NotResumable, NoWayOn, Replan, Stopped, replan, rest_of_task, stopped_run
+from plugnproduce.service.teaching import ReportsNothing, Taught, judge_taught, reported_quantities, reported_value
 
 if TYPE_CHECKING:
     from plugnproduce import reasoning
@@ -182,6 +186,12 @@ __all__ = [
     "Generation",
     "ImplausibleStep",
     "ImplausibleTask",
+    "NoWayOn",
+    "NotResumable",
+    "Replan",
+    "ReportsNothing",
+    "Stopped",
+    "Taught",
     "Knowledge",
     "Library",
     "Link",
@@ -225,7 +235,9 @@ __all__ = [
     "generate",
     "generate_configurations",
     "generation",
+    "goal_from_text",
     "impact",
+    "judge_taught",
     "knowledge",
     "knowledge_for_cell",
     "local_name",
@@ -238,10 +250,15 @@ __all__ = [
     "read_configurations",
     "reasoning",
     "repair",
+    "replan",
     "report",
+    "reported_quantities",
+    "reported_value",
+    "rest_of_task",
     "rules_path",
     "runs",
     "runs_folder",
+    "stopped_run",
     "task",
     "task_from_text",
     "task_text",

@@ -38,3 +38,10 @@ def plan_pddl(goal_or_path: Goal | str | Path, cell_or_path: CellArg,
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     return export(goal_or_path if isinstance(goal_or_path, Goal) else load_goal(goal_or_path), the_cell, k)
+
+
+def goal_from_text(data: bytes | str, name: str) -> Goal:
+    """Read a goal from YAML text (the HMI's Goal view); ``name`` names it in messages."""
+    from plugnproduce.description.goalfile import parse_goal
+
+    return parse_goal(data.encode("utf-8") if isinstance(data, str) else data, name)

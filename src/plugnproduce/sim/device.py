@@ -13,6 +13,7 @@ chart does not wait for in its current state is refused (XIRP ``not-accepted``, 
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import logging
 import math
 from collections.abc import Coroutine, Mapping
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 import rdflib
 
 from plugnproduce.description.model import Command, DeviceDescription
+from plugnproduce.description.reports import reported_values
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles
@@ -91,7 +93,8 @@ class SimulatedDevice:
                  lds: str | None = None, speed: float = 1.0) -> None:
         """``bin``: the simulated bin the device works on, if any; ``lds``: the Local Discovery Server an OPC UA
         device registers with, if any; ``speed``: how much faster than real time the device works (its chart's
-        delays and declared durations divided by it)."""
+        delays and declared durations divided by it). A device in a state it reported
+        (:meth:`DeviceDescription.reported`) starts its chart there."""
         if not (math.isfinite(speed) and speed > 0):
             raise ValueError(f"speed factor {speed!r}: expected a positive number")
         self.description = device
@@ -99,7 +102,10 @@ class SimulatedDevice:
         self.network = network
         self.faults = faults if faults is not None else xirp.Faults()
         self.bin = bin
-        self.interpreter = Interpreter(device.chart, io_processors={device.protocol: self},
+        chart = device.chart
+        if device.reported_state and [device.initial] != chart.initial:  # it starts where it was left (a resume)
+            chart = dataclasses.replace(chart, initial=[device.initial])
+        self.interpreter = Interpreter(chart, io_processors={device.protocol: self},
                                        base_dir=Path(device.chart_file).parent)
         self.speed = speed
         self.timer = DeviceTimer(device)
@@ -112,6 +118,7 @@ class SimulatedDevice:
         self._answers: dict[str, asyncio.Future[dict[str, Any]]] = {}
         """Per event a request is answered with at once (an OPC UA method's output arguments), its caller."""
         self._pending: set[asyncio.Task[Any]] = set()
+        self._reports = reported_values(device)
 
     @property
     def id(self) -> str:
@@ -224,8 +231,10 @@ class SimulatedDevice:
         return self.timer.delay(nominal) / self.speed
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
-        if request.name == xirp.STATE:
-            return {xirp.STATE_RESULT: self.state}
+        if request.name == xirp.STATE:  # with the values its chart says it reports (teach-in reads them)
+            dm = self.interpreter.dm
+            return {xirp.STATE_RESULT: self.state, **{q: dm[r.variable] for q, r in self._reports.items()
+                                                      if r.variable in dm}}
         try:
             self._accept(request.name, request.params)
         except LookupError as exc:

@@ -13,7 +13,7 @@ from fastapi.responses import PlainTextResponse, Response, StreamingResponse
 
 from plugnproduce.hmi.hub import Hub, format_event
 from plugnproduce.hmi.routes import hub_of
-from plugnproduce.hmi.schemas import RunIn
+from plugnproduce.hmi.schemas import ResumeIn, RunIn
 from plugnproduce.hmi.security import allow_read, require_token
 from plugnproduce.hmi.views import run_json
 
@@ -55,6 +55,22 @@ async def stop_run(run_id: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     """Stop the run; every device stays in a safe state."""
     await hub.runner.stop(run_id)
     return _view(hub, run_id)
+
+
+@router.post("/api/runs/{run_id}/replan", dependencies=change, summary="Re-plan a failed or stopped run")
+async def replan_run(run_id: str, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+    """Ask each device its state and plan the rest of the run's task from there: the plan (its task file,
+    steps and repairs) and the states, for the operator to confirm (409 when nothing plausible goes on)."""
+    return await hub.replan_run(run_id)
+
+
+@router.post("/api/runs/{run_id}/resume", dependencies=change, status_code=status.HTTP_202_ACCEPTED,
+             summary="Resume a failed or stopped run")
+async def resume_run(run_id: str, body: ResumeIn, hub: Hub = Depends(hub_of)) -> dict[str, Any]:
+    """Re-plan the run and start the plan; its journal begins with the stop, the re-plan and the confirmation.
+    With ``states`` (the plan's, as shown), 409 when the devices have changed since."""
+    new_id = await hub.resume_run(run_id, body.states)
+    return _view(hub, new_id)
 
 
 @router.get("/api/runs/{run_id}/journal", dependencies=read, response_model=None,

@@ -15,6 +15,7 @@ from __future__ import annotations
 import asyncio
 import logging
 from collections.abc import AsyncIterator
+from typing import Any
 
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.files import DeviceFiles
@@ -196,12 +197,17 @@ class XirpClient:
 
     async def state(self, *, timeout: float | None = None) -> str:
         """The device's current state: the id of its device state chart's state (the ``state`` request)."""
+        return (await self.report(timeout=timeout))[0]
+
+    async def report(self, *, timeout: float | None = None) -> tuple[str, dict[str, Any]]:
+        """The device's current state and the values it reports with it (its other results: the quantities its
+        chart's ``<data pnp:quantity=...>`` hold, by quantity name), from one ``state`` request."""
         results = await self.request(STATE, timeout=timeout)
-        value = results.get(STATE_RESULT)
+        value = results.pop(STATE_RESULT, None)
         if not isinstance(value, str) or not value:
             raise ProtocolError(f"{STATE} of {self._what}: expected a string result {STATE_RESULT}; got "
                                 f"{sorted(results) or 'none'}")
-        return value
+        return value, results
 
     async def _exchange(self, name: str, params: Params, timeout: float | None) -> Response:
         if self._lost is not None or self._closing:

@@ -4,12 +4,14 @@
 // and unit fit, as the server describes them); a step whose process gives outputs may be named.
 // A step may lie in a branch: it takes the outputs of the steps before it on every path to it.
 // Values are refused with the messages of the task shapes: the dialog validates the task through
-// the API (as `pnp validate` would) before it lets the step in.
+// the API (as `pnp validate` would) before it lets the step in. A parameter whose quantity a device reports
+// has "Teach" beside it (teach.js).
 
 import { post } from "./api.js";
 import { $, fill, h, num } from "./dom.js";
 import { earlierOnPath, numberOf, rowOf, withStep } from "./places.js";
 import { offer, state, taskBody } from "./state.js";
+import { teachButton } from "./teach.js";
 
 const POSE_AXES = ["x", "y", "z", "rx", "ry", "rz"];
 
@@ -68,9 +70,11 @@ function showSource(box) {
   box.querySelectorAll("input").forEach((i) => { i.disabled = linked; });
 }
 
-function paramField(p, value, at) {
+function paramField(p, value, at, root) {
   const found = sources(p, at);
   const box = valueField(p, value && value.from ? undefined : value);
+  const teach = teachButton(p, box, root);
+  if (teach) box.append(teach);
   if (found.length || (value && value.from)) {
     box.append(sourceField(p, value, found));
     box.querySelector("select.source").addEventListener("change", () => showSource(box));
@@ -243,7 +247,7 @@ export function editStep(command, at, previous) {
   $("#dialog-ok").textContent = previous ? "Save step" : "Add step";
   fill($("#dialog-roles"), h("legend", {}, "Devices"), nameField(process, previous),
     process.roles.map((r) => roleField(process, r, previous)));
-  const params = process.parameters.map((p) => paramField(p, previous && previous.params ? previous.params[p.name] : undefined, at));
+  const params = process.parameters.map((p) => paramField(p, previous && previous.params ? previous.params[p.name] : undefined, at, root));
   fill($("#dialog-params"), h("legend", {}, "Parameters"), params.length ? params : h("p", { class: "hint" }, "This process has no parameters."));
   clearErrors(root);
   return new Promise((resolve) => {

@@ -6,8 +6,10 @@ import { initCharts, renderChartChoices, showChart } from "./charts.js";
 import { initDerivations } from "./derivation.js";
 import { $ } from "./dom.js";
 import { addStep, initEditor, renderTask, scheduleCheck } from "./editor.js";
+import { initGoal } from "./goal.js";
 import { initRun, renderRun, renderStart, takeDeviceState, takeRecord } from "./run.js";
 import { loadTask, on, state } from "./state.js";
+import { loadReports } from "./teach.js";
 import { initZoom } from "./zoom.js";
 
 function askToken() {
@@ -56,6 +58,7 @@ function follow() {
   events.addEventListener("cell", json((data) => {
     takeCell(data);
     renderChartChoices();
+    loadReports();
     if (data.change) scheduleCheck();
   }));
   events.addEventListener("device-state", json(takeDeviceState));
@@ -74,9 +77,11 @@ async function boot() {
   for (const p of processes) state.processes.set(p.command, p);
   state.pluggable = cell.pluggable;
   state.catalogue = catalogue;
+  await loadReports();
   initCell({ onAdd: addStep, onChart: showChart });
   initDerivations();
   initEditor();
+  initGoal();
   initCharts();
   initZoom();
   loadTask();

@@ -6,6 +6,7 @@ import { renderDeviceState } from "./cell.js";
 import { $, announce, fill, h, showValue } from "./dom.js";
 import { loopText } from "./loops.js";
 import { placeKey } from "./places.js";
+import { initResume, renderResume } from "./resume.js";
 import { state, stepPositions, taskBody } from "./state.js";
 
 /** Where step position `n` of the run lies in the editor's task: {row, loop, iteration}. */
@@ -139,6 +140,7 @@ export function renderRun() {
   const running = Boolean(run && run.status === "running");
   renderStart();
   $("#run-stop").disabled = !running;
+  renderResume(run);
   if (!run) return;
   const status = $("#run-status");
   status.textContent = statusText(run);
@@ -236,6 +238,11 @@ async function stop() {
 export async function initRun() {
   $("#run-start").addEventListener("click", start);
   $("#run-stop").addEventListener("click", stop);
+  initResume((answer) => {
+    adopt(answer);
+    announce(statusText(state.run));
+    renderRun();
+  }, () => state.run);
   const runs = await get("/api/runs");
   const last = runs.active || (runs.runs.length ? runs.runs[runs.runs.length - 1].run : null);
   if (last) state.run = await get(`/api/runs/${encodeURIComponent(last)}`);

@@ -16,6 +16,7 @@ export const state = {
   check: null, // the last check (with repairs) of the task as it is
   run: null, // {run, status, step, states, faults, lines}
   generated: [], // charts of the last generation
+  reports: {}, // device -> the quantities it reports with its state (teach-in)
 };
 
 const bus = new EventTarget();

@@ -1,0 +1,95 @@
+"""Teach-in: a value a device reports (a pose it was guided to), held to the device's contracts like any other.
+
+The controller reads the value from the device (:func:`plugnproduce.controller.teach`); this module says which
+values a device reports (its chart's ``<data pnp:quantity=...>``, :mod:`plugnproduce.description.reports`) and
+judges one against every contract of the device's requests that take that quantity
+(:func:`plugnproduce.description.contracts.breach`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from plugnproduce.description.contracts import breach, shorten
+from plugnproduce.description.model import Argument, DeviceDescription
+from plugnproduce.description.reports import ReportedValue, reported_values
+from plugnproduce.errors import PlugNProduceError, UnknownName
+from plugnproduce.ontology.vocabulary import local_name
+
+
+class ReportsNothing(PlugNProduceError):
+    """A device whose chart declares no value it reports with its state."""
+
+
+@dataclass(frozen=True)
+class Taught:
+    """A value read from a device, and what its contracts say of it."""
+
+    device: str
+    quantity: str
+    value: Any
+    state: str
+    """The state the device reported with it."""
+    unit: str
+    held_to: tuple[str, ...]
+    """The contracts it was held to, in words (``MoveTo TargetPose: reach 1.45 m``)."""
+    refused: tuple[str, ...]
+    """Why a contract refuses it (none: every one takes it)."""
+
+    @property
+    def accepted(self) -> bool:
+        """Whether every contract takes the value."""
+        return not self.refused
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict."""
+        return {"device": self.device, "quantity": self.quantity, "value": self.value, "unit": self.unit,
+                "state": self.state, "accepted": self.accepted, "held_to": list(self.held_to),
+                "refused": list(self.refused)}
+
+    def line(self) -> str:
+        """``robot TargetPose = [0.4, 0.0, 0.6, 0, 180, 0] (robot is home)``."""
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{self.device} {self.quantity} = {shorten(self.value, 200)}{unit} ({self.device} is {self.state})"
+
+
+def reported_quantities(device: DeviceDescription) -> list[str]:
+    """The quantities the device reports with its state (``TargetPose``), sorted."""
+    return sorted(reported_values(device))
+
+
+def reported_value(device: DeviceDescription, quantity: str) -> ReportedValue:
+    """The value ``quantity`` the device reports (UnknownName, with those it does report; ReportsNothing)."""
+    reports = reported_values(device)
+    if not reports:
+        raise ReportsNothing(f"device {device.id} reports no value with its state: its chart "
+                             f"{device.chart_file.rsplit('/', 1)[-1]} has no <data pnp:quantity=...>")
+    if quantity not in reports:
+        raise UnknownName("reported quantity", quantity, reports, owner=f"device {device.id}")
+    return reports[quantity]
+
+
+def judge_taught(device: DeviceDescription, quantity: str, value: Any, state: str) -> Taught:
+    """Hold a value the device reported to each contract of its requests that take ``quantity``."""
+    reported = reported_value(device, quantity)
+    contracts = [a for a in device.arguments if local_name(a.quantity) == quantity]
+    held, refused = [], []
+    for contract in contracts:
+        held.append(f"{contract.request} {quantity}: {_limits(contract)}")
+        why = breach(value, reported.unit, contract)
+        if why is not None:
+            refused.append(f"{device.id} {contract.request} {quantity} {why}")
+    return Taught(device.id, quantity, value, state, reported.unit, tuple(held), tuple(refused))
+
+
+def _limits(contract: Argument) -> str:
+    parts = [local_name(contract.datatype)] if contract.datatype else []
+    if contract.reach is not None:
+        parts.append(f"reach {contract.reach:g} m")
+    unit = f" {contract.unit}" if contract.unit else ""
+    if contract.minimum is not None:
+        parts.append(f"at least {contract.minimum:g}{unit}")
+    if contract.maximum is not None:
+        parts.append(f"at most {contract.maximum:g}{unit}")
+    return ", ".join(parts) or "any value"
