@@ -19,6 +19,8 @@ CELLS = sorted((D / "cells").glob("*.yaml"))
 COMMANDS = sorted(p.stem for p in (D / "processes").glob("*.ttl"))
 
 BIN_PICKING = {"gripper": "gripper", "localizer": "binpicking-pc", "robot": "robot", "sensor": "sensor3d"}
+MIXED = {"gripper": "gripper", "localizer": "binpicking-pc-ua", "robot": "robot", "sensor": "sensor3d",
+         "screwdriver": "screwdriver-ua"}
 ASSEMBLY = {"gripper": "vacuum-gripper", "robot": "cobot", "screwdriver": "screwdriver", "machine": "cnc",
             "conveyor": "conveyor"}
 
@@ -56,6 +58,18 @@ TABLE: dict[tuple[str, str], tuple[tuple[tuple[str, str], ...], str | None, bool
     ("bin-picking", "scan-bin"): (roles(BIN_PICKING, "sensor"), None, True),
     ("bin-picking", "screw"): NOT_OFFERED,
     ("bin-picking", "transport"): NOT_OFFERED,
+    ("mixed", "bin-pick"): (roles(MIXED, "gripper", "localizer", "robot", "sensor"), None, True),
+    ("mixed", "close-gripper"): (roles(MIXED, "gripper"), None, True),
+    ("mixed", "localize-part"): (roles(MIXED, "localizer", "sensor"), None, True),
+    ("mixed", "machine-part"): NOT_OFFERED,
+    ("mixed", "move-to"): (roles(MIXED, "robot"), None, True),
+    ("mixed", "open-gripper"): (roles(MIXED, "gripper"), "wrong_state: open", None),  # needs it closed
+    ("mixed", "pick"): (roles(MIXED, "gripper", "robot"), None, True),
+    ("mixed", "pick-and-place"): (roles(MIXED, "gripper", "robot"), None, True),
+    ("mixed", "place"): (roles(MIXED, "gripper", "robot"), "wrong_state: open", None),  # needs it closed
+    ("mixed", "scan-bin"): (roles(MIXED, "sensor"), None, True),
+    ("mixed", "screw"): (roles(MIXED, "robot", "screwdriver"), None, True),
+    ("mixed", "transport"): NOT_OFFERED,
 }
 """Each cell offers each command with one binding at most; a second binding would be a row of its own."""
 

@@ -75,11 +75,11 @@ class Plan:
 
 
 def _numbers(chart: Chart) -> list[int] | None:
-    data = next((d for d in chart.data if d.id == PLAN and d.expr), None)
-    if data is None or data.expr is None:
+    text = next((d.text or d.expr for d in chart.data if d.id == PLAN), None)  # inline content, or an expression
+    if text is None:
         return None
     try:
-        value = ast.literal_eval(data.expr)
+        value = ast.literal_eval(text.strip())
     except (ValueError, SyntaxError):
         return None
     if not isinstance(value, list) or not all(isinstance(v, int) for v in value):

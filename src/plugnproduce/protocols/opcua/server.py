@@ -17,7 +17,7 @@ from urllib.parse import urlparse
 
 from asyncua import Node, Server, ua
 
-from plugnproduce.errors import ProtocolError
+from plugnproduce.errors import PlugNProduceError, ProtocolError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.opcua.security import Security, secure_server
 from plugnproduce.protocols.opcua.spec import (
@@ -52,7 +52,7 @@ for _name in ("asyncua.server", "asyncua.server.server", "asyncua.server.address
     logging.getLogger(_name).setLevel(logging.ERROR)  # security-None and method-failure chatter
 
 
-class RequestRefused(Exception):  # noqa: N818 - what the device says
+class RequestRefused(PlugNProduceError):  # noqa: N818 - what the device says
     """The device does not take the request now (``BadInvalidState``) or its arguments (``BadInvalidArgument``)."""
 
     def __init__(self, message: str, bad_arguments: bool = False) -> None:
