@@ -16,6 +16,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import sys
+from collections.abc import Callable, Mapping
 from types import ModuleType
 
 _STAND_INS: dict[str, ModuleType] = {}
@@ -44,3 +45,25 @@ def lazy_module(name: str) -> ModuleType:
         raise ModuleNotFoundError(f"no module named {name!r}", name=name)
     stand_in = _STAND_INS[name] = _LazyModule(name)
     return stand_in
+
+
+def lazy_names(package: str, where: Mapping[str, str]) -> tuple[Callable[[str], object], Callable[[], list[str]]]:
+    """A package's ``__getattr__`` and ``__dir__`` (:pep:`562`) for names imported from their modules on first use.
+
+    ``where`` maps each name to the module that defines it (relative to ``package`` when it starts with a dot),
+    followed by ``:NAME`` when it has another name there. A name, once imported, is kept in the package.
+    """
+    namespace = sys.modules[package].__dict__
+
+    def get(name: str) -> object:
+        if name not in where:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        module, _, original = where[name].partition(":")
+        value = getattr(importlib.import_module(module, package), original or name)
+        namespace[name] = value
+        return value
+
+    def names() -> list[str]:
+        return sorted({*namespace, *where})
+
+    return get, names

@@ -9,8 +9,9 @@ part of it.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from plugnproduce.lazy import lazy_names
 
 if TYPE_CHECKING:
     from plugnproduce.batch.batches import CSV_HEADER as BATCH_CSV_HEADER
@@ -32,41 +33,29 @@ if TYPE_CHECKING:
     from plugnproduce.batch.clusterpeer import ClusterAccess, ClusterError
     from plugnproduce.batch.purchases import Purchase
 
-_WHERE: dict[str, tuple[str, str]] = {
-    "batch": ("batches", "batch"),
-    "BATCH_CSV_HEADER": ("batches", "CSV_HEADER"),
-    "BatchRow": ("batches", "BatchRow"),
-    "bounded_lines": ("batches", "bounded_lines"),
-    "check_cluster_address": ("cluster", "check_address"),
-    "cluster_mapper": ("cluster", "cluster_mapper"),
-    "ClusterAccess": ("clusterpeer", "ClusterAccess"),
-    "ClusterError": ("clusterpeer", "ClusterError"),
-    "Configuration": ("batches", "Configuration"),
-    "configurations_from": ("batches", "configurations_from"),
-    "Engine": ("batches", "Engine"),
-    "engine": ("batches", "engine"),
-    "generate": ("batches", "generate"),
-    "Purchase": ("purchases", "Purchase"),
-    "read_configurations": ("batches", "read_configurations"),
-    "report": ("batches", "report"),
-    "report_from": ("batches", "report_from"),
+_WHERE: dict[str, str] = {
+    "batch": ".batches",
+    "BATCH_CSV_HEADER": ".batches:CSV_HEADER",
+    "BatchRow": ".batches",
+    "bounded_lines": ".batches",
+    "check_cluster_address": ".cluster:check_address",
+    "cluster_mapper": ".cluster",
+    "ClusterAccess": ".clusterpeer",
+    "ClusterError": ".clusterpeer",
+    "Configuration": ".batches",
+    "configurations_from": ".batches",
+    "Engine": ".batches",
+    "engine": ".batches",
+    "generate": ".batches",
+    "Purchase": ".purchases",
+    "read_configurations": ".batches",
+    "report": ".batches",
+    "report_from": ".batches",
 }
 """Each name this package offers: the module it is defined in (below this package) and its name there."""
 
 
-def __getattr__(name: str) -> object:
-    """Import the module that defines ``name`` on its first use (:pep:`562`), so that importing the package loads
-    neither clingo nor owlready2 nor any of its parts."""
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module, attr = _WHERE[name]
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), attr)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *_WHERE})
+__getattr__, __dir__ = lazy_names(__name__, _WHERE)  # loads neither clingo nor owlready2 nor any part until used
 
 
 __all__ = [

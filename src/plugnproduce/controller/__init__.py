@@ -14,8 +14,9 @@ protocols, executor, sim).
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from plugnproduce.lazy import lazy_names
 
 if TYPE_CHECKING:
     from plugnproduce.controller.interfaces import (
@@ -84,13 +85,7 @@ _WHERE = {
 controller (``pnp sim plug`` needs :mod:`.devices` alone) loads no network stack."""
 
 
-def __getattr__(name: str) -> object:
-    """A name of :data:`_WHERE`, imported from its module on first use."""
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(_WHERE[name]), name)
-    globals()[name] = value
-    return value
+__getattr__, __dir__ = lazy_names(__name__, _WHERE)
 
 
 __all__ = [

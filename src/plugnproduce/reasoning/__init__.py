@@ -17,8 +17,9 @@ The batch over many cells (:mod:`plugnproduce.batch`) uses this layer and is not
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
+
+from plugnproduce.lazy import lazy_names
 
 if TYPE_CHECKING:
     from plugnproduce.reasoning.asp.derivation import Node
@@ -46,52 +47,40 @@ if TYPE_CHECKING:
     from plugnproduce.reasoning.repairs.sideeffects import AssessedRepair, SideEffect, assess
     from plugnproduce.reasoning.repairs.windows import repair
 
-_WHERE: dict[str, tuple[str, str]] = {
-    "assess": ("repairs.sideeffects", "assess"),
-    "AssessedRepair": ("repairs.sideeffects", "AssessedRepair"),
-    "Capabilities": ("asp.results", "Capabilities"),
-    "capabilities": ("checks.offers", "capabilities"),
-    "check": ("checks.plausibility", "check"),
-    "CheckResult": ("asp.results", "CheckResult"),
-    "Counterfactual": ("explanation.counterfactuals", "Counterfactual"),
-    "counterfactuals_from_repairs": ("explanation.counterfactuals", "from_repairs"),
-    "Edit": ("asp.results", "Edit"),
-    "explain_offered": ("explanation.why", "explain_offered"),
-    "explain_plausible": ("explanation.why", "explain_plausible"),
-    "explain_process": ("checks.offers", "explain_process"),
-    "explain_step": ("checks.plausibility", "explain_step"),
-    "Explanation": ("explanation.why", "Explanation"),
-    "Node": ("asp.derivation", "Node"),
-    "normalised": ("checks.contracts", "normalised"),
-    "NotOffered": ("asp.results", "NotOffered"),
-    "Offer": ("asp.results", "Offer"),
-    "ontology_of": ("explanation.axioms", "ontology_of"),
-    "Problem": ("asp.results", "Problem"),
-    "ProcessExplanation": ("asp.results", "ProcessExplanation"),
-    "Reason": ("asp.results", "Reason"),
-    "Repair": ("asp.results", "Repair"),
-    "repair": ("repairs.windows", "repair"),
-    "RepairCosts": ("asp.results", "RepairCosts"),
-    "SideEffect": ("repairs.sideeffects", "SideEffect"),
-    "StepCheck": ("asp.results", "StepCheck"),
-    "StepExplanation": ("asp.results", "StepExplanation"),
+_WHERE: dict[str, str] = {
+    "assess": ".repairs.sideeffects",
+    "AssessedRepair": ".repairs.sideeffects",
+    "Capabilities": ".asp.results",
+    "capabilities": ".checks.offers",
+    "check": ".checks.plausibility",
+    "CheckResult": ".asp.results",
+    "Counterfactual": ".explanation.counterfactuals",
+    "counterfactuals_from_repairs": ".explanation.counterfactuals:from_repairs",
+    "Edit": ".asp.results",
+    "explain_offered": ".explanation.why",
+    "explain_plausible": ".explanation.why",
+    "explain_process": ".checks.offers",
+    "explain_step": ".checks.plausibility",
+    "Explanation": ".explanation.why",
+    "Node": ".asp.derivation",
+    "normalised": ".checks.contracts",
+    "NotOffered": ".asp.results",
+    "Offer": ".asp.results",
+    "ontology_of": ".explanation.axioms",
+    "Problem": ".asp.results",
+    "ProcessExplanation": ".asp.results",
+    "Reason": ".asp.results",
+    "Repair": ".asp.results",
+    "repair": ".repairs.windows",
+    "RepairCosts": ".asp.results",
+    "SideEffect": ".repairs.sideeffects",
+    "StepCheck": ".asp.results",
+    "StepExplanation": ".asp.results",
 }
 """Each name this package offers: the module it is defined in (below this package) and its name there."""
 
 
-def __getattr__(name: str) -> object:
-    """Import the module that defines ``name`` on its first use (:pep:`562`), so that importing the package loads
-    neither clingo nor owlready2 nor any of its parts."""
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module, attr = _WHERE[name]
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), attr)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *_WHERE})
+__getattr__, __dir__ = lazy_names(__name__, _WHERE)  # loads neither clingo nor owlready2 nor any part until used
 
 
 __all__ = [

@@ -26,7 +26,6 @@ the heavy ones imported on first use (:data:`_ELSEWHERE`), so that ``pnp --help`
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.flow import Loop
@@ -43,7 +42,7 @@ from plugnproduce.description.model import (
 )
 from plugnproduce.executor.journal import describe
 from plugnproduce.knowledge import Knowledge, Library
-from plugnproduce.lazy import lazy_module
+from plugnproduce.lazy import lazy_module, lazy_names
 from plugnproduce.service.batches import (
     batch,
     batch_cycle_times,
@@ -150,14 +149,7 @@ _ELSEWHERE = {
 the service names it otherwise)."""
 
 
-def __getattr__(name: str) -> object:
-    """A name of :data:`_ELSEWHERE`, imported from its module on first use."""
-    if name not in _ELSEWHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module, _, original = _ELSEWHERE[name].partition(":")
-    value = getattr(importlib.import_module(module), original or name)
-    globals()[name] = value
-    return value
+__getattr__, __dir__ = lazy_names(__name__, _ELSEWHERE)
 
 __all__ = [
     "BATCH_CSV_HEADER",

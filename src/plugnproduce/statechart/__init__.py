@@ -8,9 +8,9 @@
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
 
+from plugnproduce.lazy import lazy_names
 from plugnproduce.statechart.model import (
     CONCEPT,
     PNP_NS,
@@ -30,22 +30,12 @@ if TYPE_CHECKING:
     from plugnproduce.statechart.io.schema import schema_problems
     from plugnproduce.statechart.io.writer import write_chart
 
-_WHERE = {"parse_chart": "io.reader", "read_chart": "io.reader", "schema_problems": "io.schema",
-          "write_chart": "io.writer"}
+_WHERE = {"parse_chart": ".io.reader", "read_chart": ".io.reader", "schema_problems": ".io.schema",
+          "write_chart": ".io.writer"}
 """The SCXML reader, writer and schema, imported on first use (:pep:`562`): the model alone (what a description
 or a pickled engine holds) needs neither the XML parser nor the description files' safe readers."""
 
-
-def __getattr__(name: str) -> object:
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *_WHERE})
+__getattr__, __dir__ = lazy_names(__name__, _WHERE)
 
 
 __all__ = [

@@ -14,9 +14,9 @@ See ``docs/opcua.md``.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from plugnproduce.lazy import lazy_names
 from plugnproduce.protocols.opcua.spec import (
     EVENT_PREFIX,
     MAX_ARRAY,
@@ -38,15 +38,11 @@ if TYPE_CHECKING:
     from plugnproduce.protocols.opcua.client import OpcUaDeviceClient
     from plugnproduce.protocols.opcua.server import OpcUaDeviceServer, RequestHandler, RequestRefused
 
-_LAZY = {"OpcUaDeviceClient": "client", "OpcUaDeviceServer": "server", "RequestHandler": "server",
-         "RequestRefused": "server"}
+_LAZY = {"OpcUaDeviceClient": ".client", "OpcUaDeviceServer": ".server", "RequestHandler": ".server",
+         "RequestRefused": ".server"}
+"""The client and server classes, imported (with asyncua) when first asked for."""
 
-
-def __getattr__(name: str) -> Any:
-    """The client and server classes, imported (with asyncua) when first asked for."""
-    if name in _LAZY:
-        return getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__, __dir__ = lazy_names(__name__, _LAZY)
 
 __all__ = [
     "EVENT_PREFIX",
