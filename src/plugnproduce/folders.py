@@ -28,3 +28,19 @@ def runs_folder() -> Path:
     """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``runs`` in the user's state folder."""
     given = os.environ.get(RUNS_VARIABLE)
     return Path(given) if given else Path(platformdirs.user_state_dir(APP)) / "runs"
+
+
+def keep_newest(path: Path, data: bytes, keep: int) -> None:
+    """Write ``data`` to ``path`` whole and at once (a concurrent reader sees no half file), then keep only the
+    newest ``keep`` files of its kind beside it: those named like it up to its first ``-``, with its suffix."""
+    import tempfile
+
+    kind = path.name.split("-", 1)[0]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{kind}-", dir=path.parent)
+    with os.fdopen(fd, "wb") as f:
+        f.write(data)
+    os.replace(tmp, path)
+    old = sorted(path.parent.glob(f"{kind}-*{path.suffix}"), key=lambda p: p.stat().st_mtime, reverse=True)[keep:]
+    for p in old:
+        p.unlink(missing_ok=True)

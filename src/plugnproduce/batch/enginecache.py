@@ -13,10 +13,8 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import os
 import pickle
 import sys
-import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
@@ -63,18 +61,8 @@ def cached(key: str | None, build: Callable[[], object], folder: Path | None = N
                              ValueError, IndexError):
         return pickle.loads(path.read_bytes())  # noqa: S301 - the user's own cache folder, named by content
     value = build()
-    _keep(path, pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL))
+    with contextlib.suppress(OSError):  # a cache that cannot be written only costs time
+        folders.keep_newest(path, pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL), KEEP)
     return value
 
 
-def _keep(path: Path, data: bytes) -> None:
-    """Write whole and at once (a concurrent reader sees no half file); keep only the newest :data:`KEEP`."""
-    with contextlib.suppress(OSError):  # a cache that cannot be written only costs time
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=".batch-", dir=path.parent)
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-        old = sorted(path.parent.glob("batch-*.pickle"), key=lambda p: p.stat().st_mtime, reverse=True)[KEEP:]
-        for p in old:
-            p.unlink(missing_ok=True)

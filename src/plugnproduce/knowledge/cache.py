@@ -18,7 +18,6 @@ import hashlib
 import os
 import pickle
 import sys
-import tempfile
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
@@ -95,20 +94,9 @@ def cached_knowledge(libraries: Sequence[Library], load: Callable[[], Knowledge]
             return kept
     knowledge = load()
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
-        _keep(path, pickle.dumps((knowledge, _outside(knowledge)), protocol=pickle.HIGHEST_PROTOCOL))
+        data = pickle.dumps((knowledge, _outside(knowledge)), protocol=pickle.HIGHEST_PROTOCOL)
+        folders.keep_newest(path, data, KEEP)
     return knowledge
-
-
-def _keep(path: Path, data: bytes) -> None:
-    """Write whole and at once (a concurrent reader sees no half file); keep only the newest :data:`KEEP`."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".knowledge-", dir=path.parent)
-    with os.fdopen(fd, "wb") as f:
-        f.write(data)
-    os.replace(tmp, path)
-    old = sorted(path.parent.glob("knowledge-*.pickle"), key=lambda p: p.stat().st_mtime, reverse=True)[KEEP:]
-    for p in old:
-        p.unlink(missing_ok=True)
 
 
 def kept_files(folder: Path | None = None) -> Iterable[Path]:

@@ -140,13 +140,7 @@ def grow(rules: Sequence[str], facts: str, horizons: Iterable[int],
     """
     ctl, messages = _control(["--warn=none", *arguments])
     _ground(ctl, messages, rules, facts)
-    before = None
-    for t in horizons:
-        ctl.ground([("step", [clingo.Number(t)]), ("check", [clingo.Number(t)])])
-        if before is not None:
-            ctl.release_external(before)
-        before = clingo.Function("query", [clingo.Number(t)])
-        ctl.assign_external(before, True)
+    for t in _grown(ctl, horizons):
         yield t, _optimum(ctl)
 
 
@@ -156,6 +150,12 @@ def grow_optima(rules: Sequence[str], facts: str, horizons: Iterable[int], most:
     clingo finds them: the plans a further criterion (their cycle time) chooses among."""
     ctl, messages = _control(["--warn=none", "--opt-mode=optN", f"--models={most}", *arguments])
     _ground(ctl, messages, rules, facts)
+    for t in _grown(ctl, horizons):
+        yield t, _optima(ctl)
+
+
+def _grown(ctl: clingo.Control, horizons: Iterable[int]) -> Iterator[int]:
+    """Each horizon in turn, its parts ``step(t)`` and ``check(t)`` grounded and only its ``query(t)`` true."""
     before = None
     for t in horizons:
         ctl.ground([("step", [clingo.Number(t)]), ("check", [clingo.Number(t)])])
@@ -163,7 +163,7 @@ def grow_optima(rules: Sequence[str], facts: str, horizons: Iterable[int], most:
             ctl.release_external(before)
         before = clingo.Function("query", [clingo.Number(t)])
         ctl.assign_external(before, True)
-        yield t, _optima(ctl)
+        yield t
 
 
 def _optima(ctl: clingo.Control) -> list[Model]:
