@@ -216,6 +216,10 @@ EXPECTED = {
     ("gentle-tending", "tending-without-gripper"): (False, None, {"absent", "no_device"}),
     ("tending-door-shut", "tending-without-gripper"): (False, None, {"wrong_state", "no_device"}),
     ("screw-twice", "packml-screwing"): (True, "proved", set()),  # a hierarchical (PackML-style) device chart
+    ("approach-while-opening", "timed-cell"): (True, "proved", set()),  # declared durations, a motion model
+    ("approach-while-opening", "two-robots"): (False, None, {"ambiguous"}),  # two robots fit: bind one
+    ("pick-place-timed", "timed-cell"): (True, "proved", set()),
+    ("pick-place-timed", "two-robots"): (False, None, {"ambiguous"}),
 }
 """What the check and verification answer for every pair: a change in either is a failing row, never a skip."""
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import click
 import typer
 
 from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
@@ -62,8 +61,8 @@ def resume(
         if yes:
             return "--yes"
         try:
-            return "the operator" if click.confirm("continue?", default=False, err=True) else None
-        except click.Abort:  # no answer (end of input)
+            return "the operator" if typer.confirm("continue?", default=False, err=True) else None
+        except typer.Abort:  # no answer (end of input)
             return None
 
     def show(record: dict[str, object]) -> None:
