@@ -24,7 +24,7 @@ ratio of each; the load average is printed at the start and the end.
 
 Each figure is the best of ``--repeat`` measurements, with the garbage collector as the
 program leaves it: the benchmark does not touch it (the runtime keeps the collector off
-large charts itself, see ``plugnproduce.statechart.runtime.gcpause``). Target: at least 10x
+large charts itself, see ``plugnproduce.statechart.gcpause``). Target: at least 10x
 python-statemachine on every chart.
 """
 

@@ -11,8 +11,8 @@ import pytest
 
 from plugnproduce.description.model import Cell
 from plugnproduce.description.paths import NoPath
-from plugnproduce.description.unitcache import Incompatible
-from plugnproduce.description.units import UnitError, convert
+from plugnproduce.description.quantities.unitcache import Incompatible
+from plugnproduce.description.quantities.units import UnitError, convert
 from plugnproduce.errors import PlugNProduceError, UnknownName, bug_message
 from plugnproduce.sim.bin import BinError
 

@@ -10,7 +10,7 @@ import pytest
 
 from plugnproduce import folders, helpcache, service
 from plugnproduce.batch import enginecache
-from plugnproduce.description import unitcache
+from plugnproduce.description.quantities import unitcache
 from plugnproduce.sim import control
 
 

@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from plugnproduce import __version__
 from plugnproduce.cli import app
-from plugnproduce.cli.helptext import argument_name
+from plugnproduce.cli.console.helptext import argument_name
 from plugnproduce.executor.journal import Journal
 
 runner = CliRunner()

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from plugnproduce import service
-from plugnproduce.cli.pipes import QuietPipe
+from plugnproduce.cli.console.pipes import QuietPipe
 from tests.lines import WAIT
 from tests.processes import stop
 

@@ -13,7 +13,7 @@ from pathlib import Path
 from rich.console import Console
 
 from plugnproduce import service
-from plugnproduce.cli.progress import Phases
+from plugnproduce.cli.console.progress import Phases
 from tests.lines import WAIT
 from tests.processes import stop
 

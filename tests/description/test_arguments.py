@@ -8,7 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 from plugnproduce.cli import app
-from plugnproduce.description.units import Amount, UnitError, convert, read_amount, unit_known
+from plugnproduce.description.quantities.units import Amount, UnitError, convert, read_amount, unit_known
 from tests.conftest import edit
 
 

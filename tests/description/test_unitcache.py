@@ -9,7 +9,7 @@ from pathlib import Path
 import pint
 import pytest
 
-from plugnproduce.description.unitcache import UnitTable, table_file
+from plugnproduce.description.quantities.unitcache import UnitTable, table_file
 
 PAIRS = [("kN", "N"), ("N", "kN"), ("mm/s", "m/s"), ("km/h", "m/s"), ("deg", "rad"), ("percent", "dimensionless"),
          ("N m", "N mm"), ("kPa", "bar"), ("ms", "s"), ("m deg", "mm rad"), ("lbf", "N"), ("inch", "mm")]

@@ -7,8 +7,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from plugnproduce.statechart import SCXML_NS, parse_chart
-from plugnproduce.statechart.runtime import gcpause
+from plugnproduce.statechart import SCXML_NS, gcpause, parse_chart
 from plugnproduce.statechart.runtime.interpreter import Interpreter
 
 CHART = (f'<scxml xmlns="{SCXML_NS}" version="1.0" datamodel="python" initial="a">'

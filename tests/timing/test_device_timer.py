@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from plugnproduce import service
-from plugnproduce.description.durations import RequestDuration, RequestTimer
 from plugnproduce.description.model import DeviceDescription
+from plugnproduce.description.quantities.durations import RequestDuration, RequestTimer
 from plugnproduce.sim.device import SimulatedDevice
 from plugnproduce.timing import DeviceTimer, chart_delays
 

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, NoReturn, TypeVar
 
 import typer
 
-from plugnproduce.cli.helptext import PlainTyper
+from plugnproduce.cli.console.helptext import PlainTyper
 from plugnproduce.errors import DescriptionError, PlugNProduceError, bug_message
 
 if TYPE_CHECKING:  # the knowledge is loaded by the commands that need it
@@ -164,7 +164,7 @@ def emit_json(data: object) -> None:
 
 def main() -> None:
     """Entry point of the ``pnp`` console script."""
-    from plugnproduce.cli.pipes import tolerate_closed_stdout
+    from plugnproduce.cli.console.pipes import tolerate_closed_stdout
 
     tolerate_closed_stdout()
     app()

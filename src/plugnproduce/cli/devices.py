@@ -20,7 +20,7 @@ from plugnproduce.cli.app import (
     interface_address,
     knowledge,
 )
-from plugnproduce.cli.helptext import PlainTyper
+from plugnproduce.cli.console.helptext import PlainTyper
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
 from plugnproduce.lazy import lazy_module
 

@@ -29,7 +29,7 @@ from plugnproduce.cli.app import (
     interface_address,
     knowledge,
 )
-from plugnproduce.cli.progress import on_a_terminal
+from plugnproduce.cli.console.progress import on_a_terminal
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:

@@ -18,8 +18,8 @@ from plugnproduce.cli.app import (
     interface_address,
     knowledge,
 )
+from plugnproduce.cli.console.progress import Phases, on_a_terminal
 from plugnproduce.cli.generate import refuse
-from plugnproduce.cli.progress import Phases, on_a_terminal
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:

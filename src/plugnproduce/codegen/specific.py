@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from plugnproduce.chartnames import STEP, VALUES
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.description.paths import find_path
-from plugnproduce.description.units import convert
+from plugnproduce.description.quantities.units import convert
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp

@@ -15,7 +15,7 @@ from rdflib.namespace import RDF, RDFS, XSD
 
 from plugnproduce.description.loader import Loaded
 from plugnproduce.description.model import ChartState, DeviceDescription, ProcessDescription, Task, Where
-from plugnproduce.description.units import number_in
+from plugnproduce.description.quantities.units import number_in
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP
 

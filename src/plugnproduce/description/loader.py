@@ -17,7 +17,6 @@ import yaml
 from rdflib.namespace import RDF, RDFS, XSD
 
 from plugnproduce.description.charts import device_chart
-from plugnproduce.description.durations import RequestDuration
 from plugnproduce.description.model import (
     Argument,
     Cell,
@@ -27,7 +26,9 @@ from plugnproduce.description.model import (
 )
 from plugnproduce.description.processfile import load_process as load_process
 from plugnproduce.description.processfile import process_from as process_from
-from plugnproduce.description.ranges import output_ranges
+from plugnproduce.description.quantities.durations import RequestDuration
+from plugnproduce.description.quantities.ranges import output_ranges
+from plugnproduce.description.quantities.units import unit_known
 from plugnproduce.description.rdf import Loaded as Loaded
 from plugnproduce.description.rdf import file_of as file_of
 from plugnproduce.description.rdf import (
@@ -43,7 +44,6 @@ from plugnproduce.description.taskfile import _mapping, _plain, _unknown_keys
 from plugnproduce.description.taskfile import load_task as load_task
 from plugnproduce.description.taskfile import parse_task as parse_task
 from plugnproduce.description.taskfile import task_to_yaml as task_to_yaml
-from plugnproduce.description.units import unit_known
 from plugnproduce.errors import DescriptionError, excerpt
 from plugnproduce.ontology.names import turtle_spelling, unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy

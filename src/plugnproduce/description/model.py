@@ -25,7 +25,7 @@ from plugnproduce.errors import UnknownName
 from plugnproduce.statechart.model import Chart
 
 if TYPE_CHECKING:
-    from plugnproduce.description.durations import RequestDuration
+    from plugnproduce.description.quantities.durations import RequestDuration
 
 Protocol = Literal["xirp", "upnp", "opcua"]
 PROTOCOLS: tuple[Protocol, ...] = ("xirp", "upnp", "opcua")

@@ -3,7 +3,7 @@
 The plausibility check proves what it can before a run; the values it cannot know (an earlier
 step's output, a value a device reports) are known only now. Immediately before a request is
 sent, each argument its device's transition accepts is judged by the one definition of "within
-contract" (:func:`plugnproduce.description.contracts.breach`): datatype, size, unit, minimum,
+contract" (:func:`plugnproduce.description.quantities.contracts.breach`): datatype, size, unit, minimum,
 maximum and reach; a required argument must be there. A number given in another unit than the
 contract's (an output in ``mm``, a value that changes between loop iterations) goes out converted.
 
@@ -20,9 +20,9 @@ from typing import Any
 
 from plugnproduce.chartnames import output_variable
 from plugnproduce.codegen.task import GeneratedTask, StepChart
-from plugnproduce.description.contracts import breach, shorten
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Link
-from plugnproduce.description.units import UnitError, convert
+from plugnproduce.description.quantities.contracts import breach, shorten
+from plugnproduce.description.quantities.units import UnitError, convert
 from plugnproduce.ontology.vocabulary import local_name
 
 

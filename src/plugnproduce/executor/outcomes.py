@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from plugnproduce.description.contracts import shorten
+from plugnproduce.description.quantities.contracts import shorten
 from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
 
 MAX_NAME = 2048

@@ -3,7 +3,7 @@
 The controller reads the value from the device (:func:`plugnproduce.controller.teach`); this module says which
 values a device reports (its chart's ``<data pnp:quantity=...>``, :mod:`plugnproduce.description.reports`) and
 judges one against every contract of the device's requests that take that quantity
-(:func:`plugnproduce.description.contracts.breach`).
+(:func:`plugnproduce.description.quantities.contracts.breach`).
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from plugnproduce.description.contracts import breach, shorten
 from plugnproduce.description.model import Argument, DeviceDescription
+from plugnproduce.description.quantities.contracts import breach, shorten
 from plugnproduce.description.reports import ReportedValue, reported_values
 from plugnproduce.errors import PlugNProduceError, UnknownName
 from plugnproduce.ontology.vocabulary import local_name

@@ -2,7 +2,7 @@
 
 The chart's delays are the ``<send delay="...">`` elements that a state's ``onentry`` (or a transition
 into it) schedules: a transition triggered by such an event takes that delay. A declared duration
-(:mod:`plugnproduce.description.durations`) replaces the first delay that follows the request. The
+(:mod:`plugnproduce.description.quantities.durations`) replaces the first delay that follows the request. The
 simulator and the estimate both time a device with a :class:`DeviceTimer`, so they agree by construction.
 """
 
@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-from plugnproduce.description.durations import RequestTimer
 from plugnproduce.description.model import ChartTransition, DeviceDescription
+from plugnproduce.description.quantities.durations import RequestTimer
 from plugnproduce.statechart.model import OnEntry, Parallel, Send, State, Transition, iter_states
 from plugnproduce.statechart.runtime.actions import parse_delay
 from plugnproduce.statechart.runtime.evaluator import EvaluationError

@@ -14,8 +14,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from plugnproduce.description.contracts import breach
 from plugnproduce.description.model import ChartTransition, DeviceDescription
+from plugnproduce.description.quantities.contracts import breach
 from plugnproduce.ontology.vocabulary import local_name
 
 

@@ -16,9 +16,9 @@ from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from typing import TYPE_CHECKING
 
-from plugnproduce.description.contracts import KINDS
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
 from plugnproduce.description.paths import NoPath, find_path, in_concept
+from plugnproduce.description.quantities.contracts import KINDS
 from plugnproduce.errors import UnknownName
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s

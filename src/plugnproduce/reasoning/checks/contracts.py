@@ -18,7 +18,6 @@ import math
 from collections.abc import Iterator, Sequence
 from typing import TYPE_CHECKING
 
-from plugnproduce.description.contracts import breach
 from plugnproduce.description.model import (
     Argument,
     Cell,
@@ -28,7 +27,8 @@ from plugnproduce.description.model import (
     Task,
     Where,
 )
-from plugnproduce.description.units import Amount, UnitError, convert, read_amount
+from plugnproduce.description.quantities.contracts import breach
+from plugnproduce.description.quantities.units import Amount, UnitError, convert, read_amount
 from plugnproduce.errors import QuantityError, excerpt
 from plugnproduce.reasoning.asp.facts import DATATYPES
 from plugnproduce.reasoning.asp.results import Problem, Reason, StepCheck
@@ -176,5 +176,6 @@ def _beyond_own_range(value: object, par: Parameter) -> bool:
 
 def _beyond(value: object, par: Parameter, contract: Argument) -> str | None:
     """Why ``value`` (in the parameter's unit) breaks the device's contract, or None if it keeps it
-    (the one definition, :func:`plugnproduce.description.contracts.breach`; the type check tells of a wrong type)."""
+    (the one definition, :func:`plugnproduce.description.quantities.contracts.breach`; the type check tells of a
+    wrong type)."""
     return breach(value, par.unit, contract, types=False)

@@ -2,7 +2,7 @@
 
 A value a device reports is known only at run time, where the executor's monitor holds it to the
 contract of the device it goes to. Where the producing device declares the range of the output
-(:mod:`plugnproduce.description.ranges`), the check proves more: a pose reported within 1.2 m of the
+(:mod:`plugnproduce.description.quantities.ranges`), the check proves more: a pose reported within 1.2 m of the
 base, lifted by an offset of 0.2 m, stays within a robot's reach of 1.45 m. Each link is said to be
 either proven safe or checked at run time, with the reason.
 """
@@ -14,8 +14,8 @@ from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Argument, Cell, Link, ProcessDescription, Step, Task
-from plugnproduce.description.ranges import OutputRange, output_ranges
-from plugnproduce.description.units import UnitError, convert
+from plugnproduce.description.quantities.ranges import OutputRange, output_ranges
+from plugnproduce.description.quantities.units import UnitError, convert
 from plugnproduce.reasoning.asp.results import CheckResult, LinkSafety
 from plugnproduce.reasoning.checks.contracts import contracts_for
 

@@ -57,10 +57,10 @@ from typing import Any
 
 from plugnproduce.errors import ExecutionError
 from plugnproduce.safeio import read_bytes
+from plugnproduce.statechart import gcpause
 from plugnproduce.statechart.io.checks import check_structure
 from plugnproduce.statechart.io.reader import parse_chart
 from plugnproduce.statechart.model import Chart
-from plugnproduce.statechart.runtime import gcpause
 from plugnproduce.statechart.runtime.clock import Clock, MonotonicClock
 from plugnproduce.statechart.runtime.compiled import CompiledChart, CState, CTransition
 from plugnproduce.statechart.runtime.datamodel import Datamodel

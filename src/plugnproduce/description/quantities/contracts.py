@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from plugnproduce.description.model import Argument
-from plugnproduce.description.units import UnitError, convert
+from plugnproduce.description.quantities.units import UnitError, convert
 from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
 
 XSD = "http://www.w3.org/2001/XMLSchema#"

@@ -11,7 +11,7 @@ import typer
 from typer import _click as click  # typer vendors its own click: its commands take these types
 from typer.core import TyperCommand, TyperGroup
 
-from plugnproduce.cli.coercion import plain_values
+from plugnproduce.cli.console.coercion import plain_values
 
 
 def is_argument(param: click.Parameter) -> bool:
@@ -30,7 +30,7 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 class PlainCommand(TyperCommand):
     """A command whose usage line and help name its arguments plainly, and whose texts and paths are taken
-    without pydantic (:mod:`plugnproduce.cli.coercion`)."""
+    without pydantic (:mod:`plugnproduce.cli.console.coercion`)."""
 
     def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
         """As typer parses them, texts and paths turned plainly."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from functools import cache
 from typing import TYPE_CHECKING
 
-from plugnproduce.description.unitcache import Incompatible, UnitTable, table_file
+from plugnproduce.description.quantities.unitcache import Incompatible, UnitTable, table_file
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.lazy import lazy_module
 

@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 
 from plugnproduce.description.model import Command, DeviceDescription, Where
-from plugnproduce.description.units import unit_known
+from plugnproduce.description.quantities.units import unit_known
 from plugnproduce.errors import DescriptionError
 from plugnproduce.statechart.model import PNP_NS, Param, Send, walk
 
