@@ -1,8 +1,9 @@
 """The estimate against a simulated run: the simulator takes the same durations, scaled by ``--speed``.
 
 The run's time is what its journal records from the first step to the end, times the speed factor
-(simulated seconds). It also holds the controller's own latency per command (journal writes, messages on
-loopback), which the estimate leaves out; the factors are chosen so that the devices' time dominates.
+(simulated seconds). It also holds the controller's own latency per command (its step, messages on
+loopback, a timer's millisecond), which the estimate leaves out: 1 to 4 % of the built-in bin-picking task
+at speed 1 (``bench/bench_cycle_time.py``). At speed 0.5 it counts half, a margin for a loaded machine.
 """
 
 from __future__ import annotations
@@ -40,10 +41,11 @@ def simulated(task: Path, cell: Path, speed: float, journal: Path) -> float:
     return float((end["t"] - first) * speed)
 
 
-def test_the_builtin_cell_runs_within_ten_percent_of_its_estimate(tmp_path: Path) -> None:
-    task, cell = BUILTIN / "tasks" / "pick-and-place.yaml", BUILTIN / "cells" / "bin-picking.yaml"
+def test_the_builtin_bin_picking_task_runs_within_ten_percent_of_its_estimate(tmp_path: Path) -> None:
+    """Issue 27: 30 commands over XIRP and UPnP; each command's record is fsynced while it goes out."""
+    task, cell = BUILTIN / "tasks" / "bin-picking.yaml", BUILTIN / "cells" / "bin-picking.yaml"
     estimate = estimated(task, cell)
-    run = simulated(task, cell, 0.25, tmp_path / "run.jsonl")  # four times slower than the charts say
+    run = simulated(task, cell, 0.5, tmp_path / "run.jsonl")  # half as fast as the charts say
     assert abs(run - estimate) <= 0.10 * estimate, (estimate, run)
 
 
