@@ -56,6 +56,9 @@ def test_describe_reads_like_a_log() -> None:
         "→ gripper: xirp.request.Close"
     )
     assert describe({"kind": "end", "outcome": "failed", "reason": "timeout"}) == "end: failed (timeout)"
+    assert describe({"kind": "start", "task": "t", "cell": "c", "speed": 0.25}) == (
+        "start task t on cell c (simulated devices, speed 0.25)")
+    assert describe({"kind": "start", "task": "t", "cell": "c"}) == "start task t on cell c"  # real devices
 
 
 def test_what_the_run_observed_is_flushed_at_once_and_fsynced_before_the_next_command(

@@ -1,21 +1,21 @@
 """The run journal: an append-only, fsynced JSON-lines file per run.
 
-Every run writes one record per line: ``start`` (task, cell, chart digest, number of
-steps), then ``command`` (sent to a device), ``event`` (from a device or the chart), ``state``
-(a device region entered a state), ``step`` (a step began, with its role bindings), ``fault``, after a fault
-one ``stop`` per device (the safe-stop request sent, its answer, the state the device reports) and finally
-``end`` (outcome). A run that resumes a stopped one (``pnp resume``) writes, right after its ``start``,
-``stopped`` (the run it resumes and how that one stopped), ``replan`` (the states the devices reported and the
-rest planned from them) and ``continue`` (who confirmed it). A line is flushed to the operating system
-before the run goes on, so after a crash of the controller the journal holds everything up to the crash,
-and a run without ``end`` is told apart from a finished one. It is made durable on disk (fsynced) with
-``start``, ``fault``, ``stop`` and ``end`` before the run goes on, and with each ``command`` while the command
-goes out: its fsync runs in a thread, and the next command, fault, stop or end waits until it is done (a failed
-fsync fails that next write). What the run observed in between (``step``, ``state``, ``event``, ``value``,
-``branch``) is fsynced with the next of these. One fsync per record held up the event loop for milliseconds
-each, several times per command, while the devices' events waited; one fsync before each command added as
-much to every command's time (2 to 13 ms measured on a busy disk, more on an SD card). So a power failure of
-the controller may lose the record of the one command in flight; a crash of the controller loses nothing.
+Every run writes one record per line: ``start`` (task, cell, chart digest, number of steps; with simulated devices,
+their ``speed`` factor), then ``command`` (sent to a device), ``event`` (from a device or the chart), ``state`` (a
+device region entered a state), ``step`` (a step began, with its role bindings), ``fault``, after a fault one
+``stop`` per device (the safe-stop request sent, its answer, the state the device reports) and finally ``end``
+(outcome). A run that resumes a stopped one (``pnp resume``) writes, right after its ``start``, ``stopped`` (the run
+it resumes and how that one stopped), ``replan`` (the states the devices reported and the rest planned from them)
+and ``continue`` (who confirmed it). A line is flushed to the operating system before the run goes on, so after a
+crash of the controller the journal holds everything up to the crash, and a run without ``end`` is told apart from a
+finished one. It is made durable on disk (fsynced) with ``start``, ``fault``, ``stop`` and ``end`` before the run
+goes on, and with each ``command`` while the command goes out: its fsync runs in a thread, and the next command,
+fault, stop or end waits until it is done (a failed fsync fails that next write). What the run observed in between
+(``step``, ``state``, ``event``, ``value``, ``branch``) is fsynced with the next of these. One fsync per record held
+up the event loop for milliseconds each, several times per command, while the devices' events waited; one fsync
+before each command added as much to every command's time (2 to 13 ms measured on a busy disk, more on an SD card).
+So a power failure of the controller may lose the record of the one command in flight; a crash of the controller
+loses nothing.
 Nothing is ever rewritten.
 """
 
@@ -210,7 +210,9 @@ def describe(record: dict[str, Any]) -> str:
     """One human line for a journal record."""
     kind = record["kind"]
     if kind == "start":
-        return f"start task {record.get('task')} on cell {record.get('cell')}"
+        speed = f" (simulated devices, speed {record['speed']:g})" if isinstance(record.get("speed"), int | float) \
+            else ""
+        return f"start task {record.get('task')} on cell {record.get('cell')}{speed}"
     if kind in ("stopped", "replan", "continue"):
         return _resumed(record)
     if kind == "step":

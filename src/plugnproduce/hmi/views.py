@@ -196,6 +196,7 @@ def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[s
         "run": run_id,
         "task": start.get("task"),
         "cell": start.get("cell"),
+        "speed": start.get("speed"),
         "status": status,
         "steps": start.get("steps"),
         "step": steps[-1] if steps else None,
