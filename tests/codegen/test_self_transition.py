@@ -8,6 +8,7 @@ send it. Code generation, the plausibility check, the cycle-time estimate and ve
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -56,3 +57,27 @@ def test_issue_27_check_estimate_and_verify_walk_the_same_open_to_open_path() ->
     answer = json.loads(verify.stdout)
     assert answer["verdict"] == "proved"
     assert answer["states"] > 10  # the gripper's configuring is explored, not skipped (10 states without it)
+
+
+def test_issue_27_an_angle_the_gripper_takes_only_when_closed_is_a_finding_of_check_verify_and_generate(
+        tmp_path: Path) -> None:
+    """The same library with a gripper that takes SetAngle only in closed: reaching it would close the gripper
+    where the step says it stays open, so no route takes the angle, and the three commands say it would be lost."""
+    library = tmp_path / "timed-cell"
+    shutil.copytree(TIMED, library)
+    chart = library / "devices" / "tc-gripper.scxml"
+    text = chart.read_text(encoding="utf-8")
+    set_angle = '    <transition event="xirp.request.SetAngle" target="configuring" pnp:accepts="OpeningAngle"/>\n'
+    opens = '    <transition event="xirp.request.Open" target="opening"/>\n'
+    chart.write_text(text.replace(set_angle, "").replace(opens, opens + set_angle), encoding="utf-8")
+    task, cell = library / "tasks" / TASK.name, library / "cells" / CELL.name
+    lost = [f"{task}:{line}: step {step} (approach-and-open): parameter opening_angle (opening angle) goes to device "
+            "'tc-gripper' (role 'gripper'), but the route its chart takes from state 'open' passes no command that "
+            "accepts opening angle; the value would be lost" for line, step in ((7, 2), (9, 3))]
+    for command in (["check"], ["verify"], ["generate", "-o", str(tmp_path / "out")]):
+        result = subprocess.run([sys.executable, "-m", "plugnproduce", "--library", str(library), command[0],
+                                 str(task), "--cell", str(cell), *command[1:]], capture_output=True, text=True,
+                                timeout=300)
+        assert result.returncode == 1, (command, result.stdout, result.stderr)
+        assert [line for line in (result.stdout + result.stderr).splitlines() if "opening_angle" in line] == lost
+    assert not (tmp_path / "out").exists()

@@ -25,8 +25,8 @@ def taken(steps: tuple[ChartTransition, ...], wanted: frozenset[str]) -> frozens
 
 def networkx_path(device: DeviceDescription, source: str, concept: str, taxonomy: Taxonomy,
                   wanted: frozenset[str] = frozenset()) -> ChartPath:
-    """The shortest path; but when another path's requests take more of ``wanted``, the shortest of those
-    taking the most (a parameter is not dropped while the chart can take it)."""
+    """The shortest path; but when another path, each of whose requests takes some of ``wanted``, takes more of
+    ``wanted``, the shortest of those taking the most (a parameter is not dropped while the chart can take it)."""
     shortest = networkx_shortest(device, source, concept, taxonomy, wanted)
     takeable = taken(device.transitions, wanted)
     if takeable <= taken(shortest.steps, wanted):
@@ -36,7 +36,7 @@ def networkx_path(device: DeviceDescription, source: str, concept: str, taxonomy
         for n in range(len(takeable) + 1):
             for part in itertools.combinations(sorted(takeable), n):
                 for i, t in enumerate(device.transitions):
-                    if t.source == state.id:
+                    if t.source == state.id and (not t.request or taken((t,), wanted)):
                         g.add_edge((state.id, frozenset(part)), (t.target, frozenset(part) | taken((t,), wanted)),
                                    key=i, transition=t, weight=commands(t))
     goals = [s.id for s in device.states if s.concept and taxonomy.is_a(s.concept, concept)]
@@ -144,3 +144,14 @@ def test_issue_27_open_to_open_handing_over_an_angle_goes_through_the_request_ta
         ("open", "SetAngle", "configuring"), ("configuring", None, "open")]
     deaf = find_path(gripper, "open", P + "Open", k.taxonomy, frozenset({P + "TargetPose"}))
     assert deaf.steps == ()  # nothing in the gripper's chart takes a pose: it stays open
+
+
+def test_issue_27_no_other_request_is_sent_on_the_way_to_the_one_taking_the_angle() -> None:
+    """A gripper that takes its angle only when closed: closing it on the way would move it where the step says
+    it stays open; the route stays put (and the check says the value would be lost)."""
+    k = service.knowledge()
+    gripper = next(d for d in k.devices if d.id == "gripper")
+    moved = tuple(dataclasses.replace(t, source="closed") if t.request and t.request.name == "SetAngle" else t
+                  for t in gripper.transitions)
+    closed_only = dataclasses.replace(gripper, transitions=moved)
+    assert find_path(closed_only, "open", P + "Open", k.taxonomy, frozenset({P + "OpeningAngle"})).steps == ()

@@ -8,11 +8,13 @@ whose requests accept more of the parameters the step hands over wins (a lift wi
 pose moves to it rather than homing), then the one first by state ids, so the result
 never depends on dict or set order.
 
-A parameter the step hands over is never dropped while the chart has a way to take it: when the
-shortest path takes fewer of them than some other path does, the path that takes the most of them
-wins, shortest among those. So a region from a state to another state of the same concept (Open →
-Open, handing over an opening angle) goes through the device's request for it (open → configuring
-→ open) instead of staying put; without parameters it stays put.
+A parameter the step hands over is not dropped while the chart has a way to take it: when the
+shortest path takes fewer of them than some other path whose every request takes one of them, that
+path wins (the one taking the most, shortest among those). So a region from a state to another state
+of the same concept (Open → Open, handing over an opening angle) goes through the device's request for
+it (open → configuring → open) instead of staying put; without parameters it stays put. A route that
+would need another request on the way (close the gripper to reach its angle request) is not taken:
+the plausibility check says the value would be lost.
 """
 
 from __future__ import annotations
@@ -130,7 +132,9 @@ def _shortest_path(edges: Edges, source: str, goals: set[str], wanted: frozenset
 
 def _taking_most(edges: Edges, source: str, goals: set[str], wanted: frozenset[str]) -> ChartPath | None:
     """The path from ``source`` to a goal state whose requests take the most of ``wanted`` (at least one), the
-    fewest commands among those, then first by state ids and lines; None if no path takes any.
+    fewest commands among those, then first by state ids and lines; None if no path takes any. Every request on
+    it takes some of ``wanted``: the device is not closed, homed or moved on the way only to reach a request
+    that takes a parameter (the plausibility check then says the value would be lost).
 
     The search runs on the chart paired with what is taken so far: a state may be passed again once more is
     taken (open → configuring → open), and there are finitely many such pairs."""
@@ -154,13 +158,16 @@ Pair = tuple[str, frozenset[str]]
 
 
 def _taking(edges: Edges, start: Pair, wanted: frozenset[str]) -> dict[Pair, dict[Pair, list[ChartTransition]]]:
-    """The chart's transitions between (state, quantities taken) pairs reachable from ``start``."""
+    """The chart's transitions between (state, quantities taken) pairs reachable from ``start``: those that send
+    no request, and those whose request takes some of ``wanted``."""
     out: dict[Pair, dict[Pair, list[ChartTransition]]] = {start: {}}
     todo = [start]
     while todo:
         state, taken = here = todo.pop()
         for target, transitions in edges[state].items():
             for t in transitions:
+                if t.request and not handed_over((t,), wanted):
+                    continue  # no other request on the way: it would move the device in ways the step does not say
                 there = (target, taken | handed_over((t,), wanted))
                 out[here].setdefault(there, []).append(t)
                 if there not in out:
