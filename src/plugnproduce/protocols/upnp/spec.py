@@ -271,7 +271,7 @@ def reported_of(results: Mapping[str, Any], names: Sequence[str], where: str) ->
             raise ValueError(f"{where}: {name} is no text of at most {MAX_REPORT} characters")
         try:
             out[name] = json.loads(text, parse_constant=_no_constant)
-        except ValueError:
+        except (ValueError, RecursionError):  # nested deeper than the decoder recurses: no value either
             raise ValueError(f"{where}: {name} is not a JSON value: {text[:60]!r}") from None
     return out
 
