@@ -11,8 +11,11 @@ import asyncio
 import dataclasses
 import json
 import os
+import re
+import signal
 import subprocess
 import sys
+import time
 from collections.abc import Awaitable, Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -28,6 +31,7 @@ from plugnproduce.protocols.opcua import NodeSpec, OpcUaDeviceServer, namespace_
 from plugnproduce.protocols.upnp import SsdpNetwork, private_network
 from plugnproduce.sim.cell import SimulatedCell
 from tests.lines import WAIT
+from tests.processes import started, stop
 
 SHORT_ARM = Path(__file__).parent.parent / "data" / "libraries" / "short-arm"
 CELL = SHORT_ARM / "cells" / "short-arms.yaml"
@@ -197,3 +201,32 @@ def test_a_upnp_device_reporting_a_value_that_is_no_json_is_one_line() -> None:
 
     assert asyncio.run(scenario()) == ("device short-arm-upnp: GetDeviceState: TargetPose is not a JSON value: "
                                        "'[Infinity, 0, 0, 0, 180, 0]'")
+
+
+def test_teach_against_pnp_sim_up_as_separate_processes(tmp_path: Path) -> None:
+    """``pnp sim up`` runs the library's arms; a plain asyncua client guides the OPC UA arm; ``pnp teach`` reads
+    it (taken) and the UPnP arm, still stretched out (refused)."""
+    env = {**os.environ, "PNP_SSDP_PORT": str(private_network().port)}
+    state, log = tmp_path / "control.json", tmp_path / "sim.log"
+    up_command = [sys.executable, "-m", "plugnproduce", "--library", str(SHORT_ARM), "sim", "up", str(CELL),
+                  "--state-file", str(state)]
+    teach = [sys.executable, "-m", "plugnproduce", "--library", str(SHORT_ARM), "teach"]
+    with log.open("w") as out, started(up_command, env=env, stdout=out, stderr=subprocess.STDOUT) as up:
+        deadline = time.monotonic() + WAIT
+        while not state.exists() or "is up" not in log.read_text():  # it writes both once its devices are announced
+            assert up.poll() is None, log.read_text()
+            assert time.monotonic() < deadline, "pnp sim up did not come up"
+            time.sleep(0.05)
+        endpoint = re.search(r"^short-arm-ua +opcua (opc\.tcp://\S+)$", log.read_text(), re.M)
+        assert endpoint is not None, log.read_text()
+        asyncio.run(guide_over_opcua(endpoint.group(1), "short-arm-ua", GUIDED))
+        ua_arm, upnp_arm = (subprocess.run([*teach, arm, "TargetPose", "--cell", str(CELL), "--discovery-timeout",
+                                            str(WAIT)], env=env, capture_output=True, text=True, timeout=3 * WAIT)
+                            for arm in ("short-arm-ua", "short-arm-upnp"))
+        assert stop(up, signal.SIGINT) == 0, log.read_text()
+    assert ua_arm.returncode == 0, ua_arm.stderr
+    assert ua_arm.stdout.splitlines() == [f"short-arm-ua TargetPose = {GUIDED} (short-arm-ua is at_pose)",
+                                          "within MoveTo TargetPose: Pose, reach 0.5 m"]
+    assert upnp_arm.returncode == 1, upnp_arm.stderr
+    assert upnp_arm.stderr.splitlines() == ["refused: short-arm-upnp MoveTo TargetPose reaches at most 0.5 m from "
+                                            "its base; the pose is 0.721 m away"]
