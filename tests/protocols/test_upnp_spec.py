@@ -16,6 +16,7 @@ from plugnproduce.protocols.upnp import (
     UntrustedUrlError,
     VariableSpec,
     device_type_for,
+    payload_of,
     report_text,
     reported_of,
     service_spec_from_chart_events,
@@ -120,3 +121,11 @@ def test_the_reported_values_of_a_state_query_are_read_from_json_and_a_missing_o
     assert reported_of(results, ["TargetPose", "Force"], "device arm") == {"TargetPose": [0.35, 0.15, 0.22, 0, 180, 45]}
     spec = with_state_query(ServiceSpec(), reports=["TargetPose"])
     assert [a.name for a in spec.action(STATE_ACTION).outputs] == ["State", "TargetPose"]
+
+
+def test_an_event_value_nested_deeper_than_the_json_decoder_recurses_is_kept_as_its_text() -> None:
+    """A device's GENA notification is read in the controller's event callback: a value it cannot decode stays
+    the text it was (the run's contract checks then refuse it), never an exception there."""
+    deep = "[" * 2000 + "]" * 2000
+    values = {"PartLocalized__part_pose": deep, "PartLocalized__outcome": '"PartFound"'}
+    assert payload_of(values, "PartLocalized") == {"part_pose": deep, "outcome": "PartFound"}

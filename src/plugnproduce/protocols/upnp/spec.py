@@ -194,7 +194,7 @@ def payload_of(values: Mapping[str, Any], event: str) -> dict[str, Any]:
         if variable.startswith(prefix):
             try:
                 out[variable[len(prefix):]] = json.loads(text) if isinstance(text, str) else text
-            except ValueError:
+            except (ValueError, RecursionError):  # no JSON, or nested deeper than the decoder recurses
                 out[variable[len(prefix):]] = text
     return out
 
