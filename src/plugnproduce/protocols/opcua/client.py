@@ -105,20 +105,29 @@ class OpcUaDeviceClient:
 
     async def state(self, timeout: float) -> str:
         """The ``State`` variable: the id of the chart state the device is in."""
+        return (await self.report((), timeout))[0]
+
+    async def report(self, names: Sequence[str], timeout: float) -> tuple[str, dict[str, Any]]:
+        """The ``State`` variable and, read with it in one request, the variable ``ns:NAME`` of each of ``names``
+        the device has: the values it reports with its state (teach-in), by name."""
         try:
-            value = await asyncio.wait_for(self._read_state(), timeout)
+            state, values = await asyncio.wait_for(self._read_report(names[:MAX_ARGUMENTS]), timeout)
         except ProtocolError:
             raise
         except Exception as exc:
             raise _wrapped(exc, self.device, f"read its {STATE_VARIABLE}", timeout) from exc
-        if not isinstance(value, str) or not value or len(value) > 256:
-            raise ProtocolError(f"device {self.device}: {STATE_VARIABLE} is {str(value)[:80]!r}; "
+        if not isinstance(state, str) or not state or len(state) > 256:
+            raise ProtocolError(f"device {self.device}: {STATE_VARIABLE} is {str(state)[:80]!r}; "
                                 "expected the id of a chart state")
-        return value
+        return state, {n: from_wire(v, f"device {self.device}: {n}") for n, v in values.items() if v is not None}
 
-    async def _read_state(self) -> Any:
-        node = await self._node.get_child(f"{self._ns}:{STATE_VARIABLE}")
-        return await node.read_value()
+    async def _read_report(self, names: Sequence[str]) -> tuple[Any, dict[str, Any]]:
+        nodes = {STATE_VARIABLE: await self._node.get_child(f"{self._ns}:{STATE_VARIABLE}")}
+        for name in (n for n in names if n != STATE_VARIABLE):
+            with contextlib.suppress(ua.UaStatusCodeError):  # BadNoMatch: the device does not report it
+                nodes[name] = await self._node.get_child(f"{self._ns}:{name}")
+        values = dict(zip(nodes, await self._client.read_values(list(nodes.values())), strict=True))
+        return values.pop(STATE_VARIABLE), values
 
     async def call(self, name: str, params: Mapping[str, Any], timeout: float) -> dict[str, Any]:
         """Call the method ``name`` with ``params`` (by input argument name); its output arguments by name."""
