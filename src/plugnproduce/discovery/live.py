@@ -165,10 +165,8 @@ class LiveCell:
             raise
         self._news = asyncio.get_running_loop().time()
         if self.lds is not None:
-            from plugnproduce.discovery.opcua import registered  # asyncua loads only for an LDS
-
             try:
-                self._ask_lds(await registered(self.lds, self.device_budget))
+                await self._asked_lds(self.lds)
             except BaseException:
                 search.stop()
                 await self._listener.stop()
@@ -281,14 +279,24 @@ class LiveCell:
 
     async def _follow_lds(self, lds: str) -> None:
         """Ask the LDS again and again: plug the devices newly registered, unplug those no longer registered."""
-        from plugnproduce.discovery.opcua import registered
-
         while True:
             await asyncio.sleep(LDS_POLL)
-            try:
-                self._ask_lds(await registered(lds, self.device_budget))
-            except ProtocolError as exc:  # the LDS is away for now: the cell stays as it is
-                _LOGGER.warning("%s", exc)
+            await self._asked_lds(lds)
+
+    async def _asked_lds(self, lds: str) -> None:
+        """Ask the LDS once. One that fails (away, silent, an answer beyond the limits) is refused, named by its
+        URL, once until it answers again; the cell stays as it is and discovery by SSDP goes on."""
+        from plugnproduce.discovery.opcua import registered  # asyncua loads only for an LDS
+
+        try:
+            servers = await registered(lds, self.device_budget)
+        except ProtocolError as exc:
+            said = self.refused.get(lds)
+            if said is None or said.reason != " ".join(str(exc).split())[:500]:
+                self._publish(CellChange("refused", lds, self.cell, str(exc), lds))
+            return
+        self.refused.pop(lds, None)
+        self._ask_lds(servers)
 
     def _ask_lds(self, servers: list[tuple[str, str]]) -> None:
         listed = {opcua_spec.application_uri_for(device): (device, url) for device, url in servers}

@@ -9,12 +9,10 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import logging
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from asyncua import Client, Node, ua
-from asyncua.common.connection import TransportLimits
 from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
@@ -24,9 +22,6 @@ from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
     MAX_ARGUMENTS,
-    MAX_CHUNK,
-    MAX_CHUNKS,
-    MAX_MESSAGE,
     MAX_STRING,
     STATE_VARIABLE,
     Kind,
@@ -35,6 +30,7 @@ from plugnproduce.protocols.opcua.spec import (
     parse_endpoint,
     to_wire,
 )
+from plugnproduce.protocols.opcua.transport import bound_transport
 from plugnproduce.safeio import MAX_BYTES
 
 EventCallback = Callable[[str, dict[str, Any]], None]
@@ -47,11 +43,6 @@ _KINDS: dict[int, Kind] = {ua.ObjectIds.Double: "double", ua.ObjectIds.Float: "d
                            ua.ObjectIds.Boolean: "bool", ua.ObjectIds.String: "string"}
 _REFUSALS = {"BadInvalidState": "does not accept it in its current state",
              "BadInvalidArgument": "refused its arguments", "BadTypeMismatch": "refused its arguments' types"}
-
-for _name in ("asyncua.client.client", "asyncua.client.ua_client", "asyncua.common.subscription",
-              "asyncua.client.ua_client.UaClient", "asyncua.uaprotocol"):
-    logging.getLogger(_name).setLevel(logging.CRITICAL)  # a lost server is reported to the run, not logged twice
-
 
 class OpcUaDeviceClient:
     """A session with one device's OPC UA server; make it with :meth:`connect`, end it with :meth:`close`."""
@@ -78,8 +69,7 @@ class OpcUaDeviceClient:
         security = from_environment() if security is None else security
         check_plain(security, device, endpoint, host)
         client = Client(endpoint, timeout=timeout)
-        client.max_messagesize, client.max_chunkcount = MAX_MESSAGE, MAX_CHUNKS
-        _bound_transport(client)
+        bound_transport(client)
         try:
             await asyncio.wait_for(_secure_and_connect(client, security, device), timeout)
         except TimeoutError as exc:
@@ -267,39 +257,6 @@ def _on_close(client: Client, then: Callable[[], None]) -> None:
         then()
 
     protocol.connection_lost = connection_lost
-
-
-class _Limits(TransportLimits):  # type: ignore[misc]
-    """The transport limits of one connection, held to ours whatever the server's Acknowledge says (asyncua
-    takes the server's limits as its own, and 0 from the server would mean none)."""
-
-    def update_client_limits(self, msg: ua.Acknowledge) -> None:
-        super().update_client_limits(msg)
-        _cap(self)
-
-
-def _cap(limits: Any) -> None:
-    limits.max_recv_buffer = _capped(limits.max_recv_buffer, MAX_CHUNK)
-    limits.max_chunk_count = _capped(limits.max_chunk_count, MAX_CHUNKS)
-    limits.max_message_size = _capped(limits.max_message_size, MAX_MESSAGE)
-
-
-def _capped(value: int, limit: int) -> int:
-    return limit if value <= 0 else min(value, limit)
-
-
-def _bound_transport(client: Client) -> None:
-    """Every connection the client opens (for its endpoints and its session) receives at most ``MAX_CHUNKS``
-    chunks of ``MAX_CHUNK`` bytes per message: a server's larger answer ends the connection."""
-    uaclient = client.uaclient
-    make = uaclient._make_protocol
-
-    def bounded() -> Any:
-        protocol = make()
-        protocol._connection._limits = _Limits(MAX_CHUNK, MAX_CHUNK, MAX_CHUNKS, MAX_MESSAGE)
-        return protocol
-
-    uaclient._make_protocol = bounded
 
 
 async def _secure_and_connect(client: Client, security: Security, device: str) -> None:

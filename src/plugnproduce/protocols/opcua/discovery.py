@@ -12,20 +12,17 @@ offline (``IsOnline`` false, as a device that stops says): so a device that stop
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
+import os
 import time
 from typing import Any
 
 from asyncua import Client, Server, ua
 
-from plugnproduce.errors import ProtocolError
-from plugnproduce.protocols.opcua.spec import (
-    APPLICATION_URI_PREFIX,
-    MAX_CHUNKS,
-    MAX_MESSAGE,
-    REGISTRATION_PERIOD,
-    format_endpoint,
-)
+from plugnproduce.errors import ProtocolConnectionError, ProtocolError
+from plugnproduce.protocols.opcua.spec import APPLICATION_URI_PREFIX, REGISTRATION_PERIOD, format_endpoint
+from plugnproduce.protocols.opcua.transport import LIMIT, bound_transport
 
 MAX_SERVERS = 256
 """Most servers a FindServers answer may list."""
@@ -34,10 +31,15 @@ KEEP = 3 * REGISTRATION_PERIOD
 """Seconds a registration lasts without being renewed."""
 
 logging.getLogger("asyncua.server.internal_server").setLevel(logging.ERROR)
+logging.getLogger("asyncua.server.server").setLevel(logging.CRITICAL)  # security-None chatter, and a port taken
+# is said by LocalDiscoveryServer.start in one line
 
 
 class LocalDiscoveryServer:
-    """An LDS on ``host``:``port`` (0: a free port); ``await start()``, ``await stop()``."""
+    """An LDS on ``host``:``port`` (0: a free port); ``await start()``, ``await stop()``, or ``async with``.
+
+    The simulated cell runs one beside its devices (``pnp sim up --serve-lds``), the controller one for the
+    devices of the network (``pnp discover --serve-lds``, ``pnp serve --serve-lds``)."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 4840, keep: float = KEEP) -> None:
         """``keep``: seconds a registration lasts unless renewed."""
@@ -73,9 +75,21 @@ class LocalDiscoveryServer:
             return find(params, sockname)
 
         internal.register_server, internal.find_servers = register_server, find_servers
-        await server.start()
+        try:
+            await server.start()
+        except OSError as exc:
+            raise ProtocolConnectionError(f"Local Discovery Server: cannot listen on "
+                                          f"{format_endpoint(self._host, self._port)}: "
+                                          f"{os.strerror(exc.errno) if exc.errno else exc}") from exc
         self._server = server
         self.endpoint = format_endpoint(self._host, server.bserver._server.sockets[0].getsockname()[1])
+
+    async def __aenter__(self) -> LocalDiscoveryServer:
+        await self.start()
+        return self
+
+    async def __aexit__(self, *exc_info: object) -> None:
+        await self.stop()
 
     def _expire(self, known: dict[str, Any]) -> None:
         """Forget the registrations not renewed within ``keep`` seconds."""
@@ -93,13 +107,18 @@ class LocalDiscoveryServer:
 
 
 async def find_servers(lds: str, timeout: float) -> list[tuple[str, str]]:
-    """The Plug'n'Produce devices registered with the LDS at ``lds``: (device id, discovery URL) each."""
+    """The Plug'n'Produce devices registered with the LDS at ``lds``: (device id, discovery URL) each.
+
+    The connection is held to the limits of a device's (:mod:`.transport`): an answer beyond them ends it, and
+    the LDS is refused (a :class:`ProtocolError` naming it)."""
     client = Client(lds, timeout=timeout)
-    client.max_messagesize, client.max_chunkcount = MAX_MESSAGE, MAX_CHUNKS
+    beyond = bound_transport(client)
     try:
-        servers = await asyncio.wait_for(client.connect_and_find_servers(), timeout)
+        servers = await asyncio.wait_for(_ask(client, beyond), timeout)
     except TimeoutError as exc:
         raise ProtocolError(f"Local Discovery Server {lds}: no FindServers answer within {timeout:g} s") from exc
+    except _TooLarge as exc:
+        raise ProtocolError(f"Local Discovery Server {lds}: its FindServers answer is larger than {LIMIT}") from exc
     except Exception as exc:  # a foreign server's failure is a refusal, never a crash
         raise ProtocolError(f"Local Discovery Server {lds}: FindServers failed: {str(exc)[:200]}") from exc
     if not isinstance(servers, list) or len(servers) > MAX_SERVERS:
@@ -110,3 +129,25 @@ async def find_servers(lds: str, timeout: float) -> list[tuple[str, str]]:
         if isinstance(uri, str) and uri.startswith(APPLICATION_URI_PREFIX) and urls and isinstance(urls[0], str):
             found.append((uri[len(APPLICATION_URI_PREFIX):][:128], urls[0][:300]))
     return found
+
+
+class _TooLarge(Exception):
+    """The server sent a message beyond the connection's limits."""
+
+
+async def _ask(client: Client, beyond: asyncio.Event) -> Any:
+    """FindServers, ended as soon as the server goes beyond the connection's limits (asyncua would wait for the
+    answer the dropped message held until the timeout)."""
+    asking = asyncio.ensure_future(client.connect_and_find_servers())
+    told = asyncio.ensure_future(beyond.wait())
+    try:
+        await asyncio.wait((asking, told), return_when=asyncio.FIRST_COMPLETED)
+        if beyond.is_set():
+            raise _TooLarge
+        return asking.result()
+    finally:
+        for task in (asking, told):
+            if not task.done():
+                task.cancel()
+                with contextlib.suppress(BaseException):
+                    await task

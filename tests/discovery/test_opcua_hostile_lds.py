@@ -1,0 +1,112 @@
+"""A hostile Local Discovery Server: a real asyncua server that tells the controller it takes messages of any size
+and answers FindServers with megabytes. The connection that asks it is held to the same limit as a device's
+(16 chunks of 64 KiB), so the answer ends the connection and is never parsed; the LDS is refused in one line
+naming it, and discovery of the others (by SSDP) goes on."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import os
+import sys
+from collections.abc import AsyncIterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from asyncua import Server, ua
+from asyncua.common.connection import TransportLimits
+
+from plugnproduce import service
+from plugnproduce.description.loader import load_device
+from plugnproduce.discovery import LiveCell
+from plugnproduce.errors import ProtocolError
+from plugnproduce.ontology.taxonomy import load_taxonomy
+from plugnproduce.protocols.opcua.discovery import find_servers
+from plugnproduce.protocols.opcua.spec import MAX_MESSAGE, format_endpoint
+from plugnproduce.protocols.upnp import private_network
+from plugnproduce.sim.device import SimulatedDevice
+from tests.lines import WAIT
+
+SERVERS = 200
+"""Servers the hostile LDS lists: fewer than the controller's count limit, each with 12 KB of discovery URLs."""
+
+
+class _Boundless(TransportLimits):  # type: ignore[misc]
+    """Acknowledges any client with "no limits" and then sends whatever it has, whatever the client asked for."""
+
+    def create_acknowledge_and_set_limits(self, msg: ua.Hello) -> ua.Acknowledge:
+        ack = super().create_acknowledge_and_set_limits(msg)
+        ack.MaxMessageSize = ack.MaxChunkCount = 0
+        self.max_message_size = self.max_chunk_count = 0
+        return ack
+
+
+@pytest.fixture
+async def hostile_lds() -> AsyncIterator[str]:
+    """An LDS whose FindServers answer is about 2.4 MB: 200 servers of the device naming rule, 60 long URLs each."""
+    server = Server()
+    await server.init()
+    server.limits = _Boundless()
+    server.set_endpoint(format_endpoint("127.0.0.1", 0))
+    server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+    for n in range(SERVERS):
+        registered = ua.RegisteredServer(ServerUri=f"urn:plugnproduce:device:flood{n}",
+                                         ServerNames=[ua.LocalizedText("flood")], IsOnline=True,
+                                         DiscoveryUrls=[f"opc.tcp://127.0.0.1:1/{'x' * 200}{k}" for k in range(60)])
+        server.iserver.register_server(registered)
+    await server.start()
+    port = server.bserver._server.sockets[0].getsockname()[1]  # type: ignore[union-attr]
+    try:
+        yield format_endpoint("127.0.0.1", port)
+    finally:
+        await server.stop()
+
+
+async def test_a_findservers_answer_beyond_the_message_limit_is_refused_naming_the_lds(hostile_lds: str) -> None:
+    with pytest.raises(ProtocolError) as refused:
+        await find_servers(hostile_lds, WAIT)
+    said = str(refused.value)
+    assert said.startswith(f"Local Discovery Server {hostile_lds}: its FindServers answer is larger than "
+                           f"{MAX_MESSAGE >> 20} MiB"), said
+    assert "\n" not in said
+
+
+def _device(name: str) -> Any:
+    return load_device(Path(service.builtin("devices", f"{name}.ttl")), load_taxonomy())
+
+
+async def test_discovery_goes_on_beside_a_hostile_lds(hostile_lds: str) -> None:
+    """The live cell names the LDS among the refused, and finds the device that answers SSDP all the same."""
+    network = private_network()
+    async with SimulatedDevice(_device("gripper"), network=network) as gripper, \
+            LiveCell(load_taxonomy(), network=network, lds=hostile_lds, search_timeout=WAIT,
+                     expected=["gripper"]) as live:
+        assert [(d.id, d.endpoint) for d in live.cell.devices] == [("gripper", gripper.endpoint)]
+        refusal = live.refused[hostile_lds]
+    assert refusal.location == hostile_lds
+    assert refusal.reason.startswith(f"Local Discovery Server {hostile_lds}: its FindServers answer is larger")
+
+
+async def test_pnp_discover_says_the_refused_lds_in_one_line_and_lists_the_others(hostile_lds: str) -> None:
+    network = private_network()
+    env = {**os.environ, "PNP_SSDP_PORT": str(network.port)}
+    async with SimulatedDevice(_device("gripper"), network=network):
+        proc = await asyncio.create_subprocess_exec(
+            sys.executable, "-m", "plugnproduce", "discover", "--lds", hostile_lds, "--expect", "1",
+            "--timeout", "3600", env=env, stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)
+        out, err = await asyncio.wait_for(proc.communicate(), 10 * WAIT)
+    assert proc.returncode == 0, out.decode() + err.decode()
+    lines = out.decode().splitlines()
+    assert lines[0].split()[0] == "gripper", lines
+    refused = [line for line in lines if line.startswith("refused")]
+    assert refused == [f"refused Local Discovery Server {hostile_lds}: its FindServers answer is larger than "
+                       f"{MAX_MESSAGE >> 20} MiB (at most 16 chunks of 64 KiB)"], lines
+    assert err.decode() == ""
+
+    proc = await asyncio.create_subprocess_exec(
+        sys.executable, "-m", "plugnproduce", "discover", "--json", "--lds", hostile_lds, "--timeout", "0.5",
+        "--settle", "0.2", env=env, stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)
+    out, err = await asyncio.wait_for(proc.communicate(), 10 * WAIT)
+    assert proc.returncode == 0, out.decode() + err.decode()
+    assert [r["url"] for r in json.loads(out)["refused"]] == [hostile_lds]
