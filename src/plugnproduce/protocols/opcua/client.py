@@ -17,6 +17,7 @@ from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.protocols.opcua.identity import UserIdentity
 from plugnproduce.protocols.opcua.security import PeerRefused, Security, check_plain, from_environment, secure_client
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
@@ -70,8 +71,9 @@ class OpcUaDeviceClient:
         check_plain(security, device, endpoint, host)
         client = Client(endpoint, timeout=timeout)
         bound_transport(client)
+        identity: list[UserIdentity | None] = [None]
         try:
-            await asyncio.wait_for(_secure_and_connect(client, security, device), timeout)
+            await asyncio.wait_for(_secure_and_connect(client, security, device, identity), timeout)
         except TimeoutError as exc:
             await _quietly_close(client)
             raise ProtocolTimeout(f"device {device}: {endpoint} did not open a session within {timeout:g} s") \
@@ -82,7 +84,8 @@ class OpcUaDeviceClient:
         except Exception as exc:  # any failure of a foreign server is a refused connection, never a crash
             await _quietly_close(client)
             raise ProtocolConnectionError(f"device {device}: cannot connect to {endpoint} "
-                                          f"(security mode {security.mode}): {_refusal(exc, security.mode)}") from exc
+                                          f"(security mode {security.mode}): "
+                                          f"{_refusal(exc, security.mode, identity[0])}") from exc
         try:
             ns, node = await asyncio.wait_for(_device_node(client, device), timeout)
         except ProtocolError:
@@ -259,8 +262,10 @@ def _on_close(client: Client, then: Callable[[], None]) -> None:
     protocol.connection_lost = connection_lost
 
 
-async def _secure_and_connect(client: Client, security: Security, device: str) -> None:
-    await secure_client(client, security, device)
+async def _secure_and_connect(client: Client, security: Security, device: str,
+                              identity: list[UserIdentity | None]) -> None:
+    """Connect with the security and user identity of ``device``, the identity given kept in ``identity``."""
+    identity[0] = await secure_client(client, security, device)
     await client.connect()
 
 
@@ -271,11 +276,19 @@ _CERTIFICATE_REFUSALS = {
 }
 
 
-def _refusal(exc: BaseException, mode: str) -> str:
-    """What a failed connection says, a refused certificate in words: refused by the controller (its own
-    validator) or by the device."""
+_IDENTITY_REFUSALS = frozenset({"BadIdentityTokenRejected", "BadIdentityTokenInvalid", "BadUserAccessDenied"})
+
+
+def _refusal(exc: BaseException, mode: str, identity: UserIdentity | None = None) -> str:
+    """What a failed connection says, a refused certificate in words (refused by the controller, its own
+    validator, or by the device), or a refused user identity."""
     if isinstance(exc, ua.UaStatusCodeError):
         name = type(exc).__name__
+        if name in _IDENTITY_REFUSALS and identity is None:
+            return f"{name}: the device asks for a user name and password; the users file gives none for it " \
+                   "(PNP_OPCUA_USERS)"
+        if name in _IDENTITY_REFUSALS and identity is not None:
+            return f"{name}: the device refused the user {identity.user!r} of {identity.source}"
         if isinstance(exc.__cause__, PeerRefused):
             return f"{name}: {_CERTIFICATE_REFUSALS.get(name, 'its certificate is refused')}"
         if name.startswith("BadCertificate") or name == "BadSecurityChecksFailed":
