@@ -110,3 +110,19 @@ async def test_pnp_discover_says_the_refused_lds_in_one_line_and_lists_the_other
     out, err = await asyncio.wait_for(proc.communicate(), 10 * WAIT)
     assert proc.returncode == 0, out.decode() + err.decode()
     assert [r["url"] for r in json.loads(out)["refused"]] == [hostile_lds]
+
+
+async def test_pnp_run_names_the_refused_lds_where_it_says_the_devices_missing(hostile_lds: str) -> None:
+    """Before, an LDS that could not be asked ended the run's discovery at once; now the run waits for the
+    cell's devices as always, and the line that says them missing names the LDS refused and why."""
+    env = {**os.environ, "PNP_SSDP_PORT": str(private_network().port), "PNP_LDS": hostile_lds}
+    proc = await asyncio.create_subprocess_exec(
+        sys.executable, "-m", "plugnproduce", "run", str(service.builtin("tasks", "pick-and-screw.yaml")),
+        "--cell", str(service.builtin("cells", "mixed.yaml")), "--discovery-timeout", "1", env=env,
+        stdout=asyncio.subprocess.PIPE, stderr=asyncio.subprocess.PIPE)
+    out, err = await asyncio.wait_for(proc.communicate(), 10 * WAIT)
+    assert proc.returncode == 2, out.decode() + err.decode()
+    assert err.decode().splitlines() == [
+        "error: device(s) robot, gripper, sensor3d, binpicking-pc-ua, screwdriver-ua of the cell not found on the "
+        f"network within 1 s; refused Local Discovery Server {hostile_lds}: its FindServers answer is larger than "
+        f"{MAX_MESSAGE >> 20} MiB (at most 16 chunks of 64 KiB)"]
