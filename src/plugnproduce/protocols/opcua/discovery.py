@@ -27,6 +27,14 @@ from plugnproduce.protocols.opcua.transport import LIMIT, bound_transport
 MAX_SERVERS = 256
 """Most servers a FindServers answer may list."""
 
+MAX_REGISTERED = MAX_SERVERS - 1
+"""Most registrations the LDS keeps at once: with itself, as many servers as a FindServers answer may list."""
+MAX_TEXT = 200
+"""Longest application URI, product URI, gateway URI or server name a registration may give (characters)."""
+MAX_URLS = 4
+"""Most discovery URLs a registration may give, each at most :data:`MAX_URL` characters."""
+MAX_URL = 300
+
 KEEP = 3 * REGISTRATION_PERIOD
 """Seconds a registration lasts without being renewed."""
 
@@ -46,6 +54,9 @@ class LocalDiscoveryServer:
         self._host, self._port, self.keep = host, port, keep
         self._server: Server | None = None
         self._renewed: dict[str, float] = {}  # application URI -> monotonic time of its last registration
+        self._known: dict[str, Any] = {}
+        self._register: Any = None
+        self._find: Any = None
         self.registrations = 0
         """How many RegisterServer calls it took (first registrations and renewals)."""
         self.endpoint: str | None = None
@@ -59,22 +70,9 @@ class LocalDiscoveryServer:
         server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
         await server.set_application_uri("urn:plugnproduce:lds")
         internal = server.iserver
-        register, find = internal.register_server, internal.find_servers
-
-        def register_server(registered: Any, conf: Any = None) -> None:
-            self.registrations += 1
-            if not registered.IsOnline:  # the server goes offline: it leaves the list now
-                internal._known_servers.pop(registered.ServerUri, None)
-                self._renewed.pop(registered.ServerUri, None)
-                return
-            self._renewed[registered.ServerUri] = time.monotonic()
-            register(registered, conf)
-
-        def find_servers(params: Any, sockname: Any = None) -> Any:
-            self._expire(internal._known_servers)
-            return find(params, sockname)
-
-        internal.register_server, internal.find_servers = register_server, find_servers
+        self._known, self._register, self._find = internal._known_servers, internal.register_server, \
+            internal.find_servers
+        internal.register_server, internal.find_servers = self._on_register, self._on_find
         try:
             await server.start()
         except OSError as exc:
@@ -83,6 +81,27 @@ class LocalDiscoveryServer:
                                           f"{os.strerror(exc.errno) if exc.errno else exc}") from exc
         self._server = server
         self.endpoint = format_endpoint(self._host, server.bserver._server.sockets[0].getsockname()[1])
+
+    def _on_register(self, registered: Any, conf: Any = None) -> None:
+        """RegisterServer: a registration within the limits is taken or renewed; one going offline ends now."""
+        self.registrations += 1
+        uri = registered.ServerUri
+        if not registered.IsOnline:  # the server goes offline: it leaves the list now
+            self._known.pop(uri, None)
+            self._renewed.pop(uri, None)
+            return
+        _check_registration(registered)
+        if uri not in self._renewed and len(self._renewed) >= MAX_REGISTERED:
+            self._expire(self._known)
+            if len(self._renewed) >= MAX_REGISTERED:
+                raise ua.UaStatusCodeError(ua.StatusCodes.BadResourceUnavailable)
+        self._renewed[uri] = time.monotonic()
+        self._register(registered, conf)
+
+    def _on_find(self, params: Any, sockname: Any = None) -> Any:
+        """FindServers: the registrations still kept (and the LDS itself)."""
+        self._expire(self._known)
+        return self._find(params, sockname)
 
     async def __aenter__(self) -> LocalDiscoveryServer:
         await self.start()
@@ -104,6 +123,18 @@ class LocalDiscoveryServer:
         if self._server is not None:
             server, self._server = self._server, None
             await server.stop()
+
+
+def _check_registration(registered: Any) -> None:
+    """Refuse (``BadInvalidArgument``) a registration beyond the limits: so whatever registers, the LDS's
+    FindServers answer stays well within the message limit of the controller that asks it."""
+    names = registered.ServerNames or []
+    texts = [registered.ServerUri, registered.ProductUri, registered.GatewayServerUri,
+             *(getattr(n, "Text", None) for n in names[:1]), *(getattr(n, "Locale", None) for n in names[:1])]
+    urls = registered.DiscoveryUrls or []
+    if not registered.ServerUri or not names or len(names) > MAX_URLS or not urls or len(urls) > MAX_URLS \
+            or any(len(t or "") > MAX_TEXT for t in texts) or any(len(u or "") > MAX_URL for u in urls):
+        raise ua.UaStatusCodeError(ua.StatusCodes.BadInvalidArgument)
 
 
 async def find_servers(lds: str, timeout: float) -> list[tuple[str, str]]:
