@@ -126,3 +126,32 @@ async def test_pnp_run_names_the_refused_lds_where_it_says_the_devices_missing(h
         "error: device(s) robot, gripper, sensor3d, binpicking-pc-ua, screwdriver-ua of the cell not found on the "
         f"network within 1 s; refused Local Discovery Server {hostile_lds}: its FindServers answer is larger than "
         f"{MAX_MESSAGE >> 20} MiB (at most 16 chunks of 64 KiB)"]
+
+
+async def test_a_silent_lds_holds_up_nothing(tmp_path: Path) -> None:
+    """An LDS that accepts the connection and never says a word is asked beside the search, as a device is
+    read: the device answering SSDP is in the cell while the LDS has not been refused yet (before, discovery
+    waited for the LDS's whole budget before it began)."""
+    writers: list[asyncio.StreamWriter] = []
+
+    async def mute(_reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        writers.append(writer)
+
+    silent = await asyncio.start_server(mute, "127.0.0.1", 0)
+    lds = format_endpoint("127.0.0.1", silent.sockets[0].getsockname()[1])
+    network = private_network()
+    try:
+        async with SimulatedDevice(_device("gripper"), network=network), \
+                LiveCell(load_taxonomy(), network=network, lds=lds, search_timeout=WAIT, expected=["gripper"],
+                         device_budget=10 * WAIT) as live:
+            assert [d.id for d in live.cell.devices] == ["gripper"]
+            assert live.refused == {}  # the LDS is still being asked
+            deadline = asyncio.get_running_loop().time() + WAIT
+            while not writers:  # it was asked (its connection accepted)
+                assert asyncio.get_running_loop().time() < deadline, "the LDS was never asked"
+                await asyncio.sleep(0.05)
+    finally:
+        for writer in writers:
+            writer.close()
+        silent.close()
+        await silent.wait_closed()

@@ -144,14 +144,11 @@ class LiveCell:
             await self._listener.stop()
             raise
         self._news = asyncio.get_running_loop().time()
-        if self.lds is not None:
-            try:
-                await self._asked_lds(self.lds)
-            except BaseException:
-                search.stop()
-                await self._listener.stop()
-                raise
-            self._lds_task = asyncio.create_task(self._follow_lds(self.lds))
+        if self.lds is not None:  # asked beside the search, as a device is read: a slow LDS holds up nothing
+            first = asyncio.create_task(self._asked_lds(self.lds))
+            self._readings.add(first)
+            first.add_done_callback(self._readings.discard)
+            self._lds_task = asyncio.create_task(self._follow_lds(self.lds, first))
         self._search = asyncio.create_task(self._follow_search(search))
         self._task = asyncio.create_task(self._follow())
         try:
@@ -257,8 +254,10 @@ class LiveCell:
             elif ad.udn in self._devices:
                 self._start(self._unplug_confirmed(ad.udn), ad)
 
-    async def _follow_lds(self, lds: str) -> None:
-        """Ask the LDS again and again: plug the devices newly registered, unplug those no longer registered."""
+    async def _follow_lds(self, lds: str, first: asyncio.Task[None]) -> None:
+        """After the ``first`` question, ask the LDS again and again: plug the devices newly registered, unplug
+        those no longer registered."""
+        await first
         while True:
             await asyncio.sleep(LDS_POLL)
             await self._asked_lds(lds)
