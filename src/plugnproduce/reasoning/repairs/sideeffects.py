@@ -21,6 +21,7 @@ from plugnproduce.reasoning.asp.derivation import Node, asp
 from plugnproduce.reasoning.asp.results import CheckResult, Repair
 from plugnproduce.reasoning.checks.offers import CELL
 from plugnproduce.reasoning.checks.plausibility import TASK, check
+from plugnproduce.reasoning.checks.recheck import Moves, recheck
 
 if TYPE_CHECKING:
     from plugnproduce.knowledge import Knowledge
@@ -62,6 +63,9 @@ class AssessedRepair:
     side_effects: tuple[SideEffect, ...]
     confirmed: bool
     """Checking the repaired task again finds it plausible (:func:`assess` proposes only such repairs)."""
+    checked: CheckResult | None = dataclasses.field(default=None, compare=False, repr=False)
+    """That check of the repaired task (in the cell with the devices the repair adds), for what follows from it
+    (its estimated cycle time), so that a long task is not checked once more."""
 
     @property
     def severity(self) -> int:
@@ -286,15 +290,16 @@ def assess(repairs: Sequence[Repair], task: Task, cell: Cell, knowledge: Knowled
     the solver's order. A repair the check does not confirm is no repair: it is left out. ``before``: the check
     of ``task`` in ``cell``, when the caller has it already."""
     before = before if before is not None else check(task, cell, knowledge)
+    moves = Moves(cell, knowledge, task, before)  # a long task's steps the repair left alone are not checked again
     out = []
     for r in repairs:
         added = tuple(d for d in catalogue if d.id in r.added_devices)
         the_cell = dataclasses.replace(cell, devices=cell.devices + added)
-        result = check(r.task, the_cell, knowledge)
+        result = (None if added else recheck(r.task, moves)) or check(r.task, the_cell, knowledge)
         if not result.plausible:
             continue
         effects = side_effects(task, r.task, result, the_cell, knowledge, before, r.origins)
-        out.append(AssessedRepair(0, r, tuple(effects), True))
+        out.append(AssessedRepair(0, r, tuple(effects), True, result))
     return [dataclasses.replace(a, rank=n) for n, a in enumerate(sorted(out, key=ranking), start=1)]
 
 
