@@ -51,6 +51,8 @@ class Moves:
         """The devices' states before the first step."""
         self.bindings: dict[Hashable, dict[str, str]] = {}
         self.moves: dict[tuple[Hashable, States], States] = {}
+        self.checked_again = 0
+        """How many steps :meth:`checked` has checked (the rest followed known moves)."""
         if straight(task):
             self.learn(task, result)
 
@@ -80,6 +82,7 @@ class Moves:
         devices = tuple(dataclasses.replace(d, initial=states.get(d.id, d.initial)) for d in self.cell.devices)
         run = Task("run", tuple(dataclasses.replace(st, index=k) for k, st in enumerate(steps, start=1)), "run")
         result = check(run, dataclasses.replace(self.cell, devices=devices), self.knowledge)
+        self.checked_again += len(steps)
         if not result.plausible:
             return None
         self.learn(run, result)
