@@ -93,6 +93,8 @@ class AssessedRepair:
 @dataclass(frozen=True)
 class _Cell:
     knowledge: Knowledge
+    _answers: dict[tuple[str, str | None, str], bool] = dataclasses.field(default_factory=dict, compare=False)
+    """What :meth:`is_a` and :meth:`process_is` answered (a long task asks the same at every step)."""
 
     @property
     def taxonomy(self) -> Taxonomy:
@@ -103,11 +105,17 @@ class _Cell:
         return self.knowledge.processes_by_id
 
     def is_a(self, iri: str | None, local: str) -> bool:
-        return iri is not None and self.taxonomy.is_a(iri, PNP_IRI + local)
+        key = ("concept", iri, local)
+        if key not in self._answers:
+            self._answers[key] = iri is not None and self.taxonomy.is_a(iri, PNP_IRI + local)
+        return self._answers[key]
 
     def process_is(self, command: str, local: str) -> bool:
-        proc = self.processes.get(command)
-        return proc is not None and any(self.is_a(c, local) for c in proc.classes)
+        key = ("process", command, local)
+        if key not in self._answers:
+            proc = self.processes.get(command)
+            self._answers[key] = proc is not None and any(self.is_a(c, local) for c in proc.classes)
+        return self._answers[key]
 
     def moves(self, command: str, role: str) -> bool:
         proc = self.processes.get(command)
@@ -220,9 +228,12 @@ def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: T
              original: Task, origins: Sequence[int]) -> list[SideEffect]:
     out: list[SideEffect] = []
     held: dict[str, int] = {}
+    concepts: dict[tuple[str, str | None], str | None] = {}  # _concept, indexed: the first device and state
+    for dev in reversed(cell.devices):
+        concepts.update({(dev.id, st.id): st.concept for st in reversed(dev.states)})
     for i, step in enumerate(result.steps, start=1):
         for d in step.bindings.values():
-            after = _concept(cell, d, _after(result, i).get(d))
+            after = concepts.get((d, _after(result, i).get(d)))
             if d in held and k.is_a(after, "Open") and not k.process_is(step.command, "PlaceProcess"):
                 picker = f"step {held[d]} ({result.steps[held[d] - 1].command})"
                 out.append(SideEffect("drops_part", f"step {i} ({step.command}) opens device '{d}', which holds the "
