@@ -4,15 +4,17 @@ medium task, and the repaired tasks are checked again from the task's own check 
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 from plugnproduce import service
-from plugnproduce.description.model import Cell, Loop, Task
+from plugnproduce.description.model import Cell, Loop, Step, Task
 from plugnproduce.reasoning.checks.plausibility import check
 from plugnproduce.reasoning.checks.recheck import Moves, recheck
 from plugnproduce.reasoning.repairs import repairs, windows
 from tests.reasoning.faulty_tasks import faulty_task
 
 KNOWLEDGE = service.knowledge()
+MACHINE_TENDING = Path(__file__).parents[1] / "data" / "libraries" / "machine-tending"
 
 
 def joined(parts: list[Task]) -> tuple[Task, list[range]]:
@@ -74,3 +76,24 @@ def test_a_task_with_a_loop_is_not_checked_from_moves(cell: Cell) -> None:
     best = windows.windowed_repair(task, cell, KNOWLEDGE, top=1)[0]
     looped = dataclasses.replace(best.task, loops=(Loop(1, 3, 4, None, 2),))
     assert recheck(looped, moves) is None
+
+
+def test_a_long_task_of_a_library_outside_the_package_is_checked_again_from_its_own_check() -> None:
+    cell_file = MACHINE_TENDING / "cells" / "machine-tending.yaml"
+    knowledge, cell = service.knowledge_for_cell(cell_file), service.cell(cell_file)
+    close = Step(0, "close-door")
+    cycle = [*service.task(MACHINE_TENDING / "tasks" / "machine-tending.yaml").steps, close]
+    door_open = [*service.task(MACHINE_TENDING / "tasks" / "machining-door-open.yaml").steps, close]
+    task, _ = joined([Task("cycle", tuple(steps), "t.yaml") for steps in
+                      (cycle * 4, door_open, cycle * 4, door_open, cycle * 3)])  # 89 steps: repaired in windows
+    before = check(task, cell, knowledge)
+    assert [(p.step, p.kind) for p in before.problems] == [(31, "wrong_state"), (65, "wrong_state")]
+    moves = Moves(cell, knowledge, task, before)
+    found = windows.repair(task, cell, knowledge, top=3)
+    assert [e.text for e in found[0].edits] == ["insert close-door before step 31 (machine)",
+                                                "insert close-door before step 65 (machine)"]
+    for r in found:
+        again = recheck(r.task, moves)
+        assert again is not None and again.plausible
+        assert again == check(r.task, cell, knowledge)
+    assert moves.checked_again < 10
