@@ -60,10 +60,18 @@ async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cel
         left = deadline - asyncio.get_running_loop().time()
         if left <= 0:
             raise DevicesMissing(f"device(s) {', '.join(missing)} of the cell not found on the network "
-                                 f"within {timeout:g} s")
+                                 f"within {timeout:g} s{_refusals(live)}")
         with contextlib.suppress(TimeoutError):
             await live.next_change(left)
     return Cell(live.cell.name, tuple(live.cell.device(d) for d in wanted))
+
+
+def _refusals(live: LiveCell) -> str:
+    """What discovery refused meanwhile (a device, a Local Discovery Server), the latest three, as the end of the
+    line that says what is missing: a device refused may be one of them, an LDS refused may have listed them."""
+    said = [r.reason if r.udn == r.location else f"{r.udn} at {r.location}: {r.reason}"
+            for r in list(live.refused.values())[-3:]]
+    return "".join(f"; refused {s}" for s in said)
 
 
 async def run_task(
