@@ -95,17 +95,6 @@ def _solved(rules: tuple[str, ...], facts: str) -> Model:
     return found[-1]
 
 
-def symbols(rules: Sequence[str], facts: str) -> list[clingo.Symbol]:
-    """The shown atoms of the one model of a program that needs no search, undecoded (for large models)."""
-    ctl, messages = _control(["--warn=none"])
-    _ground(ctl, messages, rules, facts)
-    found: list[Sequence[clingo.Symbol]] = []
-    result = ctl.solve(on_model=lambda m: found.append(m.symbols(shown=True)))
-    if not result.satisfiable or not found:
-        raise EncodingError(f"{', '.join(rules)} has no model for these facts; stratified encodings always have one")
-    return list(found[-1])
-
-
 def optimise(
     rules: Sequence[str],
     facts: str,

@@ -4,8 +4,9 @@ a device in another state than before, are checked again (a repaired long task c
 The check of a straight task (no loops, no branches, one round, no step taking another's output) is a fold over
 its steps: a step's bindings follow from the step and the cell alone, and the states it leaves its devices in
 and its problems from the step, the cell and the states its bound devices start in (chain.lp, resolve.lp,
-params.lp; the values against the devices' contracts, :mod:`.contracts` and :mod:`.accepts`, need only the
-step and its bindings); a device no step uses keeps its state. So each problem-free step of the earlier check
+params.lp; the values against the devices' contracts, :mod:`.contracts`, need only the step and its bindings,
+and whether a value is taken on its device's route, :mod:`.accepts`, the state that route starts from); a
+device no step uses keeps its state. So each problem-free step of the earlier check
 is a known move: the same step (command, bindings, values) starting from the same states of the same devices
 is problem-free again and leaves them as it did. :func:`recheck` follows the new task through those moves
 and checks, for real and with the states found there, every run of steps it has not seen
