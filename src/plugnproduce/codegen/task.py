@@ -26,8 +26,8 @@ from plugnproduce.codegen.specific import (
 from plugnproduce.description.model import Cell, ChartTransition, Command, Link, ProcessDescription, Step, Task
 from plugnproduce.description.paths import NoPath, in_concept
 from plugnproduce.errors import PlugNProduceError
+from plugnproduce.ontology.iris import concept_value, local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (
     Assign,

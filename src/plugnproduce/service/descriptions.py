@@ -8,16 +8,11 @@ from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, TypedDict
 
-from plugnproduce.description.loader import (
-    cell_libraries,
-    load_cell,
-    load_devices,
-    load_task,
-    parse_task,
-    task_to_yaml,
-)
+from plugnproduce.description.cellfile import cell_libraries, load_cell
 from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.description.taskfile import load_task, parse_task, task_to_yaml
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
+from plugnproduce.knowledge.devicecache import device_reader
 from plugnproduce.lazy import lazy_module
 from plugnproduce.resources import descriptions_path
 
@@ -49,9 +44,20 @@ def knowledge(libraries: tuple[str | Path, ...] = (), builtin: bool = True) -> K
 
 
 def knowledge_for_cell(path: str | Path, base: Knowledge | None = None) -> Knowledge:
-    """``base`` (default: built-in) with the libraries a cell file lists under ``libraries:``."""
+    """``base`` (default: built-in) with the libraries a cell file lists under ``libraries:`` (read back from the
+    cache folder as :func:`knowledge` is, unless ``base`` tries TBox files out)."""
     base = base or knowledge()
-    return base.with_libraries(library_folders(cell_libraries(path)))
+    extra = tuple(lib for lib in library_folders(cell_libraries(path)) if lib not in base.libraries)
+    if not extra:
+        return base
+    if base.extra_tbox or base.left_out:
+        return base.with_libraries(extra)
+    return _loaded(base.libraries + extra)
+
+
+def _read_cell(path: str | Path, k: Knowledge) -> Cell:
+    """A cell file with its devices, each read back from the cache folder while unchanged."""
+    return load_cell(path, k.taxonomy, k.device, device_reader(k.taxonomy))
 
 
 def _k(k: Knowledge | None) -> Knowledge:
@@ -75,14 +81,16 @@ def validate_tasks(tasks: list[Task], knowledge: Knowledge | None = None) -> Rep
 
 def cell(path: str | Path, knowledge: Knowledge | None = None) -> Cell:
     """Read a cell file (with the libraries it lists, added to ``knowledge``)."""
-    k = knowledge_for_cell(path, knowledge)
-    return load_cell(path, k.taxonomy, k.device)
+    return _read_cell(path, knowledge_for_cell(path, knowledge))
 
 
 def catalogue(folder: str | Path | None = None, knowledge: Knowledge | None = None) -> list[DeviceDescription]:
     """Read a catalogue of device descriptions (default: every device of the loaded libraries)."""
     k = _k(knowledge)
-    return list(k.devices) if folder is None else load_devices(folder, k.taxonomy)
+    if folder is None:
+        return list(k.devices)
+    read = device_reader(k.taxonomy)
+    return sorted((read(f) for f in sorted(Path(folder).glob("*.ttl"))), key=lambda d: d.id)
 
 
 def task(path: str | Path) -> Task:
@@ -138,7 +146,7 @@ def cell_and_knowledge(cell_or_path: CellArg, knowledge: Knowledge | None) -> tu
             return cell_or_path, knowledge_for_cell(cell_or_path.file, knowledge)
         return cell_or_path, _k(knowledge)
     k = knowledge_for_cell(cell_or_path, knowledge)
-    return load_cell(cell_or_path, k.taxonomy, k.device), k
+    return _read_cell(cell_or_path, k), k
 
 
 def as_task(task_or_path: TaskArg) -> Task:

@@ -19,7 +19,7 @@ from plugnproduce.codegen.specific import Flow, RegionResult, Varying
 from plugnproduce.codegen.task import GeneratedTask, StepChart, step_values
 from plugnproduce.description.model import ChartTransition, DeviceDescription, Loop, ProcessDescription, RegionState
 from plugnproduce.description.quantities.units import convert
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.timing.requests import DeviceTimer
 
 
