@@ -184,6 +184,5 @@ def test_a_warm_capabilities_or_check_loads_nothing_it_has_no_use_for(tmp_path: 
     answer = "9 of 12 process commands offered" if args[0] == "capabilities" else "bin-picking: plausible"
     assert answer in out and "exit 0" in out
     loaded = set(out.rsplit("loaded: ", 1)[1].split())
-    used = {"plugnproduce.codegen", "lxml"} if args[0] == "check" else set()  # a check estimates the cycle time
-    # along the specific process charts, which code generation builds
-    assert sorted(h for h in NOT_FOR_A_WARM_ANSWER if h in loaded and h not in used) == []
+    assert sorted(h for h in NOT_FOR_A_WARM_ANSWER if h in loaded) == []  # a check's cycle time estimate (which
+    # follows the specific process charts code generation builds) is read back too

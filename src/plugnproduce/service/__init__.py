@@ -122,7 +122,7 @@ if TYPE_CHECKING:
     )
     from plugnproduce.service.resumes import NotResumable, NoWayOn, Replan, Stopped, replan, rest_of_task, stopped_run
     from plugnproduce.service.teaching import ReportsNothing, Taught, judge_taught, reported_quantities, reported_value
-    from plugnproduce.timing.estimate import CycleTime
+    from plugnproduce.timing.cycle import CycleTime
     from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
@@ -159,7 +159,7 @@ _ELSEWHERE = {
     "Taxonomy": "plugnproduce.ontology.taxonomy",
     **dict.fromkeys(("concept_value", "local_name"), "plugnproduce.ontology.iris"),
     **dict.fromkeys(("Plan", "Unreachable"), "plugnproduce.planning"),
-    "CycleTime": "plugnproduce.timing.estimate",
+    "CycleTime": "plugnproduce.timing.cycle",
     **dict.fromkeys(("BATCH_CSV_HEADER", "ClusterAccess", "Configuration", "Engine", "bounded_lines",
                      "check_cluster_address",
                      "configurations_from", "read_configurations"), "plugnproduce.batch"),
