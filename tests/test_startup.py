@@ -167,11 +167,13 @@ NOT_FOR_A_WARM_ANSWER = ("pydantic", "asyncio", "owlready2", "pyshacl", "xmlsche
                          "plugnproduce.hmi", "plugnproduce.verification", "rdflib", "lxml", "networkx",
                          "plugnproduce.description.loader", "plugnproduce.batch", "plugnproduce.planning",
                          "plugnproduce.executor", "plugnproduce.service.batches", "plugnproduce.service.goals",
-                         "plugnproduce.service.resumes")
+                         "plugnproduce.service.resumes", "yaml", "plugnproduce.safeio",
+                         "plugnproduce.description.taskfile", "importlib.resources")
 """What answering ``pnp capabilities`` and ``pnp check`` from files seen before has no use for (typer turns the
 file names into paths without pydantic; the event loop is started only by the commands that talk to devices;
-the taxonomy, the processes and the cell's devices come read and reasoned from the cache folder, so neither RDF
-nor XML is parsed; the service loads only the use cases the command calls)."""
+the taxonomy, the processes, the cell's devices, the cell and task files and the cycle time come read and
+reasoned from the cache folder, so neither RDF, XML nor YAML is parsed; the service loads only the use cases the
+command calls)."""
 
 
 @pytest.mark.parametrize("args", [("capabilities", "--cell", "descriptions/cells/bin-picking.yaml"),

@@ -11,14 +11,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import yaml
-
 from plugnproduce.description.model import Cell, DeviceDescription
-from plugnproduce.description.taskfile import _mapping, _plain, _unknown_keys
 from plugnproduce.errors import DescriptionError, excerpt
-from plugnproduce.safeio import parse_yaml_node
+from plugnproduce.folders import kept
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # YAML is read when a cell file is not kept in the cache folder
+    import yaml
+
     from plugnproduce.ontology.taxonomy import Taxonomy
 
 
@@ -28,9 +27,34 @@ def _load_device(path: Path, taxonomy: Taxonomy) -> DeviceDescription:
     return load_device(path, taxonomy)
 
 
+def _files(value: object) -> bool:
+    return (isinstance(value, tuple) and len(value) == 2 and isinstance(value[0], str)
+            and isinstance(value[1], list) and all(isinstance(f, Path) and isinstance(n, int) for f, n in value[1]))
+
+
+def _folders(value: object) -> bool:
+    return isinstance(value, list) and all(isinstance(f, Path) for f in value)
+
+
 def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
-    """A cell file's name and its device description files with the lines that list them."""
-    p = Path(path)
+    """A cell file's name and its device description files with the lines that list them (as read before while
+    the file is unchanged, :func:`~plugnproduce.folders.kept`)."""
+    return kept("cellfiles", Path(path), _device_files, _files)
+
+
+def cell_libraries(path: str | Path) -> list[Path]:
+    """The library folders a cell file lists under ``libraries:`` (relative to the cell file; as read before
+    while the file is unchanged and each folder is there)."""
+    folders = kept("celllibraries", Path(path), _libraries, _folders)
+    return folders if all(f.is_dir() for f in folders) else _libraries(Path(path))
+
+
+def _device_files(p: Path) -> tuple[str, list[tuple[Path, int]]]:
+    import yaml
+
+    from plugnproduce.description.taskfile import _mapping, _plain, _unknown_keys
+    from plugnproduce.safeio import parse_yaml_node
+
     top = _mapping(parse_yaml_node(p), p, "cell")
     _unknown_keys(top, {"cell", "devices", "libraries"}, p, "cell")
     if "cell" not in top or "devices" not in top or not isinstance(top["devices"], yaml.SequenceNode):
@@ -43,9 +67,12 @@ def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
     return str(_plain(top["cell"])), files
 
 
-def cell_libraries(path: str | Path) -> list[Path]:
-    """The library folders a cell file lists under ``libraries:`` (relative to the cell file)."""
-    p = Path(path)
+def _libraries(p: Path) -> list[Path]:
+    import yaml
+
+    from plugnproduce.description.taskfile import _mapping
+    from plugnproduce.safeio import parse_yaml_node
+
     top = _mapping(parse_yaml_node(p), p, "cell")
     node = top.get("libraries")
     if node is None:

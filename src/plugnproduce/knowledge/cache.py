@@ -14,16 +14,13 @@ as the user's files.
 from __future__ import annotations
 
 import contextlib
-import functools
 import hashlib
-import os
 import pickle
-import sys
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
-import plugnproduce
 from plugnproduce import folders
+from plugnproduce.folders import code_digest as code_digest
 from plugnproduce.knowledge.libraries import Knowledge, Library
 from plugnproduce.ontology.taxonomy import ontology_files
 from plugnproduce.resources import ontology_path
@@ -41,21 +38,6 @@ def cache_folder() -> Path:
 
 def _files(root: Path) -> list[Path]:
     return sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts)
-
-
-@functools.lru_cache(maxsize=1)
-def code_digest() -> str:
-    """The package's code and the interpreter's version, by each module's name, size and time of change (reading
-    it all would cost more than it saves); looked at once per process."""
-    h = hashlib.sha256(f"{sys.version}\0".encode())
-    here = Path(plugnproduce.__file__).parent
-    for folder, dirs, names in os.walk(here):
-        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
-        for name in sorted(n for n in names if n.endswith(".py")):
-            stat = os.stat(os.path.join(folder, name))
-            h.update(f"{os.path.relpath(os.path.join(folder, name), here)}\0{stat.st_size}\0{stat.st_mtime_ns}\0"
-                     .encode())
-    return h.hexdigest()
 
 
 def digest(libraries: Sequence[Library]) -> str | None:

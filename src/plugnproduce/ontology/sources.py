@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING
 from urllib.parse import unquote, urljoin, urlparse
 
 from plugnproduce.errors import DescriptionError, HostileInputError, UnreadableError, tidy
-from plugnproduce.safeio import MAX_TRIPLES, parse_turtle_bytes, parse_xml_bytes, read_bytes
 
 if TYPE_CHECKING:  # the parsers are imported when a file is read: listing the files needs none of them
     import rdflib
@@ -62,6 +61,8 @@ _READ_MOST = 256
 
 def read_tbox_file(path: Path) -> TBoxFile:
     """Read one TBox file in whichever of the three formats it is; parsed once per content."""
+    from plugnproduce.safeio import read_bytes  # the hardened readers: when a file is read, not when one is listed
+
     p = Path(path)
     data = read_bytes(p)
     key = (str(p), hashlib.sha256(data).hexdigest())
@@ -73,6 +74,8 @@ def read_tbox_file(path: Path) -> TBoxFile:
 
 
 def _read(path: Path, data: bytes) -> TBoxFile:
+    from plugnproduce.safeio import MAX_TRIPLES, parse_turtle_bytes, parse_xml_bytes
+
     if not data.lstrip(b"\xef\xbb\xbf \t\r\n").startswith(b"<"):
         g, text = parse_turtle_bytes(data, path)
         return TBoxFile(path, g, "turtle", text)
@@ -185,6 +188,8 @@ def _catalogs(importer: Path, root: Path) -> list[Path]:
 
 def _catalog_entry(catalog: Path, iri: str) -> Path | None:
     """The file a Protégé catalog maps ``iri`` to (its ``uri`` entries; relative to the catalog or its xml:base)."""
+    from plugnproduce.safeio import parse_xml_bytes, read_bytes
+
     tree = parse_xml_bytes(read_bytes(catalog), catalog)
     for el in tree.getroot().iter(f"{{{_CATALOG_NS}}}uri"):
         if el.get("name", "").rstrip("#/") == iri.rstrip("#/") and el.get("uri"):

@@ -20,7 +20,6 @@ from plugnproduce.errors import OntologyError
 from plugnproduce.ontology.iris import PNP_IRI, local_name
 from plugnproduce.ontology.sources import folder_files
 from plugnproduce.resources import ontology_path
-from plugnproduce.safeio import read_bytes
 
 if TYPE_CHECKING:  # reading and classifying a TBox needs rdflib; the closure read back from a cache does not
     import rdflib
@@ -131,6 +130,8 @@ def _digest(files: Iterable[Path]) -> str:
     """The cache key of a TBox: every file's name and bytes, in order. The format is told by the bytes
     (see :mod:`~plugnproduce.ontology.sources`), so the same TBox saved as Turtle, RDF/XML or OWL/XML has three
     keys; imported files are among ``files`` (the libraries list them), so editing one reclassifies."""
+    from plugnproduce.safeio import read_bytes
+
     h = hashlib.sha256()
     for p in files:
         h.update(p.name.encode() + b"\0" + read_bytes(p) + b"\0")

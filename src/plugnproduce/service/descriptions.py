@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, TypedDict
 
 from plugnproduce.description.cellfile import cell_libraries, load_cell
 from plugnproduce.description.model import Cell, DeviceDescription, Task
-from plugnproduce.description.taskfile import load_task, parse_task, task_to_yaml
+from plugnproduce.folders import kept
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
 from plugnproduce.knowledge.devicecache import device_reader
 from plugnproduce.lazy import lazy_module
@@ -93,18 +93,28 @@ def catalogue(folder: str | Path | None = None, knowledge: Knowledge | None = No
     return sorted((read(f) for f in sorted(Path(folder).glob("*.ttl"))), key=lambda d: d.id)
 
 
-def task(path: str | Path) -> Task:
-    """Read a task file."""
+def _load_task(path: Path) -> Task:
+    from plugnproduce.description.taskfile import load_task  # YAML: only for a task file not kept
+
     return load_task(path)
+
+
+def task(path: str | Path) -> Task:
+    """Read a task file (as read before while the file is unchanged, :func:`plugnproduce.folders.kept`)."""
+    return kept("task", Path(path), _load_task, lambda value: isinstance(value, Task))
 
 
 def task_from_text(data: bytes | str, name: str) -> Task:
     """Read a task description from YAML text (an upload, an editor's buffer); ``name`` names it in messages."""
+    from plugnproduce.description.taskfile import parse_task
+
     return parse_task(data.encode("utf-8") if isinstance(data, str) else data, name)
 
 
 def task_text(the_task: Task, block: bool = False) -> str:
     """A task as a YAML task file (``block``: every value on a line of its own)."""
+    from plugnproduce.description.taskfile import task_to_yaml
+
     return task_to_yaml(the_task, block)
 
 
