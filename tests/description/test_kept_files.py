@@ -11,7 +11,8 @@ import pytest
 
 import plugnproduce.description.taskfile
 from plugnproduce import service
-from plugnproduce.description.cellfile import cell_device_files, cell_libraries
+from plugnproduce.description.cellfile import kept_cell_device_files as cell_device_files
+from plugnproduce.description.cellfile import kept_cell_libraries as cell_libraries
 from plugnproduce.description.model import Task
 from plugnproduce.errors import DescriptionError
 

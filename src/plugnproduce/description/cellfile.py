@@ -36,17 +36,25 @@ def _folders(value: object) -> bool:
     return isinstance(value, list) and all(isinstance(f, Path) for f in value)
 
 
-def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
-    """A cell file's name and its device description files with the lines that list them (as read before while
-    the file is unchanged, :func:`~plugnproduce.folders.kept`)."""
+def kept_cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
+    """:func:`cell_device_files`, as read before while the file is unchanged (:func:`~plugnproduce.folders.kept`)."""
     return kept("cellfiles", Path(path), _device_files, _files)
 
 
-def cell_libraries(path: str | Path) -> list[Path]:
-    """The library folders a cell file lists under ``libraries:`` (relative to the cell file; as read before
-    while the file is unchanged and each folder is there)."""
+def kept_cell_libraries(path: str | Path) -> list[Path]:
+    """:func:`cell_libraries`, as read before while the file is unchanged and each folder is there."""
     folders = kept("celllibraries", Path(path), _libraries, _folders)
     return folders if all(f.is_dir() for f in folders) else _libraries(Path(path))
+
+
+def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
+    """A cell file's name and its device description files with the lines that list them."""
+    return _device_files(Path(path))
+
+
+def cell_libraries(path: str | Path) -> list[Path]:
+    """The library folders a cell file lists under ``libraries:`` (relative to the cell file)."""
+    return _libraries(Path(path))
 
 
 def _device_files(p: Path) -> tuple[str, list[tuple[Path, int]]]:
@@ -116,13 +124,15 @@ def not_a_description(entry: Path) -> str | None:
 
 def load_cell(path: str | Path, taxonomy: Taxonomy,
               by_id: Callable[[str], DeviceDescription | None] | None = None,
-              read: Callable[[Path], DeviceDescription] | None = None) -> Cell:
-    """Read a cell (YAML) and all its device descriptions (each by ``read``, default
+              read: Callable[[Path], DeviceDescription] | None = None,
+              entries: Callable[[Path], tuple[str, list[tuple[Path, int]]]] = cell_device_files) -> Cell:
+    """Read a cell (YAML) and all its device descriptions (its entries by ``entries``, e.g.
+    :func:`kept_cell_device_files`; each device by ``read``, default
     :func:`~plugnproduce.description.loader.load_device` with ``taxonomy``).
 
     An entry that is no file but a plain id (``robot``) names a catalogue device, found by ``by_id``.
     """
-    name, files = cell_device_files(path)
+    name, files = entries(Path(path))
     devices = []
     for f, line in files:
         if (why := not_a_description(f)) is not None:

@@ -8,7 +8,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, TypedDict
 
-from plugnproduce.description.cellfile import cell_libraries, load_cell
+from plugnproduce.description.cellfile import kept_cell_device_files, kept_cell_libraries, load_cell
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.folders import kept
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
@@ -47,7 +47,7 @@ def knowledge_for_cell(path: str | Path, base: Knowledge | None = None) -> Knowl
     """``base`` (default: built-in) with the libraries a cell file lists under ``libraries:`` (read back from the
     cache folder as :func:`knowledge` is, unless ``base`` tries TBox files out)."""
     base = base or knowledge()
-    extra = tuple(lib for lib in library_folders(cell_libraries(path)) if lib not in base.libraries)
+    extra = tuple(lib for lib in library_folders(kept_cell_libraries(path)) if lib not in base.libraries)
     if not extra:
         return base
     if base.extra_tbox or base.left_out:
@@ -56,8 +56,8 @@ def knowledge_for_cell(path: str | Path, base: Knowledge | None = None) -> Knowl
 
 
 def _read_cell(path: str | Path, k: Knowledge) -> Cell:
-    """A cell file with its devices, each read back from the cache folder while unchanged."""
-    return load_cell(path, k.taxonomy, k.device, device_reader(k.taxonomy))
+    """A cell file with its devices, the file and each device read back from the cache folder while unchanged."""
+    return load_cell(path, k.taxonomy, k.device, device_reader(k.taxonomy), kept_cell_device_files)
 
 
 def _k(k: Knowledge | None) -> Knowledge:
