@@ -89,8 +89,9 @@ def catalogue(folder: str | Path | None = None, knowledge: Knowledge | None = No
     k = _k(knowledge)
     if folder is None:
         return list(k.devices)
-    read = device_reader(k.taxonomy)
-    return sorted((read(f) for f in sorted(Path(folder).glob("*.ttl"))), key=lambda d: d.id)
+    from plugnproduce.description.loader import load_devices  # a catalogue of thousands is read, not kept
+
+    return load_devices(folder, k.taxonomy)
 
 
 def _load_task(path: Path) -> Task:
