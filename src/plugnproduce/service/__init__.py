@@ -106,7 +106,7 @@ if TYPE_CHECKING:
         validate_tasks,
     )
     from plugnproduce.service.explanations import explain_offered, explain_plausible, explain_process, explain_step
-    from plugnproduce.service.goals import goal_from_text, plan, plan_pddl
+    from plugnproduce.service.goals import goal_findings, goal_from_text, plan, plan_pddl
     from plugnproduce.service.journals import new_run_id, report, runs, runs_folder
     from plugnproduce.service.programs import (
         Generated,
@@ -143,7 +143,7 @@ _ELSEWHERE = {
                     "plugnproduce.service.descriptions"),
     **dict.fromkeys(("explain_offered", "explain_plausible", "explain_process", "explain_step"),
                     "plugnproduce.service.explanations"),
-    **dict.fromkeys(("goal_from_text", "plan", "plan_pddl"), "plugnproduce.service.goals"),
+    **dict.fromkeys(("goal_findings", "goal_from_text", "plan", "plan_pddl"), "plugnproduce.service.goals"),
     **dict.fromkeys(("new_run_id", "report", "runs", "runs_folder"), "plugnproduce.service.journals"),
     **dict.fromkeys(("Generated", "Generation", "ImplausibleTask", "Unverified", "cycle_time", "generate",
                      "generation", "plan_run", "repair_cycle_times", "verify"), "plugnproduce.service.programs"),
@@ -252,6 +252,7 @@ __all__ = [
     "generate",
     "generate_configurations",
     "generation",
+    "goal_findings",
     "goal_from_text",
     "impact",
     "judge_taught",
