@@ -1,0 +1,62 @@
+"""The values a Specific Process State Chart sends: each request's arguments as the generated chart writes them
+(converted to the device's unit, a pose relative to a reported one, the defaults), and the states between."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from lxml import etree
+
+from plugnproduce import service
+
+NS = {"s": "http://www.w3.org/2005/07/scxml"}
+LIBRARIES = Path(__file__).parents[1] / "data" / "libraries"
+CELL = service.builtin("cells", "bin-picking.yaml")
+
+
+def sends(task: Path, cell: Path, libraries: tuple[Path, ...] = ()) -> list[tuple[str, str, list[tuple[str, str]]]]:
+    """Each request of the task chart: the controller state it leaves, its event and its (argument, expr) pairs."""
+    generation = service.generation(task, cell, knowledge=service.knowledge(libraries))
+    assert generation.check.plausible, [str(p) for p in generation.check.problems]
+    tree = etree.fromstring(next(c.data for c in generation.charts if c.kind == "task"))
+    return [(s.getparent().getparent().get("id"), s.get("event"), [(p.get("name"), p.get("expr")) for p in s])
+            for s in tree.iterfind(".//s:send", NS) if ".request." in (s.get("event") or "")]
+
+
+def test_a_force_in_newtons_is_sent_in_the_kilonewtons_the_device_takes(tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text("task: close-in-kn\nsteps:\n  - command: close-gripper\n    params: {grip_force: 45}\n"
+                    "  - command: move-to\n  - command: open-gripper\n", encoding="utf-8")
+    library = LIBRARIES / "kilonewton-gripper"
+    assert sends(task, library / "cells" / "bin-picking-kn.yaml", (library,)) == [
+        ("s1_kn_gripper_open", "xirp.request.Close", [("GripForce", "0.045")]),
+        # the process's own defaults: the speed a number, the pose written as text in the ontology
+        ("s2_robot_idle", "xirp.request.MoveTo", [("Speed", "50"), ("TargetPose", "[0.30, 0.00, 0.40, 0, 180, 0]")]),
+        ("s3_kn_gripper_closed", "xirp.request.Open", [])]
+
+
+def test_a_pose_relative_to_a_reported_one_is_the_reported_pose_plus_its_offset() -> None:
+    found = "pnp_out_localize_part_pose"
+    lifted = "[" + ", ".join(f"{found}[{i}] + {o}" for i, o in enumerate((0.0, 0.0, 0.2, 0.0, 0.0, 0.0))) + "]"
+    requests = sends(LIBRARIES / "relative-lift" / "tasks" / "lift-with-the-part.yaml", CELL)
+    assert requests[:6] == [
+        ("s1_binpicking_pc_ready", "upnp.request.Localize", [("PartType", "'bracket'")]),
+        ("s1_sensor3d_ready", "upnp.request.Capture", [("Exposure", "25")]),
+        ("s2_gripper_open", "xirp.request.Close", [("GripForce", "45")]),
+        ("s2_robot_idle", "xirp.request.MoveTo", [("TargetPose", found), ("Speed", "50")]),
+        ("s2_robot_at_part", "xirp.request.MoveTo", [("TargetPose", lifted), ("Speed", "50")]),
+        ("s3_gripper_closed", "xirp.request.Open", [])]
+    assert ("s3_robot_idle", "xirp.request.MoveTo", [("TargetPose", "[0.6, -0.2, 0.1, 0, 180, 0]"),
+                                                     ("Speed", "80")]) in requests
+
+
+@pytest.mark.parametrize(("value", "expr"), [
+    ("[0.55, -0.25, 0.1, 0, 180, 0]", "[0.55, -0.25, 0.1, 0, 180, 0]"),
+    ('"0.55 -0.25 0.1 0 180 0"', "[0.55, -0.25, 0.1, 0, 180, 0]"),
+])
+def test_a_pose_written_as_a_list_or_as_text_is_sent_as_a_list(tmp_path: Path, value: str, expr: str) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text(f"task: pose\nsteps:\n  - command: move-to\n    params: {{target_pose: {value}, speed: 30}}\n",
+                    encoding="utf-8")
+    assert sends(task, CELL) == [("s1_robot_idle", "xirp.request.MoveTo", [("Speed", "30"), ("TargetPose", expr)])]
