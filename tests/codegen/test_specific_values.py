@@ -60,3 +60,19 @@ def test_a_pose_written_as_a_list_or_as_text_is_sent_as_a_list(tmp_path: Path, v
     task.write_text(f"task: pose\nsteps:\n  - command: move-to\n    params: {{target_pose: {value}, speed: 30}}\n",
                     encoding="utf-8")
     assert sends(task, CELL) == [("s1_robot_idle", "xirp.request.MoveTo", [("Speed", "30"), ("TargetPose", expr)])]
+
+
+def test_a_library_request_takes_its_length_in_millimetres_and_the_glue_it_is_not_given(tmp_path: Path) -> None:
+    library = LIBRARIES / "glue-dispensing"
+    task = tmp_path / "task.yaml"
+    task.write_text("task: glue\nsteps:\n  - command: lay-bead\n    params: {length: 12 cm}\n", encoding="utf-8")
+    assert sends(task, library / "cells" / "glue-cell.yaml", (library,)) == [
+        ("s1_dispenser_ready", "upnp.request.Dispense", [("GlueKind", "'epoxy'"), ("BeadLength", "120.0")])]
+
+
+def test_a_text_of_six_words_that_are_no_numbers_is_sent_as_text(tmp_path: Path) -> None:
+    task = tmp_path / "task.yaml"
+    task.write_text("task: words\nsteps:\n  - command: localize-part\n"
+                    "    params: {exposure: 25, part_type: big red bracket with two holes}\n", encoding="utf-8")
+    assert sends(task, CELL)[0] == ("s1_binpicking_pc_ready", "upnp.request.Localize",
+                                    [("PartType", "'big red bracket with two holes'")])
