@@ -3,12 +3,17 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
 from lxml import etree
 
 from plugnproduce import service
+from plugnproduce.description.loader import load_device
+from plugnproduce.executor.chartmap import StateInfo, chart_map
+from plugnproduce.statechart import parse_chart
+from tests.conftest import edit
 
 NS = {"s": "http://www.w3.org/2005/07/scxml"}
 LIBRARIES = Path(__file__).parents[1] / "data" / "libraries"
@@ -76,3 +81,40 @@ def test_a_text_of_six_words_that_are_no_numbers_is_sent_as_text(tmp_path: Path)
                     "    params: {exposure: 25, part_type: big red bracket with two holes}\n", encoding="utf-8")
     assert sends(task, CELL)[0] == ("s1_binpicking_pc_ready", "upnp.request.Localize",
                                     [("PartType", "'big red bracket with two holes'")])
+
+
+def test_a_library_process_whose_states_do_not_begin_with_the_role_keeps_their_names(tmp_path: Path) -> None:
+    # a library's squeeze: the close-gripper process with its general states named jaws_open and jaws_closed
+    processes = tmp_path / "squeezing" / "processes"
+    processes.mkdir(parents=True)
+    for suffix in (".ttl", ".scxml"):
+        text = service.builtin("processes", "close-gripper" + suffix).read_text(encoding="utf-8")
+        text = text.replace("close-gripper", "squeeze").replace("gripper_open", "jaws_open")
+        (processes / ("squeeze" + suffix)).write_text(text.replace("gripper_closed", "jaws_closed"), encoding="utf-8")
+    task = tmp_path / "task.yaml"
+    task.write_text("task: squeeze\nsteps:\n  - command: squeeze\n    params: {grip_force: 45}\n", encoding="utf-8")
+    assert sends(task, CELL, (tmp_path / "squeezing",)) == [
+        ("s1_gripper_jaws_open", "xirp.request.Close", [("GripForce", "45")])]
+
+
+def test_the_journal_reads_each_state_of_a_region_as_its_devices_state() -> None:
+    # what the executor tells of each controller state of the localisation: its device and the device's state
+    generation = service.generation(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
+    chart = parse_chart(next(c.data for c in generation.charts if c.kind == "task"), "task.scxml")
+    found = {k: v for k, v in chart_map(chart).items() if k.startswith("s1_binpicking")}
+    assert found == {f"s1_binpicking_pc{name}": StateInfo("binpicking-pc", state, "localize-part", False)
+                     for name, state in (("", None), ("_ready", "ready"), ("_localizing", "localizing"),
+                                         ("_done", "localized"))}
+
+
+def test_a_force_for_a_device_that_declares_no_unit_is_sent_as_written(tmp_path: Path) -> None:
+    # the gripper's Close takes a plain number: the 45 N of the task go out as 45, not converted to a float
+    for f in ("gripper.ttl", "gripper.scxml"):
+        shutil.copy(service.builtin("devices", f), tmp_path)
+    edit(tmp_path / "gripper.ttl", 'pnp:unit "N" ;\n    pnp:minValue 20', 'pnp:unit "" ;\n    pnp:minValue 20')
+    cell = service.cell(CELL).with_device(load_device(tmp_path / "gripper.ttl", service.knowledge().taxonomy))
+    task = tmp_path / "task.yaml"
+    task.write_text("task: plain\nsteps:\n  - command: close-gripper\n    params: {grip_force: 45}\n", encoding="utf-8")
+    generation = service.generation(task, cell)
+    chart = etree.fromstring(next(c.data for c in generation.charts if c.kind == "task"))
+    assert [(p.get("name"), p.get("expr")) for p in chart.iterfind(".//s:send/s:param", NS)] == [("GripForce", "45")]
