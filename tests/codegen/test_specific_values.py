@@ -100,11 +100,14 @@ def test_a_library_process_whose_states_do_not_begin_with_the_role_keeps_their_n
 def test_the_journal_reads_each_state_of_a_region_as_its_devices_state() -> None:
     # what the executor tells of each controller state of the localisation: its device and the device's state
     generation = service.generation(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
-    chart = parse_chart(next(c.data for c in generation.charts if c.kind == "task"), "task.scxml")
-    found = {k: v for k, v in chart_map(chart).items() if k.startswith("s1_binpicking")}
+    data = next(c.data for c in generation.charts if c.kind == "task")
+    found = {k: v for k, v in chart_map(parse_chart(data, "task.scxml")).items() if k.startswith("s1_binpicking")}
     assert found == {f"s1_binpicking_pc{name}": StateInfo("binpicking-pc", state, "localize-part", False)
                      for name, state in (("", None), ("_ready", "ready"), ("_localizing", "localizing"),
                                          ("_done", "localized"))}
+    region = etree.fromstring(data).find(".//s:state[@id='s1_binpicking_pc']", NS)
+    pnp = "{http://plugnproduce.org/ontology#}"
+    assert (region.get(pnp + "role"), region.get(pnp + "device")) == ("localizer", "binpicking-pc")
 
 
 def test_a_force_for_a_device_that_declares_no_unit_is_sent_as_written(tmp_path: Path) -> None:
@@ -118,3 +121,12 @@ def test_a_force_for_a_device_that_declares_no_unit_is_sent_as_written(tmp_path:
     generation = service.generation(task, cell)
     chart = etree.fromstring(next(c.data for c in generation.charts if c.kind == "task"))
     assert [(p.get("name"), p.get("expr")) for p in chart.iterfind(".//s:send/s:param", NS)] == [("GripForce", "45")]
+
+
+def test_the_cycle_time_follows_each_regions_path_and_its_synchronisation() -> None:
+    # the localizer waits for the sensor's capture (180 ms) before localizing (150 ms); a pick moves the robot
+    # (250 ms), closes the gripper (120 ms) once there, and lifts (250 ms)
+    estimate = service.cycle_time(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
+    assert estimate is not None
+    assert [(s.step, s.command, round(s.seconds, 6)) for s in estimate.steps[:3]] == [
+        (1, "localize-part", 0.33), (2, "pick", 0.62), (3, "place", 0.62)]
