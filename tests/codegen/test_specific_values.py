@@ -101,10 +101,14 @@ def test_the_journal_reads_each_state_of_a_region_as_its_devices_state() -> None
     # what the executor tells of each controller state of the localisation: its device and the device's state
     generation = service.generation(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
     data = next(c.data for c in generation.charts if c.kind == "task")
-    found = {k: v for k, v in chart_map(parse_chart(data, "task.scxml")).items() if k.startswith("s1_binpicking")}
+    states = chart_map(parse_chart(data, "task.scxml"))
+    found = {k: v for k, v in states.items() if k.startswith("s1_binpicking")}
     assert found == {f"s1_binpicking_pc{name}": StateInfo("binpicking-pc", state, "localize-part", False)
                      for name, state in (("", None), ("_ready", "ready"), ("_localizing", "localizing"),
                                          ("_done", "localized"))}
+    # the pick's gripper: between sending Close and the event that it closed, the state the device is in
+    assert {k: v.device_state for k, v in states.items() if k.startswith("s2_gripper")} == {
+        "s2_gripper": None, "s2_gripper_open": "open", "s2_gripper_closed_1a": "closing", "s2_gripper_closed": "closed"}
     region = etree.fromstring(data).find(".//s:state[@id='s1_binpicking_pc']", NS)
     pnp = "{http://plugnproduce.org/ontology#}"
     assert (region.get(pnp + "role"), region.get(pnp + "device")) == ("localizer", "binpicking-pc")
