@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from lxml import etree
+from statemachine.io.scxml.processor import SCXMLProcessor
 
 from plugnproduce import service
 from plugnproduce.description.loader import load_device
@@ -134,3 +135,16 @@ def test_the_cycle_time_follows_each_regions_path_and_its_synchronisation() -> N
     assert estimate is not None
     assert [(s.step, s.command, round(s.seconds, 6)) for s in estimate.steps[:3]] == [
         (1, "localize-part", 0.33), (2, "pick", 0.62), (3, "place", 0.62)]
+
+
+def test_a_general_transition_the_device_needs_no_move_for_goes_straight_on(tmp_path: Path) -> None:
+    # the holding library's hold: from AtPose to AtPose, after a move-to left the robot at its pose
+    task = tmp_path / "task.yaml"
+    task.write_text("task: hold\nsteps:\n  - command: move-to\n  - command: hold\n", encoding="utf-8")
+    generation = service.generation(task, CELL, knowledge=service.knowledge((LIBRARIES / "holding",)))
+    chart = etree.fromstring(next(c.data for c in generation.charts if c.kind == "task"))
+    there = chart.find(".//s:state[@id='s2_robot_there']", NS)
+    assert [(t.get("event"), t.get("cond"), t.get("target")) for t in there] == [(None, None, "s2_robot_still")]
+    processor = SCXMLProcessor()
+    processor.parse_scxml("closed_world", next(c.data for c in generation.charts if c.kind == "closed-world").decode())
+    assert set(processor.start().configuration_values) == {"done"}
