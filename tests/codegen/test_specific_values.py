@@ -138,13 +138,16 @@ def test_the_cycle_time_follows_each_regions_path_and_its_synchronisation() -> N
 
 
 def test_a_general_transition_the_device_needs_no_move_for_goes_straight_on(tmp_path: Path) -> None:
-    # the holding library's hold: from AtPose to AtPose, after a move-to left the robot at its pose
+    # the holding library's hold: from AtPose to AtPose once the gripper is open, after a move-to
     task = tmp_path / "task.yaml"
     task.write_text("task: hold\nsteps:\n  - command: move-to\n  - command: hold\n", encoding="utf-8")
     generation = service.generation(task, CELL, knowledge=service.knowledge((LIBRARIES / "holding",)))
     chart = etree.fromstring(next(c.data for c in generation.charts if c.kind == "task"))
     there = chart.find(".//s:state[@id='s2_robot_there']", NS)
-    assert [(t.get("event"), t.get("cond"), t.get("target")) for t in there] == [(None, None, "s2_robot_still")]
+    assert [(t.get("event"), t.get("cond"), t.get("target")) for t in there] == [
+        (None, "In('s2_gripper_open')", "s2_robot_still")]
+    # the gripper's role has one state: it is done at once
+    assert chart.find(".//s:state[@id='s2_gripper']/s:final[@id='s2_gripper_open']", NS) is not None
     processor = SCXMLProcessor()
     processor.parse_scxml("closed_world", next(c.data for c in generation.charts if c.kind == "closed-world").decode())
     assert set(processor.start().configuration_values) == {"done"}
