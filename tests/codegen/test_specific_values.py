@@ -151,3 +151,16 @@ def test_a_general_transition_the_device_needs_no_move_for_goes_straight_on(tmp_
     processor = SCXMLProcessor()
     processor.parse_scxml("closed_world", next(c.data for c in generation.charts if c.kind == "closed-world").decode())
     assert set(processor.start().configuration_values) == {"done"}
+
+
+def test_an_argument_the_process_does_not_supply_takes_the_devices_own_default(tmp_path: Path) -> None:
+    # the glue library with no default glue in its process: the dispenser's own default (here acrylic) goes out
+    library = tmp_path / "glue-dispensing"
+    shutil.copytree(LIBRARIES / "glue-dispensing", library)
+    edit(library / "devices" / "dispenser.ttl", 'pnp:defaultValue "epoxy"', 'pnp:defaultValue "acrylic"')
+    edit(library / "processes" / "lay-bead.ttl", 'pnp:unit "" ;   # a text has no unit: ""\n    pnp:defaultValue "epoxy" .',
+         'pnp:unit "" .')
+    task = tmp_path / "task.yaml"
+    task.write_text("task: glue\nsteps:\n  - command: lay-bead\n    params: {length: 12 cm}\n", encoding="utf-8")
+    assert sends(task, library / "cells" / "glue-cell.yaml", (library,)) == [
+        ("s1_dispenser_ready", "upnp.request.Dispense", [("BeadLength", "120.0"), ("GlueKind", "'acrylic'")])]
