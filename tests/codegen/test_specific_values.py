@@ -164,3 +164,12 @@ def test_an_argument_the_process_does_not_supply_takes_the_devices_own_default(t
     task.write_text("task: glue\nsteps:\n  - command: lay-bead\n    params: {length: 12 cm}\n", encoding="utf-8")
     assert sends(task, library / "cells" / "glue-cell.yaml", (library,)) == [
         ("s1_dispenser_ready", "upnp.request.Dispense", [("BeadLength", "120.0"), ("GlueKind", "'acrylic'")])]
+
+
+def test_the_generated_program_lists_each_devices_requests_and_events_in_order() -> None:
+    commands = service.generate(service.builtin("tasks", "bin-picking.yaml"), CELL).task.commands()
+    first = [(device, c.kind, c.name) for step, device, c in commands if step == 2]
+    assert first == [("gripper", "request", "Open"), ("gripper", "event", "gripper_opened"),
+                     ("robot", "request", "MoveTo"), ("robot", "event", "motion_done"),
+                     ("robot", "request", "MoveTo"), ("robot", "event", "motion_done")]
+    assert len(commands) == 48
