@@ -10,6 +10,7 @@ import pytest
 
 from plugnproduce import reasoning, service
 from plugnproduce.description.loader import load_device
+from plugnproduce.errors import UnknownName
 from plugnproduce.reasoning.checks import branches, plausibility
 from tests.conftest import edit
 from tests.reasoning.test_flow_check import CELL, checked, line_of
@@ -234,8 +235,26 @@ def test_a_task_over_the_limits_is_refused_at_the_branch_where_they_were_passed(
     _limits(monkeypatch, paths, steps)
     result, path = checked(tmp_path, LIMITED)
     [problem] = result.problems
-    assert problem.kind == "too_many_paths" and problem.where.line == line_of(path, "PartFound:")
+    assert (problem.step, problem.command, problem.kind) == (1, "localize-part", "too_many_paths")
+    assert str(problem.where) == f"{path}:{line_of(path, 'PartFound:')}" and problem.reason.where == (problem.where,)
     assert f"at most {paths} paths of {steps} steps in all" in problem.text
+    assert (result.task, result.cell, result.plausible, result.steps) == ("three-paths", "bin-picking", False, ())
+
+
+@pytest.mark.parametrize("n", [0, 5])
+def test_a_step_the_branched_task_does_not_have_is_not_explained(tmp_path: Path, n: int) -> None:
+    path = tmp_path / "task.yaml"
+    path.write_text(LIMITED, encoding="utf-8")
+    with pytest.raises(UnknownName) as refused:
+        service.explain_step(path, CELL, n)
+    assert str(refused.value) == f"unknown step {n}; the task has steps 1 to 4"
+
+
+def test_the_first_step_of_a_branched_task_is_explained_as_the_first(tmp_path: Path) -> None:
+    path = tmp_path / "task.yaml"
+    path.write_text(LIMITED, encoding="utf-8")
+    ex = service.explain_step(path, CELL, 1)
+    assert (ex.step, ex.command, ex.plausible) == (1, "localize-part", True)
 
 
 GRIPPER_CLOSED = """task: closed
