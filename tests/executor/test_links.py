@@ -1,0 +1,188 @@
+"""The controller's link to one device, per protocol, against one simulated device on loopback (no cell, no run):
+what a request sends, which device an event, a lost connection or an anomaly is reported for, and the state asked."""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+from collections.abc import AsyncIterator, Mapping
+from contextlib import asynccontextmanager
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from plugnproduce import service
+from plugnproduce.description.model import DeviceDescription
+from plugnproduce.errors import ProtocolError
+from plugnproduce.executor.links import DeviceLink, UpnpLink, open_link, query_report, query_state
+from plugnproduce.protocols import upnp, xirp
+from plugnproduce.sim.bin import SimulatedBin
+from plugnproduce.sim.device import SimulatedDevice
+from tests.lines import WAIT
+
+BIN_PICKING = service.builtin("cells", "bin-picking.yaml")
+MIXED = service.builtin("cells", "mixed.yaml")
+
+
+def device(cell: Path, name: str) -> DeviceDescription:
+    return service.cell(cell).device(name)
+
+
+class Heard:
+    """What a link reported through its three callbacks, in order, each with the device it named."""
+
+    def __init__(self) -> None:
+        self.events: asyncio.Queue[tuple[str, str, Mapping[str, Any]]] = asyncio.Queue()
+        self.lost: asyncio.Queue[tuple[str, str]] = asyncio.Queue()
+        self.anomalies: asyncio.Queue[tuple[str, str]] = asyncio.Queue()
+
+    async def open(self, live: DeviceDescription) -> DeviceLink:
+        return await open_link(live, lambda d, name, params: self.events.put_nowait((d, name, params)),
+                               lambda d, reason: self.lost.put_nowait((d, reason)),
+                               lambda d, what: self.anomalies.put_nowait((d, what)))
+
+
+@asynccontextmanager
+async def simulated(described: DeviceDescription, **options: Any) -> AsyncIterator[tuple[SimulatedDevice,
+                                                                                         DeviceDescription]]:
+    """One simulated device on a private SSDP network, and its description pointing at where it listens."""
+    async with SimulatedDevice(described, network=upnp.private_network(), **options) as sim:
+        yield sim, dataclasses.replace(described, endpoint=sim.endpoint, command_timeout=WAIT)
+
+
+async def test_an_xirp_link_sends_the_request_and_reports_the_event_for_its_device() -> None:
+    heard = Heard()
+    async with simulated(device(BIN_PICKING, "gripper")) as (sim, live):
+        link = await heard.open(live)
+        try:
+            assert await link.state(WAIT) == "open"
+            await link.request("Close", {"GripForce": 40}, WAIT)
+            assert await asyncio.wait_for(heard.events.get(), WAIT) == ("gripper", "gripper_closed", {})
+            assert await link.state(WAIT) == "closed" == sim.state
+        finally:
+            await link.close()
+    assert heard.lost.empty() and heard.anomalies.empty()  # a polite close is no lost connection
+
+
+async def test_an_xirp_request_the_device_refuses_raises_with_its_reason() -> None:
+    async with simulated(device(BIN_PICKING, "gripper")) as (_, live):
+        link = await Heard().open(live)
+        try:
+            with pytest.raises(ProtocolError, match="gripper is open; it does not accept Open now"):
+                await link.request("Open", {}, WAIT)
+        finally:
+            await link.close()
+
+
+async def test_a_pulled_xirp_cable_is_reported_as_lost_for_its_device() -> None:
+    heard = Heard()
+    async with simulated(device(BIN_PICKING, "gripper")) as (sim, live):
+        link = await heard.open(live)
+        try:
+            assert await sim.drop_connections() == 1
+            who, reason = await asyncio.wait_for(heard.lost.get(), WAIT)
+        finally:
+            await link.close()
+    assert who == "gripper" and "connection" in reason
+
+
+async def test_a_duplicated_xirp_event_is_reported_as_an_anomaly_of_its_device() -> None:
+    heard = Heard()
+    faults = xirp.Faults()
+    faults.add(xirp.FaultKind.DUPLICATE_EVENT, "gripper_closed")
+    async with simulated(device(BIN_PICKING, "gripper"), faults=faults) as (_, live):
+        link = await heard.open(live)
+        try:
+            await link.request("Close", {"GripForce": 40}, WAIT)
+            who, what = await asyncio.wait_for(heard.anomalies.get(), WAIT)
+        finally:
+            await link.close()
+    assert who == "gripper" and "gripper_closed" in what
+    assert (await heard.events.get())[:2] == ("gripper", "gripper_closed") and heard.events.empty()
+
+
+async def test_a_upnp_link_sends_the_action_and_reports_the_event_with_the_values_it_carries() -> None:
+    heard = Heard()
+    parts = SimulatedBin(3, seed=5)
+    top = max(SimulatedBin(3, seed=5).parts, key=lambda p: p.pose[2])
+    async with simulated(device(BIN_PICKING, "binpicking-pc"), bin=parts) as (_, live):
+        link = await heard.open(live)
+        try:
+            assert isinstance(link, UpnpLink)
+            assert await link.state(WAIT) == "ready"
+            await link.request("Localize", {"PartType": "bracket"}, WAIT)
+            event = await asyncio.wait_for(heard.events.get(), WAIT)
+            assert await link.state(WAIT) == "localized"
+        finally:
+            await link.close()
+    assert event == ("binpicking-pc", "PartLocalized",
+                     {"outcome": "PartFound", "part_pose": top.pose, "part_type": "bracket"})
+    assert heard.events.empty()  # the values came with the event, not as events of their own
+
+
+async def test_a_upnp_link_writes_a_pose_as_the_wire_format_says() -> None:
+    async with simulated(device(BIN_PICKING, "binpicking-pc")) as (_, live):
+        received: list[dict[str, Any]] = []
+
+        async def handler(action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
+            received.append({"action": action, **arguments})
+            return {upnp.STATE_ARGUMENT: ""} if action == upnp.STATE_ACTION else {"Result": "accepted"}
+
+        spec = upnp.with_state_query(upnp.service_spec_from_chart_events({"MoveTo": ["TargetPose", "Speed"]}, []))
+        async with upnp.UpnpDeviceServer("scara", "Recording robot", upnp.device_type_for("Robot"), spec, handler,
+                                         network=upnp.private_network()) as server:
+            recording = dataclasses.replace(live, id="scara", endpoint=server.location or "")
+            link = await Heard().open(recording)
+            try:
+                await link.request("MoveTo", {"TargetPose": [0.4, 0.1, 0.05, 0, 180, 0], "Speed": 50}, WAIT)
+                with pytest.raises(ProtocolError, match=f"^device scara: {upnp.STATE_ACTION} answered no {upnp.STATE_ARGUMENT}$"):
+                    await link.state(WAIT)
+            finally:
+                await link.close()
+    assert received == [{"action": "MoveTo", "TargetPose": "0.4 0.1 0.05 0 180 0", "Speed": "50"},
+                        {"action": upnp.STATE_ACTION}]
+
+
+async def test_an_opc_ua_method_answer_is_reported_as_the_event_it_stands_for() -> None:
+    heard = Heard()
+    async with simulated(device(MIXED, "binpicking-pc-ua")) as (_, live):
+        link = await heard.open(live)
+        try:
+            assert await link.state(WAIT) == "ready"
+            await link.request("Localize", {"PartType": "bracket"}, WAIT)
+            event = heard.events.get_nowait()  # the method's output arguments: there when the call returns
+            assert await link.state(WAIT) == "localized"
+        finally:
+            await link.close()
+    assert event[:2] == ("binpicking-pc-ua", "PartLocalized")
+    assert event[2]["part_pose"] == [0.4, 0.1, 0.05, 0.0, 180.0, 0.0]
+    assert heard.lost.empty() and heard.anomalies.empty()
+
+
+@pytest.mark.parametrize(("cell", "name", "state"), [(BIN_PICKING, "gripper", "open"),
+                                                       (BIN_PICKING, "binpicking-pc", "ready")])
+async def test_query_state_answers_the_state_of_its_device_chart(cell: Path, name: str, state: str) -> None:
+    async with simulated(device(cell, name)) as (_, live):
+        assert await query_state(live, WAIT) == state
+
+
+async def test_query_report_reads_the_pose_the_robot_reports_with_its_state() -> None:
+    async with simulated(device(BIN_PICKING, "robot")) as (_, live):
+        state, values = await query_report(live, WAIT)
+    assert (state, list(values)) == ("home", ["TargetPose"])
+    assert list(values["TargetPose"]) == [0.4, 0.0, 0.6, 0.0, 180.0, 0.0]
+
+
+async def test_query_report_over_upnp_says_its_state_query_reports_the_state_only() -> None:
+    async with simulated(device(BIN_PICKING, "binpicking-pc")) as (_, live):
+        with pytest.raises(ProtocolError, match="^device binpicking-pc speaks upnp, whose state query reports its "
+                                                "state only; values are read with it over XIRP$"):
+            await query_report(live, WAIT)
+
+
+async def test_a_protocol_no_link_speaks_is_refused_naming_the_three_that_are() -> None:
+    odd = dataclasses.replace(device(BIN_PICKING, "gripper"), protocol="modbus")
+    with pytest.raises(ProtocolError, match="^device gripper: protocol 'modbus' is not supported; "
+                                            "expected xirp, upnp or opcua$"):
+        await Heard().open(odd)
