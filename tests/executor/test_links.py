@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import dataclasses
+import math
 from collections.abc import AsyncIterator, Mapping
 from contextlib import asynccontextmanager
 from pathlib import Path
@@ -14,7 +15,7 @@ import pytest
 
 from plugnproduce import service
 from plugnproduce.description.model import DeviceDescription
-from plugnproduce.errors import ProtocolError
+from plugnproduce.errors import ProtocolError, ProtocolTimeout
 from plugnproduce.executor.links import DeviceLink, UpnpLink, open_link, query_report, query_state
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.sim.bin import SimulatedBin
@@ -23,6 +24,10 @@ from tests.lines import WAIT
 
 BIN_PICKING = service.builtin("cells", "bin-picking.yaml")
 MIXED = service.builtin("cells", "mixed.yaml")
+GUIDED = [0.35, 0.15, 0.22, 0.0, 180.0, 45.0]
+SHORT = 0.5
+"""The timeout a test gives one request; its device's own command timeout is far longer (LONG)."""
+LONG = 3600.0
 
 
 def device(cell: Path, name: str) -> DeviceDescription:
@@ -160,6 +165,27 @@ async def test_an_opc_ua_method_answer_is_reported_as_the_event_it_stands_for() 
     assert heard.lost.empty() and heard.anomalies.empty()
 
 
+async def test_an_opc_ua_link_reports_the_event_an_anomaly_and_the_lost_session_for_its_device() -> None:
+    heard = Heard()
+    async with simulated(device(MIXED, "screwdriver-ua")) as (sim, live):
+        link = await heard.open(live)
+        try:
+            await link.request("Start", {"Torque": 3.0}, WAIT)
+            event = await asyncio.wait_for(heard.events.get(), WAIT)
+            assert sim._opcua is not None
+            await sim._opcua.emit("Completed", {"achieved_torque": math.nan})  # a value no device may send
+            anomaly = await asyncio.wait_for(heard.anomalies.get(), WAIT)
+            await sim.stop()  # the server goes away under the session
+            lost = await asyncio.wait_for(heard.lost.get(), WAIT)
+        finally:
+            await link.close()
+    assert event == ("screwdriver-ua", "Completed", {"achieved_torque": 3.0})
+    assert anomaly[0] == "screwdriver-ua" and anomaly[1].endswith("achieved_torque: nan is no finite number")
+    assert lost[0] == "screwdriver-ua"
+    assert lost[1].startswith(("the server closed the connection", "the OPC UA session ended")), lost
+    assert heard.events.empty()
+
+
 @pytest.mark.parametrize(("cell", "name", "state"), [(BIN_PICKING, "gripper", "open"),
                                                        (BIN_PICKING, "binpicking-pc", "ready")])
 async def test_query_state_answers_the_state_of_its_device_chart(cell: Path, name: str, state: str) -> None:
@@ -186,3 +212,100 @@ async def test_a_protocol_no_link_speaks_is_refused_naming_the_three_that_are() 
     with pytest.raises(ProtocolError, match="^device gripper: protocol 'modbus' is not supported; "
                                             "expected xirp, upnp or opcua$"):
         await Heard().open(odd)
+
+
+async def test_an_xirp_request_carries_its_values_to_the_device() -> None:
+    async with simulated(device(BIN_PICKING, "robot")) as (sim, live):
+        link = await Heard().open(live)
+        try:
+            await link.request("MoveTo", {"TargetPose": GUIDED, "Speed": 10}, WAIT)
+            while await link.state(WAIT) != "at_pose":  # bounded: the robot's chart reaches it or the test fails
+                await asyncio.sleep(0.02)
+        finally:
+            await link.close()
+        state, values = await query_report(live, WAIT)
+    assert state == "at_pose" and list(values["TargetPose"]) == GUIDED
+
+
+def never_answering(**options: Any) -> xirp.Faults:
+    faults = xirp.Faults()
+    for name in ("Close", "state"):
+        faults.add(xirp.FaultKind.DROP_RESPONSE, name, times=None)
+    return faults
+
+
+async def test_an_xirp_link_waits_for_an_answer_as_long_as_it_is_told_not_as_the_device_says() -> None:
+    gripper = dataclasses.replace(device(BIN_PICKING, "gripper"), command_timeout=LONG)
+    async with simulated(gripper, faults=never_answering()) as (_, live):
+        live = dataclasses.replace(live, command_timeout=LONG)
+        link = await Heard().open(live)
+        try:
+            with pytest.raises(ProtocolTimeout, match=f"request Close to .*: no response within {SHORT:g} s$"):
+                await asyncio.wait_for(link.request("Close", {"GripForce": 40}, SHORT), WAIT)
+            with pytest.raises(ProtocolTimeout, match=f"request state to .*: no response within {SHORT:g} s$"):
+                await asyncio.wait_for(link.state(SHORT), WAIT)
+        finally:
+            await link.close()
+        with pytest.raises(ProtocolTimeout, match=f"no response within {SHORT:g} s$"):
+            await asyncio.wait_for(query_state(live, SHORT), WAIT)
+
+
+@asynccontextmanager
+async def silent_server() -> AsyncIterator[int]:
+    """A port on loopback that takes connections and never says a word."""
+    held: list[tuple[asyncio.Task[Any] | None, asyncio.StreamWriter]] = []
+
+    async def hold(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        held.append((asyncio.current_task(), writer))
+        await reader.read()
+
+    server = await asyncio.start_server(hold, "127.0.0.1", 0)
+    try:
+        yield server.sockets[0].getsockname()[1]
+    finally:
+        server.close()
+        for _, writer in held:
+            writer.close()
+        await asyncio.gather(*(t for t, _ in held if t is not None), return_exceptions=True)
+        await server.wait_closed()
+
+
+async def test_a_device_that_never_greets_is_given_up_after_its_own_command_timeout() -> None:
+    async with silent_server() as port:
+        silent = dataclasses.replace(device(BIN_PICKING, "gripper"), endpoint=f"xirp://127.0.0.1:{port}",
+                                     command_timeout=SHORT)
+        with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {SHORT:g} s$"):
+            await asyncio.wait_for(Heard().open(silent), WAIT)
+        with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {SHORT:g} s$"):
+            await asyncio.wait_for(query_report(dataclasses.replace(silent, command_timeout=LONG), SHORT), WAIT)
+
+
+async def test_a_upnp_link_waits_for_an_answer_as_long_as_it_is_told_not_as_the_device_says() -> None:
+    release = asyncio.Event()
+
+    async def handler(action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
+        await release.wait()
+        return {"Result": "accepted"}
+
+    spec = upnp.with_state_query(upnp.service_spec_from_chart_events({"Localize": ["PartType"]}, []))
+    async with upnp.UpnpDeviceServer("slow", "Slow PC", upnp.device_type_for("Localizer"), spec, handler,
+                                     network=upnp.private_network()) as server:
+        slow = dataclasses.replace(device(BIN_PICKING, "binpicking-pc"), id="slow", endpoint=server.location or "",
+                                   command_timeout=LONG)
+        link = await Heard().open(slow)
+        try:
+            with pytest.raises(ProtocolTimeout, match="Localize .*: no answer in time$"):
+                await asyncio.wait_for(link.request("Localize", {"PartType": "bracket"}, SHORT), WAIT)
+            with pytest.raises(ProtocolTimeout, match=f"{upnp.STATE_ACTION} .*: no answer in time$"):
+                await asyncio.wait_for(link.state(SHORT), WAIT)
+        finally:
+            release.set()
+            await link.close()
+
+
+async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its_own_command_timeout() -> None:
+    async with silent_server() as port:
+        silent = dataclasses.replace(device(BIN_PICKING, "binpicking-pc"), command_timeout=SHORT,
+                                     endpoint=f"http://127.0.0.1:{port}/device.xml")
+        with pytest.raises(ProtocolTimeout):
+            await asyncio.wait_for(Heard().open(silent), WAIT)
