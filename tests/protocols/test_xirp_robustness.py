@@ -7,13 +7,16 @@ condition (a response, the end of a connection), bounded by a timeout.
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import socket
 from collections.abc import AsyncIterator, Callable
 from typing import Any
 
 import pytest
 
+from plugnproduce import service
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout
+from plugnproduce.executor.links import open_link
 from plugnproduce.protocols.xirp import (
     MAX_FRAME,
     NAMESPACE,
@@ -234,6 +237,22 @@ async def test_a_device_that_never_says_hello_is_a_timeout() -> None:
     async with fake:
         with pytest.raises(ProtocolTimeout, match="no connection and hello within 0.1 s"):
             await XirpClient.connect(HOST, port, timeout=0.1)
+
+
+async def test_a_device_slower_to_greet_than_its_command_timeout_is_still_connected() -> None:
+    """Opening a link waits for the greeting longer than a command (the gripper's 2 s): a busy device host is
+    not a lost device."""
+    async def greet_late(writer: asyncio.StreamWriter) -> None:
+        await asyncio.sleep(0.5)
+        writer.write(encode_frame(Hello("gripper", ROBOT)))
+
+    fake, port = await _fake_device(lambda writer: asyncio.ensure_future(greet_late(writer)))
+    gripper = dataclasses.replace(service.cell(service.builtin("cells", "bin-picking.yaml")).device("gripper"),
+                                  endpoint=f"xirp://{HOST}:{port}", command_timeout=0.05)
+    async with fake:
+        link = await open_link(gripper, lambda *_: None, lambda *_: None, lambda *_: None)
+        assert link.device == "gripper"
+        await link.close()
 
 
 async def test_a_device_that_greets_with_something_else_is_refused() -> None:

@@ -20,6 +20,15 @@ from plugnproduce.protocols import upnp, xirp
 EventCallback = Callable[[str, str, Mapping[str, Any]], None]
 ProblemCallback = Callable[[str, str], None]
 
+CONNECT_TIMEOUT = 10.0
+"""Seconds a device has at least to accept a connection and greet (a device's command timeout may be shorter:
+a gripper answers a command in 2 s, but a busy host can take longer than that to accept a connection)."""
+
+
+def connect_timeout(device: DeviceDescription) -> float:
+    """How long opening a connection to ``device`` may take: its command timeout, at least :data:`CONNECT_TIMEOUT`."""
+    return max(device.command_timeout, CONNECT_TIMEOUT)
+
 
 class DeviceLink(Protocol):
     """A connection to one device."""
@@ -52,7 +61,7 @@ class XirpLink:
                    on_anomaly: ProblemCallback) -> XirpLink:
         """Connect to the device's endpoint."""
         client = await xirp.XirpClient.connect_endpoint(
-            device.endpoint, timeout=device.command_timeout,
+            device.endpoint, timeout=connect_timeout(device),
             on_event=lambda e: on_event(device.id, e.name, dict(e.params)))
         client.stats.on_anomaly = lambda what: on_anomaly(device.id, what)
         return cls(device.id, client, on_lost)
@@ -88,7 +97,7 @@ class UpnpLink:
                    on_anomaly: ProblemCallback) -> UpnpLink:
         """Read the device's UPnP description (where it was discovered) and subscribe to its events."""
         host = urlparse(device.endpoint).hostname or ""
-        client = await upnp.UpnpDeviceClient.connect(device.endpoint, host, timeout=device.command_timeout)
+        client = await upnp.UpnpDeviceClient.connect(device.endpoint, host, timeout=connect_timeout(device))
         def changed(variable: str, _value: Any) -> None:
             if not upnp.is_payload_variable(variable):  # a value an event carries comes with its counter
                 on_event(device.id, variable, upnp.payload_of(client.values, variable))
@@ -129,7 +138,7 @@ class OpcUaLink:
         """Open a session with the device's server and subscribe to the events its chart sends."""
         from plugnproduce.protocols.opcua import OpcUaDeviceClient  # asyncua loads only for an OPC UA cell
 
-        client = await OpcUaDeviceClient.connect(device.endpoint, device.id, device.command_timeout)
+        client = await OpcUaDeviceClient.connect(device.endpoint, device.id, connect_timeout(device))
         events = sorted({c.name for t in (*device.transitions, *device.stops) for c in t.sends if c.kind == "event"})
         try:
             await client.subscribe(events, lambda name, values: on_event(device.id, name, values),
