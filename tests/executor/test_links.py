@@ -16,6 +16,7 @@ import pytest
 from plugnproduce import service
 from plugnproduce.description.model import DeviceDescription
 from plugnproduce.errors import ProtocolError, ProtocolTimeout
+from plugnproduce.executor import links
 from plugnproduce.executor.links import DeviceLink, UpnpLink, open_link, query_report, query_state
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.sim.bin import SimulatedBin
@@ -270,11 +271,15 @@ async def silent_server() -> AsyncIterator[int]:
         await server.wait_closed()
 
 
-async def test_a_device_that_never_greets_is_given_up_after_its_own_command_timeout() -> None:
+@pytest.mark.parametrize(("floor", "command_timeout", "given_up"), [(SHORT, 2 * SHORT, 2 * SHORT),
+                                                                     (2 * SHORT, SHORT, 2 * SHORT)])
+async def test_a_device_that_never_greets_is_given_up_after_its_command_timeout_or_the_floor_if_longer(
+        monkeypatch: pytest.MonkeyPatch, floor: float, command_timeout: float, given_up: float) -> None:
+    monkeypatch.setattr(links, "CONNECT_TIMEOUT", floor)  # 10 s in earnest: a test need not wait that long
     async with silent_server() as port:
         silent = dataclasses.replace(device(BIN_PICKING, "gripper"), endpoint=f"xirp://127.0.0.1:{port}",
-                                     command_timeout=SHORT)
-        with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {SHORT:g} s$"):
+                                     command_timeout=command_timeout)
+        with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {given_up:g} s$"):
             await asyncio.wait_for(Heard().open(silent), WAIT)
         with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {SHORT:g} s$"):
             await asyncio.wait_for(query_report(dataclasses.replace(silent, command_timeout=LONG), SHORT), WAIT)
@@ -303,9 +308,11 @@ async def test_a_upnp_link_waits_for_an_answer_as_long_as_it_is_told_not_as_the_
             await link.close()
 
 
-async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its_own_command_timeout() -> None:
+async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its_own_command_timeout(
+        monkeypatch: pytest.MonkeyPatch) -> None:
     async with silent_server() as port:
         silent = dataclasses.replace(device(BIN_PICKING, "binpicking-pc"), command_timeout=SHORT,
                                      endpoint=f"http://127.0.0.1:{port}/device.xml")
+        monkeypatch.setattr(links, "CONNECT_TIMEOUT", SHORT)  # 10 s in earnest
         with pytest.raises(ProtocolTimeout):
             await asyncio.wait_for(Heard().open(silent), WAIT)
