@@ -187,6 +187,29 @@ async def test_an_opc_ua_link_reports_the_event_an_anomaly_and_the_lost_session_
     assert heard.events.empty()
 
 
+async def test_an_opc_ua_call_and_state_read_wait_as_long_as_they_are_told(monkeypatch: pytest.MonkeyPatch) -> None:
+    release = asyncio.Event()
+
+    async def never_answers(_device: SimulatedDevice, _request: str, _values: Mapping[str, Any]) -> None:
+        await release.wait()
+
+    monkeypatch.setattr(SimulatedDevice, "_on_opcua_call", never_answers)
+    async with simulated(dataclasses.replace(device(MIXED, "binpicking-pc-ua"), command_timeout=LONG)) as (_, live):
+        link = await Heard().open(dataclasses.replace(live, command_timeout=LONG))
+        try:
+            with pytest.raises(ProtocolTimeout, match=f"^device binpicking-pc-ua: no answer to call Localize within "
+                                                      f"{SHORT:g} s$"):
+                await asyncio.wait_for(link.request("Localize", {"PartType": "bracket"}, SHORT), WAIT)
+            client = link._client  # type: ignore[attr-defined]
+            monkeypatch.setattr(client, "_read_state", release.wait)  # a State read the server never answers
+            with pytest.raises(ProtocolTimeout, match=f"^device binpicking-pc-ua: no answer to read its State within "
+                                                      f"{SHORT:g} s$"):
+                await asyncio.wait_for(link.state(SHORT), WAIT)
+        finally:
+            release.set()
+            await link.close()
+
+
 @pytest.mark.parametrize(("cell", "name", "state"), [(BIN_PICKING, "gripper", "open"),
                                                        (BIN_PICKING, "binpicking-pc", "ready")])
 async def test_query_state_answers_the_state_of_its_device_chart(cell: Path, name: str, state: str) -> None:
