@@ -110,6 +110,11 @@ GUARDS = (
 )
 
 _S = "src/plugnproduce/"
+_DEAD_END_BATCH = tuple(f"tests/reasoning/test_dead_end.py::{t}" for t in (
+    "test_the_batch_says_what_check_says_for_every_configuration_with_or_without_the_dead_end",
+    "test_the_batch_names_the_dead_end_as_the_reason_and_buys_a_gripper_that_can_close"))
+_BATCH_WORKERS = tuple(f"tests/reasoning/test_batch.py::{t}" for t in (  # how the work is shared, not the answers
+    "test_two_workers_give_the_same_rows_as_one", "test_workers_start_only_for_work_large_enough_to_repay_them"))
 CORE = (
     Guard("codegen-flow", (_S + "codegen/flow.py",),
           ("tests/codegen/test_loops_and_links.py", "tests/codegen/test_branch_charts.py",
@@ -137,8 +142,12 @@ CORE = (
           ("tests/reasoning/test_branch_check.py", "tests/reasoning/test_nested_loop_check.py")),
     Guard("reasoning-dataflow", (_S + "reasoning/checks/dataflow.py",),
           ("tests/reasoning/test_flow_check.py", "tests/reasoning/test_plausibility.py")),
-    Guard("reasoning-feasibility", (_S + "batch/feasibility.py",), ("tests/reasoning/test_batch.py",)),
-    Guard("reasoning-purchases", (_S + "batch/purchases.py",), ("tests/reasoning/test_batch.py",)),
+    Guard("reasoning-feasibility", (_S + "batch/feasibility.py",),
+          ("tests/reasoning/test_batch.py", *_DEAD_END_BATCH), deselect=_BATCH_WORKERS),
+    Guard("reasoning-purchases", (_S + "batch/purchases.py",),
+          ("tests/reasoning/test_batch.py", *_DEAD_END_BATCH),
+          deselect=(*_BATCH_WORKERS,  # they compare offered and plausible only, never a purchase
+                    "tests/reasoning/test_batch.py::test_answers_agree_with_the_full_reasoner_on_random_configurations")),
     Guard("reasoning-windows", (_S + "reasoning/repairs/windows.py",), ("tests/reasoning/test_windows.py",)),
     Guard("reasoning-lifting", (_S + "reasoning/repairs/lifting.py",), ("tests/reasoning/test_repair_lifting.py",)),
     Guard("executor-links", (_S + "executor/links.py",), ("tests/executor/test_links.py",)),
