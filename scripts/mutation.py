@@ -85,7 +85,7 @@ GUARDS = (
            "tests/protocols/test_upnp_loopback.py"),
           ("x__host_key", "x_check_trusted", "x_resolve_trusted", "xǁTrustedRequesterǁ*", "xǁNoRedirectRequesterǁ*",
            "x_load_device", "xǁUpnpDeviceClientǁfetch_files", "xǁUpnpDeviceClientǁfrom_found", "x_describe")),
-    Guard("discovery-trust", ("src/plugnproduce/discovery/live.py",),
+    Guard("discovery-trust", ("src/plugnproduce/discovery/served.py",),
           ("tests/discovery/test_served.py",),
           ("x_read_served", "x__is_served_chart", "x__safe_name")),
     Guard("tokens", ("src/plugnproduce/hmi/security.py",),

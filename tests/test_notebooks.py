@@ -72,10 +72,13 @@ EXPECTED: dict[str, list[str]] = {
         r"pick_pose:\s+from: localize_part\s+output: part_pose",
         r"plausible: True",
         r"verified: proved",
+        r"step 2 pick +\d+\.\d\d s",
+        r"estimated cycle time: \d+\.\d\d s per iteration of the loop \((\d+\.\d\d) s per part\)",
         r"buy: screwdriver 1400",
         r"ours: \['close-gripper', 'place', 'move-to', 'close-gripper'\]",
         r"Fast Downward: SOLVED_OPTIMALLY \['close-gripper', 'place', 'move-to', 'close-gripper'\]",
         r"outcome: succeeded",
+        r"speed: 1; seconds per part: \d+\.\d\d \d+\.\d\d \d+\.\d\d \(estimate \d+\.\d\d\)",  # 3 parts
     ],
     "operator": [
         r"→ gripper: Close \{'GripForce': 30\}",

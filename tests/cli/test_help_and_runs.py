@@ -48,11 +48,12 @@ def test_arguments_are_named_in_capitals(path: tuple[str, ...], command: click.C
             assert argument_name(param).split(".")[0].isupper(), f"{' '.join(path)}: {param.name}"
 
 
-def journal(folder: Path, name: str, start: float, outcome: str | None) -> None:
-    """A run's journal started at ``start`` (epoch seconds), finished with ``outcome`` 2.5 s later (None: crashed)."""
+def journal(folder: Path, name: str, start: float, outcome: str | None, **simulated: float) -> None:
+    """A run's journal started at ``start`` (epoch seconds), finished with ``outcome`` 2.5 s later (None: crashed);
+    ``speed=F``: on simulated devices working at speed F."""
     times = iter([start, start + 1, start + 2.5])
     with Journal(folder / f"{name}.jsonl", clock=lambda: next(times)) as j:
-        j.write("start", task=f"task-{name}", cell="bin-picking")
+        j.write("start", task=f"task-{name}", cell="bin-picking", **simulated)
         j.write("step", step=1, command="bin-pick")
         if outcome is not None:
             j.write("end", outcome=outcome)
@@ -61,7 +62,7 @@ def journal(folder: Path, name: str, start: float, outcome: str | None) -> None:
 @pytest.fixture()
 def past_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.setenv("PNP_RUNS", str(tmp_path))
-    journal(tmp_path, "b-second", 2_000_000_000.0, "failed")
+    journal(tmp_path, "b-second", 2_000_000_000.0, "failed", speed=0.25)
     journal(tmp_path, "a-third", 2_000_000_100.0, None)
     journal(tmp_path, "c-first", 1_900_000_000.0, "succeeded")
     return tmp_path
@@ -71,10 +72,11 @@ def test_runs_lists_newest_first(past_runs: Path) -> None:
     result = runner.invoke(app, ["runs"])
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()
-    assert lines[0].split() == ["ID", "TASK", "CELL", "START", "STATUS", "DURATION"]
+    assert lines[0].split() == ["ID", "TASK", "CELL", "START", "STATUS", "SPEED", "DURATION"]
     assert [line.split()[0] for line in lines[1:]] == ["a-third", "b-second", "c-first"]
-    assert lines[1].split()[5:] == ["crashed", "1.0", "s"]
-    assert lines[2].split()[1:3] == ["task-b-second", "bin-picking"] and lines[2].split()[5:] == ["failed", "2.5", "s"]
+    assert lines[1].split()[5:] == ["crashed", "-", "1.0", "s"]  # real devices: no speed factor
+    assert lines[2].split()[1:3] == ["task-b-second", "bin-picking"]
+    assert lines[2].split()[5:] == ["failed", "0.25", "2.5", "s"]  # simulated four times slower
 
 
 def test_runs_as_json(past_runs: Path) -> None:
@@ -83,7 +85,8 @@ def test_runs_as_json(past_runs: Path) -> None:
     assert [r["id"] for r in runs] == ["a-third", "b-second", "c-first"]
     assert runs[2] == {"id": "c-first", "task": "task-c-first", "cell": "bin-picking",
                        "start": "2030-03-17T17:46:40+00:00", "status": "succeeded", "duration": 2.5,
-                       "journal": str(past_runs / "c-first.jsonl")}
+                       "speed": None, "journal": str(past_runs / "c-first.jsonl")}
+    assert runs[1]["speed"] == 0.25
 
 
 def test_no_runs_yet(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -1,8 +1,10 @@
-"""The path search gives the paths networkx's all-shortest-paths search gave, without networkx at start-up."""
+"""The path search gives the paths networkx's all-shortest-paths search gave, without networkx at start-up; and a
+parameter is not dropped while the chart can take it (an Open → Open region goes through the request taking it)."""
 
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import random
 
 import networkx as nx
@@ -17,8 +19,49 @@ P = "http://plugnproduce.org/ontology#"
 LIBRARIES = service.builtin("devices").parents[1] / "tests" / "data" / "libraries"
 
 
+def taken(steps: tuple[ChartTransition, ...], wanted: frozenset[str]) -> frozenset[str]:
+    return frozenset(q for t in steps if t.request for q in t.accepts if q in wanted)
+
+
 def networkx_path(device: DeviceDescription, source: str, concept: str, taxonomy: Taxonomy,
                   wanted: frozenset[str] = frozenset()) -> ChartPath:
+    """The shortest path; but when another path, each of whose requests takes some of ``wanted``, takes more of
+    ``wanted``, the shortest of those taking the most (a parameter is not dropped while the chart can take it)."""
+    shortest = networkx_shortest(device, source, concept, taxonomy, wanted)
+    takeable = taken(device.transitions, wanted)
+    if takeable <= taken(shortest.steps, wanted):
+        return shortest
+    g = nx.MultiDiGraph()  # (state, what is taken so far), every pair there is
+    for state in device.states:
+        for n in range(len(takeable) + 1):
+            for part in itertools.combinations(sorted(takeable), n):
+                for i, t in enumerate(device.transitions):
+                    if t.source == state.id and (not t.request or taken((t,), wanted)):
+                        g.add_edge((state.id, frozenset(part)), (t.target, frozenset(part) | taken((t,), wanted)),
+                                   key=i, transition=t, weight=commands(t))
+    goals = [s.id for s in device.states if s.concept and taxonomy.is_a(s.concept, concept)]
+    for count in range(len(takeable), len(taken(shortest.steps, wanted)), -1):
+        ends = [n for n in g.nodes if n[0] in goals and len(n[1]) == count]
+        h = g.copy()
+        h.add_edges_from((n, "\0goal", -1, {"weight": 0}) for n in ends)
+        try:
+            candidates = list(nx.all_shortest_paths(h, (source, frozenset()), "\0goal", weight="weight"))
+        except (nx.NetworkXNoPath, nx.NodeNotFound):
+            continue
+        ranked = []
+        for nodes in candidates:
+            steps = tuple(min(h.get_edge_data(a, b).values(),
+                              key=lambda e: (e["weight"], -len(wanted.intersection(e["transition"].accepts)),
+                                             e["transition"].line or 0))["transition"]
+                          for a, b in zip(nodes[:-2], nodes[1:-1], strict=True))
+            ranked.append((tuple(n[0] for n in nodes[:-1]), tuple(t.line or 0 for t in steps), steps))
+        states, _, steps = min(ranked)
+        return ChartPath(source, states[-1], steps)
+    return shortest
+
+
+def networkx_shortest(device: DeviceDescription, source: str, concept: str, taxonomy: Taxonomy,
+                      wanted: frozenset[str] = frozenset()) -> ChartPath:
     """The search as it was written with networkx (a multigraph, a goal node, ``all_shortest_paths``)."""
     goals = [s.id for s in device.states if s.concept and taxonomy.is_a(s.concept, concept)]
     if source in goals:
@@ -89,3 +132,26 @@ def test_random_charts_with_ties_silent_transitions_and_cycles() -> None:
         for source in ids:
             for concept in concepts:
                 same_answer(device, source, concept, k.taxonomy, frozenset({P + "TargetPose"}))
+
+
+def test_issue_27_open_to_open_handing_over_an_angle_goes_through_the_request_taking_it() -> None:
+    k = service.knowledge()
+    gripper = next(d for d in k.devices if d.id == "gripper")
+    stay = find_path(gripper, "open", P + "Open", k.taxonomy)
+    assert stay.steps == ()
+    angle = find_path(gripper, "open", P + "Open", k.taxonomy, frozenset({P + "OpeningAngle"}))
+    assert [(t.source, t.request.name if t.request else None, t.target) for t in angle.steps] == [
+        ("open", "SetAngle", "configuring"), ("configuring", None, "open")]
+    deaf = find_path(gripper, "open", P + "Open", k.taxonomy, frozenset({P + "TargetPose"}))
+    assert deaf.steps == ()  # nothing in the gripper's chart takes a pose: it stays open
+
+
+def test_issue_27_no_other_request_is_sent_on_the_way_to_the_one_taking_the_angle() -> None:
+    """A gripper that takes its angle only when closed: closing it on the way would move it where the step says
+    it stays open; the route stays put (and the check says the value would be lost)."""
+    k = service.knowledge()
+    gripper = next(d for d in k.devices if d.id == "gripper")
+    moved = tuple(dataclasses.replace(t, source="closed") if t.request and t.request.name == "SetAngle" else t
+                  for t in gripper.transitions)
+    closed_only = dataclasses.replace(gripper, transitions=moved)
+    assert find_path(closed_only, "open", P + "Open", k.taxonomy, frozenset({P + "OpeningAngle"})).steps == ()

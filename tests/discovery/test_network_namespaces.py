@@ -36,11 +36,12 @@ def environment(tmp_path: Path, **more: str) -> dict[str, str]:
 
 
 @contextmanager
-def simulated(host: Host, cell: str, tmp_path: Path, *options: str) -> Iterator[Path]:
-    """``pnp sim up CELL OPTIONS`` in ``host``'s namespace, until its devices are announced; stopped by Ctrl-C."""
+def simulated(host: Host, cell: str, tmp_path: Path, *options: str, **env: str) -> Iterator[Path]:
+    """``pnp sim up CELL OPTIONS`` in ``host``'s namespace (``env`` added to its environment), until its devices
+    are announced; stopped by Ctrl-C."""
     state, log = tmp_path / f"{host.namespace}.json", tmp_path / f"{host.namespace}.log"
     with log.open("w") as out, started(host.pnp("sim", "up", cell, "--state-file", str(state), *options),
-                                       env=environment(tmp_path), stdout=out, stderr=subprocess.STDOUT) as up:
+                                       env=environment(tmp_path, **env), stdout=out, stderr=subprocess.STDOUT) as up:
         deadline = time.monotonic() + WAIT
         while not state.exists():  # written once the devices are announced
             assert up.poll() is None, log.read_text()

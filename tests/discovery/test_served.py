@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from plugnproduce import service
-from plugnproduce.discovery.live import read_served
+from plugnproduce.discovery.served import read_served
 from plugnproduce.errors import DescriptionError
 from plugnproduce.protocols.upnp import FoundDevice, RemoteFiles, UntrustedUrlError
 from plugnproduce.resources import descriptions_path

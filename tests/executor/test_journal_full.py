@@ -48,9 +48,29 @@ def test_a_failed_write_is_raised_with_its_record_and_nothing_more_is_written(tm
 
         monkeypatch.setattr("os.fsync", failing)
         with pytest.raises(JournalWriteError, match="cannot be written: No space left on device") as caught:
-            journal.write("command", step=1)
-        assert caught.value.record["kind"] == "command"
+            journal.write("fault", step=1)
+        assert caught.value.record["kind"] == "fault"
         monkeypatch.setattr("os.fsync", real_fsync)
         with pytest.raises(JournalWriteError):
             journal.write("end", outcome="failed")  # a torn line stays the last one
-    assert [r["kind"] for r in read_journal(tmp_path / "j.jsonl").records] == ["start", "command"]
+    assert [r["kind"] for r in read_journal(tmp_path / "j.jsonl").records] == ["start", "fault"]
+
+
+def test_a_command_s_failed_fsync_fails_the_next_write_and_nothing_more_is_written(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The command's record is fsynced while the command goes out; the next command, fault, stop or end
+    waits for it, and its failure is theirs: the run then stops safely."""
+    with Journal(tmp_path / "j.jsonl") as journal:
+        journal.write("start", task="t")
+
+        def failing(fd: int) -> None:
+            raise OSError(5, "Input/output error")
+
+        monkeypatch.setattr("os.fsync", failing)
+        journal.write("command", step=1)
+        with pytest.raises(JournalWriteError, match="cannot be written: Input/output error") as caught:
+            journal.write("command", step=2)
+        assert caught.value.record["kind"] == "command" and caught.value.record["step"] == 2
+        with pytest.raises(JournalWriteError):
+            journal.write("end", outcome="failed")
+    assert [r.get("step") for r in read_journal(tmp_path / "j.jsonl").records] == [None, 1]

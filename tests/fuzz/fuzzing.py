@@ -331,7 +331,7 @@ def xirp_seeds() -> list[bytes]:
 def run_served(ws: Workspace, device: str, description: bytes, chart: bytes, location: str) -> str:
     """What the live cell reads from a device it found: its Turtle and chart as served, then the endpoint rule."""
     from plugnproduce import service
-    from plugnproduce.discovery.live import read_served
+    from plugnproduce.discovery.served import read_served
     from plugnproduce.protocols.upnp import FoundDevice, RemoteFiles
 
     base = location.rsplit("/", 1)[0]

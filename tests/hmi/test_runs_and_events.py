@@ -32,10 +32,12 @@ async def test_a_run_walks_every_step_and_journals_it(client: httpx.AsyncClient,
     journal = (await client.get(f"/api/runs/{run['run']}/journal")).json()
     kinds = [r["kind"] for r in journal]
     assert kinds[0] == "start" and kinds[-1] == "end" and kinds.count("step") == 2
+    assert journal[0]["speed"] == 1.0 and run["speed"] == 1.0  # the simulated devices work in real time
     assert {"device": "gripper", "command": "Close"}.items() <= next(r for r in journal if r["kind"] == "command"
                                                                        and r["device"] == "gripper").items()
     listed = (await client.get("/api/runs")).json()
     assert listed["active"] is None and listed["runs"][0]["status"] == "succeeded"
+    assert listed["runs"][0]["speed"] == 1.0
 
 
 async def test_a_device_lost_during_a_run_is_a_fault(client: httpx.AsyncClient, hmi: Hmi) -> None:

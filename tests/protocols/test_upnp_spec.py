@@ -8,6 +8,7 @@ import pytest
 
 from plugnproduce.errors import DescriptionError, ProtocolError
 from plugnproduce.protocols.upnp import (
+    STATE_ACTION,
     ActionSpec,
     ArgumentSpec,
     DeviceFiles,
@@ -15,8 +16,12 @@ from plugnproduce.protocols.upnp import (
     UntrustedUrlError,
     VariableSpec,
     device_type_for,
+    payload_of,
+    report_text,
+    reported_of,
     service_spec_from_chart_events,
     udn_for,
+    with_state_query,
 )
 from plugnproduce.protocols.upnp.boundary import check_trusted, resolve_trusted
 
@@ -98,3 +103,29 @@ def test_file_url_elsewhere_is_refused(reference: str) -> None:
     assert isinstance(info.value, ProtocolError)
     assert "pnp:chartURL of gripper" in str(info.value)
     assert "refused" in str(info.value)
+
+
+@pytest.mark.parametrize(("text", "why"), [
+    ("[NaN, 0, 0, 0, 180, 0]", "is not a JSON value"),
+    ("[" * 2000 + "]" * 2000, "is not a JSON value"),  # deeper than the decoder recurses
+    ("[0.4, 0.0", "is not a JSON value"),
+    ("[" + "0, " * 2000 + "0]", "is no text of at most 4096 characters"),
+])
+def test_a_reported_value_that_is_no_bounded_json_value_is_refused_naming_the_device(text: str, why: str) -> None:
+    with pytest.raises(ValueError, match=f"^device arm: GetDeviceState: TargetPose {why}"):
+        reported_of({"State": "home", "TargetPose": text}, ["TargetPose"], "device arm: GetDeviceState")
+
+
+def test_the_reported_values_of_a_state_query_are_read_from_json_and_a_missing_one_is_left_out() -> None:
+    results = {"State": "at_pose", "TargetPose": report_text([0.35, 0.15, 0.22, 0, 180, 45])}
+    assert reported_of(results, ["TargetPose", "Force"], "device arm") == {"TargetPose": [0.35, 0.15, 0.22, 0, 180, 45]}
+    spec = with_state_query(ServiceSpec(), reports=["TargetPose"])
+    assert [a.name for a in spec.action(STATE_ACTION).outputs] == ["State", "TargetPose"]
+
+
+def test_an_event_value_nested_deeper_than_the_json_decoder_recurses_is_kept_as_its_text() -> None:
+    """A device's GENA notification is read in the controller's event callback: a value it cannot decode stays
+    the text it was (the run's contract checks then refuse it), never an exception there."""
+    deep = "[" * 2000 + "]" * 2000
+    values = {"PartLocalized__part_pose": deep, "PartLocalized__outcome": '"PartFound"'}
+    assert payload_of(values, "PartLocalized") == {"part_pose": deep, "outcome": "PartFound"}

@@ -1,8 +1,9 @@
 """The estimate against a simulated run: the simulator takes the same durations, scaled by ``--speed``.
 
 The run's time is what its journal records from the first step to the end, times the speed factor
-(simulated seconds). It also holds the controller's own latency per command (journal writes, messages on
-loopback), which the estimate leaves out; the factors are chosen so that the devices' time dominates.
+(simulated seconds). It also holds the controller's own latency per command (its step, messages on
+loopback, a timer's millisecond), which the estimate leaves out: 1 to 4 % of the built-in bin-picking task
+at speed 1 (``bench/bench_cycle_time.py``). At speed 0.5 it counts half, a margin for a loaded machine.
 """
 
 from __future__ import annotations
@@ -30,20 +31,23 @@ def estimated(task: Path, cell: Path) -> float:
 
 
 def simulated(task: Path, cell: Path, speed: float, journal: Path) -> float:
-    """Simulated seconds from the run's first step to its end, as its journal records them."""
+    """Simulated seconds from the run's first step to its end, as its journal records them, times the speed
+    factor its start records."""
     result = pnp("run", str(task), "--cell", str(cell), "--sim", "--speed", str(speed), "--journal", str(journal))
     assert result.returncode == 0, result.stdout + result.stderr
     records = [json.loads(line) for line in journal.read_text().splitlines()]
+    assert records[0]["kind"] == "start" and records[0]["speed"] == speed
     first = next(r["t"] for r in records if r["kind"] == "step")
     end = next(r for r in records if r["kind"] == "end")
     assert end["outcome"] == "succeeded"
-    return float((end["t"] - first) * speed)
+    return float((end["t"] - first) * records[0]["speed"])
 
 
-def test_the_builtin_cell_runs_within_ten_percent_of_its_estimate(tmp_path: Path) -> None:
-    task, cell = BUILTIN / "tasks" / "pick-and-place.yaml", BUILTIN / "cells" / "bin-picking.yaml"
+def test_the_builtin_bin_picking_task_runs_within_ten_percent_of_its_estimate(tmp_path: Path) -> None:
+    """Issue 27: 30 commands over XIRP and UPnP; each command's record is fsynced while it goes out."""
+    task, cell = BUILTIN / "tasks" / "bin-picking.yaml", BUILTIN / "cells" / "bin-picking.yaml"
     estimate = estimated(task, cell)
-    run = simulated(task, cell, 0.25, tmp_path / "run.jsonl")  # four times slower than the charts say
+    run = simulated(task, cell, 0.5, tmp_path / "run.jsonl")  # half as fast as the charts say
     assert abs(run - estimate) <= 0.10 * estimate, (estimate, run)
 
 

@@ -78,18 +78,25 @@ def discover(
     lds: str | None = typer.Option(None, "--lds", metavar="opc.tcp://HOST:PORT",
                                    help="Also the OPC UA devices registered with this Local Discovery Server "
                                         "(FindServers); default PNP_LDS."),
+    serve_lds: int | None = typer.Option(None, "--serve-lds", metavar="PORT", min=0, max=65535,
+                                         help="Run a Local Discovery Server on the controller's address at PORT "
+                                              "(0: a free one; 4840 is the standard) for the OPC UA devices to "
+                                              "register with; with --watch they plug and unplug live."),
 ) -> None:
     """List the devices found on the network (SSDP on loopback or --interface, and the OPC UA devices registered
-    with --lds), with class and skills, and those refused.
+    with --lds or --serve-lds), with class and skills, and those refused.
 
     The search ends when no new device answered for --settle seconds, at the latest after --timeout;
     with --expect or --cell it waits for those devices instead. Exit 0 found, 1 some expected device
     missing, 2 bad input.
     """
     address = interface_address(interface)
+    if lds is not None and serve_lds is not None:
+        fail("--lds and --serve-lds: give one (ask that LDS, or run one here)")
     wanted = [d.id for d in service.cell(cell, knowledge(cell)).devices] if cell is not None else []
+    search = Search(timeout, settle, expect, wanted, lds, serve_lds)
     try:
-        missing = asyncio.run(_discover(json_out, watch, Search(timeout, settle, expect, wanted), address, lds))
+        missing = asyncio.run(_discover(json_out, watch, search, address))
     except KeyboardInterrupt:
         return
     if missing:
@@ -104,6 +111,10 @@ class Search:
     settle: float
     expect: int | None
     wanted: list[str]
+    lds: str | None = None
+    """The Local Discovery Server to ask, if any."""
+    serve_lds: int | None = None
+    """The port of the Local Discovery Server to run, if any."""
 
     @property
     def waits(self) -> bool:
@@ -129,15 +140,24 @@ class Search:
                 f"(--expect N or --cell CELL waits for them)")
 
 
-async def _discover(json_out: bool, watch: bool, search: Search, address: str, lds: str | None) -> list[str]:
+async def _discover(json_out: bool, watch: bool, search: Search, address: str) -> list[str]:
     began = time.monotonic()
+    served: list[str] = []
+
+    def serving(endpoint: str) -> None:
+        served.append(endpoint)
+        if not json_out:
+            typer.echo(f"{'lds':16} opcua {endpoint}")
+
     async with devices.discovery(knowledge(), search_timeout=search.timeout, expected=search.wanted,
                                  expected_count=search.expect, quiet=None if search.waits else search.settle,
-                                 interface=address, lds=lds) as live:
+                                 interface=address, lds=search.lds, serve_lds=search.serve_lds,
+                                 echo=serving) as live:
         cell, seconds = live.cell, time.monotonic() - began
         missing = search.missing(cell)
         _show_found(live, cell, json_out, watch, {"searched_seconds": round(seconds, 1), "missing": missing,
-                                                  "summary": search.summary(seconds, missing)})
+                                                  "summary": search.summary(seconds, missing),
+                                                  **({"lds": served[0]} if served else {})})
         if missing and not json_out:
             typer.echo(f"error: {search.summary(seconds, missing)}", err=True)
         if watch:
@@ -155,10 +175,16 @@ def _show_found(live: LiveCell, cell: Cell, json_out: bool, watch: bool, search:
         for d in _device_json(cell):
             typer.echo(f"{d['id']:16} {', '.join(d['classes']):22} {d['protocol']:5} {', '.join(d['skills'])}")
         for r in _refused_json(live):
-            typer.echo(f"refused {r['udn']} at {r['url']}: {r['reason']}")
+            typer.echo(f"refused {_refused_what(r['udn'], r['url'])}{r['reason']}")
         typer.echo(f"offered: {', '.join(_offered(cell)) or 'nothing'}")
         if not search["missing"]:
             typer.echo(str(search["summary"]))
+
+
+def _refused_what(udn: str, url: str) -> str:
+    """What was refused, before the reason: ``UDN at URL: ``; nothing for a Local Discovery Server (named by its
+    URL: the reason names it)."""
+    return "" if udn == url else f"{udn} at {url}: "
 
 
 async def _watch(live: LiveCell, cell: Cell, json_out: bool) -> None:
@@ -176,8 +202,10 @@ async def _watch(live: LiveCell, cell: Cell, json_out: bool) -> None:
         if json_out:
             typer.echo(json.dumps(line))
         else:
-            where = f" at {change.location}" if change.location else ""
-            typer.echo(f"{change.kind} {change.device}{where}" + (f": {change.reason}" if change.reason else ""))
+            if change.kind == "refused":
+                typer.echo(f"refused {_refused_what(change.device, change.location)}{change.reason}")
+            else:
+                typer.echo(f"{change.kind} {change.device}" + (f" at {change.location}" if change.location else ""))
             typer.echo(f"offered: {', '.join(line['offered']) or 'nothing'}")  # type: ignore[arg-type]
 
 

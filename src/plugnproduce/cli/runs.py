@@ -14,7 +14,12 @@ if TYPE_CHECKING:
 else:
     service = lazy_module("plugnproduce.service")  # `pnp --help` imports none of it
 
-HEADER = ("ID", "TASK", "CELL", "START", "STATUS", "DURATION")
+HEADER = ("ID", "TASK", "CELL", "START", "STATUS", "SPEED", "DURATION")
+
+
+def _speed(factor: float | None) -> str:
+    """A simulated run's speed factor (``-``: real devices)."""
+    return "-" if factor is None else f"{factor:g}"
 
 
 def _duration(seconds: float | None) -> str:
@@ -29,9 +34,10 @@ def _duration(seconds: float | None) -> str:
 @app.command()
 @boundary
 def runs(json_out: bool = JSON_OPTION) -> None:
-    """List the past runs (in PNP_RUNS), newest first: id, task, cell, start, status and duration.
+    """List the past runs (in PNP_RUNS), newest first: id, task, cell, start, status, speed and duration.
 
-    A run without an end is shown as crashed (or it is still running). 'pnp report RUN' prints one.
+    A run without an end is shown as crashed (or it is still running). SPEED is the factor a run's simulated
+    devices worked at (pnp run --sim --speed F); '-' for real devices. 'pnp report RUN' prints one.
 
     Exit 0 listed (none too), 2 an unreadable runs folder.
     """
@@ -42,7 +48,8 @@ def runs(json_out: bool = JSON_OPTION) -> None:
     if not past:
         typer.echo(f"no runs yet in {service.runs_folder()}", err=True)
         return
-    rows = [HEADER] + [(r.id, r.task, r.cell, r.started_text(), r.status, _duration(r.duration)) for r in past]
+    rows = [HEADER] + [(r.id, r.task, r.cell, r.started_text(), r.status, _speed(r.speed), _duration(r.duration))
+                       for r in past]
     widths = [max(len(row[i]) for row in rows) for i in range(len(HEADER) - 1)]
     for row in rows:
         typer.echo("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=False)) + "  " + row[-1])

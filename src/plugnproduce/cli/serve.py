@@ -33,7 +33,8 @@ LOOPBACK_NAMES = ("127.0.0.1", "localhost")
 
 
 def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int | None = None,
-                bin_seed: int = 0, discovery_timeout: float | None = None, interface: str | None = None) -> CellSource:
+                bin_seed: int = 0, discovery_timeout: float | None = None, interface: str | None = None,
+                serve_lds: int | None = None) -> CellSource:
     """The cell the HMI shows, as discovery sees it.
 
     With ``sim`` the devices of ``cell`` (default: the built-in bin-picking cell) are simulated
@@ -43,12 +44,15 @@ def cell_source(cell: Path | None, sim: bool, faults: str = "", bin_parts: int |
     the ones on the network (``PNP_SSDP_PORT``) and plug in themselves. Both are on ``interface`` (a name or an
     address; default ``PNP_INTERFACE``, else loopback). ``discovery_timeout`` bounds the
     wait for discovery to see the simulated devices start, plug or unplug (default
-    ``controller.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s).
+    ``controller.SIMULATED_DISCOVERY_SECONDS``), or, without ``sim``, the first search (default 1 s). Without
+    ``sim``, ``serve_lds`` (a port, 0: any free one) runs a Local Discovery Server on the interface for the OPC UA
+    devices to register with (its endpoint printed once it listens).
     """
     if not sim:
         name = service.cell(cell, knowledge()).name if cell else "live"
         return controller.LiveCellSource(controller.network_from_env(interface), name=name, knowledge=knowledge(cell),
-                                         search_timeout=discovery_timeout or 1.0)
+                                         search_timeout=discovery_timeout or 1.0, serve_lds=serve_lds,
+                                         announce=lambda lds: typer.echo(f"Local Discovery Server on {lds}"))
     cell = cell or service.builtin("cells", "bin-picking.yaml")
     k = knowledge(cell)
     parts = controller.SimulatedBin(bin_parts, bin_seed) if bin_parts is not None else None
@@ -64,12 +68,13 @@ def runner_for(source: CellSource, cell: Path | None = None) -> Runner:
     return controller.ExecutorRunner(source, service.runs_folder(), knowledge(cell))
 
 
-def _listen(host: str, port: int) -> socket.socket:
+def _listen(host: str, port: int, option: str = "--port") -> socket.socket:
     family = socket.AF_INET6 if ":" in host else socket.AF_INET
     try:
         return socket.create_server((host, port), family=family)
     except OSError as exc:
-        fail(f"--host {host} --port {port}: cannot listen: {exc.strerror or exc}")
+        where = f"--host {host} --port {port}" if option == "--port" else f"{option} {port} on {host}"
+        fail(f"{where}: cannot listen: {exc.strerror or exc}")
 
 
 @app.command()
@@ -96,6 +101,10 @@ def serve(
         help="With --sim: most seconds discovery may take to see the simulated devices start, plug or unplug "
              "(default 60: a busy machine answers late); without: the first search (default 1)."),
     interface: str | None = INTERFACE_OPTION,
+    serve_lds: int | None = typer.Option(None, "--serve-lds", metavar="PORT", min=0, max=65535,
+                                         help="Without --sim: run a Local Discovery Server on the controller's "
+                                              "address at PORT (0: a free one; 4840 is the standard) for the OPC "
+                                              "UA devices to register with; they plug and unplug live."),
 ) -> None:
     """Serve the Generic HMI: the live cell, offered commands, task editor, check/repair, runs.
 
@@ -113,7 +122,12 @@ def serve(
         fail("--faults needs --sim: faults are injected into simulated devices")
     if bin_parts is not None and not sim:
         fail("--bin-parts works on simulated devices: add --sim")
-    source = cell_source(cell, sim, faults, bin_parts, bin_seed, discovery_timeout, interface_address(interface))
+    if serve_lds is not None and sim:
+        fail("--serve-lds works without --sim: the simulated devices are found without one")
+    address = interface_address(interface)
+    if serve_lds:
+        _listen(address, serve_lds, "--serve-lds").close()  # a port taken is said now, not when the HMI starts
+    source = cell_source(cell, sim, faults, bin_parts, bin_seed, discovery_timeout, address, serve_lds)
     the_cell = cell or (service.builtin("cells", "bin-picking.yaml") if sim else None)
     allowed = list(LOOPBACK_NAMES) if host in LOOPBACK_NAMES else None
     application = create_app(source, runner_for(source, the_cell), token, allowed_hosts=allowed,

@@ -6,7 +6,8 @@ Each function imports the network stack when it is called: ``pnp sim plug`` need
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection
+import contextlib
+from collections.abc import AsyncIterator, Callable, Collection
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -17,20 +18,39 @@ if TYPE_CHECKING:
     from plugnproduce.sim.cell import SimulatedCell
 
 
-def discovery(knowledge: Knowledge, *, search_timeout: float, expected: Collection[str] = (),
-              expected_count: int | None = None, quiet: float | None = None, interface: str | None = None,
-              lds: str | None = None) -> LiveCell:
+@contextlib.asynccontextmanager
+async def discovery(knowledge: Knowledge, *, search_timeout: float, expected: Collection[str] = (),
+                    expected_count: int | None = None, quiet: float | None = None, interface: str | None = None,
+                    lds: str | None = None, serve_lds: int | None = None,
+                    echo: Callable[[str], None] | None = None) -> AsyncIterator[LiveCell]:
     """The cell as discovery sees it on ``interface`` (an address) and the SSDP port ``PNP_SSDP_PORT`` names,
     followed while the context is open; the search at its start waits for the ``expected`` devices,
     ``expected_count`` of them, or ``quiet`` seconds without news, within ``search_timeout``; the OPC UA devices
-    registered with the Local Discovery Server ``lds`` (else ``PNP_LDS``, else none) are in it too."""
+    registered with the Local Discovery Server ``lds`` (else ``PNP_LDS``, else none) are in it too. With
+    ``serve_lds`` (a port, 0: any free one) the controller runs that LDS itself, on ``interface``, for the devices
+    to register with (its endpoint told to ``echo`` before the search)."""
     from plugnproduce.discovery import LiveCell
     from plugnproduce.protocols.opcua.spec import chosen_lds
     from plugnproduce.protocols.upnp import network_from_env
 
-    return LiveCell(knowledge.taxonomy, network=network_from_env(interface), search_timeout=search_timeout,
-                    expected=expected, expected_count=expected_count, quiet=quiet,
-                    lds=chosen_lds(lds))
+    network = network_from_env(interface)
+    async with contextlib.AsyncExitStack() as stack:
+        if serve_lds is not None:
+            lds = await serve_lds_on(stack, network.interface, serve_lds)
+            if echo is not None:
+                echo(lds)
+        async with LiveCell(knowledge.taxonomy, network=network, search_timeout=search_timeout, expected=expected,
+                            expected_count=expected_count, quiet=quiet, lds=chosen_lds(lds)) as live:
+            yield live
+
+
+async def serve_lds_on(stack: contextlib.AsyncExitStack, address: str, port: int) -> str:
+    """A Local Discovery Server on ``address``:``port``, stopped with ``stack``; its endpoint."""
+    from plugnproduce.protocols.opcua.discovery import LocalDiscoveryServer
+
+    server = await stack.enter_async_context(LocalDiscoveryServer(address, port))
+    assert server.endpoint is not None
+    return server.endpoint
 
 
 def simulated_cell(cell: Cell, catalogue: list[DeviceDescription], knowledge: Knowledge, faults: str = "",
@@ -58,20 +78,11 @@ async def run_simulated(sim: SimulatedCell, state_file: Path | None, echo: Calla
     from plugnproduce.sim import control
     from plugnproduce.sim.cell import run_simulated_cell
 
-    if serve_lds is None:
+    async with contextlib.AsyncExitStack() as stack:
+        if serve_lds is not None:
+            sim.lds = await serve_lds_on(stack, sim.network.interface, serve_lds)
+            echo(f"{'lds':16} opcua {sim.lds}")
         await run_simulated_cell(sim, state_file or control.default_state_file(), echo=echo)
-        return
-    from plugnproduce.protocols.opcua.discovery import LocalDiscoveryServer
-
-    lds = LocalDiscoveryServer(sim.network.interface, serve_lds)
-    await lds.start()
-    try:
-        assert lds.endpoint is not None
-        echo(f"{'lds':16} opcua {lds.endpoint}")
-        sim.lds = lds.endpoint
-        await run_simulated_cell(sim, state_file or control.default_state_file(), echo=echo)
-    finally:
-        await lds.stop()
 
 
 def control_address() -> tuple[str, int]:

@@ -29,8 +29,13 @@ class LiveCellSource:
     unplug themselves."""
 
     def __init__(self, network: SsdpNetwork | None = None, name: str = "live", search_timeout: float = 1.0,
-                 knowledge: Knowledge | None = None) -> None:
+                 knowledge: Knowledge | None = None, serve_lds: int | None = None,
+                 announce: Callable[[str], None] | None = None) -> None:
+        """``serve_lds``: run a Local Discovery Server on the network's address at this port (0: a free one) for
+        the OPC UA devices to register with, its endpoint told to ``announce`` once it listens (else the one
+        ``PNP_LDS`` names is asked, if any)."""
         self.network = network if network is not None else network_from_env()
+        self._serve_lds, self._announce = serve_lds, announce
         self._live = LiveCell((knowledge or service.knowledge()).taxonomy, network=self.network, name=name,
                               search_timeout=search_timeout, lds=chosen_lds())
         self._cell = Cell(name, ())
@@ -63,7 +68,13 @@ class LiveCellSource:
                 for r in sorted(self._live.refused.values(), key=lambda r: r.udn)]
 
     async def start(self) -> None:
-        """Start following SSDP announcements."""
+        """Start following SSDP announcements (and the LDS)."""
+        if self._serve_lds is not None:
+            from plugnproduce.controller.devices import serve_lds_on
+
+            self._live.lds = await serve_lds_on(self._stack, self.network.interface, self._serve_lds)
+            if self._announce is not None:
+                self._announce(self._live.lds)
         await self._stack.enter_async_context(self._live)
         self._follower = asyncio.create_task(self._follow(), name="follow the live cell")
 

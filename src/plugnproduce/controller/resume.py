@@ -70,9 +70,11 @@ async def replan_live(stopped: Stopped, cell: Cell, devices: Cell, knowledge: Kn
 
 
 async def continue_run(plan: Replan, cell: Cell, devices: Cell, knowledge: Knowledge, confirmed_by: str,
-                       journal: Path | None = None, observer: RecordObserver | None = None) -> TaskRun:
+                       journal: Path | None = None, observer: RecordObserver | None = None,
+                       speed: float | None = None) -> TaskRun:
     """The continuation of a confirmed plan, ready to run: the devices are asked their states again and must be
-    where the plan starts (:class:`NoWayOn` if one moved meanwhile)."""
+    where the plan starts (:class:`NoWayOn` if one moved meanwhile); ``speed``: the speed factor of simulated
+    devices (None: real devices)."""
     now = await reported_states(devices)
     moved = [f"{d} was {s}, is {now.get(d)}" for d, s in sorted(plan.states.items()) if now.get(d) != s]
     if moved:
@@ -83,7 +85,7 @@ async def continue_run(plan: Replan, cell: Cell, devices: Cell, knowledge: Knowl
                                                                                {"confirmed_by": confirmed_by}))
     path = journal or runs_folder() / f"{new_run_id(plan.task.name)}.jsonl"
     return start_run(generated, Cell(devices.name, devices.devices, cell.file), path, observer, knowledge.prefixes,
-                     preamble)
+                     preamble, speed=speed)
 
 
 @dataclass(frozen=True)
@@ -115,8 +117,9 @@ async def resume_run(run: str | Path, cell_or_path: Cell | str | Path | None, co
     wanted = [d.id for d in the_cell.devices]
     network = private_network() if simulate is not None else network_from_env()
     async with contextlib.AsyncExitStack() as stack:
+        speed = None
         if simulate is not None:
-            await stack.enter_async_context(_simulated(the_cell, stopped, simulate, network))
+            speed = (await stack.enter_async_context(_simulated(the_cell, stopped, simulate, network))).speed
         live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
                                                         expected=wanted))
         devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
@@ -125,7 +128,7 @@ async def resume_run(run: str | Path, cell_or_path: Cell | str | Path | None, co
         who = await asyncio.to_thread(confirm, plan)
         if who is None:
             return Resumed(plan, None)
-        the_run = await continue_run(plan, the_cell, devices, k, who, journal, observer)
+        the_run = await continue_run(plan, the_cell, devices, k, who, journal, observer, speed)
         if started is not None:
             started(the_run)
         follow = asyncio.create_task(_follow_unplugs(live, the_run))

@@ -60,10 +60,18 @@ async def find_devices(live: LiveCell, wanted: list[str], timeout: float) -> Cel
         left = deadline - asyncio.get_running_loop().time()
         if left <= 0:
             raise DevicesMissing(f"device(s) {', '.join(missing)} of the cell not found on the network "
-                                 f"within {timeout:g} s")
+                                 f"within {timeout:g} s{_refusals(live)}")
         with contextlib.suppress(TimeoutError):
             await live.next_change(left)
     return Cell(live.cell.name, tuple(live.cell.device(d) for d in wanted))
+
+
+def _refusals(live: LiveCell) -> str:
+    """What discovery refused meanwhile (a device, a Local Discovery Server), the latest three, as the end of the
+    line that says what is missing: a device refused may be one of them, an LDS refused may have listed them."""
+    said = [r.reason if r.udn == r.location else f"{r.udn} at {r.location}: {r.reason}"
+            for r in list(live.refused.values())[-3:]]
+    return "".join(f"; refused {s}" for s in said)
 
 
 async def run_task(
@@ -116,6 +124,7 @@ async def run_task(
             where = "loopback" if network.interface == LOOPBACK.interface else network.interface
             say(f"starting {len(the_cell.devices)} simulated device(s) on {where}")
             await stack.enter_async_context(_simulated(the_cell, network, faults, bin_parts, bin_seed, speed))
+        simulated = speed if simulate else None
         say(f"discovering devices: {', '.join(d.id for d in the_cell.devices)}")
         wanted = [d.id for d in the_cell.devices]
         live = await stack.enter_async_context(LiveCell(k.taxonomy, network=network, name=the_cell.name,
@@ -123,7 +132,7 @@ async def run_task(
         devices = await find_devices(live, wanted, discovery_timeout or (SIMULATED_DISCOVERY_SECONDS if simulate
                                                                          else DISCOVERY_SECONDS))
         run = await planned_run(the_task, the_cell, devices, journal, knowledge=k, observer=observer,
-                                progress=say, generated=generated)
+                                progress=say, generated=generated, speed=simulated)
         if started is not None:
             started(run)
         follow = asyncio.create_task(_follow_unplugs(live, run))
@@ -146,10 +155,11 @@ def _simulated(cell: Cell, network: SsdpNetwork, faults: str, bin_parts: int | N
 
 async def planned_run(task: Task, cell: Cell, devices: Cell, journal: Path, *, knowledge: Knowledge | None = None,
                       observer: RecordObserver | None = None, progress: Callable[[str], None] | None = None,
-                      generated: GeneratedTask | None = None) -> TaskRun:
+                      generated: GeneratedTask | None = None, speed: float | None = None) -> TaskRun:
     """The run of ``task`` in ``cell`` on ``devices`` (its devices at the endpoints discovery found), journalling
     into ``journal``: checked and generated from the state each device reports (:func:`reported_states`), unless
-    ``generated`` is the task planned already; it starts when its ``run()`` is awaited.
+    ``generated`` is the task planned already; it starts when its ``run()`` is awaited. ``speed``: the speed factor
+    of simulated devices, journalled with the start (None: real devices).
 
     Every run starts here: ``pnp run`` (:func:`run_task`) and the HMI's (:class:`~.runner.ExecutorRunner`).
     Raises :class:`StateNotReported` or :class:`~plugnproduce.service.ImplausibleTask` before any command goes out.
@@ -163,7 +173,7 @@ async def planned_run(task: Task, cell: Cell, devices: Cell, journal: Path, *, k
     if progress is not None:
         progress("running")
     named = Cell(devices.name, devices.devices, devices.file or the_cell.file)  # the cell file is journalled
-    return start_run(generated, named, journal, observer, prefixes=k.prefixes)
+    return start_run(generated, named, journal, observer, prefixes=k.prefixes, speed=speed)
 
 
 class StateNotReported(PlugNProduceError):
@@ -209,16 +219,17 @@ async def live_cell(cell_or_path: CellArg, knowledge: Knowledge | None = None,
 
 def start_run(generated: GeneratedTask, devices: Cell, journal: Path,
               observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None,
-              preamble: tuple[tuple[str, dict[str, Any]], ...] = ()) -> TaskRun:
+              preamble: tuple[tuple[str, dict[str, Any]], ...] = (), speed: float | None = None) -> TaskRun:
     """A run of a planned task (:func:`plan_run`) against ``devices`` (a cell whose devices carry their
     real endpoints), journalling into ``journal``; it starts when its ``run()`` is awaited.
 
     :func:`planned_run` makes every run this way, once the task is planned. ``preamble``: records journalled
-    right after ``start`` (a resumed run's, :mod:`.resume`).
+    right after ``start`` (a resumed run's, :mod:`.resume`); ``speed``: the speed factor of simulated devices
+    (None: real devices).
     """
     from plugnproduce.executor.run import TaskRun
 
-    return TaskRun(generated, devices, journal, observer, prefixes, preamble)
+    return TaskRun(generated, devices, journal, observer, prefixes, preamble, speed=speed)
 
 
 async def _follow_unplugs(live: LiveCell, run: TaskRun) -> None:

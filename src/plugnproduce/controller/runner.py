@@ -72,7 +72,7 @@ class ExecutorRunner:
         observe, started = self._observer(run_id, observer)
         try:  # planned from the state each device reports, not its chart's initial state
             run = await planned_run(task, cell, cell, self._dir / f"{run_id}.jsonl", knowledge=self._knowledge,
-                                    observer=observe)
+                                    observer=observe, speed=self._speed())
         except StateNotReported as exc:
             raise RunRefused(f"task {task.name!r} cannot be planned in cell {cell.name!r}: {exc}") from exc
         except ImplausibleTask as exc:
@@ -109,10 +109,14 @@ class ExecutorRunner:
         observe, started = self._observer(new_id, observer)
         try:
             run = await continue_run(plan, cell, cell, await self._known(), "the operator",
-                                     self._dir / f"{new_id}.jsonl", observe)
+                                     self._dir / f"{new_id}.jsonl", observe, self._speed())
         except NoWayOn as exc:
             raise RunRefused(str(exc)) from exc
         return await self._launch(new_id, run, started)
+
+    def _speed(self) -> float | None:
+        """The speed factor of the simulated devices runs go to (None: real devices)."""
+        return self._source.sim.speed if isinstance(self._source, SimulatedCellSource) else None
 
     async def _known(self) -> Knowledge:
         """The knowledge runs are planned with (the built-in library unless given)."""

@@ -6,8 +6,9 @@ unit (``pnp:unit``)::
 
     <data id="pose" expr="[0.40, 0.00, 0.60, 0, 180, 0]" pnp:quantity="TargetPose"/>
 
-The device answers its state query with the state and each such value, named after the quantity
-(``docs/xirp.md``, *state*).
+The device answers its state query with the state and each such value, named after the quantity, over
+each protocol: a result of XIRP's ``state`` response (``docs/xirp.md``, *state*), an out-argument of UPnP's
+``GetDeviceState`` holding JSON (``docs/upnp.md``), a variable beside OPC UA's ``State`` (``docs/opcua.md``).
 """
 
 from __future__ import annotations

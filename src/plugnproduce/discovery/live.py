@@ -24,22 +24,15 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import ipaddress
 import logging
-import re
 from collections.abc import AsyncIterator, Collection, Coroutine
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import Literal
-from urllib.parse import urlparse
 
-from rdflib.term import Node
-
-from plugnproduce.description.loader import device_from, file_of, parse_description
 from plugnproduce.description.model import Cell, DeviceDescription
+from plugnproduce.discovery.served import read_served
 from plugnproduce.errors import DescriptionError, ProtocolError, ProtocolTimeout, excerpt
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP
 from plugnproduce.protocols.opcua import spec as opcua_spec
 from plugnproduce.protocols.upnp import (
     LOOPBACK,
@@ -48,20 +41,13 @@ from plugnproduce.protocols.upnp import (
     DeviceSearch,
     FoundDevice,
     Refusal,
-    RemoteFiles,
     SearchHit,
     SsdpNetwork,
-    UntrustedUrlError,
     UpnpDeviceClient,
     describe,
 )
-from plugnproduce.protocols.xirp import format_endpoint, parse_endpoint
 
 _LOGGER = logging.getLogger(__name__)
-
-SERVED = Path("/served")
-"""Where a discovered device's files are said to be: a name for messages and relative IRIs, never a folder
-on disk (a device's chart is only the chart it serves)."""
 
 CONFIRM_TIMEOUT = 1.0
 """Seconds a device's address is given to answer before its byebye is believed."""
@@ -74,12 +60,6 @@ LDS_POLL = 1.0
 
 DEVICE_BUDGET = 15.0
 """Seconds reading one discovered device (its UPnP description, Turtle description and chart) may take in all."""
-
-
-def _safe_name(name: str) -> str:
-    """A file name that stays inside its folder, from anything a device sends."""
-    cleaned = re.sub(r"[^A-Za-z0-9_.-]", "_", name).lstrip(".")
-    return cleaned[:100] or "unnamed"
 
 
 @dataclass(frozen=True)
@@ -164,16 +144,11 @@ class LiveCell:
             await self._listener.stop()
             raise
         self._news = asyncio.get_running_loop().time()
-        if self.lds is not None:
-            from plugnproduce.discovery.opcua import registered  # asyncua loads only for an LDS
-
-            try:
-                self._ask_lds(await registered(self.lds, self.device_budget))
-            except BaseException:
-                search.stop()
-                await self._listener.stop()
-                raise
-            self._lds_task = asyncio.create_task(self._follow_lds(self.lds))
+        if self.lds is not None:  # asked beside the search, as a device is read: a slow LDS holds up nothing
+            first = asyncio.create_task(self._asked_lds(self.lds))
+            self._readings.add(first)
+            first.add_done_callback(self._readings.discard)
+            self._lds_task = asyncio.create_task(self._follow_lds(self.lds, first))
         self._search = asyncio.create_task(self._follow_search(search))
         self._task = asyncio.create_task(self._follow())
         try:
@@ -279,16 +254,28 @@ class LiveCell:
             elif ad.udn in self._devices:
                 self._start(self._unplug_confirmed(ad.udn), ad)
 
-    async def _follow_lds(self, lds: str) -> None:
-        """Ask the LDS again and again: plug the devices newly registered, unplug those no longer registered."""
-        from plugnproduce.discovery.opcua import registered
-
+    async def _follow_lds(self, lds: str, first: asyncio.Task[None]) -> None:
+        """After the ``first`` question, ask the LDS again and again: plug the devices newly registered, unplug
+        those no longer registered."""
+        await first
         while True:
             await asyncio.sleep(LDS_POLL)
-            try:
-                self._ask_lds(await registered(lds, self.device_budget))
-            except ProtocolError as exc:  # the LDS is away for now: the cell stays as it is
-                _LOGGER.warning("%s", exc)
+            await self._asked_lds(lds)
+
+    async def _asked_lds(self, lds: str) -> None:
+        """Ask the LDS once. One that fails (away, silent, an answer beyond the limits) is refused, named by its
+        URL, once until it answers again; the cell stays as it is and discovery by SSDP goes on."""
+        from plugnproduce.discovery.opcua import registered  # asyncua loads only for an LDS
+
+        try:
+            servers = await registered(lds, self.device_budget)
+        except ProtocolError as exc:
+            said = self.refused.get(lds)
+            if said is None or said.reason != " ".join(str(exc).split())[:500]:
+                self._publish(CellChange("refused", lds, self.cell, str(exc), lds))
+            return
+        self.refused.pop(lds, None)
+        self._ask_lds(servers)
 
     def _ask_lds(self, servers: list[tuple[str, str]]) -> None:
         listed = {opcua_spec.application_uri_for(device): (device, url) for device, url in servers}
@@ -402,63 +389,3 @@ class LiveCell:
         async with await UpnpDeviceClient.from_found(found) as client:
             files = await client.fetch_files()
         return read_served(files, found, self.taxonomy)
-
-
-def _is_served_chart(named: Node, chart: Path) -> bool:
-    """Whether a chart a description names is the chart the device served (a NUL, even %00, names no file)."""
-    path = file_of(named)
-    return "\0" not in str(path) and path.resolve() == chart.resolve()
-
-
-def read_served(files: RemoteFiles, found: FoundDevice, taxonomy: Taxonomy) -> DeviceDescription:
-    """Read the description and chart a device served (fetched already) as any description, from memory.
-
-    The chart must be the one the device serves and an XIRP endpoint must be on the host the
-    device was found at; anything else is refused (:class:`DescriptionError`, :class:`ProtocolError`),
-    naming the URL the device served the file at.
-    """
-    folder = SERVED / _safe_name(found.udn)  # names the files for messages and relative IRIs; nothing is written
-    ttl = folder / _safe_name(Path(urlparse(files.description_url).path).name or "description.ttl")
-    chart = folder / _safe_name(Path(urlparse(files.chart_url).path).name or "chart.scxml")
-    try:
-        loaded = parse_description(files.description.encode("utf-8"), ttl)
-        for named in loaded.graph.objects(None, PNP.stateChart):
-            if not _is_served_chart(named, chart):
-                raise DescriptionError(f"device {found.udn} names its chart <{excerpt(str(named))}>; expected "
-                                       f"the chart it serves ({chart.name})", ttl)
-        device = device_from(loaded, taxonomy, charts={chart: files.chart.encode("utf-8")})
-    except DescriptionError as exc:  # say where the device serves the file, not the name it was read under
-        served = {str(ttl): files.description_url, str(chart): files.chart_url}
-        raise DescriptionError(exc.message.replace(str(folder), ""), served.get(exc.file or "", found.location),
-                               exc.line) from exc
-    if device.protocol == "upnp":  # reached where it was found, whatever its Turtle says
-        return replace(device, endpoint=found.location)
-    host = urlparse(found.location).hostname  # None: found at no host, so no endpoint is on its host
-    named_host, port, path = _endpoint_parts(device.protocol, device.endpoint)
-    if host is None or (named_host != host and not (named_host.lower() == "localhost" and _is_loopback(host))):
-        raise UntrustedUrlError(f"device {excerpt(device.id)} found at {host or excerpt(found.location)} "
-                                f"names {_NAMES[device.protocol]} endpoint {excerpt(device.endpoint)} on another "
-                                "host; refused")
-    # reached where it was found, never by name
-    if device.protocol == "opcua":
-        return replace(device, endpoint=opcua_spec.format_endpoint(host, port, path))
-    return replace(device, endpoint=format_endpoint(host, port))
-
-
-_NAMES = {"xirp": "XIRP", "opcua": "OPC UA"}
-
-
-def _endpoint_parts(protocol: str, endpoint: str) -> tuple[str, int, str]:
-    """Host, port and path of an XIRP or OPC UA endpoint (a ProtocolError for any other)."""
-    if protocol == "opcua":
-        return opcua_spec.parse_endpoint(endpoint)
-    host, port = parse_endpoint(endpoint)
-    return host, port, ""
-
-
-def _is_loopback(host: str) -> bool:
-    """Whether ``host`` is a loopback address (``localhost`` always names this machine)."""
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False

@@ -2,7 +2,7 @@
 
 ``FindServers`` on the LDS lists the devices' servers; each is read beside the others, within its own time
 budget: its own description (Turtle and chart, the String variables of ``ns:Description``, each within the
-size limit) is read by the same trust rules as a UPnP device's (:func:`~plugnproduce.discovery.live.read_served`):
+size limit) is read by the same trust rules as a UPnP device's (:func:`~plugnproduce.discovery.served.read_served`):
 the chart must be the one it serves, and the endpoint its Turtle names must be on the host it was found at.
 A device that breaks a rule, does not answer or serves nonsense is refused, named with the reason; the others
 are found all the same.
@@ -14,7 +14,7 @@ import asyncio
 from urllib.parse import urlparse
 
 from plugnproduce.description.model import DeviceDescription
-from plugnproduce.discovery.live import read_served
+from plugnproduce.discovery.served import read_served
 from plugnproduce.errors import DescriptionError, ProtocolError
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.protocols.opcua.spec import application_uri_for

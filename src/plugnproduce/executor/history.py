@@ -1,4 +1,5 @@
-"""Past runs: one summary per journal in the runs folder (id, task, cell, start, status, duration), newest first.
+"""Past runs: one summary per journal in the runs folder (id, task, cell, start, status, duration, and the speed
+factor of simulated devices), newest first.
 
 A summary reads only a journal's first record (``start``) and its last complete one
 (``end``, if the run finished), so listing many long runs stays quick.
@@ -27,6 +28,8 @@ class RunSummary:
     started: float | None
     status: str
     duration: float | None
+    speed: float | None = None
+    """How much faster than real time the devices worked, when they were simulated (None: real devices)."""
 
     def started_text(self) -> str:
         """The start as local ``YYYY-MM-DD HH:MM:SS``, or ``?`` when the journal has no start."""
@@ -38,7 +41,8 @@ class RunSummary:
         """A JSON-ready dict; the start in ISO 8601 (UTC), the duration in seconds."""
         started = None if self.started is None else datetime.fromtimestamp(self.started, UTC).isoformat()
         return {"id": self.id, "task": self.task, "cell": self.cell, "start": started, "status": self.status,
-                "duration": None if self.duration is None else round(self.duration, 3), "journal": str(self.path)}
+                "duration": None if self.duration is None else round(self.duration, 3), "speed": self.speed,
+                "journal": str(self.path)}
 
 
 def _record(line: bytes) -> dict[str, Any] | None:
@@ -77,8 +81,10 @@ def summarize(path: str | Path) -> RunSummary:
         status = "crashed"
     ended = last.get("t")
     duration = ended - started if isinstance(started, int | float) and isinstance(ended, int | float) else None
+    speed = start.get("speed")
     return RunSummary(p.stem, p, str(start.get("task", "?")), str(start.get("cell", "?")),
-                      started if isinstance(started, int | float) else None, status, duration)
+                      started if isinstance(started, int | float) else None, status, duration,
+                      float(speed) if isinstance(speed, int | float) and not isinstance(speed, bool) else None)
 
 
 def list_runs(folder: str | Path) -> list[RunSummary]:

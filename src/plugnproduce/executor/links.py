@@ -14,6 +14,7 @@ from typing import Any, Protocol
 from urllib.parse import urlparse
 
 from plugnproduce.description.model import DeviceDescription
+from plugnproduce.description.reports import reported_values
 from plugnproduce.errors import ProtocolError
 from plugnproduce.protocols import upnp, xirp
 
@@ -166,13 +167,46 @@ class OpcUaLink:
 async def query_report(device: DeviceDescription, timeout: float) -> tuple[str, dict[str, Any]]:
     """Connect to a device, ask its state and the values it reports with it (teach-in), disconnect.
 
-    Over XIRP the ``state`` response carries them; a UPnP device's state query reports its state only."""
-    if device.protocol != "xirp":
-        raise ProtocolError(f"device {device.id} speaks {device.protocol}, whose state query reports its state "
-                            "only; values are read with it over XIRP")
-    client = await xirp.XirpClient.connect_endpoint(device.endpoint, timeout=timeout)
+    Each protocol's state query carries them: XIRP's ``state`` response as its other results, UPnP's
+    ``GetDeviceState`` as its other out-arguments (JSON), OPC UA as the variables ``ns:QUANTITY`` beside
+    ``ns:State``, read in one request. A value the device does not report is left out."""
+    kinds = {"xirp": _xirp_report, "upnp": _upnp_report, "opcua": _opcua_report}
+    if device.protocol not in kinds:
+        raise ProtocolError(f"device {device.id}: protocol {device.protocol!r} is not supported; "
+                            "expected xirp, upnp or opcua")
+    return await kinds[device.protocol](device, sorted(reported_values(device)), timeout)
+
+
+async def _xirp_report(device: DeviceDescription, _names: list[str], timeout: float) -> tuple[str, dict[str, Any]]:
+    client = await xirp.XirpClient.connect_endpoint(device.endpoint, timeout=connect_timeout(device))
     try:
         return await client.report(timeout=timeout)
+    finally:
+        await client.close()
+
+
+async def _upnp_report(device: DeviceDescription, names: list[str], timeout: float) -> tuple[str, dict[str, Any]]:
+    client = await upnp.UpnpDeviceClient.connect(device.endpoint, urlparse(device.endpoint).hostname or "",
+                                                 timeout=connect_timeout(device))
+    try:
+        results = await client.invoke(upnp.STATE_ACTION, {}, timeout=timeout)
+    finally:
+        await client.close()
+    state = results.get(upnp.STATE_ARGUMENT)
+    if not isinstance(state, str) or not state:
+        raise ProtocolError(f"device {device.id}: {upnp.STATE_ACTION} answered no {upnp.STATE_ARGUMENT}")
+    try:
+        return state, upnp.reported_of(results, names, f"device {device.id}: {upnp.STATE_ACTION}")
+    except ValueError as exc:
+        raise ProtocolError(str(exc)) from None
+
+
+async def _opcua_report(device: DeviceDescription, names: list[str], timeout: float) -> tuple[str, dict[str, Any]]:
+    from plugnproduce.protocols.opcua import OpcUaDeviceClient  # asyncua loads only for an OPC UA device
+
+    client = await OpcUaDeviceClient.connect(device.endpoint, device.id, connect_timeout(device))
+    try:
+        return await client.report(names, timeout)
     finally:
         await client.close()
 

@@ -59,10 +59,12 @@ class TaskRun:
 
     def __init__(self, generated: GeneratedTask, cell: Cell, journal_path: Path,
                  observer: RecordObserver | None = None, prefixes: Mapping[str, str] | None = None,
-                 preamble: tuple[tuple[str, dict[str, Any]], ...] = ()) -> None:
+                 preamble: tuple[tuple[str, dict[str, Any]], ...] = (), *, speed: float | None = None) -> None:
         """``preamble``: records (kind, fields) journalled right after ``start``, before anything goes out (a
-        resumed run's ``stopped``, ``replan`` and ``continue``)."""
+        resumed run's ``stopped``, ``replan`` and ``continue``); ``speed``: how much faster than real time the
+        devices work when they are simulated, journalled with ``start`` (None: real devices, not journalled)."""
         self.generated = generated
+        self.speed = speed
         self._preamble = preamble
         self.cell = cell
         self.journal_path = journal_path
@@ -101,7 +103,8 @@ class TaskRun:
         with Journal(self.journal_path) as self._journal:
             self._record("start", task=self.generated.task.name, cell=self.cell.name, chart_sha256=self._digest,
                          steps=len(self.generated.steps), devices={d.id: d.endpoint for d in self.cell.devices},
-                         task_file=task_to_yaml(self.generated.task), cell_file=self.cell.file)
+                         task_file=task_to_yaml(self.generated.task), cell_file=self.cell.file,
+                         **({} if self.speed is None else {"speed": self.speed}))
             for kind, fields in self._preamble:
                 self._record(kind, **fields)
             try:

@@ -156,7 +156,8 @@ def explain_command(cell: Cell, command: str) -> dict[str, Any]:
 
 def plan_goal(data: bytes, filename: str, cell: Cell) -> dict[str, Any]:
     """``service.plan`` of a goal given as YAML: the plan's steps and task (as the editor's JSON, and as a task
-    file) with the check's verdict, or why no plan reaches the goal and what to buy."""
+    file) with the check's verdict and its estimated cycle time (``pnp check``'s, null when there is none), or
+    why no plan reaches the goal and what to buy."""
     k = _knowledge()
     goal = service.goal_from_text(data, filename)
     found = service.plan(goal, cell, k, _catalogue())
@@ -165,8 +166,10 @@ def plan_goal(data: bytes, filename: str, cell: Cell) -> dict[str, Any]:
         return {"goal": goal.name, "reachable": False, "reasons": list(found.reasons),
                 "purchase": None if buy is None else {"device": buy.id, "label": buy.label, "cost": buy.cost}}
     checked = service.check(found.task, cell, k)
+    estimate = service.cycle_time(found.task, cell, k, checked)
     steps = [{"step": s.index, "command": s.command, "bind": dict(s.bind),
               "params": {n: (v.to_plain() if hasattr(v, "to_plain") else v) for n, v in s.params.items()}}
              for s in found.task.one_round()[:found.steps]]
     return {"goal": goal.name, "reachable": True, "steps": steps, "until": goal.until and goal.until.rsplit("#", 1)[-1],
-            "plausible": checked.plausible, "text": found.text, "task": task_json(found.task)}
+            "plausible": checked.plausible, "text": found.text, "task": task_json(found.task),
+            "cycle_time": estimate.to_json() if estimate is not None else None}

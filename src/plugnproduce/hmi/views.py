@@ -27,7 +27,8 @@ DATATYPES = {"decimal": "decimal", "integer": "integer", "boolean": "boolean", "
 
 def device_json(device: DeviceDescription, taxonomy: Taxonomy, state: str | None = None) -> dict[str, Any]:
     """A device as ``pnp discover --json`` shows it (:func:`plugnproduce.service.device_view`), with its cost,
-    states, chart picture and (when known) its current chart state."""
+    states, the state concepts they stand for (as a goal's ``end`` names them), chart picture and (when known) its
+    current chart state."""
     concept = None
     if state is not None:
         try:
@@ -40,6 +41,7 @@ def device_json(device: DeviceDescription, taxonomy: Taxonomy, state: str | None
         "state": state,
         "state_concept": taxonomy.label(concept) if concept else None,
         "states": [s.id for s in device.states],
+        "concepts": list(dict.fromkeys(concept_value(s.concept) for s in device.states if s.concept)),
         "chart": f"/api/charts/device/{device.id}.svg",
     }
 
@@ -196,6 +198,7 @@ def run_json(run_id: str, records: list[dict[str, Any]], active: bool) -> dict[s
         "run": run_id,
         "task": start.get("task"),
         "cell": start.get("cell"),
+        "speed": start.get("speed"),
         "status": status,
         "steps": start.get("steps"),
         "step": steps[-1] if steps else None,

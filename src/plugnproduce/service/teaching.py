@@ -74,6 +74,7 @@ def judge_taught(device: DeviceDescription, quantity: str, value: Any, state: st
     """Hold a value the device reported to each contract of its requests that take ``quantity``."""
     reported = reported_value(device, quantity)
     contracts = [a for a in device.arguments if local_name(a.quantity) == quantity]
+    value = _as_declared(value, contracts)
     held, refused = [], []
     for contract in contracts:
         held.append(f"{contract.request} {quantity}: {_limits(contract)}")
@@ -81,6 +82,17 @@ def judge_taught(device: DeviceDescription, quantity: str, value: Any, state: st
         if why is not None:
             refused.append(f"{device.id} {contract.request} {quantity} {why}")
     return Taught(device.id, quantity, value, state, reported.unit, tuple(held), tuple(refused))
+
+
+def _as_declared(value: Any, contracts: list[Argument]) -> Any:
+    """A pose whatever protocol carried it: six numbers as floats (JSON over UPnP keeps ``0`` an integer, XIRP and
+    OPC UA Double[6] do not), when a contract takes the quantity as a Pose; any other value as it came."""
+    if not any(local_name(c.datatype) == "Pose" for c in contracts if c.datatype):
+        return value
+    if isinstance(value, list) and len(value) == 6 and all(isinstance(v, int | float) and not isinstance(v, bool)
+                                                            for v in value):
+        return [float(v) for v in value]
+    return value
 
 
 def _limits(contract: Argument) -> str:

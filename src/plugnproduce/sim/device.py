@@ -130,6 +130,11 @@ class SimulatedDevice:
         """The chart state the device is in."""
         return self.interpreter.configuration[-1] if self.interpreter.configuration else self.description.initial
 
+    def reported(self) -> dict[str, Any]:
+        """The values its chart says it reports with its state, as they are now, by quantity (teach-in)."""
+        dm = self.interpreter.dm
+        return {q: dm[r.variable] for q, r in self._reports.items() if r.variable in dm}
+
     @property
     def endpoint(self) -> str:
         """Where a controller reaches the device: ``xirp://host:port`` or the UPnP description URL."""
@@ -169,7 +174,8 @@ class SimulatedDevice:
 
             security = await device_security(d.id)  # PNP_OPCUA_PKI: the folder's missing certificates are made
             self._opcua = OpcUaDeviceServer(node_spec(d), self._on_opcua_call, lambda: self.state,
-                                            host=self.network.interface, files=self._files, security=security)
+                                            host=self.network.interface, files=self._files, security=security,
+                                            reported=lambda quantity: self.reported().get(quantity))
             await self._opcua.start()
             if self.lds is not None:
                 await self._opcua.register(self.lds)
@@ -178,7 +184,8 @@ class SimulatedDevice:
             files = self._files(self._opcua.endpoint)
         else:
             spec = upnp.with_state_query(upnp.service_spec_from_chart_events(requests, events,
-                                                                              payloads=event_payloads(d)))
+                                                                              payloads=event_payloads(d)),
+                                         reports=sorted(self._reports))
             files = self._files(d.endpoint)
         self._upnp = upnp.UpnpDeviceServer(d.id, d.label, upnp.device_type_for(device_class), spec,
                                            self._on_upnp_action, files=files, network=self.network)
@@ -232,9 +239,7 @@ class SimulatedDevice:
 
     def _on_xirp_request(self, request: xirp.Request) -> xirp.Results:
         if request.name == xirp.STATE:  # with the values its chart says it reports (teach-in reads them)
-            dm = self.interpreter.dm
-            return {xirp.STATE_RESULT: self.state, **{q: dm[r.variable] for q, r in self._reports.items()
-                                                      if r.variable in dm}}
+            return {xirp.STATE_RESULT: self.state, **self.reported()}
         try:
             self._accept(request.name, request.params)
         except LookupError as exc:
@@ -263,7 +268,8 @@ class SimulatedDevice:
 
     async def _on_upnp_action(self, action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
         if action == upnp.STATE_ACTION:
-            return {upnp.STATE_ARGUMENT: self.state}
+            reported = {q: upnp.report_text(v) for q, v in self.reported().items()}
+            return {upnp.STATE_ARGUMENT: self.state, **reported}
         values = self._upnp_values(action, arguments)
         try:
             self._accept(action, values)

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from plugnproduce.description.model import DeviceDescription
+from plugnproduce.description.reports import reported_values
 from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.protocols.opcua.spec import ArgumentSpec, MethodSpec, NodeSpec, kind_of
 from plugnproduce.sim.payloads import event_payloads
@@ -30,4 +31,14 @@ def node_spec(device: DeviceDescription) -> NodeSpec:
             request,
             tuple(ArgumentSpec(local_name(q), kind_of(device.argument(request, q).datatype)) for q in quantities),
             tuple(payloads.get(answer, ())) if answer is not None else ()))
-    return NodeSpec(device.id, tuple(methods), events)
+    return NodeSpec(device.id, tuple(methods), events, reported_variables(device))
+
+
+def reported_variables(device: DeviceDescription) -> tuple[ArgumentSpec, ...]:
+    """One variable per value the chart says the device reports with its state, typed as the device's requests
+    take that quantity (a pose ``Double[6]``; a quantity no request takes: any)."""
+    out = []
+    for quantity in sorted(reported_values(device)):
+        datatypes = [a.datatype for a in device.arguments if local_name(a.quantity) == quantity and a.datatype]
+        out.append(ArgumentSpec(quantity, kind_of(datatypes[0]) if datatypes else "any"))
+    return tuple(out)

@@ -27,7 +27,8 @@ async def plan(
     work: Work = Depends(work_of),
 ) -> dict[str, Any]:
     """``service.plan`` from the devices' states: ``reachable`` with the plan's steps, its task (the editor's
-    JSON and the task file) and the check's verdict; or ``reasons`` and the cheapest ``purchase``. A goal file
+    JSON and the task file), the check's verdict and the estimated ``cycle_time`` (as ``pnp check --json`` gives
+    it); or ``reasons`` and the cheapest ``purchase``. A goal file
     that cannot be read is 400 with ``FILE:LINE: message``. The body is YAML (``application/yaml``)."""
     kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
     if kind not in YAML_TYPES:

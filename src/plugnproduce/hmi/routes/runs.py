@@ -33,7 +33,7 @@ def list_runs(hub: Hub = Depends(hub_of)) -> dict[str, Any]:
     runs = []
     for run_id in hub.runner.runs():
         view = _view(hub, run_id)
-        runs.append({k: view[k] for k in ("run", "task", "status")})
+        runs.append({k: view[k] for k in ("run", "task", "status", "speed")})
     return {"active": hub.runner.active(), "runs": runs}
 
 

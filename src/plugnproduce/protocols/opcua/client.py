@@ -9,24 +9,20 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import logging
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from asyncua import Client, Node, ua
-from asyncua.common.connection import TransportLimits
 from asyncua.common.methods import call_method_full
 
 from plugnproduce.errors import DescriptionError, ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.protocols.files import DeviceFiles
+from plugnproduce.protocols.opcua.identity import UserIdentity
 from plugnproduce.protocols.opcua.security import PeerRefused, Security, check_plain, from_environment, secure_client
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
     MAX_ARGUMENTS,
-    MAX_CHUNK,
-    MAX_CHUNKS,
-    MAX_MESSAGE,
     MAX_STRING,
     STATE_VARIABLE,
     Kind,
@@ -35,6 +31,7 @@ from plugnproduce.protocols.opcua.spec import (
     parse_endpoint,
     to_wire,
 )
+from plugnproduce.protocols.opcua.transport import bound_transport
 from plugnproduce.safeio import MAX_BYTES
 
 EventCallback = Callable[[str, dict[str, Any]], None]
@@ -47,11 +44,6 @@ _KINDS: dict[int, Kind] = {ua.ObjectIds.Double: "double", ua.ObjectIds.Float: "d
                            ua.ObjectIds.Boolean: "bool", ua.ObjectIds.String: "string"}
 _REFUSALS = {"BadInvalidState": "does not accept it in its current state",
              "BadInvalidArgument": "refused its arguments", "BadTypeMismatch": "refused its arguments' types"}
-
-for _name in ("asyncua.client.client", "asyncua.client.ua_client", "asyncua.common.subscription",
-              "asyncua.client.ua_client.UaClient", "asyncua.uaprotocol"):
-    logging.getLogger(_name).setLevel(logging.CRITICAL)  # a lost server is reported to the run, not logged twice
-
 
 class OpcUaDeviceClient:
     """A session with one device's OPC UA server; make it with :meth:`connect`, end it with :meth:`close`."""
@@ -78,10 +70,10 @@ class OpcUaDeviceClient:
         security = from_environment() if security is None else security
         check_plain(security, device, endpoint, host)
         client = Client(endpoint, timeout=timeout)
-        client.max_messagesize, client.max_chunkcount = MAX_MESSAGE, MAX_CHUNKS
-        _bound_transport(client)
+        bound_transport(client)
+        identity: list[UserIdentity | None] = [None]
         try:
-            await asyncio.wait_for(_secure_and_connect(client, security, device), timeout)
+            await asyncio.wait_for(_secure_and_connect(client, security, device, identity), timeout)
         except TimeoutError as exc:
             await _quietly_close(client)
             raise ProtocolTimeout(f"device {device}: {endpoint} did not open a session within {timeout:g} s") \
@@ -92,7 +84,8 @@ class OpcUaDeviceClient:
         except Exception as exc:  # any failure of a foreign server is a refused connection, never a crash
             await _quietly_close(client)
             raise ProtocolConnectionError(f"device {device}: cannot connect to {endpoint} "
-                                          f"(security mode {security.mode}): {_refusal(exc, security.mode)}") from exc
+                                          f"(security mode {security.mode}): "
+                                          f"{_refusal(exc, security.mode, identity[0])}") from exc
         try:
             ns, node = await asyncio.wait_for(_device_node(client, device), timeout)
         except ProtocolError:
@@ -105,20 +98,29 @@ class OpcUaDeviceClient:
 
     async def state(self, timeout: float) -> str:
         """The ``State`` variable: the id of the chart state the device is in."""
+        return (await self.report((), timeout))[0]
+
+    async def report(self, names: Sequence[str], timeout: float) -> tuple[str, dict[str, Any]]:
+        """The ``State`` variable and, read with it in one request, the variable ``ns:NAME`` of each of ``names``
+        the device has: the values it reports with its state (teach-in), by name."""
         try:
-            value = await asyncio.wait_for(self._read_state(), timeout)
+            state, values = await asyncio.wait_for(self._read_report(names[:MAX_ARGUMENTS]), timeout)
         except ProtocolError:
             raise
         except Exception as exc:
             raise _wrapped(exc, self.device, f"read its {STATE_VARIABLE}", timeout) from exc
-        if not isinstance(value, str) or not value or len(value) > 256:
-            raise ProtocolError(f"device {self.device}: {STATE_VARIABLE} is {str(value)[:80]!r}; "
+        if not isinstance(state, str) or not state or len(state) > 256:
+            raise ProtocolError(f"device {self.device}: {STATE_VARIABLE} is {str(state)[:80]!r}; "
                                 "expected the id of a chart state")
-        return value
+        return state, {n: from_wire(v, f"device {self.device}: {n}") for n, v in values.items() if v is not None}
 
-    async def _read_state(self) -> Any:
-        node = await self._node.get_child(f"{self._ns}:{STATE_VARIABLE}")
-        return await node.read_value()
+    async def _read_report(self, names: Sequence[str]) -> tuple[Any, dict[str, Any]]:
+        nodes = {STATE_VARIABLE: await self._node.get_child(f"{self._ns}:{STATE_VARIABLE}")}
+        for name in (n for n in names if n != STATE_VARIABLE):
+            with contextlib.suppress(ua.UaStatusCodeError):  # BadNoMatch: the device does not report it
+                nodes[name] = await self._node.get_child(f"{self._ns}:{name}")
+        values = dict(zip(nodes, await self._client.read_values(list(nodes.values())), strict=True))
+        return values.pop(STATE_VARIABLE), values
 
     async def call(self, name: str, params: Mapping[str, Any], timeout: float) -> dict[str, Any]:
         """Call the method ``name`` with ``params`` (by input argument name); its output arguments by name."""
@@ -269,41 +271,10 @@ def _on_close(client: Client, then: Callable[[], None]) -> None:
     protocol.connection_lost = connection_lost
 
 
-class _Limits(TransportLimits):  # type: ignore[misc]
-    """The transport limits of one connection, held to ours whatever the server's Acknowledge says (asyncua
-    takes the server's limits as its own, and 0 from the server would mean none)."""
-
-    def update_client_limits(self, msg: ua.Acknowledge) -> None:
-        super().update_client_limits(msg)
-        _cap(self)
-
-
-def _cap(limits: Any) -> None:
-    limits.max_recv_buffer = _capped(limits.max_recv_buffer, MAX_CHUNK)
-    limits.max_chunk_count = _capped(limits.max_chunk_count, MAX_CHUNKS)
-    limits.max_message_size = _capped(limits.max_message_size, MAX_MESSAGE)
-
-
-def _capped(value: int, limit: int) -> int:
-    return limit if value <= 0 else min(value, limit)
-
-
-def _bound_transport(client: Client) -> None:
-    """Every connection the client opens (for its endpoints and its session) receives at most ``MAX_CHUNKS``
-    chunks of ``MAX_CHUNK`` bytes per message: a server's larger answer ends the connection."""
-    uaclient = client.uaclient
-    make = uaclient._make_protocol
-
-    def bounded() -> Any:
-        protocol = make()
-        protocol._connection._limits = _Limits(MAX_CHUNK, MAX_CHUNK, MAX_CHUNKS, MAX_MESSAGE)
-        return protocol
-
-    uaclient._make_protocol = bounded
-
-
-async def _secure_and_connect(client: Client, security: Security, device: str) -> None:
-    await secure_client(client, security, device)
+async def _secure_and_connect(client: Client, security: Security, device: str,
+                              identity: list[UserIdentity | None]) -> None:
+    """Connect with the security and user identity of ``device``, the identity given kept in ``identity``."""
+    identity[0] = await secure_client(client, security, device)
     await client.connect()
 
 
@@ -314,11 +285,19 @@ _CERTIFICATE_REFUSALS = {
 }
 
 
-def _refusal(exc: BaseException, mode: str) -> str:
-    """What a failed connection says, a refused certificate in words: refused by the controller (its own
-    validator) or by the device."""
+_IDENTITY_REFUSALS = frozenset({"BadIdentityTokenRejected", "BadIdentityTokenInvalid", "BadUserAccessDenied"})
+
+
+def _refusal(exc: BaseException, mode: str, identity: UserIdentity | None = None) -> str:
+    """What a failed connection says, a refused certificate in words (refused by the controller, its own
+    validator, or by the device), or a refused user identity."""
     if isinstance(exc, ua.UaStatusCodeError):
         name = type(exc).__name__
+        if name in _IDENTITY_REFUSALS and identity is None:
+            return f"{name}: the device asks for a user name and password; the users file gives none for it " \
+                   "(PNP_OPCUA_USERS)"
+        if name in _IDENTITY_REFUSALS and identity is not None:
+            return f"{name}: the device refused the user {identity.user!r} of {identity.source}"
         if isinstance(exc.__cause__, PeerRefused):
             return f"{name}: {_CERTIFICATE_REFUSALS.get(name, 'its certificate is refused')}"
         if name.startswith("BadCertificate") or name == "BadSecurityChecksFailed":

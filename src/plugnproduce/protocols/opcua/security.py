@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from plugnproduce.errors import ProtocolError
+from plugnproduce.protocols.opcua.identity import UserIdentity, identity_for
 from plugnproduce.protocols.opcua.spec import application_uri_for
 
 MODES = ("None", "Sign", "SignAndEncrypt")
@@ -43,6 +44,8 @@ class Security:
     pki: Path | None = None
     allow_insecure: bool = False
     """Mode None also for a device off loopback (``PNP_OPCUA_ALLOW_INSECURE=1``)."""
+    users: Path | None = None
+    """The users file: the user names and passwords of the devices that ask for one (:mod:`.identity`)."""
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
@@ -52,12 +55,15 @@ class Security:
 
 
 def from_environment(env: Mapping[str, str] | None = None) -> Security:
-    """``PNP_OPCUA_SECURITY`` (default SignAndEncrypt with a PKI folder, else None), ``PNP_OPCUA_PKI`` and
-    ``PNP_OPCUA_ALLOW_INSECURE``."""
+    """``PNP_OPCUA_SECURITY`` (default SignAndEncrypt with a PKI folder, else None), ``PNP_OPCUA_PKI``,
+    ``PNP_OPCUA_ALLOW_INSECURE`` and ``PNP_OPCUA_USERS`` (default ``PKI/users`` where it exists)."""
     env = os.environ if env is None else env
     pki = Path(env["PNP_OPCUA_PKI"]) if env.get("PNP_OPCUA_PKI") else None
     mode = env.get("PNP_OPCUA_SECURITY") or ("SignAndEncrypt" if pki is not None else "None")
-    return Security(mode, pki, env.get("PNP_OPCUA_ALLOW_INSECURE", "") in ("1", "yes", "true"))
+    users = Path(env["PNP_OPCUA_USERS"]) if env.get("PNP_OPCUA_USERS") else None
+    if users is None and pki is not None and (pki / "users").is_file():
+        users = pki / "users"
+    return Security(mode, pki, env.get("PNP_OPCUA_ALLOW_INSECURE", "") in ("1", "yes", "true"), users)
 
 
 def is_loopback(host: str) -> bool:
@@ -129,11 +135,16 @@ async def _validator(trusted: Path, peer: str) -> Any:
     return validate
 
 
-async def secure_client(client: Any, security: Security, device: str) -> None:
+async def secure_client(client: Any, security: Security, device: str) -> UserIdentity | None:
     """Give an asyncua client the controller's certificate and key, and trust only the folder's device
-    certificates (an untrusted server is refused with ``BadCertificateUntrusted``)."""
+    certificates (an untrusted server is refused with ``BadCertificateUntrusted``); and the user identity the
+    users file gives ``device``, returned (None: the session is anonymous)."""
+    identity = identity_for(security.users, device)
+    if identity is not None:
+        client.set_user(identity.user)
+        client.set_password(identity.password)
     if security.mode == "None" or security.pki is None:
-        return
+        return identity
     from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
 
     cert, key = _own(security.pki, None)
@@ -141,6 +152,7 @@ async def secure_client(client: Any, security: Security, device: str) -> None:
     client.certificate_validator = await _validator(security.pki / "trusted", "server")
     await client.set_security(SecurityPolicyBasic256Sha256, str(_readable(cert, "controller certificate")),
                               str(_readable(key, "controller private key")), mode=_mode(security))
+    return identity
 
 
 async def secure_server(server: Any, security: Security, device: str) -> None:

@@ -25,6 +25,7 @@ from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_VARIABLES,
     REGISTRATION_PERIOD,
     STATE_VARIABLE,
+    ArgumentSpec,
     Kind,
     MethodSpec,
     NodeSpec,
@@ -65,15 +66,17 @@ class OpcUaDeviceServer:
 
     def __init__(self, spec: NodeSpec, handler: RequestHandler, state: Callable[[], str], *,
                  host: str = "127.0.0.1", port: int = 0,
-                 files: Callable[[str], DeviceFiles] | None = None, security: Security | None = None) -> None:
+                 files: Callable[[str], DeviceFiles] | None = None, security: Security | None = None,
+                 reported: Callable[[str], Any] | None = None) -> None:
         """``files``: the device's own description for the endpoint it listens on, served as the String
         variables of ``ns:Description``; ``security``: the one mode it offers (default None) and its PKI
-        folder."""
+        folder; ``reported``: the value of a quantity it reports with its state, as it is when read."""
         self.security = security or Security()
         self.spec = spec
         self.files = files
         self._handler = handler
         self._state = state
+        self._reported = reported or (lambda _quantity: None)
         self._host = host
         self._port = port
         self._server: Server | None = None
@@ -95,6 +98,8 @@ class OpcUaDeviceServer:
         self._device = await server.nodes.objects.add_object(idx, self.spec.device)
         state = await self._device.add_variable(idx, STATE_VARIABLE, "", varianttype=ua.VariantType.String)
         server.iserver.set_attribute_value_callback(state.nodeid, self._read_state)
+        for report in self.spec.reports:
+            await self._add_report(server, idx, report)
         for method in self.spec.methods:
             await self._add_method(idx, method)
         for name, fields in self.spec.events.items():
@@ -142,6 +147,20 @@ class OpcUaDeviceServer:
 
     def _read_state(self, *_: Any) -> ua.DataValue:
         return ua.DataValue(ua.Variant(self._state(), ua.VariantType.String))
+
+    async def _add_report(self, server: Server, idx: int, report: ArgumentSpec) -> None:
+        """A variable holding a value the device reports, read when asked (never stale), typed by its kind."""
+        assert self._device is not None
+        datatype, rank, dimensions = _TYPES[report.kind]
+        node = await self._device.add_variable(idx, report.name, _variant(self._reported(report.name)),
+                                               datatype=ua.NodeId(datatype))
+        await node.write_value_rank(rank)
+        await node.write_array_dimensions(dimensions)
+
+        def read(*_: Any) -> ua.DataValue:
+            return ua.DataValue(_variant(self._reported(report.name)))
+
+        server.iserver.set_attribute_value_callback(node.nodeid, read)
 
     async def _add_method(self, idx: int, method: MethodSpec) -> None:
         assert self._device is not None

@@ -6,6 +6,8 @@ The naming rule (``docs/opcua.md``): the device registers the namespace ``NAMESP
 * one method ``ns:NAME`` per request ``opcua.request.NAME`` of its device state chart, whose input
   arguments are the quantities the request carries (named by the quantity, typed by :data:`KINDS`);
 * a String variable ``ns:State``: the id of the chart state the device is in (the state query);
+* a variable ``ns:QUANTITY`` per value the device reports with its state (teach-in: the chart's
+  ``<data pnp:quantity=...>``), typed as a request argument of that quantity is (a pose ``Double[6]``);
 * an object ``ns:Description`` with String variables ``TurtleName``, ``Turtle``, ``ChartName`` and ``Chart``:
   the device's own description files (read, as over UPnP, within a size and time budget);
 * the object is the source (``EventNotifier``) of the device's events: each ``opcua.event.NAME`` is an
@@ -101,6 +103,15 @@ class NodeSpec:
     device: str
     methods: tuple[MethodSpec, ...] = ()
     events: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    reports: tuple[ArgumentSpec, ...] = ()
+    """The values the device reports with its state: one variable each, beside ``State``."""
+
+    def __post_init__(self) -> None:
+        taken = {m.name for m in self.methods} | {STATE_VARIABLE, DESCRIPTION_OBJECT}
+        for report in self.reports:
+            if report.name in taken:
+                raise ProtocolError(f"device {self.device}: the reported quantity {report.name} would be a "
+                                    f"variable named like its {report.name} node; rename the quantity")
 
     @property
     def namespace(self) -> str:

@@ -194,7 +194,7 @@ def payload_of(values: Mapping[str, Any], event: str) -> dict[str, Any]:
         if variable.startswith(prefix):
             try:
                 out[variable[len(prefix):]] = json.loads(text) if isinstance(text, str) else text
-            except ValueError:
+            except (ValueError, RecursionError):  # no JSON, or nested deeper than the decoder recurses
                 out[variable[len(prefix):]] = text
     return out
 
@@ -236,12 +236,48 @@ def service_spec_from_chart_events(
     return ServiceSpec(actions, variables)
 
 
-def with_state_query(spec: ServiceSpec) -> ServiceSpec:
-    """The service with the state query :data:`STATE_ACTION` added (a chart request of that name is refused)."""
+def with_state_query(spec: ServiceSpec, reports: Sequence[str] = ()) -> ServiceSpec:
+    """The service with the state query :data:`STATE_ACTION` added (a chart request of that name is refused).
+
+    ``reports`` are the quantities the device reports with its state (teach-in): each is one more string
+    out-argument of the query, named after the quantity, holding the value as JSON (:func:`report_text`)."""
     if any(a.name == STATE_ACTION for a in spec.actions):
         raise DescriptionError(f"action {STATE_ACTION!r} is the state query; a device chart cannot wait for it")
-    query = ActionSpec(STATE_ACTION, outputs=(ArgumentSpec(STATE_ARGUMENT),))
-    return ServiceSpec((*spec.actions, query), spec.variables)
+    if STATE_ARGUMENT in reports:
+        raise DescriptionError(f"a reported quantity cannot be named {STATE_ARGUMENT!r}: the state query's "
+                               "out-argument of that name holds the state")
+    outputs = (ArgumentSpec(STATE_ARGUMENT), *(ArgumentSpec(name) for name in _unique(reports)))
+    return ServiceSpec((*spec.actions, ActionSpec(STATE_ACTION, outputs=outputs)), spec.variables)
+
+
+MAX_REPORT = 4096
+"""Longest text (characters) of a reported value the controller reads."""
+
+
+def report_text(value: Any) -> str:
+    """A value the device reports with its state, as the state query's out-argument carries it: JSON."""
+    return json.dumps(value, allow_nan=False)
+
+
+def reported_of(results: Mapping[str, Any], names: Sequence[str], where: str) -> dict[str, Any]:
+    """The values of ``names`` in a state query's answer (those it carries), read from JSON within
+    :data:`MAX_REPORT` characters; a :class:`ValueError` naming ``where`` and the value for anything else."""
+    out: dict[str, Any] = {}
+    for name in names:
+        text = results.get(name)
+        if text is None:
+            continue
+        if not isinstance(text, str) or len(text) > MAX_REPORT:
+            raise ValueError(f"{where}: {name} is no text of at most {MAX_REPORT} characters")
+        try:
+            out[name] = json.loads(text, parse_constant=_no_constant)
+        except (ValueError, RecursionError):  # nested deeper than the decoder recurses: no value either
+            raise ValueError(f"{where}: {name} is not a JSON value: {text[:60]!r}") from None
+    return out
+
+
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is no finite number")
 
 
 def _unique(items: Sequence[str]) -> list[str]:

@@ -14,7 +14,7 @@ from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.facts import fact_book, task_facts
 from plugnproduce.reasoning.asp.results import CheckResult, Problem, Reason, StepCheck, StepExplanation
 from plugnproduce.reasoning.asp.terms import Model, program
-from plugnproduce.reasoning.checks.accepts import not_accepted
+from plugnproduce.reasoning.checks.accepts import not_accepted, not_taken
 from plugnproduce.reasoning.checks.branches import (
     MAX_PATH_STEPS,
     MAX_PATHS,
@@ -90,6 +90,7 @@ def check(task: Task, cell: Cell, knowledge: Knowledge) -> CheckResult:
     steps, final = _steps(model, task)
     parameters = {p.id: {x.name: x for x in p.parameters} for p in knowledge.processes}
     lost = list(not_accepted(task, cell, steps, parameters, knowledge.taxonomy))
+    lost += not_taken(task, cell, steps, knowledge.processes_by_id, knowledge.taxonomy)
     lost += link_problems(task, knowledge)
     lost += unreported(task, cell, steps, knowledge.processes_by_id)
     lost += unreadable + list(beyond_limits(task, cell, steps, knowledge)) + flow_problems(task, knowledge)

@@ -1,27 +1,30 @@
-// The Goal view: state what must happen (a goal, as `pnp plan` reads it), see the plan the controller finds
-// in the cell as it is now and its steps, and send it to the task editor.
+// The Goal view: state what must happen (a goal, as `pnp plan` reads it, written by hand or by its form), see the
+// plan the controller finds in the cell as it is now, its steps and its estimated cycle time, and send it to the
+// task editor.
 
 import { api } from "./api.js";
 import { $, announce, fill, h, showValue } from "./dom.js";
 import { setTask } from "./editor.js";
+import { initGoalForm } from "./goalform.js";
 import { editorTask } from "./state.js";
-
-const EXAMPLE = `goal: empty-the-bin
-achieve:
-  - command: place
-    params: {place_pose: [0.60, -0.20, 0.10, 0, 180, 0]}
-until: BinEmpty
-end: {gripper: Open}
-`;
 
 let planned = null;
 
-function stepItem(s) {
+function stepItem(s, seconds) {
   const bind = Object.entries(s.bind).map(([r, d]) => `${r} ${d}`).join(", ");
   const params = Object.entries(s.params).map(([n, v]) =>
     (v && v.from ? `${n} from ${v.from}.${v.output}` : `${n} ${showValue(v)}`)).join(", ");
-  return h("li", { dataset: { command: s.command } }, h("strong", {}, s.command), bind ? ` on ${bind}` : "",
-    params ? ` (${params})` : "");
+  return h("li", { dataset: { command: s.command, seconds: seconds ?? "" } }, h("strong", {}, s.command),
+    bind ? ` on ${bind}` : "", params ? ` (${params})` : "", seconds !== undefined ? `: ${seconds.toFixed(2)} s` : "");
+}
+
+/** The plan's estimated cycle time in words (`pnp check`'s estimate), or why there is none. */
+function cycleText(answer) {
+  const estimate = answer.cycle_time;
+  if (!estimate) return "No cycle time is estimated: the plan is not plausible in the cell.";
+  const per = answer.until ? " per iteration of the loop" : "";
+  const notes = estimate.notes.length ? ` (${estimate.notes.join("; ")})` : "";
+  return `Estimated cycle time: ${estimate.total_seconds.toFixed(2)} s${per}${notes}.`;
 }
 
 function render(answer) {
@@ -33,13 +36,17 @@ function render(answer) {
     status.textContent = `No plan reaches goal ${answer.goal}: ${answer.reasons.join("; ")}.${buy}`;
     status.dataset.status = "unreachable";
     fill($("#goal-steps"), []);
+    $("#goal-cycle-time").hidden = true;
     $("#goal-task").hidden = true;
     return;
   }
   const loop = answer.until ? `, repeated until ${answer.until}` : "";
   status.textContent = `Goal ${answer.goal}: planned, ${answer.steps.length} step(s)${loop}; the check finds it ${answer.plausible ? "plausible" : "implausible"}.`;
   status.dataset.status = "planned";
-  fill($("#goal-steps"), answer.steps.map(stepItem));
+  const seconds = new Map(((answer.cycle_time && answer.cycle_time.steps) || []).map((s) => [s.step, s.seconds]));
+  fill($("#goal-steps"), answer.steps.map((s) => stepItem(s, seconds.get(s.step))));
+  $("#goal-cycle-time").textContent = cycleText(answer);
+  $("#goal-cycle-time").hidden = false;
   $("#goal-task").textContent = answer.text;
   $("#goal-task").hidden = false;
 }
@@ -67,9 +74,9 @@ function send() {
   $("#task").scrollIntoView();
 }
 
-/** Wire the Goal view (its text starts with the bin-emptying goal as an example). */
+/** Wire the Goal view (its form and text start with the bin-emptying goal as an example). */
 export function initGoal() {
-  $("#goal-text").value = EXAMPLE;
+  initGoalForm();
   $("#goal-plan").addEventListener("click", plan);
   $("#goal-send").addEventListener("click", send);
 }

@@ -73,11 +73,13 @@ function renderFlow(run) {
 
 function statusText(run) {
   const step = run.step ? `step ${run.step.step} of ${run.steps}: ${run.step.command}` : "starting";
+  // the speed factor the run's simulated devices work at, as its journal's start record says (none: real devices)
+  const on = run.speed == null ? "" : ` on simulated devices at speed ${run.speed}`;
   switch (run.status) {
-    case "running": return `Run ${run.run} of task ${run.task} is running (${step}).`;
-    case "succeeded": return `Run ${run.run} of task ${run.task} succeeded.`;
-    case "stopped": return `Run ${run.run} of task ${run.task} was stopped.`;
-    default: return `Run ${run.run} of task ${run.task} ${run.status}.`;
+    case "running": return `Run ${run.run} of task ${run.task} is running${on} (${step}).`;
+    case "succeeded": return `Run ${run.run} of task ${run.task} succeeded${on}.`;
+    case "stopped": return `Run ${run.run} of task ${run.task} was stopped${on}.`;
+    default: return `Run ${run.run} of task ${run.task} ${run.status}${on}.`;
   }
 }
 
