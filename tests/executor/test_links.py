@@ -201,7 +201,7 @@ async def test_an_opc_ua_call_and_state_read_wait_as_long_as_they_are_told(monke
                                                       f"{SHORT:g} s$"):
                 await asyncio.wait_for(link.request("Localize", {"PartType": "bracket"}, SHORT), WAIT)
             client = link._client  # type: ignore[attr-defined]
-            monkeypatch.setattr(client, "_read_state", release.wait)  # a State read the server never answers
+            monkeypatch.setattr(client, "_read_report", lambda _names: release.wait())  # a Read never answered
             with pytest.raises(ProtocolTimeout, match=f"^device binpicking-pc-ua: no answer to read its State within "
                                                       f"{SHORT:g} s$"):
                 await asyncio.wait_for(link.state(SHORT), WAIT)
@@ -224,18 +224,12 @@ async def test_query_report_reads_the_pose_the_robot_reports_with_its_state() ->
     assert list(values["TargetPose"]) == [0.4, 0.0, 0.6, 0.0, 180.0, 0.0]
 
 
-async def test_query_report_over_upnp_says_its_state_query_reports_the_state_only() -> None:
-    async with simulated(device(BIN_PICKING, "binpicking-pc")) as (_, live):
-        with pytest.raises(ProtocolError, match="^device binpicking-pc speaks upnp, whose state query reports its "
-                                                "state only; values are read with it over XIRP$"):
-            await query_report(live, WAIT)
-
-
 async def test_a_protocol_no_link_speaks_is_refused_naming_the_three_that_are() -> None:
     odd = dataclasses.replace(device(BIN_PICKING, "gripper"), protocol="modbus")
-    with pytest.raises(ProtocolError, match="^device gripper: protocol 'modbus' is not supported; "
-                                            "expected xirp, upnp or opcua$"):
-        await Heard().open(odd)
+    for opening in (Heard().open(odd), query_report(odd, WAIT)):
+        with pytest.raises(ProtocolError, match="^device gripper: protocol 'modbus' is not supported; "
+                                                "expected xirp, upnp or opcua$"):
+            await opening
 
 
 async def test_an_xirp_request_carries_its_values_to_the_device() -> None:
@@ -304,8 +298,8 @@ async def test_a_device_that_never_greets_is_given_up_after_its_command_timeout_
                                      command_timeout=command_timeout)
         with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {given_up:g} s$"):
             await asyncio.wait_for(Heard().open(silent), WAIT)
-        with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {SHORT:g} s$"):
-            await asyncio.wait_for(query_report(dataclasses.replace(silent, command_timeout=LONG), SHORT), WAIT)
+        with pytest.raises(ProtocolTimeout, match=f"no connection and hello within {given_up:g} s$"):
+            await asyncio.wait_for(query_report(silent, SHORT), WAIT)
 
 
 async def test_a_upnp_link_waits_for_an_answer_as_long_as_it_is_told_not_as_the_device_says() -> None:
