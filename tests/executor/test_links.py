@@ -25,6 +25,8 @@ from tests.lines import WAIT
 
 BIN_PICKING = service.builtin("cells", "bin-picking.yaml")
 MIXED = service.builtin("cells", "mixed.yaml")
+SHORT_ARMS = Path(__file__).parents[1] / "data" / "libraries" / "short-arm" / "cells" / "short-arms.yaml"
+"""A library's arm over XIRP, UPnP and OPC UA, each reporting the pose it was left at with its state."""
 GUIDED = [0.35, 0.15, 0.22, 0.0, 180.0, 45.0]
 SHORT = 0.5
 """The timeout a test gives one request; its device's own command timeout is far longer (LONG)."""
@@ -222,6 +224,35 @@ async def test_query_report_reads_the_pose_the_robot_reports_with_its_state() ->
         state, values = await query_report(live, WAIT)
     assert (state, list(values)) == ("home", ["TargetPose"])
     assert list(values["TargetPose"]) == [0.4, 0.0, 0.6, 0.0, 180.0, 0.0]
+
+
+@pytest.mark.parametrize("name", ["short-arm", "short-arm-upnp", "short-arm-ua"])
+async def test_query_report_reads_the_reported_pose_over_each_protocol(name: str) -> None:
+    async with simulated(device(SHORT_ARMS, name)) as (_, live):
+        state, values = await query_report(live, WAIT)
+    assert (state, list(values)) == ("home", ["TargetPose"])
+    assert list(values["TargetPose"]) == [0.40, 0.00, 0.60, 0, 180, 0]
+
+
+@pytest.mark.parametrize("name", ["short-arm-upnp", "short-arm-ua"])
+async def test_query_report_waits_for_the_answer_as_long_as_it_is_told(monkeypatch: pytest.MonkeyPatch,
+                                                                     name: str) -> None:
+    release = asyncio.Event()
+
+    async def never_answers(*_: Any) -> None:
+        await release.wait()
+
+    if name == "short-arm-ua":
+        from plugnproduce.protocols.opcua import OpcUaDeviceClient
+        monkeypatch.setattr(OpcUaDeviceClient, "_read_report", lambda *_: release.wait())  # a Read never answered
+    else:
+        monkeypatch.setattr(SimulatedDevice, "_on_upnp_action", never_answers)  # GetDeviceState never answered
+    async with simulated(dataclasses.replace(device(SHORT_ARMS, name), command_timeout=LONG)) as (_, live):
+        try:
+            with pytest.raises(ProtocolTimeout):
+                await asyncio.wait_for(query_report(dataclasses.replace(live, command_timeout=LONG), SHORT), WAIT)
+        finally:
+            release.set()
 
 
 async def test_a_protocol_no_link_speaks_is_refused_naming_the_three_that_are() -> None:
