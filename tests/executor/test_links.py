@@ -212,6 +212,21 @@ async def test_an_opc_ua_call_and_state_read_wait_as_long_as_they_are_told(monke
             await link.close()
 
 
+async def test_an_opc_ua_subscription_never_confirmed_is_given_up_after_the_command_timeout(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from plugnproduce.protocols.opcua import OpcUaDeviceClient
+
+    release = asyncio.Event()
+    monkeypatch.setattr(OpcUaDeviceClient, "_subscribe", lambda *_: release.wait())  # the server never confirms
+    async with simulated(device(MIXED, "screwdriver-ua")) as (_, live):
+        try:
+            with pytest.raises(ProtocolTimeout, match=f"^device screwdriver-ua: no answer to subscribe to its events "
+                                                      f"within {SHORT:g} s$"):
+                await asyncio.wait_for(Heard().open(dataclasses.replace(live, command_timeout=SHORT)), WAIT)
+        finally:
+            release.set()
+
+
 @pytest.mark.parametrize(("cell", "name", "state"), [(BIN_PICKING, "gripper", "open"),
                                                        (BIN_PICKING, "binpicking-pc", "ready")])
 async def test_query_state_answers_the_state_of_its_device_chart(cell: Path, name: str, state: str) -> None:
