@@ -249,7 +249,7 @@ async def test_query_report_reads_the_reported_pose_over_each_protocol(name: str
     assert list(values["TargetPose"]) == [0.40, 0.00, 0.60, 0, 180, 0]
 
 
-@pytest.mark.parametrize("name", ["short-arm-upnp", "short-arm-ua"])
+@pytest.mark.parametrize("name", ["short-arm", "short-arm-upnp", "short-arm-ua"])
 async def test_query_report_waits_for_the_answer_as_long_as_it_is_told(monkeypatch: pytest.MonkeyPatch,
                                                                      name: str) -> None:
     release = asyncio.Event()
@@ -260,9 +260,11 @@ async def test_query_report_waits_for_the_answer_as_long_as_it_is_told(monkeypat
     if name == "short-arm-ua":
         from plugnproduce.protocols.opcua import OpcUaDeviceClient
         monkeypatch.setattr(OpcUaDeviceClient, "_read_report", lambda *_: release.wait())  # a Read never answered
-    else:
+    elif name == "short-arm-upnp":
         monkeypatch.setattr(SimulatedDevice, "_on_upnp_action", never_answers)  # GetDeviceState never answered
-    async with simulated(dataclasses.replace(device(SHORT_ARMS, name), command_timeout=LONG)) as (_, live):
+    faults = never_answering()  # over XIRP: the state query's response is dropped
+    async with simulated(dataclasses.replace(device(SHORT_ARMS, name), command_timeout=LONG),
+                         faults=faults) as (_, live):
         try:
             with pytest.raises(ProtocolTimeout):
                 await asyncio.wait_for(query_report(dataclasses.replace(live, command_timeout=LONG), SHORT), WAIT)
@@ -291,7 +293,8 @@ async def test_an_xirp_request_carries_its_values_to_the_device() -> None:
     assert state == "at_pose" and list(values["TargetPose"]) == GUIDED
 
 
-def never_answering(**options: Any) -> xirp.Faults:
+def never_answering() -> xirp.Faults:
+    """Faults of a device that takes Close and the state query but never answers either."""
     faults = xirp.Faults()
     for name in ("Close", "state"):
         faults.add(xirp.FaultKind.DROP_RESPONSE, name, times=None)
