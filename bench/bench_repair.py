@@ -1,6 +1,6 @@
 """Benchmark of repair window by window against the whole-task optimum (prints figures; not a test).
 
-    python bench/bench_repair.py [--seed 1] [--whole-up-to 1000] [--processes [--rounds 3]]
+    python bench/bench_repair.py [--seed 1] [--whole-up-to 1000] [--processes [--rounds 3]] [--phases]
 
 Long bin-picking tasks with faults injected (``tests/reasoning/faulty_tasks.py``, seeded): 100,
 1,000, 2,000 and 10,000 steps with one fault per 100 steps, every place with its own speed so that
@@ -9,6 +9,8 @@ those of at most ``--whole-up-to`` steps too, and its optimal cost must equal th
 Then the same with repeated steps (windows alike are solved once), and 200-step repairs with the
 built-in catalogue.
 Targets: 1,000 steps < 2 s, 10,000 steps < 30 s, time per step roughly flat; catalogue < 2 s.
+``--processes``: ``pnp repair`` against ``pnp check`` of the same task as whole processes (CPU time, paired
+rounds); ``--phases``: where ``pnp repair`` of the 10,000-step task spends its CPU time.
 """
 
 from __future__ import annotations
@@ -91,6 +93,43 @@ def processes(seed: int, rounds: int) -> None:
                   f"(target {target})", flush=True)
 
 
+def phases(seed: int) -> None:
+    """Where ``pnp repair`` of the 10,000-step task spends its CPU time, step by step as the command takes them
+    (in this process, after start-up: reading the task, its check, the windows, checking the three repairs
+    again with their side effects, their cycle times, writing them)."""
+    from plugnproduce.reasoning.repairs.sideeffects import assess
+
+    cell_path = service.builtin("cells", "bin-picking.yaml")
+    with tempfile.TemporaryDirectory(prefix="pnp-bench-repair-") as tmp:
+        path = Path(tmp) / "faulty-10000.yaml"
+        path.write_text(service.task_text(faulty_task(5000, 100, seed, varied=True), block=True), encoding="utf-8")
+        cell = service.cell(cell_path)
+        laps: list[tuple[str, float]] = []
+
+        def lap(what: str, since: list[float] = [time.process_time()]) -> None:  # noqa: B006
+            now = time.process_time()
+            laps.append((what, now - since[0]))
+            since[0] = now
+
+        task = service.task(path)
+        lap("read the task")
+        checked = service.check(task, cell, K)
+        lap("check it")
+        found = service.repair(task, cell, None, 3, knowledge=K)
+        lap("repair it window by window (3 best)")
+        assessed = assess(found, task, cell, K, (), checked)
+        lap("check the repairs again, their side effects")
+        service.repair_cycle_times(assessed, cell, None, K)
+        lap("their cycle times")
+        for r in assessed:
+            service.task_text(r.repair.task)
+        lap("write the repaired tasks")
+    total = sum(s for _, s in laps)
+    print("pnp repair, 10,000 steps, 100 faults, in-process CPU time after start-up:")
+    for what, seconds in laps:
+        print(f"  {what:45s} {seconds:6.2f} s ({100 * seconds / total:4.1f} %)")
+
+
 def main() -> None:
     """Run the benchmark and print its figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
@@ -98,10 +137,14 @@ def main() -> None:
     parser.add_argument("--whole-up-to", type=int, default=1000, help="largest task the whole-task solver repairs")
     parser.add_argument("--processes", action="store_true", help="only pnp repair against pnp check, as processes")
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--phases", action="store_true", help="only where pnp repair of 10,000 steps spends its time")
     args = parser.parse_args()
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
-    if args.processes:
-        processes(args.seed, args.rounds)
+    if args.processes or args.phases:
+        if args.processes:
+            processes(args.seed, args.rounds)
+        if args.phases:
+            phases(args.seed)
         return
     cell = service.cell(service.builtin("cells", "bin-picking.yaml"))
     catalogue = service.catalogue()

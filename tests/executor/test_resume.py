@@ -161,7 +161,8 @@ def test_pnp_resume_shows_the_plan_asks_and_continues_with_yes(env: dict[str, st
 
 def test_pnp_resume_sim_starts_the_simulated_devices_where_the_run_left_them(tmp_path: Path) -> None:
     """A `pnp run --sim` cell ends with its run: `pnp resume --sim` simulates it again, each device in the state the
-    journal's end record left it in, on a bin of the parts left (none was taken before the fault)."""
+    journal's end record left it in, on a bin of the parts left (none was taken before the fault), at the speed the
+    run had."""
     env = {**os.environ, "PNP_RUNS": str(tmp_path / "runs")}
 
     def pnp_sim(*args: str) -> subprocess.CompletedProcess[str]:
@@ -169,7 +170,7 @@ def test_pnp_resume_sim_starts_the_simulated_devices_where_the_run_left_them(tmp
                               timeout=600, env=env)
 
     first = pnp_sim("run", str(UNTIL_EMPTY), "--sim", "--faults", GRIPPER_FAULT, "--bin-parts", "3", "--bin-seed",
-                    "2", "--journal", str(tmp_path / "first.jsonl"))
+                    "2", "--speed", "4", "--journal", str(tmp_path / "first.jsonl"))
     assert first.returncode == 1, first.stderr
     left = journal_of(tmp_path / "first.jsonl")[-1]["device_states"]
     assert left["robot"] == "at_pose"  # not its chart's initial state (home)
@@ -178,6 +179,7 @@ def test_pnp_resume_sim_starts_the_simulated_devices_where_the_run_left_them(tmp
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr
     records = journal_of(tmp_path / "resumed.jsonl")
     assert [r["kind"] for r in records[:4]] == ["start", "stopped", "replan", "continue"]
+    assert records[0]["speed"] == 4
     assert records[2]["states"] == left  # the simulated devices report where the run left them
     found = [r["params"] for r in records if r["kind"] == "event" and r["event"] == "PartLocalized"]
     assert [f["outcome"] for f in found] == ["PartFound"] * 3 + ["BinEmpty"]

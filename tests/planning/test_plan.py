@@ -132,6 +132,24 @@ def test_a_bad_goal_is_one_line_at_its_line_and_exit_2(tmp_path: Path, text: str
     assert len(done.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize(("params", "found"), [
+    ("{place_pose: [9.6, -0.2, 0.1, 0, 180, 0]}", "which reaches at most 1.45 m from its base; the pose is 9.6 m away"),
+    ("{place_pose: [0.6, -0.2, 0.1, 0, 180, 0], speed: 500}", "parameter speed = 500 % is above its maximum 100 %"),
+    ('{place_pose: "0.6 -0.2 far"}', "parameter place_pose is not a pose value"),
+])
+def test_a_goal_fixing_a_value_beyond_a_limit_is_exit_1_at_its_line_and_writes_no_task(
+        tmp_path: Path, params: str, found: str) -> None:
+    goal = goal_file(tmp_path, f"goal: g\nachieve:\n  - command: place\n    params: {params}\n")
+    task = tmp_path / "task.yaml"
+    done = pnp("plan", str(goal), "--cell", str(CELL), "-o", str(task))
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert "the check finds it implausible" in done.stdout
+    assert f"{goal}:3: step 2 (place): " in done.stdout and found in done.stdout
+    assert not task.exists()
+    answer = pnp("plan", str(goal), "--cell", str(CELL), "--json")
+    assert answer.returncode == 1 and json.loads(answer.stdout)["check"]["plausible"] is False
+
+
 def test_validate_reads_goal_files_and_names_an_unknown_command_at_its_line(tmp_path: Path) -> None:
     assert pnp("validate", str(service.builtin("goals"))).returncode == 0
     goal = goal_file(tmp_path, "goal: g\nachieve:\n  - command: plase\n")

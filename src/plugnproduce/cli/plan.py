@@ -1,7 +1,8 @@
 """``pnp plan``: goals in, tasks out.
 
-Exit codes: 0 a plan was found (and checked plausible); 1 no plan reaches the goal (with why and
-what to buy); 2 bad input, one ``file:line: message`` line.
+Exit codes: 0 a plan was found and checked plausible; 1 no plan reaches the goal (with why and what to
+buy), or the plan is not plausible (a value the goal fixes is beyond a limit: each problem at the goal's
+line); 2 bad input, one ``file:line: message`` line.
 """
 
 from __future__ import annotations
@@ -41,7 +42,8 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
     The plan is the shortest that measures what the cell can measure (a pick pose the bin-picking PC
     reports rather than a default), or with --minimize cycle-time the one of least estimated cycle time;
     it is checked like a written task. Exit 0 planned, 1 no plan reaches the goal (why, and the cheapest
-    catalogue device that would make one), 2 bad input.
+    catalogue device that would make one) or the check refuses the plan (a value the goal fixes is beyond a
+    limit; the task is then shown but not written), 2 bad input.
     """
     if minimize not in ("steps", "cycle-time"):
         raise typer.BadParameter(f"--minimize {minimize!r}: expected steps or cycle-time")
@@ -60,6 +62,8 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
         raise typer.Exit(1)
     checked = service.check(found.task, the_cell, k)
     estimate = service.cycle_time(found.task, the_cell, k, checked)
+    if not checked.plausible:
+        output = None  # a task that check refuses is shown, not written
     if output is not None:
         output.write_text(found.text, encoding="utf-8")
     if json_out:
@@ -68,6 +72,8 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
                    "defaults_not_measured": [{"step": t, "parameter": n} for t, n in found.blind],
                    "check": checked.to_json(), "minimize": minimize,
                    "cycle_time": estimate.to_json() if estimate is not None else None})
+        if not checked.plausible:
+            raise typer.Exit(1)
         return
     loop = f", repeated until {local_name(found.goal.until)}" if found.goal.until else ""
     typer.echo(f"goal {found.goal.name} in cell {checked.cell}: planned, {found.steps} steps{loop}; "
@@ -82,11 +88,15 @@ def plan(goal: Path = typer.Argument(..., metavar="GOAL", help="The goal file (Y
     if estimate is not None:
         typer.echo(f"  estimated cycle time: {estimate.total:.2f} s"
                    + (" per iteration of the loop" if found.goal.until else ""))
+    for line in service.goal_findings(found.goal, checked):
+        typer.echo(f"  {line}")
     if output is not None:
         typer.echo(f"written to {output}")
     else:
         typer.echo("")
         typer.echo(found.text, nl=False)
+    if not checked.plausible:
+        raise typer.Exit(1)
 
 
 def _unreachable(found: Unreachable, json_out: bool) -> None:

@@ -30,7 +30,7 @@ def resume(
                                           "the run's task (for a run of a planned task)."),
     yes: bool = typer.Option(False, "--yes", "-y", help="Continue without asking (for scripts)."),
     sim: bool = typer.Option(False, "--sim", help="Simulate the cell's devices, each started in the state the run "
-                                                  "left it in (for a run of pnp run --sim)."),
+                                                  "left it in, at the run's speed (for a run of pnp run --sim)."),
     faults: str = typer.Option("", "--faults", metavar="SPEC",
                                help="With --sim: faults to inject, DEVICE:KIND[:NAME[:SECONDS]],..."),
     bin_parts: int | None = typer.Option(None, "--bin-parts", metavar="N", min=0, max=10_000,

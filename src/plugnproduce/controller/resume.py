@@ -139,11 +139,11 @@ async def resume_run(run: str | Path, cell_or_path: Cell | str | Path | None, co
 
 
 def _simulated(cell: Cell, stopped: Stopped, simulate: SimulatedResume, network: SsdpNetwork) -> SimulatedCell:
-    """The cell's devices simulated, each started in the state the stopped run left it in."""
+    """The cell's devices simulated, each started in the state the stopped run left it in, at its speed factor."""
     from plugnproduce.sim.bin import SimulatedBin
     from plugnproduce.sim.cell import SimulatedCell, parse_faults
 
     left = {d: s for d, s in stopped.left.items() if any(x.id == d for x in cell.devices)}
     parts = SimulatedBin(simulate.bin_parts, simulate.bin_seed) if simulate.bin_parts is not None else None
     return SimulatedCell(cell.reported(left), network=network, faults=parse_faults(simulate.faults, cell.devices),
-                         bin=parts)
+                         bin=parts, speed=stopped.speed or 1.0)

@@ -316,9 +316,41 @@ def task_to_yaml(task: Task, block: bool = False) -> str:
         doc["description"] = task.description
     if task.repeat != 1:
         doc["repeat"] = task.repeat
-    doc["steps"] = task_entries(task)
+    entries = task_entries(task)
+    items = _step_texts(entries, block) if entries else None
+    if items is None:
+        return _dump({**doc, "steps": entries}, block)
+    return _dump(doc, block) + "steps:\n" + "".join(items)
+
+
+ITEMS_KEPT = 100_000
+"""Most step items whose text :func:`_step_texts` keeps (a long task's repairs repeat almost all its steps)."""
+
+_ITEM_TEXT: dict[tuple[bool, str], str] = {}
+
+
+def _dump(doc: object, block: bool) -> str:
     return yaml.dump(doc, Dumper=PlainDumper if block else TaskDumper, sort_keys=False, default_flow_style=False,
                      allow_unicode=True)
+
+
+def _step_texts(entries: list[dict[str, object]], block: bool) -> list[str] | None:
+    """The text of each item of the ``steps`` list, each item written once per process: an item of a block list
+    is written alike wherever it stands, so the list's text is its items' texts one after another. Items not
+    written before are written together and split where each starts (``- `` at the line's start; their other
+    lines are indented); None when the split does not give one text per item (then the whole is written)."""
+    keys = [(block, repr(e)) for e in entries]
+    new = {k: e for k, e in zip(keys, entries, strict=True) if k not in _ITEM_TEXT}
+    if new:
+        text = _dump({"steps": list(new.values())}, block).removeprefix("steps:\n")
+        starts = [m.start() for m in re.finditer(r"^- ", text, re.MULTILINE)]
+        if len(starts) != len(new) or starts[0] != 0:
+            return None
+        if len(_ITEM_TEXT) + len(new) > ITEMS_KEPT:
+            _ITEM_TEXT.clear()
+        _ITEM_TEXT.update(zip(new, (text[a:b] for a, b in zip(starts, [*starts[1:], len(text)], strict=True)),
+                              strict=True))
+    return [_ITEM_TEXT[k] for k in keys]
 
 
 class TaskDumper(PlainDumper):

@@ -81,7 +81,7 @@ from plugnproduce.service.descriptions import (
     validate_tasks,
 )
 from plugnproduce.service.explanations import explain_offered, explain_plausible, explain_process, explain_step
-from plugnproduce.service.goals import goal_from_text, plan, plan_pddl
+from plugnproduce.service.goals import goal_findings, goal_from_text, plan, plan_pddl
 from plugnproduce.service.journals import new_run_id, report, runs, runs_folder
 from plugnproduce.service.programs import (
     Generated,
@@ -227,6 +227,7 @@ __all__ = [
     "generate",
     "generate_configurations",
     "generation",
+    "goal_findings",
     "goal_from_text",
     "impact",
     "judge_taught",

@@ -12,6 +12,7 @@ from plugnproduce.service.descriptions import CellArg, _devices, cell_and_knowle
 if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
     from plugnproduce.description.goalfile import Goal
     from plugnproduce.planning import Plan, Unreachable
+    from plugnproduce.reasoning import CheckResult
 
 
 def plan(goal_or_path: Goal | str | Path, cell_or_path: CellArg, knowledge: Knowledge | None = None,
@@ -45,3 +46,13 @@ def goal_from_text(data: bytes | str, name: str) -> Goal:
     from plugnproduce.description.goalfile import parse_goal
 
     return parse_goal(data.encode("utf-8") if isinstance(data, str) else data, name)
+
+
+def goal_findings(goal: Goal, checked: CheckResult) -> list[str]:
+    """The check's problems of a planned task as lines for the goal's author: a problem with a value the goal
+    fixes is placed at the goal's item (``goal.yaml:LINE: …``), as the planned task is not a file of theirs."""
+    lines = []
+    for problem in checked.problems:
+        item = next((i for i in goal.achieve if i.command == problem.command and problem.parameter in i.params), None)
+        lines.append(f"{goal.file}:{item.line}: {problem.text}" if item is not None else problem.text)
+    return lines

@@ -159,5 +159,5 @@ def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path
         cell = the_cell
         for device in r.repair.added_devices:
             cell = cell.with_device(bought[device])
-        out.append(task_cycle_time(r.repair.task, cell, k))
+        out.append(task_cycle_time(r.repair.task, cell, k, r.checked))  # checked by the assessment already
     return out

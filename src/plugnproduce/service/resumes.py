@@ -53,6 +53,8 @@ class Stopped:
     """The step position it stopped at (its first fault's), None if it stopped before any step began."""
     left: dict[str, str] = field(default_factory=dict)
     """The state each device was left in, as the end record says (after the safe stop)."""
+    speed: float | None = None
+    """The speed factor of its simulated devices (None: it ran on real devices)."""
 
     def record(self) -> dict[str, Any]:
         """The fields of the resumed run's ``stopped`` record."""
@@ -102,9 +104,11 @@ def stopped_run(run: str | Path) -> Stopped:
     step = fault.get("step") if fault is not None else (steps[-1] if steps else None)
     cell_file = record.start.get("cell_file")
     left = record.end.get("device_states")
+    speed = record.start.get("speed")
     return Stopped(run_id, record.path, task, cell_file if isinstance(cell_file, str) else None, record.status,
                    str(record.end.get("reason", "")), step if isinstance(step, int) else None,
-                   {str(d): str(x) for d, x in left.items()} if isinstance(left, dict) else {})
+                   {str(d): str(x) for d, x in left.items()} if isinstance(left, dict) else {},
+                   float(speed) if isinstance(speed, int | float) and speed > 0 else None)
 
 
 def rest_of_task(task: Task, step: int | None) -> tuple[Task, int]:

@@ -66,7 +66,8 @@ class CycleTime:
 
 def estimate_task(generated: GeneratedTask) -> CycleTime:
     """The estimated cycle time of ``generated``, from the devices' durations."""
-    timers = {d.id: DeviceTimer(d) for s in generated.steps for d in (r.device for r in s.regions)}
+    devices = {r.device.id: r.device for s in generated.steps for r in s.regions}
+    timers = {i: DeviceTimer(d) for i, d in devices.items()}  # one per device, not per step
     notes: list[str] = []
     steps = tuple(StepTime(s.step.index, s.step.command, _step_seconds(s, timers, notes)) for s in generated.steps)
     loops = tuple(_loop_time(loop, steps) for loop in generated.task.loops if _outermost(loop, generated.task.loops))

@@ -9,7 +9,7 @@ by forbidding each found edit set (multi-shot).
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable, Iterable, Iterator, Sequence
-from functools import cache
+from functools import cache, lru_cache
 
 import clingo
 
@@ -39,6 +39,9 @@ def rules(program: str, *, show: bool = True) -> tuple[str, ...]:
 
 CAPABILITIES, BINDINGS, OFFERED, CHECK, ABILITIES, REPAIR, WINDOW, PLAN = (
     rules(p) for p in ("capabilities", "bindings", "offered", "check", "abilities", "repair", "window", "plan"))
+
+SOLVED = 4
+"""How many answers of :func:`solve` a process keeps (the programs of the last few checks)."""
 
 OPTIMISE = ("--opt-strategy=usc,disjoint",)
 """Core-guided optimisation: default branch-and-bound is unstable on these programs."""
@@ -75,7 +78,14 @@ def _ground(ctl: clingo.Control, messages: list[str], rules: Sequence[str], fact
 
 
 def solve(rules: Sequence[str], facts: str) -> Model:
-    """The one model of a program that needs no search (stratified encodings plus facts)."""
+    """The one model of a program that needs no search (stratified encodings plus facts); the same program asked
+    again in a process is answered from the last few answers (``pnp repair`` checks a task, then reads the same
+    check's states to cut the task into windows). The model is shared: read it, never change it."""
+    return _solved(tuple(rules), facts)
+
+
+@lru_cache(maxsize=SOLVED)
+def _solved(rules: tuple[str, ...], facts: str) -> Model:
     ctl, messages = _control(["--warn=none"])
     _ground(ctl, messages, rules, facts)
     found: list[Model] = []
@@ -83,17 +93,6 @@ def solve(rules: Sequence[str], facts: str) -> Model:
     if not result.satisfiable or not found:
         raise EncodingError(f"{', '.join(rules)} has no model for these facts; stratified encodings always have one")
     return found[-1]
-
-
-def symbols(rules: Sequence[str], facts: str) -> list[clingo.Symbol]:
-    """The shown atoms of the one model of a program that needs no search, undecoded (for large models)."""
-    ctl, messages = _control(["--warn=none"])
-    _ground(ctl, messages, rules, facts)
-    found: list[Sequence[clingo.Symbol]] = []
-    result = ctl.solve(on_model=lambda m: found.append(m.symbols(shown=True)))
-    if not result.satisfiable or not found:
-        raise EncodingError(f"{', '.join(rules)} has no model for these facts; stratified encodings always have one")
-    return list(found[-1])
 
 
 def optimise(

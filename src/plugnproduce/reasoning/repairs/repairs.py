@@ -199,6 +199,20 @@ class _EditReader:
                  bound: Callable[[int], dict[str, str]] | None = None):
         self.task, self.book, self.devices, self.costs = task, book, devices, costs
         self.bound = bound
+        self._readable: list[Task] = []  # shared with the readers made by with_bound
+
+    def with_bound(self, bound: Callable[[int], dict[str, str]]) -> _EditReader:
+        """This reader with other devices bound to the steps' roles (the task read in its units is shared)."""
+        reader = _EditReader(self.task, self.book, self.devices, self.costs, bound)
+        reader._readable = self._readable
+        return reader
+
+    @property
+    def readable(self) -> Task:
+        """The task with its values read in their parameters' units, read once (a long task has many resets)."""
+        if not self._readable:
+            self._readable.append(normalised(self.task, self.book.processes)[0])
+        return self._readable[0]
 
     def read(self, term: edits.EditTerm) -> Edit:
         """The edit with its sentence and cost."""
@@ -252,9 +266,8 @@ class _EditReader:
         par = next((x for x in self.book.process(self.cmd(i)).parameters if x.name == n), None)
         what = f"reset parameter {n} to its default {par.default}" if par else f"drop parameter {n} (not declared)"
         if par is not None and self.bound is not None:
-            readable, _ = normalised(self.task, self.book.processes)
             device = self.devices.get(self.bound(i).get(par.role, ""))
-            why = reset_reason(device, readable.steps[i - 1].params.get(n), par, self.book.taxonomy)
+            why = reset_reason(device, self.readable.steps[i - 1].params.get(n), par, self.book.taxonomy)
             what += f" ({why})" if why else ""
         return Edit("reset", f"step {i} ({self.cmd(i)}): {what}", self.costs.reset, i, self.cmd(i), parameter=n)
 

@@ -21,6 +21,7 @@ from plugnproduce.reasoning.asp.derivation import Node, asp
 from plugnproduce.reasoning.asp.results import CheckResult, Repair
 from plugnproduce.reasoning.checks.offers import CELL
 from plugnproduce.reasoning.checks.plausibility import TASK, check
+from plugnproduce.reasoning.checks.recheck import Moves, recheck
 
 if TYPE_CHECKING:
     from plugnproduce.knowledge import Knowledge
@@ -62,6 +63,9 @@ class AssessedRepair:
     side_effects: tuple[SideEffect, ...]
     confirmed: bool
     """Checking the repaired task again finds it plausible (:func:`assess` proposes only such repairs)."""
+    checked: CheckResult | None = dataclasses.field(default=None, compare=False, repr=False)
+    """That check of the repaired task (in the cell with the devices the repair adds), for what follows from it
+    (its estimated cycle time), so that a long task is not checked once more."""
 
     @property
     def severity(self) -> int:
@@ -89,6 +93,8 @@ class AssessedRepair:
 @dataclass(frozen=True)
 class _Cell:
     knowledge: Knowledge
+    _answers: dict[tuple[str, str | None, str], bool] = dataclasses.field(default_factory=dict, compare=False)
+    """What :meth:`is_a` and :meth:`process_is` answered (a long task asks the same at every step)."""
 
     @property
     def taxonomy(self) -> Taxonomy:
@@ -99,11 +105,17 @@ class _Cell:
         return self.knowledge.processes_by_id
 
     def is_a(self, iri: str | None, local: str) -> bool:
-        return iri is not None and self.taxonomy.is_a(iri, PNP_IRI + local)
+        key = ("concept", iri, local)
+        if key not in self._answers:
+            self._answers[key] = iri is not None and self.taxonomy.is_a(iri, PNP_IRI + local)
+        return self._answers[key]
 
     def process_is(self, command: str, local: str) -> bool:
-        proc = self.processes.get(command)
-        return proc is not None and any(self.is_a(c, local) for c in proc.classes)
+        key = ("process", command, local)
+        if key not in self._answers:
+            proc = self.processes.get(command)
+            self._answers[key] = proc is not None and any(self.is_a(c, local) for c in proc.classes)
+        return self._answers[key]
 
     def moves(self, command: str, role: str) -> bool:
         proc = self.processes.get(command)
@@ -216,9 +228,12 @@ def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: T
              original: Task, origins: Sequence[int]) -> list[SideEffect]:
     out: list[SideEffect] = []
     held: dict[str, int] = {}
+    concepts: dict[tuple[str, str | None], str | None] = {}  # _concept, indexed: the first device and state
+    for dev in reversed(cell.devices):
+        concepts.update({(dev.id, st.id): st.concept for st in reversed(dev.states)})
     for i, step in enumerate(result.steps, start=1):
         for d in step.bindings.values():
-            after = _concept(cell, d, _after(result, i).get(d))
+            after = concepts.get((d, _after(result, i).get(d)))
             if d in held and k.is_a(after, "Open") and not k.process_is(step.command, "PlaceProcess"):
                 picker = f"step {held[d]} ({result.steps[held[d] - 1].command})"
                 out.append(SideEffect("drops_part", f"step {i} ({step.command}) opens device '{d}', which holds the "
@@ -286,15 +301,16 @@ def assess(repairs: Sequence[Repair], task: Task, cell: Cell, knowledge: Knowled
     the solver's order. A repair the check does not confirm is no repair: it is left out. ``before``: the check
     of ``task`` in ``cell``, when the caller has it already."""
     before = before if before is not None else check(task, cell, knowledge)
+    moves = Moves(cell, knowledge, task, before)  # a long task's steps the repair left alone are not checked again
     out = []
     for r in repairs:
         added = tuple(d for d in catalogue if d.id in r.added_devices)
         the_cell = dataclasses.replace(cell, devices=cell.devices + added)
-        result = check(r.task, the_cell, knowledge)
+        result = (None if added else recheck(r.task, moves)) or check(r.task, the_cell, knowledge)
         if not result.plausible:
             continue
         effects = side_effects(task, r.task, result, the_cell, knowledge, before, r.origins)
-        out.append(AssessedRepair(0, r, tuple(effects), True))
+        out.append(AssessedRepair(0, r, tuple(effects), True, result))
     return [dataclasses.replace(a, rank=n) for n, a in enumerate(sorted(out, key=ranking), start=1)]
 
 

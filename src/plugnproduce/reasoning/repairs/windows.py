@@ -64,7 +64,7 @@ from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import FactBook, fact_book, task_facts
 from plugnproduce.reasoning.asp.results import Repair, RepairCosts
 from plugnproduce.reasoning.asp.schema import edits
-from plugnproduce.reasoning.asp.terms import Model, decode, program
+from plugnproduce.reasoning.asp.terms import Model, program
 from plugnproduce.reasoning.checks.contracts import normalised
 from plugnproduce.reasoning.checks.offers import CELL, cell_program
 from plugnproduce.reasoning.checks.plausibility import TASK
@@ -221,7 +221,7 @@ def windowed_repair(
     book = fact_book(knowledge)
     readable, _ = normalised(task, knowledge.processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
     facts = cell_program(book, cell) + program(task_facts(readable, TASK)) + program([s.Check(CELL, TASK)])
-    chain = _Chain(task, decode(solver.symbols(solver.CHECK, facts)))
+    chain = _Chain(task, solver.solve(solver.CHECK, facts))  # the check's own model when it checked this task
     if top < 1 or chain.plausible:  # plausible to the encodings: whatever else check() finds, repair.lp cannot fix
         return repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap) if top >= 1 else []
     present = {d.id for d in cell.devices}
@@ -355,8 +355,7 @@ class _Solver:
         """One combination as a :class:`Repair` of the whole task."""
         cost, parts, added = combo
         bound = {i: dict(b) for p in parts for i, b in p.reset_bound}
-        reader = repairs._EditReader(reader.task, reader.book, reader.devices, reader.costs,
-                                     lambda i: bound.get(i, {}))
+        reader = reader.with_bound(lambda i: bound.get(i, {}))
         terms = [t for p in parts for t in p.edits] + [edits.Add(a) for a in added]
         read = sorted((reader.read(t) for t in terms), key=lambda e: (e.step or 0, e.kind, e.text))
         task = self.chain.task

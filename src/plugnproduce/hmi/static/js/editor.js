@@ -30,7 +30,7 @@ function setSteps(steps, message, focus, focusSelector, loops = state.task.loops
   setTask({ ...state.task, steps, loops }, message);
   if (focus !== undefined) {
     const li = $(`#steps li.step[data-place="${placeKey(focus)}"]`);
-    const target = li && (li.querySelector(focusSelector) || li.querySelector("button:not([disabled])"));
+    const target = li && (li.querySelector(`${focusSelector}:not([disabled])`) || li.querySelector("button:not([disabled])"));
     if (target) target.focus();
   }
 }
@@ -115,13 +115,24 @@ function removeLoop(loop) {
 
 const ACTIONS = { edit, move, remove, branch: branchDialog, removeBranch, loop: loopDialog, removeLoop };
 
+/** Redraw `box`; a control in it that had the keyboard's focus has it again in the redrawn box (found by its
+ * label), so a check's answer arriving while someone works from the keyboard does not throw them out. */
+function keepingFocus(box, redraw) {
+  const active = document.activeElement;
+  const label = active && box.contains(active) ? active.getAttribute("aria-label") : null;
+  redraw();
+  if (label === null || box.contains(document.activeElement)) return;
+  const again = [...box.querySelectorAll("[aria-label]")].find((el) => el.getAttribute("aria-label") === label);
+  if (again) again.focus();
+}
+
 /** Show the task as it is. */
 export function renderTask() {
   const t = state.task;
   if (document.activeElement !== $("#task-name")) $("#task-name").value = t.name;
   if (document.activeElement !== $("#task-repeat")) $("#task-repeat").value = t.repeat;
   if (document.activeElement !== $("#task-description")) $("#task-description").value = t.description || "";
-  fill($("#steps"), taskItems(t, ACTIONS));
+  keepingFocus($("#steps"), () => fill($("#steps"), taskItems(t, ACTIONS)));
   $("#add-loop").disabled = t.steps.length === 0;
   $("#steps-empty").hidden = t.steps.length > 0;
   renderCheck();
