@@ -382,3 +382,23 @@ async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its
         monkeypatch.setattr(links, "CONNECT_TIMEOUT", SHORT)  # 10 s in earnest
         with pytest.raises(ProtocolTimeout):
             await asyncio.wait_for(Heard().open(silent), WAIT)
+        with pytest.raises(ProtocolTimeout):
+            await asyncio.wait_for(query_report(silent, WAIT), WAIT)
+
+
+async def test_query_report_over_upnp_refuses_an_answer_without_a_state_or_with_a_value_that_is_no_json() -> None:
+    answers = [{upnp.STATE_ARGUMENT: "", "TargetPose": "[]"}, {upnp.STATE_ARGUMENT: "home", "TargetPose": "a pose"}]
+
+    async def handler(action: str, arguments: Mapping[str, Any]) -> Mapping[str, Any]:
+        return answers.pop(0)
+
+    spec = upnp.with_state_query(upnp.service_spec_from_chart_events({}, []), ["TargetPose"])
+    async with upnp.UpnpDeviceServer("short-arm-upnp", "Recording arm", upnp.device_type_for("Robot"), spec, handler,
+                                     network=upnp.private_network()) as server:
+        arm = dataclasses.replace(device(SHORT_ARMS, "short-arm-upnp"), endpoint=server.location or "",
+                                  command_timeout=WAIT)
+        with pytest.raises(ProtocolError, match=f"^device short-arm-upnp: {upnp.STATE_ACTION} answered no "
+                                                f"{upnp.STATE_ARGUMENT}$"):
+            await query_report(arm, WAIT)
+        with pytest.raises(ProtocolError, match=f"^device short-arm-upnp: {upnp.STATE_ACTION}: TargetPose"):
+            await query_report(arm, WAIT)
