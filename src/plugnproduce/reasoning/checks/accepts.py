@@ -52,6 +52,7 @@ def not_taken(task: Task, cell: Cell, steps: tuple[StepCheck, ...], processes: M
     step's region walks it from the state it is in."""
     devices = {d.id: d for d in cell.devices}
     one_round = len(task.steps) // task.repeat
+    routes: dict[tuple[str, str, str, str, frozenset[str]], tuple[str, ...]] = {}
     for check, step in zip(steps[:one_round], task.steps[:one_round], strict=True):
         process = processes.get(step.command)
         for role in process.roles if process else ():
@@ -59,7 +60,11 @@ def not_taken(task: Task, cell: Cell, steps: tuple[StepCheck, ...], processes: M
             start = check.states.get(device.id) if device else None
             if process is None or device is None or start is None:
                 continue
-            for name in _skipped(device, process, role, start, set(step.params), taxonomy):
+            given = frozenset(step.params)
+            key = (device.id, process.id, role.name, start, given)  # all a route depends on: searched once each
+            if key not in routes:
+                routes[key] = tuple(_skipped(device, process, role, start, given, taxonomy))
+            for name in routes[key]:
                 par = process.parameter(name)
                 label = taxonomy.label(par.quantity)
                 text = (f"step {step.index} ({step.command}): parameter {name} ({label}) goes to device "
@@ -70,7 +75,7 @@ def not_taken(task: Task, cell: Cell, steps: tuple[StepCheck, ...], processes: M
                               role=role.name, device=device.id, state=start, parameter=name)
 
 
-def _skipped(device: DeviceDescription, process: ProcessDescription, role: Role, start: str, given: set[str],
+def _skipped(device: DeviceDescription, process: ProcessDescription, role: Role, start: str, given: frozenset[str],
              taxonomy: Taxonomy) -> list[str]:
     """The given parameters of ``role`` that the device's chart takes somewhere, but whose leg of the region's
     route (code generation's) passes no request taking them."""
