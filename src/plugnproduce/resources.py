@@ -7,17 +7,20 @@ no such copy, so the checkout's folder is used instead.
 
 from __future__ import annotations
 
-from importlib import resources
 from pathlib import Path
 
 DATA_FOLDERS = ("ontology", "rules", "descriptions")
+PACKAGE = Path(__file__).parent
+"""The package's folder: where ``importlib.resources`` finds its files when installed as files (the package reads
+its data as files, so it is; naming the folder directly saves every command importing ``importlib.resources`` and
+the zip support it brings)."""
 
 
 def data_path(name: str) -> Path:
     """The folder of shipped data called ``name`` (one of :data:`DATA_FOLDERS`)."""
     if name not in DATA_FOLDERS:
         raise ValueError(f"unknown data folder {name!r}; expected one of {DATA_FOLDERS}")
-    shipped = Path(str(resources.files("plugnproduce"))) / "data" / name
+    shipped = PACKAGE / "data" / name
     if shipped.is_dir():
         return shipped
     checkout = Path(__file__).resolve().parents[2] / name
@@ -43,4 +46,4 @@ def descriptions_path() -> Path:
 
 def package_file(*parts: str) -> Path:
     """A data file that lives inside the package itself (e.g. the W3C SCXML schema)."""
-    return Path(str(resources.files("plugnproduce").joinpath(*parts)))
+    return PACKAGE.joinpath(*parts)

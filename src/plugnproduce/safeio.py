@@ -13,15 +13,18 @@ import codecs
 import re
 import stat
 import warnings
+from functools import lru_cache
 from pathlib import Path
-from typing import Any, Protocol, cast
+from typing import TYPE_CHECKING, Any, Protocol, cast
 
-import rdflib
 import yaml
-from lxml import etree
-from rdflib.plugins.parsers.notation3 import BadSyntax
 
 from plugnproduce.errors import HostileInputError, UnreadableError, excerpt, shorten_words, tidy
+
+if TYPE_CHECKING:  # the XML and Turtle parsers are imported by the first file of their kind: a command that reads
+    # only YAML, or only what it kept in the cache folder, pays for neither
+    import rdflib
+    from lxml import etree
 
 MAX_BYTES = 4 * 1024 * 1024
 """Largest description file accepted (descriptions are a few kB; 4 MiB is generous)."""
@@ -88,21 +91,27 @@ def refuse_doctype(data: bytes, source: str | Path) -> None:
         )
 
 
-_PARSER = etree.XMLParser(
-    resolve_entities=False,
-    no_network=True,
-    load_dtd=False,
-    dtd_validation=False,
-    huge_tree=False,
-    remove_comments=False,
-)
+@lru_cache(maxsize=1)
+def _parser() -> etree.XMLParser:
+    from lxml import etree
+
+    return etree.XMLParser(
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        dtd_validation=False,
+        huge_tree=False,
+        remove_comments=False,
+    )
 
 
 def parse_xml_bytes(data: bytes, source: str | Path) -> etree._ElementTree:
     """Parse XML from bytes with the hardened parser; errors carry ``source`` and line."""
+    from lxml import etree
+
     refuse_doctype(data, source)
     try:
-        root = etree.fromstring(data, parser=_PARSER)
+        root = etree.fromstring(data, parser=_parser())
     except etree.XMLSyntaxError as exc:
         line = exc.lineno if exc.lineno else None
         msg = exc.msg.split(f", line {line}")[0] if exc.msg else "the parser gave no reason"
@@ -367,6 +376,9 @@ def parse_turtle(path: str | Path) -> tuple[rdflib.Graph, str]:
 def parse_turtle_bytes(data: bytes, path: str | Path) -> tuple[rdflib.Graph, str]:
     """Parse Turtle text as if it were the file at ``path`` (its relative IRIs resolve against it, and
     messages name it); returns the graph and the text (for line look-ups). Nothing is read from ``path``."""
+    import rdflib
+    from rdflib.plugins.parsers.notation3 import BadSyntax
+
     p = Path(path)
     text = _turtle_text(data, p)
     g = rdflib.Graph()

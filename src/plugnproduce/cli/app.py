@@ -162,9 +162,40 @@ def emit_json(data: object) -> None:
     sys.stdout.write("\n")
 
 
+def _command_named(args: list[str]) -> str | None:
+    """The command ``args`` run, when only the application's library options come before it (not ``--help`` or
+    ``--version``, which answer for the whole command line)."""
+    words = iter(args)
+    for word in words:
+        if word == "--library":
+            next(words, None)
+        elif not (word == "--no-builtin" or word.startswith("--library=")):
+            return None if word.startswith("-") else word
+    return None
+
+
+def _app_for(args: list[str]) -> typer.Typer:
+    """The application with only the command ``args`` run, so that typer builds that command's parameters alone
+    (building all thirty costs a tenth of a warm answer); the whole application for anything else (its help, a
+    misspelt command)."""
+    import copy
+
+    from typer.main import get_command_name
+
+    name = _command_named(args)
+    commands = [c for c in app.registered_commands
+                if c.callback is not None and (c.name or get_command_name(c.callback.__name__)) == name]
+    groups = [g for g in app.registered_groups if g.name == name]
+    if not commands and not groups:
+        return app
+    one = copy.copy(app)
+    one.registered_commands, one.registered_groups = commands, groups
+    return one
+
+
 def main() -> None:
     """Entry point of the ``pnp`` console script."""
     from plugnproduce.cli.console.pipes import tolerate_closed_stdout
 
     tolerate_closed_stdout()
-    app()
+    _app_for(sys.argv[1:])()

@@ -36,8 +36,8 @@ from dataclasses import dataclass, field
 from plugnproduce.chartnames import OUTCOME, STEP, branch_variable, rounds
 from plugnproduce.description.model import Branch, Loop, ProcessDescription, Task
 from plugnproduce.description.outcomes import body_outcomes, falling_under, taken_by
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.statechart.model import Assign, Data, Transition
 
 

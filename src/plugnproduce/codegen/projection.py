@@ -16,7 +16,7 @@ import copy
 from plugnproduce.chartnames import NEXT, PLAN, STEP
 from plugnproduce.codegen.task import GeneratedTask, plan_data
 from plugnproduce.description.model import ChartTransition, DeviceDescription
-from plugnproduce.ontology.vocabulary import concept_value
+from plugnproduce.ontology.iris import concept_value
 from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import Assign, Chart, Data, Final, Send, State, Transition, pnp, walk
 

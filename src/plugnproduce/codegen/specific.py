@@ -17,8 +17,8 @@ from plugnproduce.chartnames import STEP, VALUES
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.description.paths import find_path
 from plugnproduce.description.quantities.units import convert
+from plugnproduce.ontology.iris import concept_value, local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
 
 

@@ -26,9 +26,8 @@ from plugnproduce.codegen.specific import (
 from plugnproduce.description.model import Cell, ChartTransition, Command, Link, ProcessDescription, Step, Task
 from plugnproduce.description.paths import NoPath, in_concept
 from plugnproduce.errors import PlugNProduceError
+from plugnproduce.ontology.iris import concept_value, local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_value, local_name
-from plugnproduce.statechart.io.writer import write_chart
 from plugnproduce.statechart.model import (
     Assign,
     Cancel,
@@ -101,6 +100,9 @@ class GeneratedTask:
 
     def task_chart(self) -> bytes:
         """The Task State Chart as SCXML bytes."""
+        from plugnproduce.statechart.io.writer import write_chart  # XML: only for a chart written out, not for
+        # the model a run or a cycle time estimate reads
+
         return write_chart(self.chart)
 
     def bodies(self) -> list[StepChart]:

@@ -16,7 +16,7 @@ from plugnproduce.description.hierarchy import DeviceChart as DeviceChart
 from plugnproduce.description.hierarchy import device_chart as device_chart
 from plugnproduce.description.model import RegionState
 from plugnproduce.errors import DescriptionError
-from plugnproduce.ontology.vocabulary import concept_iri
+from plugnproduce.ontology.iris import concept_iri
 from plugnproduce.statechart.model import (
     CONCEPT,
     Chart,

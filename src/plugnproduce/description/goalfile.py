@@ -16,9 +16,9 @@ import yaml
 from plugnproduce.description.model import Link, ProcessDescription
 from plugnproduce.description.taskfile import _link, _mapping, _outcome, _plain, _str_map, _unknown_keys
 from plugnproduce.errors import DescriptionError, excerpt
+from plugnproduce.ontology.iris import concept_iri, concept_value
 from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_iri, concept_value
 from plugnproduce.safeio import parse_yaml_bytes, read_bytes
 
 MAX_ITEMS = 50

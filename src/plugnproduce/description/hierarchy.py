@@ -25,7 +25,7 @@ from pathlib import Path
 
 from plugnproduce.description.model import ChartState, ChartTransition, Command
 from plugnproduce.errors import DescriptionError
-from plugnproduce.ontology.vocabulary import concept_iri
+from plugnproduce.ontology.iris import concept_iri
 from plugnproduce.statechart.model import (
     CONCEPT,
     Chart,

@@ -9,17 +9,20 @@ kept (:class:`~plugnproduce.description.rdf.Loaded`) so the SHACL shapes can che
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 
 import rdflib
-import yaml
 from rdflib.namespace import RDF, RDFS, XSD
 
+from plugnproduce.description.cellfile import MAX_PATH as MAX_PATH
+from plugnproduce.description.cellfile import cell_device_files as cell_device_files
+from plugnproduce.description.cellfile import cell_libraries as cell_libraries
+from plugnproduce.description.cellfile import load_cell as load_cell
+from plugnproduce.description.cellfile import not_a_description as not_a_description
 from plugnproduce.description.charts import device_chart
 from plugnproduce.description.model import (
     Argument,
-    Cell,
     ChartTransition,
     DeviceDescription,
     ProcessDescription,
@@ -40,7 +43,6 @@ from plugnproduce.description.rdf import (
 )
 from plugnproduce.description.rdf import parse_description as parse_description
 from plugnproduce.description.rdf import read_description as read_description
-from plugnproduce.description.taskfile import _mapping, _plain, _unknown_keys
 from plugnproduce.description.taskfile import load_task as load_task
 from plugnproduce.description.taskfile import parse_task as parse_task
 from plugnproduce.description.taskfile import task_to_yaml as task_to_yaml
@@ -48,7 +50,6 @@ from plugnproduce.errors import DescriptionError, excerpt
 from plugnproduce.ontology.names import turtle_spelling, unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
-from plugnproduce.safeio import parse_yaml_node
 from plugnproduce.statechart.io.reader import parse_chart, read_chart
 
 SAFE_STOP = str(PNP.SafeStop)
@@ -229,95 +230,6 @@ def _argument(loaded: Loaded, a: rdflib.term.Node) -> Argument:
 def load_device(path: str | Path, taxonomy: Taxonomy) -> DeviceDescription:
     """Read a device description (Turtle + its Device State Chart)."""
     return device_from(read_description(path), taxonomy)
-
-
-# ------------------------------------------------------------------ YAML: cells (tasks: taskfile.py)
-
-
-def cell_device_files(path: str | Path) -> tuple[str, list[tuple[Path, int]]]:
-    """A cell file's name and its device description files with the lines that list them."""
-    p = Path(path)
-    top = _mapping(parse_yaml_node(p), p, "cell")
-    _unknown_keys(top, {"cell", "devices", "libraries"}, p, "cell")
-    if "cell" not in top or "devices" not in top or not isinstance(top["devices"], yaml.SequenceNode):
-        raise DescriptionError("a cell needs 'cell' (its name) and 'devices' (a list of files)", p, 1)
-    files = []
-    for node in top["devices"].value:
-        if not isinstance(node, yaml.ScalarNode):
-            raise DescriptionError("each device is a path to a device description", p, node.start_mark.line + 1)
-        files.append((_device_path(p, node), node.start_mark.line + 1))
-    return str(_plain(top["cell"])), files
-
-
-def cell_libraries(path: str | Path) -> list[Path]:
-    """The library folders a cell file lists under ``libraries:`` (relative to the cell file)."""
-    p = Path(path)
-    top = _mapping(parse_yaml_node(p), p, "cell")
-    node = top.get("libraries")
-    if node is None:
-        return []
-    if not isinstance(node, yaml.SequenceNode) or not all(isinstance(n, yaml.ScalarNode) for n in node.value):
-        raise DescriptionError("libraries must be a list of folders (relative to the cell file)", p,
-                               node.start_mark.line + 1)
-    out = []
-    for n in node.value:
-        folder = (p.parent / n.value).resolve()
-        if not folder.is_dir():
-            raise DescriptionError(f"library folder {excerpt(n.value)} not found", p, n.start_mark.line + 1)
-        out.append(folder)
-    return out
-
-
-MAX_PATH = 1024
-"""Longest device path a cell may list (file systems refuse names much longer than 255 bytes anyway)."""
-
-
-def _device_path(cell: Path, node: yaml.ScalarNode) -> Path:
-    """A device path a cell lists, resolved beside the cell; one no file system could hold is refused."""
-    value = str(node.value)
-    parts = value.replace("\\", "/").split("/")
-    if "\0" in value or len(value) > MAX_PATH or any(len(part.encode("utf-8", "replace")) > 255 for part in parts):
-        raise DescriptionError(f"device path {excerpt(value)!r} ({len(value)} characters) cannot name a file; "
-                               "expected a path to a device description", cell, node.start_mark.line + 1)
-    return (cell.parent / value).resolve()
-
-
-def not_a_description(entry: Path) -> str | None:
-    """Why a file a cell lists is no device description (a device description is a Turtle ``.ttl`` file), or None.
-
-    Nothing of the file is read, so nothing of it (``/etc/passwd``) is ever quoted.
-    """
-    if entry.suffix.lower() == ".ttl" or not entry.is_file():
-        return None
-    return (f"device entry {excerpt(entry.name)!r} is a file that is no device description; expected a "
-            "Turtle file (.ttl) or the id of a device of a loaded library")
-
-
-def load_cell(path: str | Path, taxonomy: Taxonomy,
-              by_id: Callable[[str], DeviceDescription | None] | None = None) -> Cell:
-    """Read a cell (YAML) and all its device descriptions.
-
-    An entry that is no file but a plain id (``robot``) names a catalogue device, found by ``by_id``.
-    """
-    name, files = cell_device_files(path)
-    devices = []
-    for f, line in files:
-        if (why := not_a_description(f)) is not None:
-            raise DescriptionError(why, path, line)
-        if f.is_file():
-            devices.append(load_device(f, taxonomy))
-            continue
-        known = by_id(f.name) if by_id is not None and f.suffix != ".ttl" else None
-        if known is None:
-            raise DescriptionError(f"device description {excerpt(f.name)} not found; expected a device description "
-                                   "file (relative to the cell file) or the id of a device of a loaded library",
-                                   path, line)
-        devices.append(known)
-    ids = [d.id for d in devices]
-    for d in devices:
-        if ids.count(d.id) > 1:
-            raise DescriptionError(f"device id {excerpt(d.id)!r} appears twice in the cell", path)
-    return Cell(name, tuple(devices), str(path))
 
 
 def load_devices(folder: str | Path, taxonomy: Taxonomy) -> list[DeviceDescription]:

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 from plugnproduce.description.flow import Branch, Loop
 from plugnproduce.description.model import ProcessDescription, Task
+from plugnproduce.ontology.iris import concept_iri, local_name
 from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_iri, local_name
 
 
 @dataclass(frozen=True)

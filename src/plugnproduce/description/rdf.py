@@ -14,7 +14,7 @@ import rdflib
 
 from plugnproduce.description.where import Where
 from plugnproduce.errors import DescriptionError, UnreadableError, excerpt
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.safeio import parse_turtle, parse_turtle_bytes
 
 

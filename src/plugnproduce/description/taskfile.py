@@ -19,7 +19,7 @@ import yaml
 from plugnproduce.description.flow import Branch, Loop, outermost_first
 from plugnproduce.description.model import Link, Step, Task, plain_value
 from plugnproduce.errors import DescriptionError, excerpt
-from plugnproduce.ontology.vocabulary import concept_iri, concept_value
+from plugnproduce.ontology.iris import concept_iri, concept_value
 from plugnproduce.safeio import PlainDumper, parse_yaml_bytes, read_bytes
 
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,63}")

@@ -17,7 +17,7 @@ from itertools import pairwise
 import graphviz
 
 from plugnproduce.drawing.steps import Plan, PlanStep, find_plan, pnp
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.statechart.model import Chart, Final, Parallel, Raise, Send, State, StateNode, Transition, walk
 
 COLUMN = 10

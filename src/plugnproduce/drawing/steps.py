@@ -12,7 +12,7 @@ import ast
 import re
 from dataclasses import dataclass
 
-from plugnproduce.ontology.vocabulary import PNP_IRI
+from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.statechart.model import Chart, Parallel, State, StateNode
 
 PLAN, PICKER = "pnp_plan", "next_step"

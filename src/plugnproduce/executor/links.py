@@ -14,7 +14,7 @@ from typing import Any, Protocol
 from urllib.parse import urlparse
 
 from plugnproduce.description.model import DeviceDescription
-from plugnproduce.description.reports import reported_values
+from plugnproduce.description.quantities.reports import reported_values
 from plugnproduce.errors import ProtocolError
 from plugnproduce.protocols import upnp, xirp
 

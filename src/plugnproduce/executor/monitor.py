@@ -23,7 +23,7 @@ from plugnproduce.codegen.task import GeneratedTask, StepChart
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Link
 from plugnproduce.description.quantities.contracts import breach, shorten
 from plugnproduce.description.quantities.units import UnitError, convert
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 
 
 @dataclass(frozen=True)

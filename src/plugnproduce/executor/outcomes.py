@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from plugnproduce.description.quantities.contracts import shorten
-from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
+from plugnproduce.ontology.iris import PNP_IRI, local_name
 
 MAX_NAME = 2048
 """The longest outcome name read."""

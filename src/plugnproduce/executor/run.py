@@ -42,7 +42,7 @@ from plugnproduce.executor.links import DeviceLink, open_link
 from plugnproduce.executor.monitor import Breach, Monitor
 from plugnproduce.executor.report import Fault, RunReport
 from plugnproduce.executor.safestop import stop_safely
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.statechart import parse_chart
 from plugnproduce.statechart.runtime.events import STATE_ENTERED, Event, EventData, MacroStep, MetaEvent
 from plugnproduce.statechart.runtime.interpreter import Interpreter

@@ -12,7 +12,7 @@ from typing import Any
 
 from plugnproduce.chartnames import OUTCOME, output_variable
 from plugnproduce.codegen.task import GeneratedTask
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 
 
 def produced(generated: GeneratedTask, step: int | None, device: str,

@@ -15,15 +15,15 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import os
 import pickle
-import sys
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
-import plugnproduce
 from plugnproduce import folders
-from plugnproduce.knowledge.libraries import Knowledge, Library, tbox_files
+from plugnproduce.folders import code_digest as code_digest
+from plugnproduce.knowledge.libraries import Knowledge, Library
+from plugnproduce.ontology.taxonomy import ontology_files
+from plugnproduce.resources import ontology_path
 
 FORMAT = 1
 """The layout of what is kept; another layout is another file name."""
@@ -40,25 +40,14 @@ def _files(root: Path) -> list[Path]:
     return sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts)
 
 
-def _code(h: hashlib._Hash) -> None:
-    """The package's code, by each module's name, size and time of change (reading it all would cost more than
-    it saves)."""
-    here = Path(plugnproduce.__file__).parent
-    for folder, dirs, names in os.walk(here):
-        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
-        for name in sorted(n for n in names if n.endswith(".py")):
-            stat = os.stat(os.path.join(folder, name))
-            h.update(f"{os.path.relpath(os.path.join(folder, name), here)}\0{stat.st_size}\0{stat.st_mtime_ns}\0"
-                     .encode())
-
-
 def digest(libraries: Sequence[Library]) -> str | None:
     """The digest of what the knowledge of ``libraries`` is loaded from; None when a file cannot be read (it is
     then loaded, and what is wrong said, as without a cache)."""
-    h = hashlib.sha256(f"{FORMAT}\0{sys.version}\0".encode())
-    _code(h)
+    h = hashlib.sha256(f"{FORMAT}\0{code_digest()}\0".encode())
     try:
-        for f in [*tbox_files(libraries), *(f for lib in libraries for f in _files(lib.root))]:
+        # the pnp ontology, then every file of every library: the TBox files a library imports lie inside it, so
+        # they are among its files without resolving its imports (which would mean reading RDF)
+        for f in [*ontology_files(ontology_path()), *(f for lib in libraries for f in _files(lib.root))]:
             h.update(f"{f}\0".encode() + Path(f).read_bytes() + b"\0")
     except OSError:
         return None

@@ -15,16 +15,17 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import rdflib
-
-from plugnproduce.description.loader import load_device, load_process
 from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.errors import DescriptionError, OntologyError, UnknownName
-from plugnproduce.ontology.sources import with_imports
-from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files, read_tbox
-from plugnproduce.ontology.vocabulary import PNP_IRI
+from plugnproduce.ontology.iris import PNP_IRI
+from plugnproduce.ontology.taxonomy import Taxonomy, load_taxonomy, ontology_files
 from plugnproduce.resources import descriptions_path, ontology_path
+
+if TYPE_CHECKING:  # reading Turtle (rdflib) is imported by what reads it: knowledge read back from the cache
+    # folder needs none of it
+    import rdflib
 
 KINDS = ("ontology", "devices", "processes", "cells", "tasks")
 ENV_VARIABLE = "PNP_LIBRARY"
@@ -42,6 +43,8 @@ class Library:
         if kind == "ontology":  # every Turtle, RDF/XML and OWL/XML file but SHACL shapes, then what they import
             if self.builtin:
                 return ontology_files(ontology_path())
+            from plugnproduce.ontology.sources import with_imports
+
             folder = self.root / "ontology"
             return with_imports(ontology_files(folder), self.root) if folder.is_dir() else []
         return _glob(self.root / kind, pattern)
@@ -111,8 +114,12 @@ class Knowledge:
 
     @cached_property
     def devices(self) -> tuple[DeviceDescription, ...]:
-        """The catalogue: every device description of every library, sorted by id."""
-        found = [load_device(f, self.taxonomy) for lib in self.libraries for f in lib.files("devices")]
+        """The catalogue: every device description of every library, sorted by id (each read back from the cache
+        folder while its files are unchanged, :mod:`~plugnproduce.knowledge.devicecache`)."""
+        from plugnproduce.knowledge.devicecache import device_reader
+
+        read = device_reader(self.taxonomy)
+        found = [read(f) for lib in self.libraries for f in lib.files("devices")]
         refuse_duplicates(found, "device")
         return tuple(sorted(found, key=lambda d: d.id))
 
@@ -127,6 +134,8 @@ class Knowledge:
 
     def tbox(self) -> rdflib.Graph:
         """The combined TBox as written (without the reasoner's closure)."""
+        from plugnproduce.ontology.taxonomy import read_tbox
+
         return read_tbox(self.ontology_files())
 
     @cached_property
@@ -183,6 +192,9 @@ def load_knowledge(libraries: Sequence[Library] | None = None, extra_tbox: Seque
     together; the closure is cached by the combined content. Processes are read from every
     library's ``processes/``.
     """
+    from plugnproduce.description.loader import load_process
+    from plugnproduce.ontology.sources import with_imports
+
     libs = tuple(libraries) if libraries is not None else (builtin_library(),)
     extra_tbox = [i for f in extra_tbox for i in with_imports([f], _library_root(f))]
     tbox = [f for f in tbox_files(libs) + [f for f in extra_tbox if f not in tbox_files(libs)] if f not in left_out]

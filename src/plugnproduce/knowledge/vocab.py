@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from plugnproduce.knowledge.libraries import Knowledge
+from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP_IRI
 
 Entry = dict[str, object]
 

@@ -14,8 +14,8 @@ from collections.abc import Iterator
 import rdflib
 from rdflib.namespace import OWL, RDF, RDFS
 
+from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP_IRI
 
 FORMATS = ("rdfxml", "turtle", "owlxml")
 MERGED = rdflib.URIRef("http://plugnproduce.org/ontology/merged")

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-import rdflib
-from rdflib.namespace import NamespaceManager
+from plugnproduce.ontology.iris import concept_value, local_name
 
-from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_value, local_name
+if TYPE_CHECKING:  # a Turtle file's spelling needs rdflib; checking names does not
+    from rdflib.namespace import NamespaceManager
+
+    from plugnproduce.ontology.taxonomy import Taxonomy
 
 Spelling = Callable[[str], str]
 """How a file writes a term's IRI: a chart's ``pnp:concept`` (:func:`concept_value`), a Turtle prefixed name."""
@@ -71,6 +73,8 @@ def prefixed_hint(iri: str, spell: Spelling) -> str:
 
 def turtle_spelling(namespaces: NamespaceManager) -> Spelling:
     """How a Turtle file writes a term: a prefixed name with the file's own prefixes, else ``<IRI>``."""
+    import rdflib
+
     return lambda iri: namespaces.normalizeUri(rdflib.URIRef(iri))
 
 

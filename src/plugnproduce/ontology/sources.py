@@ -20,14 +20,14 @@ import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 from urllib.parse import unquote, urljoin, urlparse
 
-import rdflib
-from lxml import etree
-from rdflib.namespace import OWL, RDF
-
 from plugnproduce.errors import DescriptionError, HostileInputError, UnreadableError, tidy
-from plugnproduce.safeio import MAX_TRIPLES, parse_turtle_bytes, parse_xml_bytes, read_bytes
+
+if TYPE_CHECKING:  # the parsers are imported when a file is read: listing the files needs none of them
+    import rdflib
+    from lxml import etree
 
 TBOX_SUFFIXES = (".ttl", ".owl", ".rdf", ".owx")
 """The file names a library's ``ontology/`` folder is read for (``shapes.ttl`` excepted)."""
@@ -61,6 +61,8 @@ _READ_MOST = 256
 
 def read_tbox_file(path: Path) -> TBoxFile:
     """Read one TBox file in whichever of the three formats it is; parsed once per content."""
+    from plugnproduce.safeio import read_bytes  # the hardened readers: when a file is read, not when one is listed
+
     p = Path(path)
     data = read_bytes(p)
     key = (str(p), hashlib.sha256(data).hexdigest())
@@ -72,6 +74,8 @@ def read_tbox_file(path: Path) -> TBoxFile:
 
 
 def _read(path: Path, data: bytes) -> TBoxFile:
+    from plugnproduce.safeio import MAX_TRIPLES, parse_turtle_bytes, parse_xml_bytes
+
     if not data.lstrip(b"\xef\xbb\xbf \t\r\n").startswith(b"<"):
         g, text = parse_turtle_bytes(data, path)
         return TBoxFile(path, g, "turtle", text)
@@ -90,6 +94,8 @@ def _read(path: Path, data: bytes) -> TBoxFile:
 
 
 def _rdfxml(data: bytes, path: Path) -> rdflib.Graph:
+    import rdflib
+
     g = rdflib.Graph()
     try:
         with warnings.catch_warnings():
@@ -104,6 +110,7 @@ def _rdfxml(data: bytes, path: Path) -> rdflib.Graph:
 def _owlxml(data: bytes, path: Path) -> rdflib.Graph:
     """OWL/XML to triples with owlready2's OWL/XML parser alone: loading it as an owlready2 ontology would
     fetch its ``Import`` IRIs from the network."""
+    import rdflib
     from owlready2.owlxml_2_ntriples import parse
 
     g = rdflib.Graph()
@@ -137,6 +144,8 @@ def folder_files(folder: Path) -> list[Path]:
 
 def with_imports(files: Iterable[Path], root: Path) -> list[Path]:
     """``files`` followed by every file they import (transitively), each once; imports resolve inside ``root``."""
+    from rdflib.namespace import OWL
+
     out: list[Path] = []
     queue = [Path(f) for f in files]
     while queue:
@@ -179,6 +188,8 @@ def _catalogs(importer: Path, root: Path) -> list[Path]:
 
 def _catalog_entry(catalog: Path, iri: str) -> Path | None:
     """The file a Protégé catalog maps ``iri`` to (its ``uri`` entries; relative to the catalog or its xml:base)."""
+    from plugnproduce.safeio import parse_xml_bytes, read_bytes
+
     tree = parse_xml_bytes(read_bytes(catalog), catalog)
     for el in tree.getroot().iter(f"{{{_CATALOG_NS}}}uri"):
         if el.get("name", "").rstrip("#/") == iri.rstrip("#/") and el.get("uri"):
@@ -209,6 +220,8 @@ def _library_tbox(root: Path) -> list[Path]:
 
 def _declared(path: Path) -> set[str]:
     """The ontology IRIs a file declares (``<iri> a owl:Ontology``); an unreadable file declares none."""
+    from rdflib.namespace import OWL, RDF
+
     try:
         g = read_tbox_file(path).graph
     except DescriptionError:

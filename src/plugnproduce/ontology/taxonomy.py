@@ -14,15 +14,15 @@ import tempfile
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-
-import rdflib
-from rdflib.namespace import OWL, RDF, RDFS
+from typing import TYPE_CHECKING
 
 from plugnproduce.errors import OntologyError
-from plugnproduce.ontology.sources import folder_files, read_tbox_file
-from plugnproduce.ontology.vocabulary import PNP, PNP_IRI, local_name
+from plugnproduce.ontology.iris import PNP_IRI, local_name
+from plugnproduce.ontology.sources import folder_files
 from plugnproduce.resources import ontology_path
-from plugnproduce.safeio import read_bytes
+
+if TYPE_CHECKING:  # reading and classifying a TBox needs rdflib; the closure read back from a cache does not
+    import rdflib
 
 CACHE_VERSION = 2
 _CAPABILITY_PREFIX = PNP_IRI + "_HasSkill_"
@@ -116,6 +116,10 @@ def ontology_files(folder: Path | None = None) -> list[Path]:
 
 def read_tbox(files: Iterable[Path]) -> rdflib.Graph:
     """Parse the TBox files (any of the three formats) into one graph, with ``file: message`` errors."""
+    import rdflib
+
+    from plugnproduce.ontology.sources import read_tbox_file
+
     g = rdflib.Graph()
     for p in files:
         g += read_tbox_file(p).graph
@@ -126,6 +130,8 @@ def _digest(files: Iterable[Path]) -> str:
     """The cache key of a TBox: every file's name and bytes, in order. The format is told by the bytes
     (see :mod:`~plugnproduce.ontology.sources`), so the same TBox saved as Turtle, RDF/XML or OWL/XML has three
     keys; imported files are among ``files`` (the libraries list them), so editing one reclassifies."""
+    from plugnproduce.safeio import read_bytes
+
     h = hashlib.sha256()
     for p in files:
         h.update(p.name.encode() + b"\0" + read_bytes(p) + b"\0")
@@ -188,12 +194,19 @@ def ship_closure(folder: Path | None = None) -> Path:
 
 
 def _named_subclasses(g: rdflib.Graph, root: rdflib.URIRef) -> set[str]:
+    import rdflib
+    from rdflib.namespace import RDFS
+
     return {str(c) for c in g.transitive_subjects(RDFS.subClassOf, root) if isinstance(c, rdflib.URIRef)}
 
 
 def classify(g: rdflib.Graph, digest: str = "") -> Taxonomy:
     """Run HermiT on the TBox ``g`` and read off the closure."""
     import owlready2
+    import rdflib
+    from rdflib.namespace import OWL, RDF
+
+    from plugnproduce.ontology.vocabulary import PNP
 
     skills = sorted(_named_subclasses(g, PNP.Skill) - {str(PNP.Skill)})
     cap = rdflib.Graph()
@@ -230,6 +243,10 @@ def classify(g: rdflib.Graph, digest: str = "") -> Taxonomy:
 
 def _read_closure(world: object, g: rdflib.Graph, skills: list[str], digest: str) -> Taxonomy:
     import owlready2
+    import rdflib
+    from rdflib.namespace import OWL, RDFS
+
+    from plugnproduce.ontology.vocabulary import PNP
 
     superclasses: dict[str, frozenset[str]] = {}
     implied: dict[str, frozenset[str]] = {}

@@ -5,7 +5,11 @@ from __future__ import annotations
 from rdflib import Namespace, URIRef
 from rdflib.namespace import DefinedNamespace
 
-PNP_IRI = "http://plugnproduce.org/ontology#"
+from plugnproduce.ontology.iris import PNP_IRI as PNP_IRI
+from plugnproduce.ontology.iris import concept_iri as concept_iri
+from plugnproduce.ontology.iris import concept_value as concept_value
+from plugnproduce.ontology.iris import local_name as local_name
+
 DEV = Namespace("http://plugnproduce.org/devices/")
 PROC = Namespace("http://plugnproduce.org/processes/")
 
@@ -79,19 +83,3 @@ class PNP(DefinedNamespace):
     hasValue: URIRef
     parameter: URIRef
     value: URIRef
-
-
-def local_name(iri: str) -> str:
-    """The part of an IRI after its last ``#`` or ``/``."""
-    cut = max(iri.rfind("#"), iri.rfind("/"))
-    return iri[cut + 1 :]
-
-
-def concept_iri(value: str) -> str:
-    """The IRI of a state or quantity concept written as a local name or a full IRI."""
-    return value if ":" in value else PNP_IRI + value
-
-
-def concept_value(iri: str) -> str:
-    """How a chart names a concept: its local name in the ``pnp`` namespace, else its full IRI."""
-    return iri[len(PNP_IRI):] if iri.startswith(PNP_IRI) else iri

@@ -25,9 +25,9 @@ from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescr
 from plugnproduce.description.outcomes import falling_under
 from plugnproduce.description.taskfile import parse_task, task_to_yaml
 from plugnproduce.errors import DescriptionError
+from plugnproduce.ontology.iris import concept_value, local_name
 from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import concept_value, local_name
 from plugnproduce.planning import schema as ps
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.facts import fact_book

@@ -8,16 +8,11 @@ from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, TypedDict
 
-from plugnproduce.description.loader import (
-    cell_libraries,
-    load_cell,
-    load_devices,
-    load_task,
-    parse_task,
-    task_to_yaml,
-)
+from plugnproduce.description.cellfile import kept_cell_device_files, kept_cell_libraries, load_cell
 from plugnproduce.description.model import Cell, DeviceDescription, Task
+from plugnproduce.folders import kept
 from plugnproduce.knowledge import Knowledge, Library, builtin_library, library_folders, load_knowledge
+from plugnproduce.knowledge.devicecache import device_reader
 from plugnproduce.lazy import lazy_module
 from plugnproduce.resources import descriptions_path
 
@@ -49,9 +44,20 @@ def knowledge(libraries: tuple[str | Path, ...] = (), builtin: bool = True) -> K
 
 
 def knowledge_for_cell(path: str | Path, base: Knowledge | None = None) -> Knowledge:
-    """``base`` (default: built-in) with the libraries a cell file lists under ``libraries:``."""
+    """``base`` (default: built-in) with the libraries a cell file lists under ``libraries:`` (read back from the
+    cache folder as :func:`knowledge` is, unless ``base`` tries TBox files out)."""
     base = base or knowledge()
-    return base.with_libraries(library_folders(cell_libraries(path)))
+    extra = tuple(lib for lib in library_folders(kept_cell_libraries(path)) if lib not in base.libraries)
+    if not extra:
+        return base
+    if base.extra_tbox or base.left_out:
+        return base.with_libraries(extra)
+    return _loaded(base.libraries + extra)
+
+
+def _read_cell(path: str | Path, k: Knowledge) -> Cell:
+    """A cell file with its devices, the file and each device read back from the cache folder while unchanged."""
+    return load_cell(path, k.taxonomy, k.device, device_reader(k.taxonomy), kept_cell_device_files)
 
 
 def _k(k: Knowledge | None) -> Knowledge:
@@ -75,28 +81,41 @@ def validate_tasks(tasks: list[Task], knowledge: Knowledge | None = None) -> Rep
 
 def cell(path: str | Path, knowledge: Knowledge | None = None) -> Cell:
     """Read a cell file (with the libraries it lists, added to ``knowledge``)."""
-    k = knowledge_for_cell(path, knowledge)
-    return load_cell(path, k.taxonomy, k.device)
+    return _read_cell(path, knowledge_for_cell(path, knowledge))
 
 
 def catalogue(folder: str | Path | None = None, knowledge: Knowledge | None = None) -> list[DeviceDescription]:
     """Read a catalogue of device descriptions (default: every device of the loaded libraries)."""
     k = _k(knowledge)
-    return list(k.devices) if folder is None else load_devices(folder, k.taxonomy)
+    if folder is None:
+        return list(k.devices)
+    from plugnproduce.description.loader import load_devices  # a catalogue of thousands is read, not kept
+
+    return load_devices(folder, k.taxonomy)
+
+
+def _load_task(path: Path) -> Task:
+    from plugnproduce.description.taskfile import load_task  # YAML: only for a task file not kept
+
+    return load_task(path)
 
 
 def task(path: str | Path) -> Task:
-    """Read a task file."""
-    return load_task(path)
+    """Read a task file (as read before while the file is unchanged, :func:`plugnproduce.folders.kept`)."""
+    return kept("task", Path(path), _load_task, lambda value: isinstance(value, Task))
 
 
 def task_from_text(data: bytes | str, name: str) -> Task:
     """Read a task description from YAML text (an upload, an editor's buffer); ``name`` names it in messages."""
+    from plugnproduce.description.taskfile import parse_task
+
     return parse_task(data.encode("utf-8") if isinstance(data, str) else data, name)
 
 
 def task_text(the_task: Task, block: bool = False) -> str:
     """A task as a YAML task file (``block``: every value on a line of its own)."""
+    from plugnproduce.description.taskfile import task_to_yaml
+
     return task_to_yaml(the_task, block)
 
 
@@ -138,7 +157,7 @@ def cell_and_knowledge(cell_or_path: CellArg, knowledge: Knowledge | None) -> tu
             return cell_or_path, knowledge_for_cell(cell_or_path.file, knowledge)
         return cell_or_path, _k(knowledge)
     k = knowledge_for_cell(cell_or_path, knowledge)
-    return load_cell(cell_or_path, k.taxonomy, k.device), k
+    return _read_cell(cell_or_path, k), k
 
 
 def as_task(task_or_path: TaskArg) -> Task:

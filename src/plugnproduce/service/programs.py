@@ -18,7 +18,7 @@ if TYPE_CHECKING:  # the concepts are imported by the use cases that need them
     from plugnproduce import reasoning
     from plugnproduce.codegen import GeneratedTask
     from plugnproduce.codegen.outputs import GeneratedChart
-    from plugnproduce.timing.estimate import CycleTime
+    from plugnproduce.timing.cycle import CycleTime
     from plugnproduce.verification import Budget, Verification
 else:
     reasoning = lazy_module("plugnproduce.reasoning")  # a validation needs no reasoner
@@ -137,12 +137,14 @@ def plan_run(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge 
 def cycle_time(task_or_path: TaskArg, cell_or_path: CellArg, knowledge: Knowledge | None = None,
                result: reasoning.CheckResult | None = None) -> CycleTime | None:
     """The estimated cycle time of a task in a cell, step by step (None: the task is not plausible there, or
-    its program cannot be generated). ``result``: the task's check, when it was checked already."""
-    from plugnproduce.timing.tasks import task_cycle_time
+    its program cannot be generated). ``result``: the task's check, when it was checked already. Read back from
+    the cache folder while the task, the cell, the processes and the taxonomy are unchanged
+    (:mod:`plugnproduce.timing.kept`)."""
+    from plugnproduce.timing.kept import kept_cycle_time
 
     the_task, (the_cell, k) = as_task(task_or_path), cell_and_knowledge(cell_or_path, knowledge)
     result = result if result is not None else checks.check(the_task, the_cell, k)
-    return task_cycle_time(the_task, the_cell, k, result)
+    return kept_cycle_time(the_task, the_cell, k, result) if result.plausible else None
 
 
 def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path: CellArg,

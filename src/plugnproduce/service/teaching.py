@@ -1,7 +1,8 @@
 """Teach-in: a value a device reports (a pose it was guided to), held to the device's contracts like any other.
 
 The controller reads the value from the device (:func:`plugnproduce.controller.teach`); this module says which
-values a device reports (its chart's ``<data pnp:quantity=...>``, :mod:`plugnproduce.description.reports`) and
+values a device reports (its chart's ``<data pnp:quantity=...>``,
+:mod:`plugnproduce.description.quantities.reports`) and
 judges one against every contract of the device's requests that take that quantity
 (:func:`plugnproduce.description.quantities.contracts.breach`).
 """
@@ -13,9 +14,9 @@ from typing import Any
 
 from plugnproduce.description.model import Argument, DeviceDescription
 from plugnproduce.description.quantities.contracts import breach, shorten
-from plugnproduce.description.reports import ReportedValue, reported_values
+from plugnproduce.description.quantities.reports import ReportedValue, reported_values
 from plugnproduce.errors import PlugNProduceError, UnknownName
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 
 
 class ReportsNothing(PlugNProduceError):

@@ -20,7 +20,7 @@ from typing import Any
 
 from plugnproduce.description.model import DeviceDescription
 from plugnproduce.errors import PlugNProduceError
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 
 AREA = ((0.30, 0.50), (0.00, 0.20))
 """The bin's floor: x and y ranges in metres."""

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 import rdflib
 
 from plugnproduce.description.model import Command, DeviceDescription
-from plugnproduce.description.reports import reported_values
+from plugnproduce.description.quantities.reports import reported_values
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.protocols import upnp, xirp
 from plugnproduce.protocols.files import DeviceFiles

@@ -4,8 +4,8 @@
 from __future__ import annotations
 
 from plugnproduce.description.model import DeviceDescription
-from plugnproduce.description.reports import reported_values
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.description.quantities.reports import reported_values
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.protocols.opcua.spec import ArgumentSpec, MethodSpec, NodeSpec, kind_of
 from plugnproduce.sim.payloads import event_payloads
 

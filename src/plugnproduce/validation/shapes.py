@@ -16,7 +16,7 @@ from rdflib.plugins.sparql.sparql import Query
 
 from plugnproduce.description.datagraph import DataGraph
 from plugnproduce.errors import OntologyError, tidy
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.resources import ontology_path
 from plugnproduce.safeio import parse_turtle
 from plugnproduce.validation.findings import Finding

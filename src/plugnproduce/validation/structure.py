@@ -13,9 +13,9 @@ from collections.abc import Iterator
 
 from plugnproduce.description.model import Command, DeviceDescription, ProcessDescription, Task
 from plugnproduce.description.outcomes import flow_findings
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.ontology.names import did_you_mean
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.validation.findings import Finding
 
 

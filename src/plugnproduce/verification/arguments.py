@@ -16,7 +16,7 @@ from typing import Any
 
 from plugnproduce.description.model import ChartTransition, DeviceDescription
 from plugnproduce.description.quantities.contracts import breach
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 
 
 def argument_problems(device: DeviceDescription, transition: ChartTransition, arguments: Any) -> list[str]:

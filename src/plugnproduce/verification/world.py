@@ -29,7 +29,7 @@ from plugnproduce.chartnames import DONE, STEP
 from plugnproduce.codegen.task import GeneratedTask
 from plugnproduce.description.model import PROTOCOLS, Cell, ChartTransition, DeviceDescription
 from plugnproduce.errors import ExecutionError
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.statechart.runtime.clock import ManualClock
 from plugnproduce.statechart.runtime.events import Event, EventData, MacroStep
 from plugnproduce.statechart.runtime.interpreter import Interpreter

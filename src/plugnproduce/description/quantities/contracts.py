@@ -19,7 +19,7 @@ from typing import Any
 
 from plugnproduce.description.model import Argument
 from plugnproduce.description.quantities.units import UnitError, convert
-from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
+from plugnproduce.ontology.iris import PNP_IRI, local_name
 
 XSD = "http://www.w3.org/2001/XMLSchema#"
 KINDS = {

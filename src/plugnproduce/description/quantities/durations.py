@@ -21,7 +21,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from plugnproduce.description.model import Where
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 
 
 @dataclass(frozen=True)

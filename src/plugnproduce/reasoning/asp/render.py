@@ -7,8 +7,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task, Where
+from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP_IRI
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.facts import SCALE
 from plugnproduce.reasoning.asp.results import Problem, Reason

@@ -6,7 +6,6 @@ import re
 from dataclasses import dataclass, field
 
 from plugnproduce.description.model import Task, Where, plain_value
-from plugnproduce.description.taskfile import task_entries
 
 _CURIE = re.compile(r" \((?:[A-Za-z][\w-]*:[\w-]+|https?://[^)\s]+)\)")
 """The ``(prefix:Term)`` a reason's text adds after each label for the engineer."""
@@ -288,6 +287,8 @@ class Repair:
     def to_json(self) -> dict[str, object]:
         """A JSON-ready dict: the task as its steps (as the task file writes them when it has loops or branches),
         and ``unrolls``: whether it writes the original's loops and branches out step by step (``note``: why)."""
+        from plugnproduce.description.taskfile import task_entries  # the task writer: YAML, for a repair's JSON
+
         steps = task_entries(self.task) if self.task.loops or self.task.branches else [
             {"command": s.command, **({"bind": dict(s.bind)} if s.bind else {}),
              **({"params": {n: plain_value(v) for n, v in s.params.items()}} if s.params else {})}

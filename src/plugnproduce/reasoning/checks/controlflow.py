@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Loop, Task, Where
 from plugnproduce.description.outcomes import loop_ending
-from plugnproduce.ontology.vocabulary import local_name
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.reasoning.asp.results import CheckResult, Problem, Reason
 from plugnproduce.reasoning.checks.branches import Path, covering, renumbered
 

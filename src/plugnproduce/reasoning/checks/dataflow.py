@@ -25,8 +25,8 @@ from plugnproduce.description.model import (
     Step,
     Task,
 )
+from plugnproduce.ontology.iris import PNP_IRI, local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP_IRI, local_name
 from plugnproduce.reasoning.asp.results import Problem, Reason, StepCheck
 from plugnproduce.statechart.model import Send, walk
 

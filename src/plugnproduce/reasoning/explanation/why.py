@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Task, Where
 from plugnproduce.errors import UnknownName
+from plugnproduce.ontology.iris import local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import local_name
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp import solver
 from plugnproduce.reasoning.asp.derivation import Node, asp

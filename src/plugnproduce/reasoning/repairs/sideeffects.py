@@ -15,8 +15,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Cell, DeviceDescription, ProcessDescription, Step, Task, Where
+from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.ontology.taxonomy import Taxonomy
-from plugnproduce.ontology.vocabulary import PNP_IRI
 from plugnproduce.reasoning.asp.derivation import Node, asp
 from plugnproduce.reasoning.asp.results import CheckResult, Repair
 from plugnproduce.reasoning.checks.offers import CELL

@@ -14,7 +14,7 @@ from typing import Any, ClassVar, Self
 import clingo
 
 from plugnproduce.errors import EncodingError
-from plugnproduce.reasoning.asp.terms import codec, quote
+from plugnproduce.reasoning.asp.terms import quote
 
 
 @dataclass(frozen=True)
@@ -123,5 +123,3 @@ def edit_text(edit: EditTerm) -> str:
     args = [str(v) if isinstance(v, int) else quote(v) for v in dataclasses.astuple(edit)]
     return f"{edit.kind}({','.join(args)})"
 
-
-codec("EditTerm", edit_text, edit_term)

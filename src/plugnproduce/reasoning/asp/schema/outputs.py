@@ -2,10 +2,29 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import clingo
 
-from plugnproduce.reasoning.asp.schema.edits import EditTerm
-from plugnproduce.reasoning.asp.terms import Atom, predicate
+from plugnproduce.reasoning.asp.terms import Atom, codec, predicate
+
+if TYPE_CHECKING:
+    from plugnproduce.reasoning.asp.schema.edits import EditTerm
+
+
+def _edit_text(edit: Any) -> str:
+    from plugnproduce.reasoning.asp.schema.edits import edit_text
+
+    return edit_text(edit)
+
+
+def _edit_term(symbol: clingo.Symbol) -> Any:
+    from plugnproduce.reasoning.asp.schema.edits import edit_term
+
+    return edit_term(symbol)
+
+
+codec("EditTerm", _edit_text, _edit_term)  # the edits' classes are made by the first repair, not by every check
 
 # ------------------------------------------------------------------ output: offered processes
 

@@ -1,0 +1,52 @@
+"""The console script builds only the command it runs (typer builds every command's parameters otherwise), and
+answers exactly as the whole command line does; its help and a misspelt command still see every command."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import typer.main
+from typer.testing import CliRunner
+
+import plugnproduce
+from plugnproduce.cli import app
+from plugnproduce.cli.app import _app_for
+
+ROOT = Path(__file__).resolve().parents[2]
+CELL = ROOT / "descriptions" / "cells" / "bin-picking.yaml"
+TASK = ROOT / "descriptions" / "tasks" / "bin-picking.yaml"
+SRC = str(Path(plugnproduce.__file__).resolve().parents[1])
+
+
+def _built(args: list[str]) -> list[str]:
+    return sorted(typer.main.get_command(_app_for(args)).commands)  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("args, built", [
+    (["capabilities", "--cell", "c.yaml"], ["capabilities"]),
+    (["--library", "lib", "--no-builtin", "check", "t.yaml"], ["check"]),
+    (["--library=lib", "repair", "t.yaml"], ["repair"]),
+    (["sim", "plug", "gripper"], ["sim"]),
+])
+def test_the_command_run_is_the_only_one_built(args: list[str], built: list[str]) -> None:
+    assert _built(args) == built
+
+
+@pytest.mark.parametrize("args", [["--help"], ["--help", "check"], ["--version"], ["capabilitiez"], []])
+def test_help_version_and_a_misspelt_command_see_every_command(args: list[str]) -> None:
+    every = sorted(typer.main.get_command(app).commands)  # type: ignore[attr-defined]
+    assert len(every) > 10 and _built(args) == every
+
+
+@pytest.mark.parametrize("args", [["capabilities", "--cell", str(CELL)], ["check", str(TASK), "--cell", str(CELL)],
+                                  ["check", str(TASK), "--cell", str(CELL), "--json"]])
+def test_the_console_script_answers_as_the_whole_command_line(args: list[str]) -> None:
+    whole = CliRunner().invoke(app, args)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (SRC, os.environ.get("PYTHONPATH"))))}
+    alone = subprocess.run([sys.executable, "-m", "plugnproduce", *args], env=env, capture_output=True, text=True,
+                           timeout=300, check=False)
+    assert (alone.returncode, alone.stdout) == (whole.exit_code, whole.stdout)
