@@ -75,11 +75,36 @@ steps:
 """
 
 
-def test_the_last_step_carries_the_value_an_earlier_step_produced() -> None:
+@pytest.fixture(scope="module")
+def localize_then_pick() -> GeneratedTask:
     k = service.knowledge()
     processes = {p.id: p for p in k.processes}
     cell = service.cell(service.builtin("cells", "bin-picking.yaml"))
     task = parse_task(LINKED.encode(), "task.yaml")
-    generated = generate_task(task, cell, bind_by_skill(task, cell, processes), processes, k.taxonomy)
-    assert values.used(generated, 2, "robot", {"TargetPose": POSE}, {output_variable("localize", "part_pose"): POSE}) == [
+    return generate_task(task, cell, bind_by_skill(task, cell, processes), processes, k.taxonomy)
+
+
+PRODUCED = {output_variable("localize", "part_pose"): POSE}
+"""The task chart's datamodel once the localisation reported its pose."""
+
+
+def test_the_last_step_carries_the_value_an_earlier_step_produced(localize_then_pick: GeneratedTask) -> None:
+    assert values.used(localize_then_pick, 2, "robot", {"TargetPose": POSE}, PRODUCED) == [
         {"value": "localize.part_pose", "used": POSE, "step": 2, "device": "robot", "parameter": "pick_pose"}]
+
+
+def test_the_first_step_produces_the_output_a_later_step_takes_under_its_name(
+        localize_then_pick: GeneratedTask) -> None:
+    found = values.produced(localize_then_pick, 1, "binpicking-pc",
+                            {"part_pose": POSE, "part_type": "bracket", "outcome": "PartFound"})
+    assert found == [{"value": "localize.part_pose", "produced": POSE, "step": 1, "device": "binpicking-pc"}]
+
+
+def test_a_request_to_another_device_of_the_step_carries_no_earlier_output(localize_then_pick: GeneratedTask) -> None:
+    # the gripper of the pick is sent no pose, even one equal to the one the robot takes
+    assert values.used(localize_then_pick, 2, "gripper", {"TargetPose": POSE}, PRODUCED) == []
+
+
+def test_a_value_other_than_the_one_produced_is_not_journalled_as_used(localize_then_pick: GeneratedTask) -> None:
+    elsewhere = [0.4, 0.1, 0.02, 0.0, 180.0, 0.0]
+    assert values.used(localize_then_pick, 2, "robot", {"TargetPose": elsewhere}, PRODUCED) == []
