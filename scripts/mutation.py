@@ -130,7 +130,7 @@ CORE = (
     Guard("reasoning-plausibility", (_S + "reasoning/checks/plausibility.py",),
           ("tests/reasoning/test_plausibility.py", "tests/reasoning/test_branch_paths.py",
            "tests/reasoning/test_branch_check.py", "tests/reasoning/test_flow_check.py",
-           "tests/reasoning/test_why.py")),
+           "tests/reasoning/test_why.py", "tests/reasoning/test_link_findings.py")),
     Guard("codegen-specific", (_S + "codegen/specific.py",),
           ("tests/codegen/test_specific_values.py", "tests/codegen/test_task_chart.py",
            "tests/codegen/test_closed_world.py"),

@@ -132,3 +132,13 @@ def test_a_task_with_more_paths_than_are_checked_is_refused_not_checked_for_ever
     result, _ = checked(tmp_path, text)
     assert [p.kind for p in result.problems] == ["too_many_paths"] and not result.plausible
     assert "at most 100 paths" in result.problems[0].text
+
+
+def test_an_unreachable_branch_is_one_bad_flow_finding_at_its_line(tmp_path: Path) -> None:
+    result, path = checked(tmp_path, GRIPPER_CLOSED.replace("NoPartFound:", "NoPartFund:"))
+    [problem] = [p for p in result.problems if p.kind == "bad_flow"]
+    where = f"{path}:{line_of(path, 'NoPartFund:')}"
+    shown = problem.to_json()
+    assert (shown["step"], shown["command"], shown["where"], shown["rests_on"], shown["iris"]) == (
+        1, "localize-part", where, [where], [])
+    assert problem.reason.code == "bad_flow" and not result.plausible

@@ -289,3 +289,38 @@ def test_a_step_no_checked_path_runs_is_explained_on_the_task_as_written(
     assert (ex.step, ex.command, ex.plausible) == (n, second, plausible)
     [gripper] = [r.text for r in ex.states if "device 'gripper'" in r.text]
     assert said in gripper, gripper
+
+
+def test_a_task_over_the_limit_of_paths_is_refused_at_the_last_branch_it_reached(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    _limits(monkeypatch, 2, 10_000)  # the second branch makes the third path, one too many
+    result, path = checked(tmp_path, LIMITED)
+    [problem] = [p.to_json() for p in result.problems]
+    second = f"{path}:{line_of(path, 'PartFound:') + 3}"
+    assert (problem["step"], problem["command"], problem["kind"]) == (1, "localize-part", "too_many_paths")
+    assert (problem["where"], problem["rests_on"], problem["iris"]) == (second, [second], [])
+    assert result.problems[0].reason.code == "too_many_paths"
+
+
+def test_a_step_of_the_second_branch_is_explained_with_its_own_number(tmp_path: Path) -> None:
+    # step 3 is the second step of the path that runs it: its number, its states and its problem say step 3
+    path = tmp_path / "task.yaml"
+    path.write_text("task: either\nsteps:\n  - command: localize-part\n    on:\n"
+                    "      PartFound: [{command: close-gripper}]\n      NoPartFound: [{command: open-gripper}]\n",
+                    encoding="utf-8")
+    ex = service.explain_step(path, CELL, 3)
+    assert (ex.step, ex.command, ex.plausible) == (3, "open-gripper", False)
+    assert [str(p) for p in ex.problems] == [
+        f"{path}:6: step 3 (open-gripper): device 'gripper' (role 'gripper') is in state 'open' [open (pnp:Open)] "
+        "(its initial state); the step needs it closed (pnp:Closed)"]
+    assert [p.step for p in ex.problems] == [3]
+
+
+def test_a_step_after_a_branch_is_explained_with_the_numbers_of_the_task(tmp_path: Path) -> None:
+    # place (step 4) is the third step of the path without the branch: the step that left the gripper is step 3
+    path = tmp_path / "task.yaml"
+    path.write_text(GRIPPER_CLOSED, encoding="utf-8")
+    ex = service.explain_step(path, CELL, 4)
+    assert (ex.step, ex.command, ex.plausible, ex.problems) == (4, "place", True, ())
+    [gripper] = [r.text for r in ex.states if "device 'gripper'" in r.text]
+    assert "left there by step 3 (pick)" in gripper, gripper
