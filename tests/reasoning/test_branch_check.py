@@ -142,3 +142,4 @@ def test_an_unreachable_branch_is_one_bad_flow_finding_at_its_line(tmp_path: Pat
     assert (shown["step"], shown["command"], shown["where"], shown["rests_on"], shown["iris"]) == (
         1, "localize-part", where, [where], [])
     assert problem.reason.code == "bad_flow" and not result.plausible
+    assert (result.task, result.cell) == ("closed", "bin-picking")

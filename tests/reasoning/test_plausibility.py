@@ -17,6 +17,17 @@ def test_the_bin_picking_task_is_plausible(cell: Cell) -> None:
     assert result.plausible and result.problems == ()
 
 
+def test_the_answer_names_the_task_the_cell_and_each_step_by_its_number(cell: Cell) -> None:
+    result = service.check(task("bin-picking-invalid"), cell)
+    assert (result.task, result.cell) == ("bin-picking-invalid", "bin-picking")
+    assert [s.index for s in result.steps] == list(range(1, len(task("bin-picking-invalid").steps) + 1))
+
+
+def test_a_step_is_explained_under_its_own_number(cell: Cell) -> None:
+    ex = service.explain_step(task("bin-picking-invalid"), cell, 2)
+    assert (ex.step, ex.plausible) == (2, False) and [p.step for p in ex.problems] == [2]
+
+
 def test_the_pick_and_place_task_is_plausible(cell: Cell) -> None:
     assert service.check(task("pick-and-place"), cell).plausible
 
