@@ -220,6 +220,8 @@ EXPECTED = {
     ("approach-while-opening", "two-robots"): (False, None, {"ambiguous"}),  # two robots fit: bind one
     ("pick-place-timed", "timed-cell"): (True, "proved", set()),
     ("pick-place-timed", "two-robots"): (False, None, {"ambiguous"}),
+    ("move-near", "mm-arm"): (True, "proved", set()),  # an arm taking its poses in "mm deg"
+    ("move-far", "mm-arm"): (False, None, {"device_limit"}),  # 2 m is beyond its 1450 mm reach
 }
 """What the check and verification answer for every pair: a change in either is a failing row, never a skip."""
 
