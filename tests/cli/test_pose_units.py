@@ -5,9 +5,12 @@ per component before it leaves the controller, and its reach is judged in the de
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 LIBRARY = Path(__file__).parents[1] / "data" / "libraries" / "mm-arm"
 CELL = LIBRARY / "cells" / "mm-arm.yaml"
@@ -47,3 +50,34 @@ def test_a_pose_two_metres_away_is_beyond_a_reach_of_1450_mm() -> None:
     assert result.returncode == 1, result.stdout + result.stderr
     assert "1450 mm" in result.stdout and "2000 mm" in result.stdout
     assert f"{task.name}:5" in result.stdout
+
+
+LOCALIZING = LIBRARY / "cells" / "mm-arm-localizing.yaml"
+TO_PART = LIBRARY / "tasks" / "move-to-part.yaml"
+
+
+def test_a_pose_from_another_step_is_converted_at_run_time(tmp_path: Path) -> None:
+    """The localizer reports the part's pose in "m deg"; the arm gets it in millimetres."""
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(TO_PART), "--cell", str(LOCALIZING), "--sim", "--journal", str(journal))
+    assert result.returncode == 0, result.stdout + result.stderr
+    records = [json.loads(line) for line in journal.read_text().splitlines()]
+    (reported,) = [r["produced"] for r in records if r["kind"] == "value" and "produced" in r]
+    (sent,) = [r["params"]["TargetPose"] for r in records if r["kind"] == "command" and r.get("device") == "mm-arm"]
+    assert sent == pytest.approx([v * 1000 for v in reported[:3]] + list(reported[3:]))
+
+
+def test_the_check_proves_a_linked_pose_within_the_reach_in_the_devices_unit() -> None:
+    result = pnp("check", str(TO_PART), "--cell", str(LOCALIZING))
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "binpicking-pc reports part_pose within 1.2 m of the base; mm-arm reaches 1450 mm" in result.stdout
+
+
+def test_a_reach_of_1000_mm_does_not_prove_a_pose_reported_within_1_2_m(tmp_path: Path) -> None:
+    library = Path(shutil.copytree(LIBRARY, tmp_path / "mm-arm"))
+    ttl = library / "devices" / "mm-arm.ttl"
+    ttl.write_text(ttl.read_text().replace("pnp:maxReach 1450", "pnp:maxReach 1000"))
+    cell = library / "cells" / "mm-arm-localizing.yaml"
+    cell.write_text(cell.read_text().replace("../../../../../descriptions", str(LIBRARY.parents[3] / "descriptions")))
+    result = pnp("check", str(library / "tasks" / "move-to-part.yaml"), "--cell", str(cell))
+    assert "within 1.2 m of the base, and mm-arm reaches only 1000 mm" in result.stdout, result.stdout + result.stderr

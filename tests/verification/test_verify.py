@@ -222,6 +222,10 @@ EXPECTED = {
     ("pick-place-timed", "two-robots"): (False, None, {"ambiguous"}),
     ("move-near", "mm-arm"): (True, "proved", set()),  # an arm taking its poses in "mm deg"
     ("move-far", "mm-arm"): (False, None, {"device_limit"}),  # 2 m is beyond its 1450 mm reach
+    ("move-near", "mm-arm-localizing"): (True, "proved", set()),
+    ("move-far", "mm-arm-localizing"): (False, None, {"device_limit"}),
+    ("move-to-part", "mm-arm"): (False, None, {"no_device"}),  # no localizer, no 3D sensor
+    ("move-to-part", "mm-arm-localizing"): (True, "proved", set()),  # the reported pose in m, the arm's in mm
 }
 """What the check and verification answer for every pair: a change in either is a failing row, never a skip."""
 

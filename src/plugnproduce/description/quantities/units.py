@@ -144,3 +144,13 @@ def convert_pose(pose: list[float], unit: str, to: str) -> list[float]:
         raise UnitError(f"{bad!r} is no pose unit; expected a length and an angle such as \"m deg\"")
     return ([convert(float(v), given[0], wanted[0]) for v in pose[:3]]
             + [convert(float(v), given[1], wanted[1]) for v in pose[3:]])
+
+
+def reach_length(unit: str) -> str:
+    """The length unit a reach is given in for a pose in ``unit``: its first part, metres for ``""``."""
+    if not unit:
+        return "m"
+    units = pose_units(unit)
+    if units is None:
+        raise UnitError(f"{unit!r} is no pose unit; expected a length and an angle such as \"m deg\"")
+    return units[0]
