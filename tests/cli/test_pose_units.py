@@ -81,3 +81,36 @@ def test_a_reach_of_1000_mm_does_not_prove_a_pose_reported_within_1_2_m(tmp_path
     cell.write_text(cell.read_text().replace("../../../../../descriptions", str(LIBRARY.parents[3] / "descriptions")))
     result = pnp("check", str(library / "tasks" / "move-to-part.yaml"), "--cell", str(cell))
     assert "within 1.2 m of the base, and mm-arm reaches only 1000 mm" in result.stdout, result.stdout + result.stderr
+
+
+def test_the_library_is_valid() -> None:
+    result = pnp("validate", *(str(p) for p in sorted(LIBRARY.glob("*/*")) if p.suffix in (".ttl", ".yaml")))
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.mark.parametrize("unit", ["mm kg", "mm", "deg mm", "mm deg s", "mm degC"])
+def test_a_device_argument_in_no_pose_unit_is_one_line_at_its_place(tmp_path: Path, unit: str) -> None:
+    """Bad input to check (exit 2), a finding of validate (exit 1) as an unknown unit is; both at its line."""
+    library = Path(shutil.copytree(LIBRARY, tmp_path / "mm-arm"))
+    ttl = library / "devices" / "mm-arm.ttl"
+    ttl.write_text(ttl.read_text().replace('pnp:unit "mm deg"', f'pnp:unit "{unit}"'))
+    for command, code in ((("check", str(library / "tasks" / "move-near.yaml"), "--cell",
+                            str(library / "cells" / "mm-arm.yaml")), 2), (("validate", str(ttl)), 1)):
+        result = pnp(*command)
+        assert result.returncode == code, result.stdout + result.stderr
+        (line,) = (result.stdout + result.stderr).splitlines()
+        assert line.startswith(f"{ttl}:16: ") and f"'{unit}' is no pose unit" in line, line
+
+
+def test_a_process_parameter_in_no_pose_unit_is_refused_at_its_line(tmp_path: Path) -> None:
+    from plugnproduce.description.loader import load_process
+    from plugnproduce.errors import DescriptionError
+
+    builtin = LIBRARY.parents[3] / "descriptions" / "processes"
+    for name in ("move-to.ttl", "move-to.scxml"):
+        shutil.copy(builtin / name, tmp_path / name)
+    ttl = tmp_path / "move-to.ttl"
+    ttl.write_text(ttl.read_text().replace('pnp:unit "m deg"', 'pnp:unit "m kg"'))
+    with pytest.raises(DescriptionError) as raised:
+        load_process(ttl)
+    assert str(raised.value).startswith(f"{ttl}:15: ") and "'m kg' is no pose unit" in str(raised.value)

@@ -154,3 +154,10 @@ def reach_length(unit: str) -> str:
     if units is None:
         raise UnitError(f"{unit!r} is no pose unit; expected a length and an angle such as \"m deg\"")
     return units[0]
+
+
+def no_pose_unit(unit: str) -> str | None:
+    """Why ``unit`` declared for a pose is no pose unit (``""`` is one: the pose as it is), or None."""
+    if not unit or pose_units(unit) is not None:
+        return None
+    return f"{unit[:MAX_TEXT]!r} is no pose unit; expected a length and an angle such as \"m deg\" or \"mm rad\""
