@@ -110,6 +110,11 @@ GUARDS = (
 )
 
 _S = "src/plugnproduce/"
+_DEAD_END_BATCH = tuple(f"tests/reasoning/test_dead_end.py::{t}" for t in (
+    "test_the_batch_says_what_check_says_for_every_configuration_with_or_without_the_dead_end",
+    "test_the_batch_names_the_dead_end_as_the_reason_and_buys_a_gripper_that_can_close"))
+_BATCH_WORKERS = tuple(f"tests/reasoning/test_batch.py::{t}" for t in (  # how the work is shared, not the answers
+    "test_two_workers_give_the_same_rows_as_one", "test_workers_start_only_for_work_large_enough_to_repay_them"))
 CORE = (
     Guard("codegen-flow", (_S + "codegen/flow.py",),
           ("tests/codegen/test_loops_and_links.py", "tests/codegen/test_branch_charts.py",
@@ -144,17 +149,24 @@ CORE = (
     Guard("reasoning-dataflow", (_S + "reasoning/checks/dataflow.py",),
           ("tests/reasoning/test_link_findings.py", "tests/reasoning/test_flow_check.py",
            "tests/reasoning/test_plausibility.py", "tests/reasoning/test_branch_check.py")),
-    Guard("reasoning-feasibility", (_S + "batch/feasibility.py",), ("tests/reasoning/test_batch.py",)),
-    Guard("reasoning-purchases", (_S + "batch/purchases.py",), ("tests/reasoning/test_batch.py",)),
+    Guard("reasoning-feasibility", (_S + "batch/feasibility.py",),
+          ("tests/reasoning/test_batch.py", *_DEAD_END_BATCH), deselect=_BATCH_WORKERS),
+    Guard("reasoning-purchases", (_S + "batch/purchases.py",),
+          ("tests/reasoning/test_batch.py", *_DEAD_END_BATCH),
+          deselect=(*_BATCH_WORKERS,  # they compare offered and plausible only, never a purchase
+                    "tests/reasoning/test_batch.py::test_answers_agree_with_the_full_reasoner_on_random_configurations")),
     Guard("reasoning-windows", (_S + "reasoning/repairs/windows.py",), ("tests/reasoning/test_windows.py",)),
     Guard("reasoning-lifting", (_S + "reasoning/repairs/lifting.py",), ("tests/reasoning/test_repair_lifting.py",)),
-    Guard("executor-links", (_S + "executor/links.py",),
-          ("tests/executor/test_run.py", "tests/executor/test_faults.py")),
+    Guard("executor-links", (_S + "executor/links.py",), ("tests/executor/test_links.py",)),
     Guard("executor-values", (_S + "executor/values.py",), ("tests/executor/test_values.py",)),
     Guard("verification", tuple(_S + f"verification/{n}.py" for n in ("arguments", "results", "search", "trace",
                                                                          "world")),
           ("tests/verification/test_verify.py", "tests/verification/test_branch_verify.py",
-           "tests/verification/test_nested_verify.py")),
+           "tests/verification/test_nested_verify.py"),
+          deselect=(  # a run on the simulated cell (the executor's work) and pnp verify in a child process
+              "tests/verification/test_verify.py::test_the_seeded_deadlock_is_not_hit_by_a_simulated_run",
+              "tests/verification/test_nested_verify.py::"
+              "test_pnp_verify_proves_the_nested_task_on_the_bin_picking_cell")),
 )
 """The core modules (the answers users rely on), each with the smallest set of test files that covers it."""
 
