@@ -114,3 +114,14 @@ def test_a_process_parameter_in_no_pose_unit_is_refused_at_its_line(tmp_path: Pa
     with pytest.raises(DescriptionError) as raised:
         load_process(ttl)
     assert str(raised.value).startswith(f"{ttl}:15: ") and "'m kg' is no pose unit" in str(raised.value)
+
+
+def test_poses_that_differ_between_steps_sharing_a_chart_go_out_in_millimetres(tmp_path: Path) -> None:
+    """The second and third move share one chart and read their poses at run time, in "m deg"."""
+    journal = tmp_path / "run.jsonl"
+    result = pnp("run", str(LIBRARY / "tasks" / "move-three.yaml"), "--cell", str(CELL), "--sim",
+                 "--journal", str(journal))
+    assert result.returncode == 0, result.stdout + result.stderr
+    records = [json.loads(line) for line in journal.read_text().splitlines()]
+    poses = [r["params"]["TargetPose"] for r in records if r["kind"] == "command" and r.get("device") == "mm-arm"]
+    assert poses == [[600, 0, 0, 0, 180, 0], [500, 100, 200, 0, 180, 0], [400, -100, 300, 0, 90, 0]]
