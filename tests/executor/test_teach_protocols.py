@@ -156,40 +156,16 @@ def test_an_opcua_device_that_does_not_report_the_pose_its_description_promises_
                                        "nothing but its state)")
 
 
-def test_a_upnp_device_that_does_not_report_the_pose_its_description_promises_is_one_line() -> None:
-    """A real device whose ``GetDeviceState`` answers its state only, behind the arm's description."""
-    network = private_network()
-
-    async def scenario() -> str:
-        spec = upnp.with_state_query(upnp.service_spec_from_chart_events({"MoveTo": ["TargetPose"]}, []))
-
-        async def answer(action: str, values: Mapping[str, Any]) -> Mapping[str, Any]:
-            return {upnp.STATE_ARGUMENT: "home"} if action == upnp.STATE_ACTION else await refuse(action, values)
-
-        async with upnp.UpnpDeviceServer("short-arm-upnp", "a plain arm", upnp.device_type_for("ArticulatedRobot"),
-                                         spec, answer, network=network) as server:
-            assert server.location is not None
-            with pytest.raises(ProtocolError) as caught:
-                await controller.read_taught(dataclasses.replace(arm("short-arm-upnp"), endpoint=server.location),
-                                             "TargetPose")
-            return str(caught.value)
-
-    assert asyncio.run(scenario()) == ("device short-arm-upnp did not report TargetPose with its state (it "
-                                       "reported nothing but its state)")
-
-
-def test_a_upnp_device_reporting_a_value_that_is_no_json_is_one_line() -> None:
-    """A device whose state query answers ``TargetPose`` with text that is not JSON (an infinite number)."""
+def _upnp_teach_refusal(reports: list[str], state: Mapping[str, Any]) -> str:
+    """What teaching ``TargetPose`` from a real UPnP arm says when its state query answers ``state``."""
     network = private_network()
 
     async def scenario() -> str:
         spec = upnp.with_state_query(upnp.service_spec_from_chart_events({"MoveTo": ["TargetPose"]}, []),
-                                     reports=["TargetPose"])
+                                     reports=reports)
 
         async def answer(action: str, values: Mapping[str, Any]) -> Mapping[str, Any]:
-            if action == upnp.STATE_ACTION:
-                return {upnp.STATE_ARGUMENT: "home", "TargetPose": "[Infinity, 0, 0, 0, 180, 0]"}
-            return await refuse(action, values)
+            return state if action == upnp.STATE_ACTION else await refuse(action, values)
 
         async with upnp.UpnpDeviceServer("short-arm-upnp", "a plain arm", upnp.device_type_for("ArticulatedRobot"),
                                          spec, answer, network=network) as server:
@@ -199,8 +175,20 @@ def test_a_upnp_device_reporting_a_value_that_is_no_json_is_one_line() -> None:
                                              "TargetPose")
             return str(caught.value)
 
-    assert asyncio.run(scenario()) == ("device short-arm-upnp: GetDeviceState: TargetPose is not a JSON value: "
-                                       "'[Infinity, 0, 0, 0, 180, 0]'")
+    return asyncio.run(scenario())
+
+
+def test_a_upnp_device_that_does_not_report_the_pose_its_description_promises_is_one_line() -> None:
+    """A real device whose ``GetDeviceState`` answers its state only, behind the arm's description."""
+    assert _upnp_teach_refusal([], {upnp.STATE_ARGUMENT: "home"}) == (
+        "device short-arm-upnp did not report TargetPose with its state (it reported nothing but its state)")
+
+
+def test_a_upnp_device_reporting_a_value_that_is_no_json_is_one_line() -> None:
+    """A device whose state query answers ``TargetPose`` with text that is not JSON (an infinite number)."""
+    assert _upnp_teach_refusal(["TargetPose"], {upnp.STATE_ARGUMENT: "home", "TargetPose": "[Infinity, 0, 0, 0, 180, 0]"}) \
+        == "device short-arm-upnp: GetDeviceState: TargetPose is not a JSON value: '[Infinity, 0, 0, 0, 180, 0]'"
+
 
 
 def test_teach_against_pnp_sim_up_as_separate_processes(tmp_path: Path) -> None:

@@ -13,6 +13,7 @@ from plugnproduce.description.loader import load_device
 from plugnproduce.errors import UnknownName
 from plugnproduce.reasoning.checks import branches, plausibility
 from tests.conftest import edit
+from tests.reasoning.test_branch_check import GRIPPER_CLOSED
 from tests.reasoning.test_flow_check import CELL, checked, line_of
 
 LIBRARY = Path(__file__).parents[1] / "data" / "libraries" / "part-finding"
@@ -255,20 +256,6 @@ def test_the_first_step_of_a_branched_task_is_explained_as_the_first(tmp_path: P
     path.write_text(LIMITED, encoding="utf-8")
     ex = service.explain_step(path, CELL, 1)
     assert (ex.step, ex.command, ex.plausible) == (1, "localize-part", True)
-
-
-GRIPPER_CLOSED = """task: closed
-steps:
-  - name: localize
-    command: localize-part
-    on:
-      NoPartFound:
-        - command: close-gripper
-  - command: pick
-    params:
-      pick_pose: {from: localize, output: part_pose}
-  - command: place
-"""
 
 
 def test_why_a_step_is_not_plausible_is_answered_on_the_path_that_makes_it_so(tmp_path: Path) -> None:

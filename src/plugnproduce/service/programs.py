@@ -151,15 +151,18 @@ def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path
                        catalogue_or_folder: list[DeviceDescription] | str | Path | None = None,
                        knowledge: Knowledge | None = None) -> list[CycleTime | None]:
     """Each repaired task's estimated cycle time in the cell with the devices its repair buys (None: no estimate).
-    Every repair starts from the same task, so their order by it is their order by the time they add."""
+    Every repair starts from the same task, so their order by it is their order by the time they add; the
+    steps they share are estimated once."""
+    from plugnproduce.timing.estimate import StepMemo
     from plugnproduce.timing.tasks import task_cycle_time
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     bought = {d.id: d for d in (k.devices if catalogue_or_folder is None else _devices(catalogue_or_folder, k))}
     out: list[CycleTime | None] = []
+    memo = StepMemo()
     for r in repairs:
         cell = the_cell
         for device in r.repair.added_devices:
             cell = cell.with_device(bought[device])
-        out.append(task_cycle_time(r.repair.task, cell, k, r.checked))  # checked by the assessment already
+        out.append(task_cycle_time(r.repair.task, cell, k, r.checked, memo))  # checked by the assessment already
     return out

@@ -11,7 +11,7 @@ once, and the estimate says so. Protocol latency is not counted.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Hashable, Mapping
 
 from plugnproduce.codegen.specific import Flow, RegionResult, Varying
 from plugnproduce.codegen.task import GeneratedTask, StepChart, step_values
@@ -23,13 +23,54 @@ from plugnproduce.timing.cycle import LoopTime as LoopTime
 from plugnproduce.timing.cycle import StepTime as StepTime
 from plugnproduce.timing.requests import DeviceTimer
 
+_TimerState = tuple[float | None, object]
 
-def estimate_task(generated: GeneratedTask) -> CycleTime:
-    """The estimated cycle time of ``generated``, from the devices' durations."""
+
+class StepMemo:
+    """Step times already estimated, for the estimates of tasks that share most of their steps (the repairs of
+    one task): a step is estimated again only when its chart, its values or the state its devices' timers
+    start it from (the declared time pending, the pose a motion starts at) differ from every step seen.
+    A step's time is a function of exactly these, so a task's estimate with a memo equals the one without."""
+
+    def __init__(self) -> None:
+        self._seen: dict[Hashable, tuple[float, tuple[str, ...], tuple[tuple[str, _TimerState], ...]]] = {}
+        self._shapes: dict[Hashable, int] = {}
+        self._kept: dict[int, object] = {}  # what a key names by identity stays alive, so no id is reused
+
+    def shape(self, chart: StepChart) -> int:
+        """A number for what a step's time depends on besides its values and its timers: its process and its
+        regions' paths through their devices' charts."""
+        shape = (chart.process.id, tuple((r.role, r.device.id, id(r.device), tuple(r.legs), tuple(r.path))
+                                         for r in chart.regions))
+        self._kept.update((id(r.device), r.device) for r in chart.regions)
+        return self._shapes.setdefault(shape, len(self._shapes))
+
+    def seconds(self, chart: StepChart, timers: Mapping[str, DeviceTimer], notes: list[str],
+                shape: int) -> float:
+        """The step's seconds, leaving its devices' timers and ``notes`` as estimating it would."""
+        devices = tuple(dict.fromkeys(r.device.id for r in chart.regions))
+        key = (shape, repr(sorted(step_values(chart.step, chart.process).items())),
+               tuple((d, repr(timers[d].state())) for d in devices))
+        if (seen := self._seen.get(key)) is None:
+            said: list[str] = []
+            seconds = _step_seconds(chart, timers, said)
+            seen = self._seen[key] = (seconds, tuple(said), tuple((d, timers[d].state()) for d in devices))
+        seconds, said_before, after = seen
+        notes.extend(said_before)
+        for device, state in after:
+            timers[device].resume(state)
+        return seconds
+
+
+def estimate_task(generated: GeneratedTask, memo: StepMemo | None = None) -> CycleTime:
+    """The estimated cycle time of ``generated``, from the devices' durations (``memo``: steps estimated for
+    other tasks in the same cell, which this estimate reuses and adds to)."""
     devices = {r.device.id: r.device for s in generated.steps for r in s.regions}
     timers = {i: DeviceTimer(d) for i, d in devices.items()}  # one per device, not per step
     notes: list[str] = []
-    steps = tuple(StepTime(s.step.index, s.step.command, _step_seconds(s, timers, notes)) for s in generated.steps)
+    shapes: dict[int, int] = {}  # a step chart's element → its shape in the memo
+    steps = tuple(StepTime(s.step.index, s.step.command, _seconds(s, timers, notes, memo, shapes))
+                  for s in generated.steps)
     loops = tuple(_loop_time(loop, steps) for loop in generated.task.loops if _outermost(loop, generated.task.loops))
     in_loops = {i for lp in loops for i in range(lp.entry, lp.last + 1)}
     total = sum(s.seconds for s in steps if s.step not in in_loops)
@@ -39,6 +80,17 @@ def estimate_task(generated: GeneratedTask) -> CycleTime:
     if generated.task.branches:
         notes.append("every branch's steps are counted")
     return CycleTime(steps, loops, total, tuple(dict.fromkeys(notes)))
+
+
+def _seconds(chart: StepChart, timers: Mapping[str, DeviceTimer], notes: list[str], memo: StepMemo | None,
+             shapes: dict[int, int]) -> float:
+    """The step's seconds: estimated, or as the memo has it."""
+    if memo is None:
+        return _step_seconds(chart, timers, notes)
+    shape = shapes.get(id(chart.element))  # steps sharing a chart share its element (alive while estimating)
+    if shape is None:
+        shape = shapes[id(chart.element)] = memo.shape(chart)
+    return memo.seconds(chart, timers, notes, shape)
 
 
 def _outermost(loop: Loop, loops: tuple[Loop, ...]) -> bool:

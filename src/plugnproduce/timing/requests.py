@@ -56,6 +56,14 @@ class DeviceTimer:
         self._requests = RequestTimer(device.durations, limit or 100.0)
         self._declared: float | None = None
 
+    def state(self) -> tuple[float | None, object]:
+        """What its next times depend on: the declared time of the request just taken, the pose it is at."""
+        return self._declared, self._requests.pose
+
+    def resume(self, state: tuple[float | None, object]) -> None:
+        """Continue from ``state`` (as :meth:`state` gave it), as if it had taken what led there."""
+        self._declared, self._requests.pose = state
+
     def request(self, name: str, values: Mapping[str, object]) -> float | None:
         """The device takes request ``name`` with ``values`` (by quantity local name): its declared time,
         which replaces the next delay (None: the chart's delays count)."""

@@ -74,6 +74,15 @@ class RequestTimer:
         self._speed_limit = speed_limit
         self._pose: object = None
 
+    @property
+    def pose(self) -> object:
+        """The pose its last motion request named (None: unknown)."""
+        return self._pose
+
+    @pose.setter
+    def pose(self, pose: object) -> None:
+        self._pose = pose
+
     def seconds(self, request: str, values: Mapping[str, object]) -> float | None:
         """The time of ``request`` with argument ``values`` (keyed by the quantities' local names, as they go
         over the wire) as declared; None when
