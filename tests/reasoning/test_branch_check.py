@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from plugnproduce import service
-from tests.reasoning.test_flow_check import CELL, TASKS, checked, line_of
+from tests.reasoning.test_flow_check import CELL, TASKS, UNTIL_EMPTY, checked, line_of
 
 THEN_HOME = (TASKS / "bin-picking-then-home.yaml").read_text(encoding="utf-8")
 
@@ -143,3 +143,16 @@ def test_an_unreachable_branch_is_one_bad_flow_finding_at_its_line(tmp_path: Pat
         1, "localize-part", where, [where], [])
     assert problem.reason.code == "bad_flow" and not result.plausible
     assert (result.task, result.cell) == ("closed", "bin-picking")
+
+
+def test_a_loop_of_a_branched_task_is_refused_where_each_of_its_ends_strands_the_gripper(tmp_path: Path) -> None:
+    text = (UNTIL_EMPTY.replace("steps:\n  - loop:", "steps:\n  - command: localize-part\n    on:\n"
+                                "      PartFound: [{command: scan-bin}]\n  - loop:", 1)
+            + "  - command: open-gripper\n    bind: {gripper: gripper}\n")
+    result, path = checked(tmp_path, text)
+    exits = [p for p in result.problems if "loop ended on BinEmpty" in p.text]
+    assert {p.text.split(":")[0] for p in exits} == {"loop ended on BinEmpty at step 3 (loop iteration 1)",
+                                                    "loop ended on BinEmpty at step 6 (loop iteration 2 and later)"}
+    assert {(p.step, p.kind, p.device, p.where.line) for p in exits} == {
+        (9, "wrong_state", "gripper", line_of(path, "- command: open-gripper"))}
+    assert not result.plausible
