@@ -151,6 +151,19 @@ def test_no_package_holds_more_than_15_modules_flat() -> None:
     assert crowded == {}
 
 
+
+def test_no_package_names_a_function_as_one_of_its_modules() -> None:
+    """A package that hands out a name on first use loses it to its module of that name once anything imports the
+    module (the import binds the module there), so ``controller.teach(...)`` failed after a test imported
+    ``controller.teach``'s module."""
+    clashes = {}
+    for init in SRC.rglob("__init__.py"):
+        exported = set(re.findall(r'^    "(\w+)",$', init.read_text(encoding="utf-8"), re.M))  # its __all__
+        modules = {m.stem for m in init.parent.glob("*.py")} | {d.name for d in init.parent.iterdir() if d.is_dir()}
+        if clash := sorted(exported & modules):
+            clashes[str(init.parent.relative_to(SRC))] = clash
+    assert clashes == {}
+
 # ---------------------------------------------------------------- the doc's package graph
 
 DOC = Path(__file__).parent.parent / "docs" / "architecture.md"

@@ -55,7 +55,7 @@ if TYPE_CHECKING:
     )
     from plugnproduce.controller.runner import ExecutorRunner
     from plugnproduce.controller.simcell import SimulatedCellSource
-    from plugnproduce.controller.teach import read_taught, teach
+    from plugnproduce.controller.teaching import read_taught, teach
     from plugnproduce.discovery import CellChange, LiveCell
     from plugnproduce.executor.run import TaskRun
     from plugnproduce.protocols.interface import chosen_address
@@ -69,7 +69,7 @@ _WHERE = {
     "LiveCellSource": "plugnproduce.controller.livecell",
     **dict.fromkeys(("NoCell", "Resumed", "SimulatedResume", "continue_run", "replan_live", "resume_run"),
                     "plugnproduce.controller.resume"),
-    **dict.fromkeys(("read_taught", "teach"), "plugnproduce.controller.teach"),
+    **dict.fromkeys(("read_taught", "teach"), "plugnproduce.controller.teaching"),
     **dict.fromkeys(("DEFAULT_BIN_PARTS", "DISCOVERY_SECONDS", "SIMULATED_DISCOVERY_SECONDS", "DevicesMissing",
                      "StateNotReported", "default_bin_parts", "find_devices", "live_cell", "planned_run",
                      "reported_states", "run_task", "start_run"), "plugnproduce.controller.run"),

@@ -1,6 +1,6 @@
 """Teach-in: a value a device reports (a pose it was guided to), held to the device's contracts like any other.
 
-The controller reads the value from the device (:func:`plugnproduce.controller.teach`); this module says which
+The controller reads the value from the device (:func:`plugnproduce.controller.teaching`); this module says which
 values a device reports (its chart's ``<data pnp:quantity=...>``,
 :mod:`plugnproduce.description.quantities.reports`) and
 judges one against every contract of the device's requests that take that quantity
