@@ -220,6 +220,14 @@ EXPECTED = {
     ("approach-while-opening", "two-robots"): (False, None, {"ambiguous"}),  # two robots fit: bind one
     ("pick-place-timed", "timed-cell"): (True, "proved", set()),
     ("pick-place-timed", "two-robots"): (False, None, {"ambiguous"}),
+    ("move-near", "mm-arm"): (True, "proved", set()),  # an arm taking its poses in "mm deg"
+    ("move-far", "mm-arm"): (False, None, {"device_limit"}),  # 2 m is beyond its 1450 mm reach
+    ("move-near", "mm-arm-localizing"): (True, "proved", set()),
+    ("move-far", "mm-arm-localizing"): (False, None, {"device_limit"}),
+    ("move-to-part", "mm-arm"): (False, None, {"no_device"}),  # no localizer, no 3D sensor
+    ("move-three", "mm-arm"): (True, "proved", set()),  # two steps share a chart, their poses read at run time
+    ("move-three", "mm-arm-localizing"): (True, "proved", set()),
+    ("move-to-part", "mm-arm-localizing"): (True, "proved", set()),  # the reported pose in m, the arm's in mm
 }
 """What the check and verification answer for every pair: a change in either is a failing row, never a skip."""
 

@@ -31,7 +31,7 @@ from plugnproduce.description.processfile import load_process as load_process
 from plugnproduce.description.processfile import process_from as process_from
 from plugnproduce.description.quantities.durations import RequestDuration
 from plugnproduce.description.quantities.ranges import output_ranges
-from plugnproduce.description.quantities.units import unit_known
+from plugnproduce.description.quantities.units import no_pose_unit, unit_known
 from plugnproduce.description.rdf import Loaded as Loaded
 from plugnproduce.description.rdf import file_of as file_of
 from plugnproduce.description.rdf import (
@@ -47,6 +47,7 @@ from plugnproduce.description.taskfile import load_task as load_task
 from plugnproduce.description.taskfile import parse_task as parse_task
 from plugnproduce.description.taskfile import task_to_yaml as task_to_yaml
 from plugnproduce.errors import DescriptionError, excerpt
+from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.ontology.names import turtle_spelling, unknown_class
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.ontology.vocabulary import PNP, local_name
@@ -167,6 +168,8 @@ def _check_arguments(arguments: tuple[Argument, ...], transitions: tuple[ChartTr
             raise ContractError(f"argument {quantity} of request {request}: no transition of the "
                                    f"chart waits for request {request} with pnp:accepts=\"{quantity}\"",
                                    path, line)
+        if a.datatype == PNP_IRI + "Pose" and (wrong := no_pose_unit(a.unit)) is not None:
+            raise ContractError(f"argument {quantity} of request {request}: {wrong}", path, line)
         if not unit_known(a.unit):
             raise ContractError(f"argument {quantity} of request {request}: unknown unit "
                                    f"{excerpt(a.unit)!r}; expected a unit such as \"N\", \"mm/s\" or \"kPa\"",

@@ -15,6 +15,7 @@ from rdflib.namespace import RDF, RDFS
 
 from plugnproduce.description.charts import process_regions
 from plugnproduce.description.model import Output, Parameter, ProcessDescription, Role
+from plugnproduce.description.quantities.units import no_pose_unit
 from plugnproduce.description.rdf import (
     Loaded,
     file_of,
@@ -25,6 +26,7 @@ from plugnproduce.description.rdf import (
     read_description,
 )
 from plugnproduce.errors import DescriptionError, excerpt
+from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.ontology.vocabulary import PNP, local_name
 from plugnproduce.statechart.io.reader import read_chart
 
@@ -81,7 +83,16 @@ def process_from(loaded: Loaded) -> ProcessDescription:
     )
 
 
+def _pose_unit(loaded: Loaded, node: rdflib.term.Node, what: str) -> None:
+    """A pose's unit is a pose unit (a length and an angle), or there is none."""
+    datatype, unit = optional_value(loaded, node, PNP.datatype), optional_value(loaded, node, PNP.unit)
+    wrong = no_pose_unit(str(unit or "")) if str(datatype) == PNP_IRI + "Pose" else None
+    if wrong is not None:
+        raise DescriptionError(f"{what}: {wrong}", loaded.path, loaded.line(str(node)))
+
+
 def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
+    _pose_unit(loaded, p, f"parameter {excerpt(str(optional_value(loaded, p, PNP.parameterName)))}")
     role = one_value(loaded, p, PNP.forRole, "role")
     role_name = optional_value(loaded, role, PNP.roleName)
     default = optional_value(loaded, p, PNP.defaultValue)
@@ -100,6 +111,7 @@ def _parameter(loaded: Loaded, p: rdflib.term.Node) -> Parameter:
 
 
 def _output(loaded: Loaded, o: rdflib.term.Node) -> Output:
+    _pose_unit(loaded, o, f"output {excerpt(str(optional_value(loaded, o, PNP.outputName)))}")
     role = one_value(loaded, o, PNP.forRole, "role")
     role_name = optional_value(loaded, role, PNP.roleName)
     name = str(one_value(loaded, o, PNP.outputName, "output name"))

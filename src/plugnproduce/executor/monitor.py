@@ -21,8 +21,8 @@ from typing import Any
 from plugnproduce.chartnames import output_variable
 from plugnproduce.codegen.task import GeneratedTask, StepChart
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Link
-from plugnproduce.description.quantities.contracts import breach, shorten
-from plugnproduce.description.quantities.units import UnitError, convert
+from plugnproduce.description.quantities.contracts import breach, pose_items, shorten
+from plugnproduce.description.quantities.units import convert, convert_pose
 from plugnproduce.ontology.iris import local_name
 
 
@@ -140,10 +140,13 @@ def _accepted(device: DeviceDescription, request: str) -> tuple[str, ...]:
 
 
 def _in_unit(value: object, unit: str, to: str) -> object:
-    """A number in ``unit`` in the contract's unit ``to`` (anything else as it is)."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not unit or not to or unit == to:
+    """A number or a pose in ``unit`` in the contract's unit ``to`` (anything else as it is); breach() has refused
+    what cannot be converted."""
+    if not unit or not to or unit == to:
         return value
-    try:
-        return convert(float(value), unit, to)
-    except UnitError:  # breach() has refused what cannot be converted; a pose's "m deg" stays as it is
+    pose = pose_items(value)
+    if pose is not None:
+        return convert_pose(pose, unit, to)
+    if isinstance(value, bool) or not isinstance(value, int | float):
         return value
+    return convert(float(value), unit, to)

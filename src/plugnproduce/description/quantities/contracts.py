@@ -7,8 +7,9 @@ source: a literal, a default, an earlier step's output, or a value that changes 
 iteration to the next.
 
 A contract (``pnp:RequestArgument``) names the argument's datatype, unit, minimum, maximum and,
-for a pose, the device's reach (``pnp:maxReach``, metres from its base). A value is judged in the
-unit it is given in and converted to the contract's unit first.
+for a pose, the device's reach (``pnp:maxReach``, from its base in the length of the contract's pose unit,
+metres if it names none). A value is judged in the unit it is given in and converted to the contract's unit
+first; a pose per component (x, y, z by the length unit, rx, ry, rz by the angle unit).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from plugnproduce.description.model import Argument
-from plugnproduce.description.quantities.units import UnitError, convert
+from plugnproduce.description.quantities.units import UnitError, convert, convert_pose, pose_units
 from plugnproduce.ontology.iris import PNP_IRI, local_name
 
 XSD = "http://www.w3.org/2001/XMLSchema#"
@@ -52,14 +53,34 @@ def breach(value: object, unit: str, contract: Argument, *, types: bool = True) 
         wrong = _type_breach(value, kind_of(contract.datatype))
         if wrong is not None:
             return wrong
-    if contract.reach is not None:
-        position = pose_position(value)
-        if position is not None and math.dist(position, (0.0, 0.0, 0.0)) > contract.reach:
-            distance = math.dist(position, (0.0, 0.0, 0.0))
-            return f"reaches at most {contract.reach:g} m from its base; the pose is {distance:.3g} m away"
+    position = pose_position(value)
+    if position is not None:
+        why = _pose_breach(position, unit, contract)
+        if why is not None:
+            return why
     if isinstance(value, bool) or not isinstance(value, int | float):
         return None
     return _limit_breach(value, unit, contract)
+
+
+def _pose_breach(position: tuple[float, float, float], unit: str, contract: Argument) -> str | None:
+    """Why a pose at ``position`` (in the pose unit ``unit``) is beyond the reach, in the contract's unit."""
+    try:
+        x, y, z = convert_pose([*position, 0.0, 0.0, 0.0], unit, contract.unit)[:3]
+    except UnitError as exc:
+        return f"takes a pose in {contract.unit}; the value is given in {unit} ({exc})"
+    units = pose_units(contract.unit)
+    length = units[0] if units is not None else "m"
+    distance = math.dist((x, y, z), (0.0, 0.0, 0.0))
+    if contract.reach is not None and distance > contract.reach:
+        return (f"reaches at most {contract.reach:g} {length} from its base; "
+                f"the pose is {_shown(distance)} {length} away")
+    return None
+
+
+def _shown(distance: float) -> str:
+    """A distance to three figures, never in an exponent (2000 mm, not 2e+03 mm)."""
+    return f"{distance:.3g}" if distance < 1000 else f"{distance:.0f}"
 
 
 def _limit_breach(value: float, unit: str, contract: Argument) -> str | None:
@@ -148,3 +169,14 @@ def shorten(value: object, limit: int = 60) -> str:
         return text
     size = f"{len(value):,} characters" if isinstance(value, str) else f"{len(text):,} characters written"
     return f"{text[:limit]}… ({size})"
+
+
+def pose_items(value: object) -> list[float] | None:
+    """A pose written as a list or as six numbers in a string, as six floats (None: no pose)."""
+    if pose_position(value) is None:
+        return None
+    try:
+        items = [float(v) for v in _items(value)]
+    except (TypeError, ValueError, OverflowError):
+        return None
+    return items if all(math.isfinite(v) for v in items) else None

@@ -115,3 +115,49 @@ def number_in(value: str, unit: str) -> float | None:
 def _spelling(unit: str) -> str:
     """How pint reads a unit written in a description (``%`` is ``percent``)."""
     return unit.replace("%", "percent")
+
+
+def pose_units(unit: str) -> tuple[str, str] | None:
+    """A pose unit ``"LENGTH ANGLE"`` (``"m deg"``, ``"mm rad"``) as its two units; None if it is none."""
+    parts = unit.split()
+    if len(parts) != 2 or not all(unit_known(p) for p in parts):
+        return None
+    try:
+        convert(1.0, parts[0], "m")
+        convert(1.0, parts[1], "deg")
+    except UnitError:
+        return None
+    return parts[0], parts[1]
+
+
+def convert_pose(pose: list[float], unit: str, to: str) -> list[float]:
+    """A pose (x, y, z, rx, ry, rz) in the pose unit ``unit`` expressed in ``to``: x, y, z by the length
+    units, rx, ry, rz by the angle units; the same pose when either is ``""`` or both are the same.
+
+    Raises :class:`UnitError` if either is no pose unit (a refusal is better than a wrong conversion).
+    """
+    if not unit or not to or unit == to:
+        return pose
+    given, wanted = pose_units(unit), pose_units(to)
+    if given is None or wanted is None:
+        bad = unit if given is None else to
+        raise UnitError(f"{bad!r} is no pose unit; expected a length and an angle such as \"m deg\"")
+    return ([convert(float(v), given[0], wanted[0]) for v in pose[:3]]
+            + [convert(float(v), given[1], wanted[1]) for v in pose[3:]])
+
+
+def reach_length(unit: str) -> str:
+    """The length unit a reach is given in for a pose in ``unit``: its first part, metres for ``""``."""
+    if not unit:
+        return "m"
+    units = pose_units(unit)
+    if units is None:
+        raise UnitError(f"{unit!r} is no pose unit; expected a length and an angle such as \"m deg\"")
+    return units[0]
+
+
+def no_pose_unit(unit: str) -> str | None:
+    """Why ``unit`` declared for a pose is no pose unit (``""`` is one: the pose as it is), or None."""
+    if not unit or pose_units(unit) is not None:
+        return None
+    return f"{unit[:MAX_TEXT]!r} is no pose unit; expected a length and an angle such as \"m deg\" or \"mm rad\""

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Argument, Cell, Link, ProcessDescription, Step, Task
 from plugnproduce.description.quantities.ranges import OutputRange, output_ranges
-from plugnproduce.description.quantities.units import UnitError, convert
+from plugnproduce.description.quantities.units import UnitError, convert, reach_length
 from plugnproduce.reasoning.asp.results import CheckResult, LinkSafety
 from plugnproduce.reasoning.checks.contracts import contracts_for
 
@@ -79,14 +79,18 @@ def _unproven(contracts: list[Argument], declared: OutputRange | None, link: Lin
 def _reach(contract: Argument, declared: OutputRange, link: Link, device: str, reporter: str) -> str:
     if contract.reach is None:
         return ""
+    try:  # each reach in the length of its own pose unit (metres where it names none)
+        mine, theirs = reach_length(declared.unit), reach_length(contract.unit)
+    except UnitError as exc:
+        return f"{reporter}'s reach of {link.output} cannot be compared with {device}'s ({exc})"
     if declared.reach is None:
-        return f"{reporter} declares no reach for {link.output}; {device} reaches {contract.reach:g} m"
+        return f"{reporter} declares no reach for {link.output}; {device} reaches {contract.reach:g} {theirs}"
     lift = math.dist(link.offset[:3], (0.0, 0.0, 0.0)) if link.offset is not None else 0.0
-    plus = f" plus an offset of {lift:g} m" if link.offset is not None else ""
-    said = f"{reporter} reports {link.output} within {declared.reach:g} m of the base{plus}"
-    if declared.reach + lift > contract.reach:
-        return f"{said}, and {device} reaches only {contract.reach:g} m"
-    return f"proven: {said}; {device} reaches {contract.reach:g} m"
+    plus = f" plus an offset of {lift:g} {mine}" if link.offset is not None else ""
+    said = f"{reporter} reports {link.output} within {declared.reach:g} {mine} of the base{plus}"
+    if convert(declared.reach + lift, mine, theirs) > contract.reach:
+        return f"{said}, and {device} reaches only {contract.reach:g} {theirs}"
+    return f"proven: {said}; {device} reaches {contract.reach:g} {theirs}"
 
 
 def _limits(contract: Argument, declared: OutputRange, device: str, reporter: str) -> str:
