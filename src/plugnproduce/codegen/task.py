@@ -151,9 +151,9 @@ def _produces(task: Task, step: Step, process: ProcessDescription,
     out = tuple((o.role, o.name, output_variable(step.name or "", o.name))
                 for o in process.outputs if o.name in wanted)
     role = process.outcome_role()
-    if role is not None and any(lp.until or lp.while_outcome for lp in task.loops_at(step.index)):
+    if role is not None and task.loops and any(lp.until or lp.while_outcome for lp in task.loops_at(step.index)):
         out += ((role.name, "outcome", OUTCOME),)
-    if role is not None and task.branches_of(step.index):
+    if role is not None and task.branches and task.branches_of(step.index):
         out += ((role.name, "outcome", branch_variable(step.index)),)
     return out
 
@@ -177,34 +177,32 @@ def generate_task(
     chart; nothing is unrolled.
     """
     consumed = consumed_outputs(task)
-    keys, values = _plan(task, cell, bindings, processes, taxonomy, consumed)
+    keys, values, end = _plan(task, cell, bindings, processes, taxonomy, consumed)
     groups: dict[_Key, list[dict[str, object]]] = {}
     for key, row in zip(keys, values, strict=True):
         groups.setdefault(key, []).append(row)
     varying = {key: _varying(rows) for key, rows in groups.items()}
     charts: dict[_Key, StepChart] = {}
-    current = {d.id: d.initial for d in cell.devices}
-    left: dict[int, dict[str, str]] = {}
     steps: list[StepChart] = []
     for i, (step, binding) in enumerate(zip(task.steps, bindings, strict=True)):
         key, process = keys[i], processes[step.command]
-        current = _branch_start(task, step.index, left, current)
-        if key not in charts:
-            bound = {n: Varying(n) if n in varying[key] else v for n, v in values[i].items()}
-            charts[key] = _step(step, process, binding, cell, dict(current), taxonomy, bound, key[4])
-        first = charts[key]
-        row = {n: v for n, v in values[i].items() if n in varying[key]}
+        vary, first = varying[key], charts.get(key)  # a key is a deep tuple: hashed once a step
+        if first is None:  # from the device states the plan found this key's first step to start in
+            bound = {n: Varying(n) if n in vary else v for n, v in values[i].items()}
+            first = charts[key] = _step(step, process, binding, cell, dict(key[2]), taxonomy, bound, key[4])
+        row = {n: v for n, v in values[i].items() if n in vary}
         steps.append(StepChart(step, process, binding, first.regions, first.element, first.body, row, first.produces))
-        current.update({r.device.id: r.end_state for r in first.regions})
-        left[step.index] = dict(current)
-    return GeneratedTask(task, steps, _task_chart(task, steps, outcome_names(task, processes, taxonomy)), current)
+    return GeneratedTask(task, steps, _task_chart(task, steps, outcome_names(task, processes, taxonomy)), end)
 
 
-def _branch_start(task: Task, index: int, left: dict[int, dict[str, str]], current: dict[str, str]) -> dict[str, str]:
-    """The device states step position ``index`` starts from: a branch's first step starts where its step left
-    the devices (not where a branch written before it did)."""
-    branch = next((b for b in task.branches if b.first == index), None)
-    return dict(left[branch.step]) if branch is not None else current
+def _branch_firsts(task: Task) -> dict[int, int]:
+    """Step position of each branch's first step → the position of the step it branches on (the first branch
+    written, when several start at one position): a branch's first step starts where that step left the devices
+    (not where a branch written before it did)."""
+    firsts: dict[int, int] = {}
+    for b in task.branches:
+        firsts.setdefault(b.first, b.step)
+    return firsts
 
 
 def _plan(
@@ -214,28 +212,34 @@ def _plan(
     processes: Mapping[str, ProcessDescription],
     taxonomy: Taxonomy,
     consumed: dict[str, set[str]],
-) -> tuple[list[_Key], list[dict[str, object]]]:
-    """Each step's key (what its chart depends on: process, bindings, device states, parameters) and values."""
+) -> tuple[list[_Key], list[dict[str, object]], dict[str, str]]:
+    """Each step's key (what its chart depends on: process, bindings, device states, parameters) and values, and
+    the device states the task ends in."""
     current = {d.id: d.initial for d in cell.devices}
+    states = tuple(sorted(current.items()))
     keys: list[_Key] = []
     values: list[dict[str, object]] = []
-    after: dict[_Key, dict[str, str]] = {}
+    after: dict[_Key, tuple[dict[str, str], tuple[tuple[str, str], ...]]] = {}
     left: dict[int, dict[str, str]] = {}
+    firsts = _branch_firsts(task)
     for step, binding in zip(task.steps, bindings, strict=True):
         process = processes[step.command]
-        current = _branch_start(task, step.index, left, current)
+        if step.index in firsts:
+            current = dict(left[firsts[step.index]])
+            states = tuple(sorted(current.items()))
         values.append(step_values(step, process))
         flows = tuple(sorted((n, v.variable if isinstance(v, Flow) else "") for n, v in values[-1].items()))
         produces = _produces(task, step, process, consumed)
-        key = (process.id, tuple(sorted(binding.items())), tuple(sorted(current.items())), flows, produces)
-        if key not in after:
+        key = (process.id, tuple(sorted(binding.items())), states, flows, produces)
+        if (ends := after.get(key)) is None:  # a key is a deep tuple: hashed as few times as can be
             placeholders: dict[str, object] = {n: Varying(n) for n in values[-1]}
-            _step(step, process, binding, cell, current, taxonomy, placeholders, produces)
-            after[key] = dict(current)
+            ended = dict(current)
+            _step(step, process, binding, cell, ended, taxonomy, placeholders, produces)
+            ends = after[key] = ended, tuple(sorted(ended.items()))
         keys.append(key)
-        current = dict(after[key])
-        left[step.index] = dict(current)
-    return keys, values
+        current, states = ends  # never changed in place: a branch's start copies it
+        left[step.index] = current
+    return keys, values, dict(current)
 
 
 def _varying(rows: list[dict[str, object]]) -> set[str]:

@@ -74,7 +74,7 @@ def normalised(task: Task, processes: Sequence[ProcessDescription],
                 text = f"step {step.index} ({step.command}): parameter {name} is {value!r}; {why}"
                 problems.append(Problem(step.index, step.command, "bad_unit", Reason("bad_unit", text, (par.quantity,),
                                         (par.where,)), task.where(step, name), role=par.role, parameter=name))
-        steps.append(dataclasses.replace(step, params=params))
+        steps.append(step if params == step.params else dataclasses.replace(step, params=params))  # most: as read
     return dataclasses.replace(task, steps=tuple(steps)), problems
 
 
