@@ -16,8 +16,7 @@ from dataclasses import dataclass, field
 from plugnproduce.chartnames import STEP, VALUES
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.description.paths import find_path
-from plugnproduce.description.quantities.contracts import pose_items
-from plugnproduce.description.quantities.units import convert, convert_pose
+from plugnproduce.description.quantities.contracts import in_unit
 from plugnproduce.ontology.iris import concept_value, local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
@@ -171,7 +170,7 @@ def _request(
         if par.quantity in accepts:
             contract = device.argument(command.name, par.quantity)
             expr = (value.expr if isinstance(value, Varying | Flow)
-                    else literal(_in_unit(value, par.unit, contract.unit)))
+                    else literal(in_unit(value, par.unit, contract.unit)))
             send.params.append(Param(name=local_name(par.quantity), expr=expr))
             given.add(par.quantity)
     for quantity in accepts:  # an argument the process does not supply takes the device's own default
@@ -181,17 +180,6 @@ def _request(
     return send
 
 
-def _in_unit(value: object, unit: str, to: str) -> object:
-    """A plain number or a pose in the parameter's unit converted to the unit the device's contract declares
-    (a pose per component, :func:`convert_pose`; one that cannot be converted raises, it never goes out as it is)."""
-    if not unit or not to or unit == to:
-        return value
-    pose = pose_items(value)
-    if pose is not None:
-        return convert_pose(pose, unit, to)
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        return value
-    return convert(float(value), unit, to)
 
 
 def literal(value: object) -> str:

@@ -21,8 +21,7 @@ from typing import Any
 from plugnproduce.chartnames import output_variable
 from plugnproduce.codegen.task import GeneratedTask, StepChart
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Link
-from plugnproduce.description.quantities.contracts import breach, pose_items, shorten
-from plugnproduce.description.quantities.units import convert, convert_pose
+from plugnproduce.description.quantities.contracts import breach, in_unit, shorten
 from plugnproduce.ontology.iris import local_name
 
 
@@ -82,7 +81,7 @@ class Monitor:
             why = breach(params[name], source.unit, contract)
             if why is not None:
                 return Breach(name, params[name], source.text, why)
-            out[name] = _in_unit(params[name], source.unit, contract.unit)
+            out[name] = in_unit(params[name], source.unit, contract.unit)
         return out
 
     def _step(self, step: int | None) -> StepChart | None:
@@ -139,14 +138,3 @@ def _accepted(device: DeviceDescription, request: str) -> tuple[str, ...]:
                                for q in t.accepts))
 
 
-def _in_unit(value: object, unit: str, to: str) -> object:
-    """A number or a pose in ``unit`` in the contract's unit ``to`` (anything else as it is); breach() has refused
-    what cannot be converted."""
-    if not unit or not to or unit == to:
-        return value
-    pose = pose_items(value)
-    if pose is not None:
-        return convert_pose(pose, unit, to)
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        return value
-    return convert(float(value), unit, to)

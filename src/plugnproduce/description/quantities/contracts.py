@@ -180,3 +180,17 @@ def pose_items(value: object) -> list[float] | None:
     except (TypeError, ValueError, OverflowError):
         return None
     return items if all(math.isfinite(v) for v in items) else None
+
+
+
+def in_unit(value: object, unit: str, to: str) -> object:
+    """A number or a pose in ``unit`` converted to ``to`` (a pose per component, :func:`convert_pose`); anything
+    else as it is. What cannot be converted raises: it never goes out as it is."""
+    if not unit or not to or unit == to:
+        return value
+    pose = pose_items(value)
+    if pose is not None:
+        return convert_pose(pose, unit, to)
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return value
+    return convert(float(value), unit, to)
