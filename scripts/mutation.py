@@ -5,7 +5,7 @@
     python scripts/mutation.py rules-chain        # one ASP encoding (rules/chain.lp; see mutation_asp.py)
     python scripts/mutation.py --jobs 2 --work build/mutation
     python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
-                                                  # (a whole run again if the module's test files changed)
+                                                  # (a whole run again if the module's list of tests changed)
 
 For each guard module, mutmut (3.x, the ``test`` extra) makes small changes to its guard
 functions, one at a time (``<`` for ``<=``, ``and`` for ``or``, a string or number changed,
@@ -14,9 +14,12 @@ below; of those, only the tests that reach the changed function. A mutant is *ki
 a test fails, *survived* when every test passes. Printed per module: mutants, killed,
 survived, timeouts, equivalent, and each survivor at its ``file:line`` with the change.
 
+Each survivor is then run again against all of the module's tests by pytest (mutmut
+runs a mutant only against the tests it saw reach the function); ``--again`` does only this,
+for the last run's survivors, with the checkout's tests, and keeps every other result.
 A survivor that cannot change any behaviour (an equivalent mutant) is listed with the
-reason in ``scripts/mutation_equivalent.txt``; it is printed as such and does not count as
-a survivor. Exit 0 when no mutant survives, 1 otherwise, 2 when the run itself fails.
+reason in ``scripts/mutation_equivalent.txt``; it is printed as such, does not count as
+a survivor, and is not run again. Exit 0 when no mutant survives, 1 otherwise, 2 when the run itself fails.
 
 The ASP encodings (``rules-NAME`` for ``rules/NAME.lp``) are changed by scripts/mutation_asp.py
 instead (delete a rule, drop a body literal, flip a comparison), and reported the same way, with
@@ -362,28 +365,75 @@ def _survivor(key: str, file: str, work: Path, functions: dict[str, str]) -> Sur
     return Survivor(key, f"{file}:{line}", " ".join(before), " ".join(after))
 
 
-def _confirmed(guard: Guard, work: Path, jobs: int, codes: dict[str, int]) -> dict[str, int]:
-    """The codes with each survivor tested again against the whole of the module's test files.
+def _pytest_mutant(guard: Guard, work: Path, key: str, timeout: float | None) -> str:
+    """Run the module's whole test selection against one mutant (``""`` for none): killed, survived or timeout."""
+    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1",
+           "MUTANT_UNDER_TEST": key}
+    command = [sys.executable, "-m", "pytest", "-x", "-q", "-n", "0", "-p", "no:cacheprovider", "-p", PLUGIN,
+               *guard.selection]
+    try:
+        done = subprocess.run(command, cwd=work / "mutants", env=env, capture_output=True, text=True,
+                              timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return "timeout"
+    return "survived" if done.returncode == 0 else "killed" if done.returncode in (1, 2, 3) else "failed"
+
+
+def _retested(guard: Guard, work: Path, jobs: int, codes: dict[str, int], keys: list[str],
+              timeout: float) -> dict[str, int]:
+    """The codes with each mutant of ``keys`` tested again against the whole of the module's test files.
 
     mutmut runs a mutant only against the tests it saw call the function, and it does not see a call made while
     a module- or session-scoped fixture is set up: a function only such a fixture reaches would survive untested.
     """
-    survivors = [k for k, code in codes.items() if code in _SURVIVED]
-    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
-    command = [sys.executable, "-m", "pytest", "-x", "-q", "-n", "0", "-p", "no:cacheprovider", "-p", PLUGIN,
-               *guard.selection]
-
     def run(key: str) -> int:
-        try:
-            done = subprocess.run(command, cwd=work / "mutants", env={**env, "MUTANT_UNDER_TEST": key},
-                                  capture_output=True, text=True, timeout=900)
-        except subprocess.TimeoutExpired:
-            return -24
-        return 1 if done.returncode in (1, 2, 3) else codes[key]
+        outcome = _pytest_mutant(guard, work, key, timeout)
+        return {"killed": 1, "timeout": -24, "survived": 0}.get(outcome, codes[key])
 
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        for key, code in zip(survivors, pool.map(run, survivors), strict=True):
+        for key, code in zip(keys, pool.map(run, keys), strict=True):
             codes[key] = code
+    return codes
+
+
+def _record(guard: Guard, work: Path, codes: dict[str, int]) -> None:
+    """The codes written back into mutmut's records, so that the next ``--again`` starts from them."""
+    for file in guard.files:
+        meta_path = work / "mutants" / (file + ".meta")
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        for key in meta["exit_code_by_key"]:
+            if key in codes:
+                meta["exit_code_by_key"][key] = codes[key]
+        meta_path.write_text(json.dumps(meta, indent=4), encoding="utf-8")
+
+
+def _survivors(guard: Guard, work: Path, codes: dict[str, int]) -> dict[str, Survivor]:
+    """Each mutant not killed and not timed out, at its ``file:line`` with its change."""
+    functions = {f: _functions((work / "mutants" / f).read_text(encoding="utf-8")) for f in guard.files}
+    found: dict[str, Survivor] = {}
+    for key, code in codes.items():
+        if code in _KILLED or code in _TIMEOUT:
+            continue
+        file = next(f for f in guard.files if key.startswith(Path(f).with_suffix("").as_posix()
+                                                            .removeprefix("src/").replace("/", ".") + "."))
+        found[key] = _survivor(key, file, work, functions[file])
+    return found
+
+
+def _again(guard: Guard, work: Path, jobs: int, listed: set[str]) -> dict[str, int]:
+    """The last run's survivors (listed equivalents left out) tested again with the checkout's tests, by pytest.
+
+    mutmut is not run again: its records of the other mutants are kept as they are (a mutmut run after a change
+    of the tests could reset them to "not run").
+    """
+    _refresh_tests(work)
+    codes = _results(guard, work)
+    pending = [k for k, code in codes.items() if code not in _KILLED and code not in _TIMEOUT and k not in listed]
+    started = time.monotonic()
+    if _pytest_mutant(guard, work, "", None) != "survived":
+        raise RuntimeError(f"the tests of {guard.name} fail without a mutant: {' '.join(guard.selection)}")
+    codes = _retested(guard, work, jobs, codes, pending, 3 * (time.monotonic() - started) + 10)
+    _record(guard, work, codes)
     return codes
 
 
@@ -391,31 +441,28 @@ def run_guard(guard: Guard, work: Path, jobs: int, known: dict[tuple[str, str, s
               again: bool = False) -> dict[str, int]:
     """Mutate one guard module (``again``: test only the last run's survivors), print its figures and survivors."""
     started = time.monotonic()
+
+    def listed(codes: dict[str, int]) -> set[str]:
+        return {k for k, s in _survivors(guard, work, codes).items() if (s.function, s.before, s.after) in known}
+
     if again and (work / "mutants").is_dir() and _selected_tests(work) == guard.selection:
-        _refresh_tests(work)
-        survivors = [k for k, code in _results(guard, work).items() if code not in _KILLED and code not in _TIMEOUT]
-        if survivors:
-            _run_mutmut(guard, work, jobs, survivors)
+        codes = _again(guard, work, jobs, listed(_results(guard, work)))
     else:
         _prepare(guard, work)
         _run_mutmut(guard, work, jobs)
-    codes = _confirmed(guard, work, jobs, _results(guard, work))
-    functions = {f: _functions((work / "mutants" / f).read_text(encoding="utf-8")) for f in guard.files}
-    counts: Counter[str] = Counter()
+        codes = _results(guard, work)
+        equivalent = listed(codes)
+        codes = _retested(guard, work, jobs, codes,
+                          [k for k, c in codes.items() if c in _SURVIVED and k not in equivalent], 900)
+        _record(guard, work, codes)
+    survivors = _survivors(guard, work, codes)
+    counts: Counter[str] = Counter(mutants=len(codes))
+    counts["killed"] = sum(1 for c in codes.values() if c in _KILLED)
+    counts["timeouts"] = sum(1 for c in codes.values() if c in _TIMEOUT)
     lines: list[str] = []
-    for key, code in sorted(codes.items(), key=lambda kv: kv[0]):
-        counts["mutants"] += 1
-        if code in _KILLED:
-            counts["killed"] += 1
-            continue
-        if code in _TIMEOUT:
-            counts["timeouts"] += 1
-            continue
-        file = next(f for f in guard.files if key.startswith(Path(f).with_suffix("").as_posix()
-                                                            .removeprefix("src/").replace("/", ".") + "."))
-        s = _survivor(key, file, work, functions[file])
+    for key, s in sorted(survivors.items()):
         why = known.get((s.function, s.before, s.after))
-        status = "equivalent" if why is not None else _SURVIVED.get(code, f"exit {code}")
+        status = "equivalent" if why is not None else _SURVIVED.get(codes[key], f"exit {codes[key]}")
         counts["equivalent" if why is not None else "survived"] += 1
         lines.append(f"  {status}: {s.where}: {s.before}  ->  {s.after}" + (f"  ({why})" if why else ""))
     seconds = time.monotonic() - started
@@ -432,7 +479,7 @@ def run_encoding(target: Target, work: Path, jobs: int, known: dict[tuple[str, s
                  again: bool = False) -> dict[str, int]:
     """Mutate one ASP encoding (``again``: test only the last run's survivors), print its figures and survivors."""
     started = time.monotonic()
-    results = mutation_asp.run_target(target, ROOT, work, jobs, again)
+    results = mutation_asp.run_target(target, ROOT, work, jobs, again, known.keys())
     counts = mutation_asp.report(target, results, known, time.monotonic() - started)
     counts["seconds"] = round(time.monotonic() - started)
     return dict(counts)

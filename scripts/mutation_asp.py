@@ -23,7 +23,7 @@ import subprocess
 import sys
 import time
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -240,8 +240,10 @@ def _key(m: Mutant) -> str:
     return json.dumps(asdict(m), sort_keys=True)
 
 
-def run_target(target: Target, root: Path, work: Path, jobs: int, again: bool = False) -> dict[str, tuple[Mutant, str]]:
-    """Test every mutant of one encoding (``again``: only the last run's survivors); the status of each."""
+def run_target(target: Target, root: Path, work: Path, jobs: int, again: bool = False,
+               listed: Collection[tuple[str, str, str]] = ()) -> dict[str, tuple[Mutant, str]]:
+    """Test every mutant of one encoding (``again``: only the last run's survivors that are not ``listed``
+    as equivalent, by (file, before, after)); the status of each."""
     original = (root / target.file).read_text(encoding="utf-8")
     record = work / "results.json"
     previous = _load(record) if again else {}
@@ -258,7 +260,8 @@ def run_target(target: Target, root: Path, work: Path, jobs: int, again: bool = 
         key = _key(mutant)
         if refused(text):
             results[key] = (mutant, "refused")
-        elif again and previous.get(key) not in (None, "survived"):
+        elif again and (previous.get(key) not in (None, "survived")
+                        or (previous.get(key) == "survived" and (mutant.file, mutant.before, mutant.after) in listed)):
             results[key] = (mutant, previous[key])
         else:
             pending.append((mutant, text))
