@@ -165,14 +165,14 @@ CORE = (
     Guard("reasoning-lifting", (_S + "reasoning/repairs/lifting.py",), ("tests/reasoning/test_repair_lifting.py",)),
     Guard("executor-links", (_S + "executor/links.py",), ("tests/executor/test_links.py",)),
     Guard("executor-values", (_S + "executor/values.py",), ("tests/executor/test_values.py",)),
-    Guard("verification", tuple(_S + f"verification/{n}.py" for n in ("arguments", "results", "search", "trace",
-                                                                         "world")),
-          ("tests/verification/test_verify.py", "tests/verification/test_branch_verify.py",
-           "tests/verification/test_nested_verify.py"),
-          deselect=(  # a run on the simulated cell (the executor's work) and pnp verify in a child process
-              "tests/verification/test_verify.py::test_the_seeded_deadlock_is_not_hit_by_a_simulated_run",
-              "tests/verification/test_nested_verify.py::"
-              "test_pnp_verify_proves_the_nested_task_on_the_bin_picking_cell")),
+    *(Guard(f"verification-{name}", (_S + f"verification/{name}.py",),
+            ("tests/verification/test_verify.py", "tests/verification/test_branch_verify.py",
+             "tests/verification/test_nested_verify.py", "tests/verification/test_hierarchical_verify.py"),
+            deselect=(  # a run on the simulated cell (the executor's work) and pnp verify in a child process
+                "tests/verification/test_verify.py::test_the_seeded_deadlock_is_not_hit_by_a_simulated_run",
+                "tests/verification/test_nested_verify.py::"
+                "test_pnp_verify_proves_the_nested_task_on_the_bin_picking_cell"))
+      for name in ("arguments", "results", "search", "trace", "world")),
 )
 """The core modules (the answers users rely on), each with the smallest set of test files that covers it."""
 
