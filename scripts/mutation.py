@@ -23,7 +23,8 @@ a survivor, and is not run again. Exit 0 when no mutant survives, 1 otherwise, 2
 
 The ASP encodings (``rules-NAME`` for ``rules/NAME.lp``) are changed by scripts/mutation_asp.py
 instead (delete a rule, drop a body literal, flip a comparison), and reported the same way, with
-the mutants clingo refuses counted apart. Their equivalents are listed under the encoding's file.
+the mutants clingo refuses counted apart. Their equivalents are listed under the encoding's file
+(and not run).
 
 Each module runs in its own work folder (``--work``, default ``build/mutation/NAME``) that
 holds a copy of the checkout, so the checkout is never changed. mutmut only changes code

@@ -242,8 +242,10 @@ def _key(m: Mutant) -> str:
 
 def run_target(target: Target, root: Path, work: Path, jobs: int, again: bool = False,
                listed: Collection[tuple[str, str, str]] = ()) -> dict[str, tuple[Mutant, str]]:
-    """Test every mutant of one encoding (``again``: only the last run's survivors that are not ``listed``
-    as equivalent, by (file, before, after)); the status of each."""
+    """Test every mutant of one encoding (``again``: only the last run's survivors); the status of each.
+
+    A mutant ``listed`` as equivalent (by file, before, after) is not run: it is taken to survive.
+    """
     original = (root / target.file).read_text(encoding="utf-8")
     record = work / "results.json"
     previous = _load(record) if again else {}
@@ -260,8 +262,9 @@ def run_target(target: Target, root: Path, work: Path, jobs: int, again: bool = 
         key = _key(mutant)
         if refused(text):
             results[key] = (mutant, "refused")
-        elif again and (previous.get(key) not in (None, "survived")
-                        or (previous.get(key) == "survived" and (mutant.file, mutant.before, mutant.after) in listed)):
+        elif (mutant.file, mutant.before, mutant.after) in listed:
+            results[key] = (mutant, "survived")
+        elif again and previous.get(key) not in (None, "survived"):
             results[key] = (mutant, previous[key])
         else:
             pending.append((mutant, text))
