@@ -69,3 +69,51 @@ def test_clingo_refuses_a_mutant_that_leaves_a_variable_unsafe(asp):
     assert asp.refused(by_change[TOO_LOW.replace(" value_num(T,I,N,V),", "")])  # V is bound nowhere else
     assert not asp.refused(by_change[TOO_LOW.replace("V < M", "V <= M")])
     assert not asp.refused(PARAMS)
+
+
+TINY = "a :- b, c.\nd :- a.\n"
+CHECKS = '''from pathlib import Path
+
+
+def test_tiny():
+    text = (Path.cwd() / "rules" / "tiny.lp").read_text(encoding="utf-8")
+    with open({log!r}, "a", encoding="utf-8") as log:
+        log.write(" ".join(text.split()) + "\\n")
+    assert {needed!r} in text
+'''
+
+
+def tiny_checkout(root: Path, log: Path, needed: str) -> None:
+    """A checkout with one encoding (``rules/tiny.lp``) and one test that needs ``needed`` in it."""
+    for name in ("src", "tests", "ontology", "rules", "descriptions"):
+        (root / name).mkdir(parents=True, exist_ok=True)
+    (root / "pyproject.toml").write_text("", encoding="utf-8")
+    (root / "rules" / "tiny.lp").write_text(TINY, encoding="utf-8")
+    (root / "tests" / "test_tiny.py").write_text(CHECKS.format(log=str(log), needed=needed), encoding="utf-8")
+
+
+def test_a_listed_equivalent_is_never_run_and_again_runs_only_the_last_survivors(asp, tmp_path: Path) -> None:
+    root, work, log = tmp_path / "checkout", tmp_path / "work", tmp_path / "runs.log"
+    tiny_checkout(root, log, "d :- a.")
+    target = asp.Target("rules-tiny", "rules/tiny.lp", ("tests/test_tiny.py",))
+    listed = {("rules/tiny.lp", "a :- b, c.", "a :- c.")}
+
+    def outcomes(again: bool) -> dict[tuple[str, str], str]:
+        results = asp.run_target(target, root, work, 1, again, listed)
+        return {(m.before, m.after): status for m, status in results.values()}
+
+    assert outcomes(False) == {("a :- b, c.", "(deleted)"): "survived", ("a :- b, c.", "a :- b."): "survived",
+                               ("a :- b, c.", "a :- c."): "survived", ("d :- a.", "(deleted)"): "killed",
+                               ("d :- a.", "d :- ."): "killed"}
+    ran = log.read_text(encoding="utf-8").splitlines()
+    assert "a :- c. d :- a." not in ran  # the listed equivalent
+    assert sorted(ran) == sorted(["a :- b, c. d :- a.", "d :- a.", "a :- b. d :- a.", "a :- b, c.",
+                                  "a :- b, c. d :- ."])
+
+    log.unlink()
+    tiny_checkout(root, log, "a :- b, c.")  # a test that kills the two survivors, and the listed one if it ran
+    again = outcomes(True)
+    assert again[("a :- b, c.", "(deleted)")] == again[("a :- b, c.", "a :- b.")] == "killed"
+    assert again[("a :- b, c.", "a :- c.")] == "survived" and again[("d :- a.", "(deleted)")] == "killed"
+    assert sorted(log.read_text(encoding="utf-8").splitlines()) == sorted(["a :- b, c. d :- a.", "d :- a.",
+                                                                           "a :- b. d :- a."])
