@@ -237,6 +237,10 @@ REPAIR_CASES = {
     "add a device from the catalogue": (
         repair_case(("close",), ("r",), 'catalogue("g"). catalogue("h"). edit_cost("add","g",510). '
                     'edit_cost("add","h",505).', COSTS.replace("400", "900")), [{'edit(add("h"))'}]),
+    "of two devices that repair alike at one cost, the one with the lower price is bought": (
+        repair_case(("close",), ("r",), 'catalogue("g"). catalogue("h"). edit_cost("add","g",500). '
+                    'edit_cost("add","h",500). tie_price("g",2100). tie_price("h",1400).', COSTS.replace("400", "900")),
+        [{'edit(add("h"))'}]),
     "reset a value that does not fit": (
         repair_case(("close",), ("g",), 'given("t",1,"force"). value_kind("t",1,"force","string").'),
         [{'edit(reset(1,"force"))'}]),
