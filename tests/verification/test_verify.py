@@ -130,11 +130,26 @@ def test_a_budget_too_small_is_inconclusive_not_a_hang() -> None:
     assert "inconclusive" in result.stdout and "budget of 10 states ran out" in result.stdout
 
 
+def test_a_budget_of_exactly_the_states_a_proof_needs_proves_it_and_one_state_less_does_not() -> None:
+    needed = json.loads(runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--json"]).stdout)["states"]
+    exactly = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--max-states", str(needed), "--json"])
+    assert exactly.exit_code == 0, exactly.output
+    assert json.loads(exactly.stdout)["verdict"] == "proved"
+    short = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--max-states", str(needed - 1), "--json"])
+    assert short.exit_code == 3, short.output
+    answer = json.loads(short.stdout)
+    assert answer["problem"] == (f"the budget of {needed - 1} states ran out before every interleaving was explored")
+    assert answer["states"] == needed - 1 and answer["trace"] == []
+
+
 def test_a_time_budget_too_small_is_inconclusive() -> None:
     result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--timeout", "1e-9", "--json"])
     assert result.exit_code == 3, result.output
     answer = json.loads(result.stdout)
-    assert answer["verdict"] == "inconclusive" and "time budget" in answer["problem"]
+    assert answer["verdict"] == "inconclusive"
+    assert answer["problem"] == "the time budget of 1e-09 s ran out before every interleaving was explored"
+    # the clock is read once every 64 configurations taken from the queue: the first reading ends the search
+    assert answer["states"] == 64
 
 
 def test_an_event_the_controller_does_not_wait_for_is_refuted(tmp_path: Path) -> None:
