@@ -223,6 +223,15 @@ def repair_case(steps: tuple[str, ...], devices: tuple[str, ...], extra: str = "
 
 REFUSED = ('given("t",1,"force"). value_kind("t",1,"force","decimal"). value_num("t",1,"force",50000). '
            'param_role("close","force","gripper"). value_refused("t",1,"force","g").')
+TAKES = ('given("t",1,"force"). value_kind("t",1,"force","decimal"). value_num("t",1,"force",50000). '
+         'param_role("close","force","gripper").')
+"""A force every gripper takes: a device refuses only what the case adds."""
+ROBOT_GRIPPER = (WORLD.replace('has_skill("g","Release").', 'has_skill("g","Release"). has_skill("g","Move").')
+                 .replace('state_is("g","o","Open").', 'state_is("g","o","Open"). state_is("g","c","Idle"). '
+                          'state_is("g","o","Moving"). state_is("g","c","AtPose").')
+                 .replace('initial("g","o")', 'initial("g","c")') + 'leaves("pick","robot","g","c","c").')
+"""Gripper ``g`` can also be the robot of ``pick`` (it starts closed, where it is Idle); only gripper ``h`` can then
+be its gripper (it starts open)."""
 REPAIR_CASES = {
     "insert the missing open": (repair_case(("close", "close"), ("g",)), [{'edit(insert(2,1,"open"))'}]),
     "swap when inserting costs more": (
@@ -252,6 +261,21 @@ REPAIR_CASES = {
         repair_case(("close",), ("r",), REFUSED.replace('"g"', '"h"') + 'catalogue("g"). catalogue("h"). '
                     'edit_cost("add","g",510). edit_cost("add","h",505).', COSTS.replace("400", "900")),
         [{'edit(add("g"))'}]),
+    "a value is sent to the device of its own role, not to another role's device that would refuse it": (
+        ROBOT_GRIPPER + SECOND_GRIPPER + cell("g", "h") + 'step("t",1,"pick").' + horizon(1) + COSTS
+        + 'param("pick","force","decimal"). given("t",1,"force"). value_kind("t",1,"force","decimal"). '
+          'value_num("t",1,"force",50000). param_role("pick","force","gripper"). value_refused("t",1,"force","g"). '
+          'param_role("move","force","robot").', [{'edit(bind(1,"gripper","h"))'}]),
+    "a reset is refused only where the device it is sent to refuses the default": (
+        repair_case(("close",), ("g", "h"), TAKES + 'value_refused("t",1,"force","g"). '
+                    'value_refused("t",1,"force","h"). default_refused("close","force","h").'),
+        [{'edit(bind(1,"gripper","g"))', 'edit(reset(1,"force"))'}]),
+    "a device that refuses the default but takes the value given keeps it": (
+        repair_case(("close",), ("g",), TAKES + 'default_refused("close","force","g").'), [set()]),
+    "a reset is held to the default of the step's own command": (
+        repair_case(("close",), ("g",), TAKES + 'value_refused("t",1,"force","g"). '
+                    'param_role("pick","force","gripper"). default_refused("pick","force","g").'),
+        [{'edit(reset(1,"force"))'}]),
     "an inserted command's defaults must fit its device": (
         repair_case(("close", "close"), ("g", "h"), 'bind("t",1,"gripper","g"). bind("t",2,"gripper","g"). '
                     'default_refused("open","width","g"). param_role("open","width","gripper").'),
