@@ -276,6 +276,17 @@ REPAIR_CASES = {
         repair_case(("close",), ("g",), TAKES + 'value_refused("t",1,"force","g"). '
                     'param_role("pick","force","gripper"). default_refused("pick","force","g").'),
         [{'edit(reset(1,"force"))'}]),
+    "an inserted command's default is held to the device of its own role only": (
+        ROBOT_GRIPPER + SECOND_GRIPPER + cell("g", "h") + 'step("t",1,"open"). bind("t",1,"gripper","h").'
+        + horizon(1) + COSTS.replace('edit_cost("insert",P,100+100*N) :- nroles(P,N).',
+                                     'edit_cost("insert",P,900) :- process(P), P != "pick". '
+                                     'edit_cost("insert","pick",300).').replace('"rebind","",200', '"rebind","",900')
+        + 'param_role("pick","force","gripper"). default_refused("pick","force","g").',
+        [{'edit(insert(1,1,"pick"))'}]),
+    "a value not given is never reset, even at no cost, where only another device refuses its default": (
+        repair_case(("close",), ("g", "h"), 'bind("t",1,"gripper","h"). param_role("close","force","gripper"). '
+                    'value_refused("t",1,"force","g"). default_refused("close","force","g").',
+                    COSTS.replace('"reset","",100', '"reset","",0')), [set()]),
     "an inserted command's defaults must fit its device": (
         repair_case(("close", "close"), ("g", "h"), 'bind("t",1,"gripper","g"). bind("t",2,"gripper","g"). '
                     'default_refused("open","width","g"). param_role("open","width","gripper").'),
