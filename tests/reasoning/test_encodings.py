@@ -287,6 +287,9 @@ REPAIR_CASES = {
         repair_case(("close",), ("g", "h"), 'bind("t",1,"gripper","h"). param_role("close","force","gripper"). '
                     'value_refused("t",1,"force","g"). default_refused("close","force","g").',
                     COSTS.replace('"reset","",100', '"reset","",0')), [set()]),
+    "an inserted command's defaults need fit only the devices it is bound to": (
+        repair_case(("close", "close"), ("g",), 'param_role("open","width","gripper"). catalogue("h"). '
+                    'edit_cost("add","h",505). default_refused("open","width","h").'), [{'edit(insert(2,1,"open"))'}]),
     "an inserted command's defaults must fit its device": (
         repair_case(("close", "close"), ("g", "h"), 'bind("t",1,"gripper","g"). bind("t",2,"gripper","g"). '
                     'default_refused("open","width","g"). param_role("open","width","gripper").'),
