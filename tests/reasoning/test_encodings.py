@@ -301,6 +301,9 @@ REPAIR_CASES = {
     "dropping a binding is priced: removing its step can be cheaper": (
         repair_case(("close",), ("g",), 'bind("t",1,"hand","g").', COSTS.replace('"rebind","",200', '"rebind","",900')),
         [{"edit(remove(1))"}]),
+    "rebinding is priced: removing its step can be cheaper": (
+        repair_case(("close",), ("g", "r"), 'bind("t",1,"gripper","r").',
+                    COSTS.replace('"rebind","",200', '"rebind","",900')), [{"edit(remove(1))"}]),
     "resetting a value is priced: removing its step can be cheaper": (
         repair_case(("close",), ("g",), 'given("t",1,"force"). value_kind("t",1,"force","string").',
                     COSTS.replace('"reset","",100', '"reset","",900')), [{"edit(remove(1))"}]),
