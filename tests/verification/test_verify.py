@@ -91,6 +91,35 @@ def test_the_counterexample_is_the_shortest(tmp_path: Path) -> None:
     assert len(result.trace) == 1 + 11
 
 
+def line_of(path: Path, text: str) -> int:
+    """The first line of ``path`` that holds ``text``."""
+    return next(i for i, t in enumerate(path.read_text(encoding="utf-8").splitlines(), 1) if text in t)
+
+
+def test_the_counterexample_tells_each_move_at_the_line_it_comes_from(tmp_path: Path) -> None:
+    cell = seeded_cell(tmp_path, napping_gripper())
+    step = (TASK, "command: bin-pick")
+    expected = [  # (file, a text of the line the move comes from, what the move does)
+        (*step, "controller starts the task; sends upnp.request.Capture to sensor3d"),
+        ("gripper", 'target="standby"', "gripper delay of idle.timeout passes: open -> standby"),
+        ("sensor3d", "upnp.request.Capture", "sensor3d receives upnp.request.Capture: ready -> capturing"),
+        ("sensor3d", 'event="capture.done" target', "sensor3d delay of capture.done passes: capturing -> captured"),
+        (*step, "controller receives sensor3d.upnp.event.CaptureDone; sends upnp.request.Localize to binpicking-pc"),
+        ("binpicking-pc", "upnp.request.Localize", "binpicking-pc receives upnp.request.Localize: ready -> localizing"),
+        ("binpicking-pc", 'event="localize.done" target',
+         "binpicking-pc delay of localize.done passes: localizing -> localized"),
+        (*step, "controller receives binpicking-pc.upnp.event.PartLocalized reporting PartFound; "
+                "sends xirp.request.MoveTo to robot"),
+        ("robot", "xirp.request.MoveTo", "robot receives xirp.request.MoveTo: home -> moving"),
+        ("robot", 'event="motion.done" target', "robot delay of motion.done passes: moving -> at_pose"),
+        (*step, "controller receives robot.xirp.event.motion_done; sends xirp.request.Close to gripper"),
+        ("gripper", '<state id="standby"',
+         "gripper receives xirp.request.Close in state standby, which has no transition for it")]
+    files = [f if isinstance(f, Path) else tmp_path / "devices" / f"{f}.scxml" for f, _, _ in expected]
+    assert [str(s) for s in service.verify(TASK, cell).trace] == [
+        f"{file}:{line_of(file, text)}: {move}" for file, (_, text, move) in zip(files, expected, strict=True)]
+
+
 def test_a_device_that_never_answers_is_a_deadlock_at_the_step_that_waits(tmp_path: Path) -> None:
     chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8").replace(
         '<onentry><send event="motion.done" delay="120ms"/></onentry>\n    <transition event="motion.done" '
