@@ -38,5 +38,5 @@ def test_a_request_on_a_superstate_is_held_to_its_contract(tmp_path: Path) -> No
     sent = dataclasses.replace(initial, requests=tuple(requests))
     _, violation = world.apply(sent, Move("request", "packml-screwdriver", "packml-screwdriver", "xirp.request.Start"))
     assert violation is not None and violation.kind == "argument"
-    assert violation.message == ("device packml-screwdriver: xirp.request.Start argument Torque is 50, outside the "
-                                 "device's limits: it takes at most 10 N m; the value is 50 N m")
+    assert violation.message == ("device packml-screwdriver: xirp.request.Start argument Torque is 50, beyond the "
+                                 "device's contract: it takes at most 10 N m; the value is 50 N m")

@@ -148,9 +148,28 @@ def test_the_arguments_a_program_sends_are_held_to_the_devices_terms() -> None:
     assert argument_problems(gripper, close, {}) == ["lacks the argument GripForce that its transition accepts"]
     assert argument_problems(gripper, close, {"GripForce": limit}) == []
     (too_much,) = argument_problems(gripper, close, {"GripForce": limit + 1})
-    assert "outside the device's limits" in too_much
+    assert too_much == f"argument GripForce is {limit + 1!r}, beyond the device's contract: it takes at most {limit:g} N; " \
+                       f"the value is {limit + 1:g} N"
     assert argument_problems(gripper, close, {"GripForce": float("nan")}) == [
         "argument GripForce is nan, not a finite value"]
+
+
+def test_a_value_the_process_takes_but_the_device_does_not_is_refuted_as_the_run_would_refuse_it(
+        tmp_path: Path) -> None:
+    # the process's grip_force is a decimal, this gripper's Close takes a whole number of newtons: the executor
+    # refuses to send 45.5 (a contract fault at step 1), so verification must not call the program proved
+    cell = seeded_cell(tmp_path, (D / "devices" / "gripper.scxml").read_text(encoding="utf-8"))
+    description = tmp_path / "devices" / "gripper.ttl"
+    description.write_text(description.read_text(encoding="utf-8").replace(
+        "pnp:quantity pnp:GripForce ;\n    pnp:datatype xsd:decimal ;",
+        "pnp:quantity pnp:GripForce ;\n    pnp:datatype xsd:integer ;"), encoding="utf-8")
+    task = tmp_path / "whole-newtons.yaml"
+    task.write_text(TASK.read_text(encoding="utf-8").replace("grip_force: 45", "grip_force: 45.5"), encoding="utf-8")
+    assert service.check(task, cell).plausible
+    result = service.verify(task, cell)
+    assert result.verdict == "refuted"
+    assert result.problem == ("device gripper: xirp.request.Close argument GripForce is 45.5, beyond the device's "
+                              "contract: it takes a whole number; the value is 45.5")
 
 
 def test_a_budget_too_small_is_inconclusive_not_a_hang() -> None:

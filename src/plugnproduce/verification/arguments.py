@@ -3,8 +3,9 @@
 The one place a request's arguments are judged during verification, by the device's own terms
 (its ``pnp:RequestArgument`` contracts): every argument the device needs (required, with no
 default of its own) must come with the request, and each value sent must be one a device can
-take: finite, and a number within the device's limits (the generated program sends values in
-the device's unit). The plausibility check holds the task to the same terms before a program
+take: finite, of the argument's own datatype and a number within the device's limits (the
+generated program sends values in the device's unit), as the executor judges each request
+before it goes out. The plausibility check holds the task to the same limits before a program
 is generated; this is the proof that the program really sends what it promised.
 """
 
@@ -32,8 +33,8 @@ def argument_problems(device: DeviceDescription, transition: ChartTransition, ar
                 problems.append(f"lacks the argument {name} that its transition accepts")
         elif not _finite(value):
             problems.append(f"argument {name} is {value!r}, not a finite value")
-        elif (why := breach(value, contract.unit, contract, types=False)) is not None:
-            problems.append(f"argument {name} is {value!r}, outside the device's limits: it {why}")
+        elif (why := breach(value, contract.unit, contract)) is not None:
+            problems.append(f"argument {name} is {value!r}, beyond the device's contract: it {why}")
     return problems
 
 
