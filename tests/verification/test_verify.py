@@ -152,6 +152,10 @@ def test_the_arguments_a_program_sends_are_held_to_the_devices_terms() -> None:
                        f"the value is {limit + 1:g} N"
     assert argument_problems(gripper, close, {"GripForce": float("nan")}) == [
         "argument GripForce is nan, not a finite value"]
+    robot = service.knowledge().device("robot")
+    move = next(t for t in robot.transitions if t.request and t.request.name == "MoveTo")
+    assert argument_problems(robot, move, {"TargetPose": [0.4, 0, float("nan"), 0, 180, 0], "Speed": 50}) == [
+        "argument TargetPose is [0.4, 0, nan, 0, 180, 0], not a finite value"]
 
 
 def test_a_value_the_process_takes_but_the_device_does_not_is_refuted_as_the_run_would_refuse_it(
