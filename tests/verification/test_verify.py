@@ -3,6 +3,7 @@ description lines, a budget that runs out, and ``pnp generate`` refusing a refut
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 from pathlib import Path
@@ -13,6 +14,8 @@ from typer.testing import CliRunner
 from plugnproduce import controller, service
 from plugnproduce.cli import app
 from plugnproduce.resources import descriptions_path
+from plugnproduce.statechart.io.reader import parse_chart
+from plugnproduce.verification import verify
 from plugnproduce.verification.arguments import argument_problems
 
 runner = CliRunner()
@@ -174,6 +177,19 @@ def test_a_value_the_process_takes_but_the_device_does_not_is_refuted_as_the_run
     assert result.verdict == "refuted"
     assert result.problem == ("device gripper: xirp.request.Close argument GripForce is 45.5, beyond the device's "
                               "contract: it takes a whole number; the value is 45.5")
+
+
+def test_a_program_that_fails_as_it_starts_is_refuted_at_its_first_step_with_no_move() -> None:
+    task, cell = D / "tasks" / "pick-and-place.yaml", service.cell(CELL)
+    generated = service.generate(task, cell).task
+    chart = generated.task_chart().replace(b'<data id="pnp_plan">[1, 2, 0]</data>', b'<data id="pnp_plan">[]</data>')
+    assert chart != generated.task_chart()  # its first choice of step reads past the plan: error, then failed
+    result = verify(dataclasses.replace(generated, chart=parse_chart(chart, "task.scxml")), cell)
+    assert (result.verdict, result.states, result.transitions) == ("refuted", 1, 0)
+    assert result.problem == "the task ends in failed, not done"
+    assert [str(s) for s in result.trace] == [f"{task}:{line_of(task, 'command: pick-and-place')}: "
+                                               "controller starts the task"]
+    assert result.lines()[0].startswith("task pick-and-place on cell bin-picking: refuted (1 states, 0 transitions, ")
 
 
 def test_a_budget_too_small_is_inconclusive_not_a_hang() -> None:
