@@ -22,6 +22,7 @@ steps:
 def test_the_shipped_branching_task_is_proved() -> None:
     result = service.verify(THEN_HOME, CELL)
     assert result.verdict == "proved", result.problem
+    assert (result.states, result.transitions) == (2703, 2800)  # both outcomes of each localisation, every round
 
 
 def test_a_fault_only_the_branch_hits_is_found_though_the_device_model_always_finds_a_part(tmp_path: Path) -> None:
