@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import shutil
+import time
 from pathlib import Path
 
 import pytest
@@ -187,7 +188,9 @@ def test_a_program_that_fails_as_it_starts_is_refuted_at_its_first_step_with_no_
     generated = service.generate(task, cell).task
     chart = generated.task_chart().replace(b'<data id="pnp_plan">[1, 2, 0]</data>', b'<data id="pnp_plan">[]</data>')
     assert chart != generated.task_chart()  # its first choice of step reads past the plan: error, then failed
+    began = time.perf_counter()
     result = verify(dataclasses.replace(generated, chart=parse_chart(chart, "task.scxml")), cell)
+    assert 0 <= result.seconds <= time.perf_counter() - began  # the time it reports is a part of the call's
     assert (result.verdict, result.states, result.transitions) == ("refuted", 1, 0)
     assert result.problem == "the task ends in failed, not done"
     assert [str(s) for s in result.trace] == [f"{task}:{line_of(task, 'command: pick-and-place')}: "
