@@ -8,6 +8,7 @@ import json
 import shutil
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from typer.testing import CliRunner
@@ -49,16 +50,24 @@ def seeded_cell(tmp_path: Path, chart: str) -> Path:
     return cell
 
 
+def verify_json(*args: str) -> tuple[int, dict[str, Any]]:
+    """``pnp verify ARGS --json``: its exit code and answer, whose seconds must lie within the call."""
+    began = time.perf_counter()
+    result = runner.invoke(app, ["verify", *args, "--json"])
+    elapsed = time.perf_counter() - began
+    answer = json.loads(result.stdout)
+    assert 0 <= answer["seconds"] <= round(elapsed, 3) + 0.001, (answer["seconds"], elapsed)
+    return result.exit_code, answer
+
+
 def napping_gripper() -> str:
     chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8")
     return chart.replace('  <state id="open" pnp:concept="Open">', NAP).replace("</scxml>", STANDBY)
 
 
 def test_the_bin_picking_task_is_proved_and_the_state_count_reported() -> None:
-    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--json"])
-    assert result.exit_code == 0, result.output
-    answer = json.loads(result.stdout)
-    assert answer["verdict"] == "proved" and answer["trace"] == []
+    code, answer = verify_json(str(TASK), "--cell", str(CELL))
+    assert code == 0 and answer["verdict"] == "proved" and answer["trace"] == []
     # the interleavings of the shipped cell's four devices over three rounds, each configuration counted once: a
     # change in what may happen next, or in what tells two configurations apart, changes these
     assert (answer["states"], answer["transitions"]) == (73, 75)
@@ -89,6 +98,9 @@ async def test_the_seeded_deadlock_is_not_hit_by_a_simulated_run(tmp_path: Path)
 
 def test_the_counterexample_is_the_shortest(tmp_path: Path) -> None:
     cell = seeded_cell(tmp_path, napping_gripper())
+    code, answer = verify_json(str(TASK), "--cell", str(cell))
+    assert code == 1 and answer["trace"][-1]["step"] == ("gripper receives xirp.request.Close in state standby, "
+                                                         "which has no transition for it")
     result = service.verify(TASK, cell)
     # After the start, the one run reaches the gripper's Close at its 10th move (sensor, localizer and robot
     # each take a request, their delay and their answer back); the nap is one move more: none is shorter.
@@ -130,12 +142,11 @@ def test_a_device_that_never_answers_is_a_deadlock_at_the_step_that_waits(tmp_pa
     chart = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8").replace(
         '<onentry><send event="motion.done" delay="120ms"/></onentry>\n    <transition event="motion.done" '
         'target="closed">', '<transition event="motion.done" target="closed">', 1)
-    result = service.verify(TASK, seeded_cell(tmp_path, chart))
-    assert result.verdict == "refuted"
-    assert result.problem == ("deadlock: the controller waits for gripper.xirp.event.gripper_closed and no device "
-                              "will send it (robot in at_pose, gripper in closing, sensor3d in captured, "
-                              "binpicking-pc in localized)")
-    assert str(result.trace[-1]).startswith(f"{TASK}:6: deadlock")
+    code, answer = verify_json(str(TASK), "--cell", str(seeded_cell(tmp_path, chart)))
+    assert code == 1 and answer["problem"] == (
+        "deadlock: the controller waits for gripper.xirp.event.gripper_closed and no device will send it "
+        "(robot in at_pose, gripper in closing, sensor3d in captured, binpicking-pc in localized)")
+    assert answer["trace"][-1]["where"] == f"{TASK}:6" and answer["trace"][-1]["step"].startswith("deadlock")
 
 
 def test_a_request_missing_an_argument_the_device_takes_is_refused_before_any_program_is_made(tmp_path: Path) -> None:
@@ -205,22 +216,18 @@ def test_a_budget_too_small_is_inconclusive_not_a_hang() -> None:
 
 
 def test_a_budget_of_exactly_the_states_a_proof_needs_proves_it_and_one_state_less_does_not() -> None:
-    needed = json.loads(runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--json"]).stdout)["states"]
-    exactly = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--max-states", str(needed), "--json"])
-    assert exactly.exit_code == 0, exactly.output
-    assert json.loads(exactly.stdout)["verdict"] == "proved"
-    short = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--max-states", str(needed - 1), "--json"])
-    assert short.exit_code == 3, short.output
-    answer = json.loads(short.stdout)
+    needed = verify_json(str(TASK), "--cell", str(CELL))[1]["states"]
+    code, exactly = verify_json(str(TASK), "--cell", str(CELL), "--max-states", str(needed))
+    assert code == 0 and exactly["verdict"] == "proved"
+    code, answer = verify_json(str(TASK), "--cell", str(CELL), "--max-states", str(needed - 1))
+    assert code == 3
     assert answer["problem"] == (f"the budget of {needed - 1} states ran out before every interleaving was explored")
     assert answer["states"] == needed - 1 and answer["trace"] == []
 
 
 def test_a_time_budget_too_small_is_inconclusive() -> None:
-    result = runner.invoke(app, ["verify", str(TASK), "--cell", str(CELL), "--timeout", "1e-9", "--json"])
-    assert result.exit_code == 3, result.output
-    answer = json.loads(result.stdout)
-    assert answer["verdict"] == "inconclusive"
+    code, answer = verify_json(str(TASK), "--cell", str(CELL), "--timeout", "1e-9")
+    assert code == 3 and answer["verdict"] == "inconclusive"
     assert answer["problem"] == "the time budget of 1e-09 s ran out before every interleaving was explored"
     # the clock is read once every 64 configurations taken from the queue: the first reading ends the search
     assert answer["states"] == 64
