@@ -223,6 +223,7 @@ def test_a_budget_of_exactly_the_states_a_proof_needs_proves_it_and_one_state_le
     assert code == 3
     assert answer["problem"] == (f"the budget of {needed - 1} states ran out before every interleaving was explored")
     assert answer["states"] == needed - 1 and answer["trace"] == []
+    assert answer["transitions"] >= answer["states"] - 1  # every configuration but the first was reached by a move
 
 
 def test_a_time_budget_too_small_is_inconclusive() -> None:
@@ -230,7 +231,7 @@ def test_a_time_budget_too_small_is_inconclusive() -> None:
     assert code == 3 and answer["verdict"] == "inconclusive"
     assert answer["problem"] == "the time budget of 1e-09 s ran out before every interleaving was explored"
     # the clock is read once every 64 configurations taken from the queue: the first reading ends the search
-    assert answer["states"] == 64
+    assert (answer["states"], answer["transitions"]) == (64, 66)
 
 
 def test_an_event_the_controller_does_not_wait_for_is_refuted(tmp_path: Path) -> None:
