@@ -131,3 +131,13 @@ def test_a_value_below_the_process_minimum(cell: Cell) -> None:
     (p,) = service.check(bad, cell).problems
     assert (p.step, p.kind, p.parameter) == (1, "too_low", "grip_force")
     assert "grip_force = 5 N is below its minimum 10 N" in p.text
+
+
+def test_a_device_bound_to_a_role_it_lacks_an_argument_for_says_which_argument(cell: Cell, device) -> None:
+    t = task("pick-and-place")
+    bound = replace(t, steps=(replace(t.steps[0], bind={"gripper": "vacuum-gripper"}), t.steps[1]))
+    (p,) = service.check(bound, cell.without("gripper").with_device(device("vacuum-gripper"))).problems
+    assert (p.step, p.kind, p.role, p.device) == (1, "cannot_play", "gripper", "vacuum-gripper")
+    assert "is bound to device 'vacuum-gripper', which cannot play it; device 'vacuum-gripper' cannot play role " \
+           "'gripper' of pick-and-place: its request SuctionOn needs the argument vacuum (pnp:Vacuum)" in p.text
+    assert any(str(w.file).endswith("vacuum-gripper.scxml") for w in p.reason.where)
