@@ -201,3 +201,16 @@ def test_the_branches_of_a_step_after_an_until_loop_are_not_run_one_after_the_ot
                           "      PartFound: [{command: close-gripper}]\n      NoPartFound: [{command: close-gripper}]\n")
     result, _ = checked(tmp_path, text)
     assert result.plausible and not result.problems, [str(p) for p in result.problems]
+
+
+def test_the_findings_of_a_step_after_an_until_loop_are_listed_by_parameter_on_every_exit(tmp_path: Path) -> None:
+    # the values out of range are found on the path that ends the loop after a whole iteration and on each exit
+    text = UNTIL_EMPTY + ("  - command: localize-part\n    on:\n      NoPartFound: [{command: scan-bin}]\n"
+                          "  - command: pick-and-place\n    params: {speed: 500, grip_force: 500}\n")
+    result, _ = checked(tmp_path, text)
+    assert [(p.step, p.kind, p.parameter) for p in result.problems] == [
+        (9, "too_high", "grip_force")] * 3 + [(9, "too_high", "speed")] * 3
+    said = "step 9 (pick-and-place): parameter grip_force = 500 N is above its maximum 140 N"
+    assert [p.text for p in result.problems][:3] == [
+        said, f"loop ended on BinEmpty at step 1 (loop iteration 1): {said}",
+        f"loop ended on BinEmpty at step 4 (loop iteration 2 and later): {said}"]
