@@ -214,3 +214,26 @@ def test_the_findings_of_a_step_after_an_until_loop_are_listed_by_parameter_on_e
     assert [p.text for p in result.problems][:3] == [
         said, f"loop ended on BinEmpty at step 1 (loop iteration 1): {said}",
         f"loop ended on BinEmpty at step 4 (loop iteration 2 and later): {said}"]
+
+
+def test_a_branch_after_an_until_loop_is_checked_from_where_each_exit_leaves(tmp_path: Path) -> None:
+    # the loop may end at localize-part with the gripper closed; then a part found after the loop closes it again
+    text = """task: close-while-looking
+steps:
+  - loop:
+      until: BinEmpty
+      max: 10
+      steps:
+        - command: close-gripper
+        - command: localize-part
+        - command: open-gripper
+  - command: localize-part
+    on:
+      PartFound: [{command: close-gripper}, {command: open-gripper}]
+"""
+    result, path = checked(tmp_path, text)
+    assert not result.plausible
+    assert sorted((p.step, p.text.split(": step")[0], p.where.line) for p in result.problems) == [
+        (8, "loop ended on BinEmpty at step 2 (loop iteration 1), branch PartFound at step 7", 12),
+        (8, "loop ended on BinEmpty at step 5 (loop iteration 2 and later), branch PartFound at step 7", 12)]
+    assert all("device 'gripper' (role 'gripper') is in state 'closed'" in p.text for p in result.problems)
