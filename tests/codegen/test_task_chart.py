@@ -46,6 +46,17 @@ def test_synchronisation_is_kept(generated) -> None:
     assert close.get("cond") == "In('s1_robot_at_part')"
 
 
+def test_a_region_waits_for_another_once_before_its_first_command_not_again_for_its_devices_answer(
+        generated) -> None:
+    # the gripper closes once the robot is at the part, then follows its own device: were its wait for
+    # gripper_closed also held to In('s1_robot_at_part'), a robot moving on first would leave it waiting for ever
+    tree = etree.fromstring(generated.task_chart())
+    region = tree.find(".//s:state[@id='s1_gripper']", NS)
+    moves = [(t.getparent().get("id"), t.get("event"), t.get("cond")) for t in region.iterfind(".//s:transition", NS)]
+    assert moves == [("s1_gripper_open", None, "In('s1_robot_at_part')"),
+                     ("s1_gripper_closed_1a", "gripper.xirp.event.gripper_closed", None)]
+
+
 def test_parameter_values_are_bound_to_the_commands(generated) -> None:
     tree = etree.fromstring(generated.task_chart())
     close = tree.find(".//s:state[@id='s1_gripper_open']//s:send", NS)

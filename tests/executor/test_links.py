@@ -374,15 +374,18 @@ async def test_a_upnp_link_waits_for_an_answer_as_long_as_it_is_told_not_as_the_
             await link.close()
 
 
-async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its_own_command_timeout(
-        monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize(("floor", "command_timeout", "given_up"), [(SHORT, 2 * SHORT, 2 * SHORT),
+                                                                     (2 * SHORT, SHORT, 2 * SHORT)])
+async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its_command_timeout_or_the_floor(
+        monkeypatch: pytest.MonkeyPatch, floor: float, command_timeout: float, given_up: float) -> None:
+    monkeypatch.setattr(links, "CONNECT_TIMEOUT", floor)  # 10 s in earnest: a test need not wait that long
     async with silent_server() as port:
-        silent = dataclasses.replace(device(BIN_PICKING, "binpicking-pc"), command_timeout=SHORT,
+        silent = dataclasses.replace(device(BIN_PICKING, "binpicking-pc"), command_timeout=command_timeout,
                                      endpoint=f"http://127.0.0.1:{port}/device.xml")
-        monkeypatch.setattr(links, "CONNECT_TIMEOUT", SHORT)  # 10 s in earnest
-        with pytest.raises(ProtocolTimeout):
+        said = f"^reading the description of device at {silent.endpoint}: no answer within {given_up:g} s$"
+        with pytest.raises(ProtocolTimeout, match=said):
             await asyncio.wait_for(Heard().open(silent), WAIT)
-        with pytest.raises(ProtocolTimeout):
+        with pytest.raises(ProtocolTimeout, match=said):
             await asyncio.wait_for(query_report(silent, WAIT), WAIT)
 
 

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 from plugnproduce import service
+from plugnproduce.description.loader import load_device
+from tests.conftest import edit
 from tests.reasoning.test_flow_check import CELL, TASKS, UNTIL_EMPTY, checked, line_of
 
 THEN_HOME = (TASKS / "bin-picking-then-home.yaml").read_text(encoding="utf-8")
@@ -156,3 +159,81 @@ def test_a_loop_of_a_branched_task_is_refused_where_each_of_its_ends_strands_the
     assert {(p.step, p.kind, p.device, p.where.line) for p in exits} == {
         (9, "wrong_state", "gripper", line_of(path, "- command: open-gripper"))}
     assert not result.plausible
+
+
+def test_a_link_in_a_branch_to_an_output_the_device_never_reports_is_refused_naming_the_branch(
+        tmp_path: Path) -> None:
+    for f in ("binpicking-pc.ttl", "binpicking-pc.scxml"):
+        shutil.copy(service.builtin("devices", f), tmp_path)
+    edit(tmp_path / "binpicking-pc.scxml", '<param name="part_pose" expr="part_pose" pnp:maxReach="1.2"/>', "")
+    cell = service.cell(CELL).with_device(load_device(tmp_path / "binpicking-pc.ttl", service.knowledge().taxonomy))
+    path = tmp_path / "task.yaml"
+    path.write_text("task: silent\nsteps:\n  - name: localize\n    command: localize-part\n    on:\n"
+                    "      PartFound:\n        - command: pick\n"
+                    "          params: {pick_pose: {from: localize, output: part_pose}}\n"
+                    "        - command: place\n", encoding="utf-8")
+    result = service.check(path, cell)
+    [problem] = [p for p in result.problems if p.kind == "bad_link"]
+    assert (problem.step, problem.device, problem.parameter) == (2, "binpicking-pc", "pick_pose")
+    assert problem.where.line == line_of(path, "pick_pose:") and not result.plausible
+    assert problem.text == ("branch PartFound at step 1: step 2 (pick): parameter pick_pose takes part_pose from "
+                            "localize, but device 'binpicking-pc' (role 'localizer') reports no part_pose: no event "
+                            "of its chart carries a value of that name")
+
+
+def test_a_step_after_an_until_loop_in_a_task_with_branches_is_checked_from_where_each_exit_leaves(
+        tmp_path: Path) -> None:
+    # as in a task without branches (test_flow_check): the loop can end at step 1 or at step 4
+    text = UNTIL_EMPTY + ("  - command: localize-part\n    on:\n      NoPartFound: [{command: scan-bin}]\n"
+                          "  - command: open-gripper\n    bind: {gripper: gripper}\n")
+    result, path = checked(tmp_path, text)
+    exits = sorted((p.step, p.text.split(": step")[0], p.where.line) for p in result.problems
+                   if "loop ended on" in p.text)
+    line = line_of(path, "- command: open-gripper")
+    assert exits == [(9, "loop ended on BinEmpty at step 1 (loop iteration 1)", line),
+                     (9, "loop ended on BinEmpty at step 4 (loop iteration 2 and later)", line)]
+    assert not result.plausible
+
+
+def test_the_branches_of_a_step_after_an_until_loop_are_not_run_one_after_the_other(tmp_path: Path) -> None:
+    # each branch closes the open gripper: run one after the other, the second would find it closed
+    text = UNTIL_EMPTY + ("  - command: localize-part\n    on:\n"
+                          "      PartFound: [{command: close-gripper}]\n      NoPartFound: [{command: close-gripper}]\n")
+    result, _ = checked(tmp_path, text)
+    assert result.plausible and not result.problems, [str(p) for p in result.problems]
+
+
+def test_the_findings_of_a_step_after_an_until_loop_are_listed_by_parameter_on_every_exit(tmp_path: Path) -> None:
+    # the values out of range are found on the path that ends the loop after a whole iteration and on each exit
+    text = UNTIL_EMPTY + ("  - command: localize-part\n    on:\n      NoPartFound: [{command: scan-bin}]\n"
+                          "  - command: pick-and-place\n    params: {speed: 500, grip_force: 500}\n")
+    result, _ = checked(tmp_path, text)
+    assert [(p.step, p.kind, p.parameter) for p in result.problems] == [
+        (9, "too_high", "grip_force")] * 3 + [(9, "too_high", "speed")] * 3
+    said = "step 9 (pick-and-place): parameter grip_force = 500 N is above its maximum 140 N"
+    assert [p.text for p in result.problems][:3] == [
+        said, f"loop ended on BinEmpty at step 1 (loop iteration 1): {said}",
+        f"loop ended on BinEmpty at step 4 (loop iteration 2 and later): {said}"]
+
+
+def test_a_branch_after_an_until_loop_is_checked_from_where_each_exit_leaves(tmp_path: Path) -> None:
+    # the loop may end at localize-part with the gripper closed; then a part found after the loop closes it again
+    text = """task: close-while-looking
+steps:
+  - loop:
+      until: BinEmpty
+      max: 10
+      steps:
+        - command: close-gripper
+        - command: localize-part
+        - command: open-gripper
+  - command: localize-part
+    on:
+      PartFound: [{command: close-gripper}, {command: open-gripper}]
+"""
+    result, path = checked(tmp_path, text)
+    assert not result.plausible
+    assert sorted((p.step, p.text.split(": step")[0], p.where.line) for p in result.problems) == [
+        (8, "loop ended on BinEmpty at step 2 (loop iteration 1), branch PartFound at step 7", 12),
+        (8, "loop ended on BinEmpty at step 5 (loop iteration 2 and later), branch PartFound at step 7", 12)]
+    assert all("device 'gripper' (role 'gripper') is in state 'closed'" in p.text for p in result.problems)

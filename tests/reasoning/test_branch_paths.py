@@ -324,3 +324,15 @@ def test_a_step_after_a_branch_is_explained_with_the_numbers_of_the_task(tmp_pat
     assert (ex.step, ex.command, ex.plausible, ex.problems) == (4, "place", True, ())
     [gripper] = [r.text for r in ex.states if "device 'gripper'" in r.text]
     assert "left there by step 3 (pick)" in gripper, gripper
+
+
+def test_a_task_whose_one_path_is_over_the_limit_of_steps_is_refused_at_its_file(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # the branch is on an outcome localize-part does not have: the only path is the one without it, 3 steps long
+    _limits(monkeypatch, 100, 2)
+    result, path = checked(tmp_path, "task: one-path\nsteps:\n  - command: localize-part\n    on:\n"
+                                     "      NoPartFund: [{command: scan-bin}]\n  - command: scan-bin\n"
+                                     "  - command: scan-bin\n")
+    [problem] = [p.to_json() for p in result.problems]
+    assert (problem["step"], problem["command"], problem["kind"]) == (1, "localize-part", "too_many_paths")
+    assert (problem["where"], problem["rests_on"]) == (str(path), [str(path)]) and not result.plausible

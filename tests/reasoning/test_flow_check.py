@@ -90,3 +90,25 @@ def test_a_link_to_an_output_the_bound_device_never_reports_is_refused(tmp_path:
     [problem] = [p for p in result.problems if p.kind == "bad_link"]
     assert not result.plausible and problem.device == "binpicking-pc" and problem.parameter == "pick_pose"
     assert "reports no part_pose: no event of its chart carries a value of that name" in problem.text
+
+
+def test_a_task_whose_only_fault_is_where_its_loop_may_end_is_not_plausible(tmp_path: Path) -> None:
+    # every iteration and the step after the last full one are fine; but the loop may end at localize-part,
+    # with the gripper still closed, and the close-gripper after the loop then finds it closed
+    text = """task: close-while-looking
+steps:
+  - loop:
+      until: BinEmpty
+      max: 10
+      steps:
+        - command: close-gripper
+        - command: localize-part
+        - command: open-gripper
+  - command: close-gripper
+"""
+    result, path = checked(tmp_path, text)
+    assert not result.plausible
+    assert sorted((p.step, p.text.split(": step")[0], p.where.line) for p in result.problems) == [
+        (7, "loop ended on BinEmpty at step 2 (loop iteration 1)", 10),
+        (7, "loop ended on BinEmpty at step 5 (loop iteration 2 and later)", 10)]
+    assert all("device 'gripper' (role 'gripper') is in state 'closed'" in p.text for p in result.problems)

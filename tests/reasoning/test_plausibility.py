@@ -131,3 +131,37 @@ def test_a_value_below_the_process_minimum(cell: Cell) -> None:
     (p,) = service.check(bad, cell).problems
     assert (p.step, p.kind, p.parameter) == (1, "too_low", "grip_force")
     assert "grip_force = 5 N is below its minimum 10 N" in p.text
+
+
+def test_a_device_bound_to_a_role_it_lacks_an_argument_for_says_which_argument(cell: Cell, device) -> None:
+    t = task("pick-and-place")
+    bound = replace(t, steps=(replace(t.steps[0], bind={"gripper": "vacuum-gripper"}), t.steps[1]))
+    (p,) = service.check(bound, cell.without("gripper").with_device(device("vacuum-gripper"))).problems
+    assert (p.step, p.kind, p.role, p.device) == (1, "cannot_play", "gripper", "vacuum-gripper")
+    assert "is bound to device 'vacuum-gripper', which cannot play it; device 'vacuum-gripper' cannot play role " \
+           "'gripper' of pick-and-place: its request SuctionOn needs the argument vacuum (pnp:Vacuum)" in p.text
+    assert any(str(w.file).endswith("vacuum-gripper.scxml") for w in p.reason.where)
+
+
+def test_the_problems_of_one_step_are_listed_role_by_role_whatever_the_devices_are_called(cell: Cell) -> None:
+    t = task("pick-and-place")
+    bad = replace(t, steps=(replace(t.steps[0], bind={"robot": "a-robot", "gripper": "z-gripper"}), t.steps[1]))
+    problems = service.check(bad, cell).problems
+    assert [(p.step, p.kind, p.role, p.device) for p in problems] == [
+        (1, "absent", "gripper", "z-gripper"), (1, "absent", "robot", "a-robot")]
+
+
+def test_the_values_of_one_step_out_of_range_are_listed_by_parameter_name(cell: Cell) -> None:
+    t = task("pick-and-place")
+    params = {"speed": 500, **t.steps[0].params, "grip_force": 500}  # written speed first
+    problems = service.check(replace(t, steps=(replace(t.steps[0], params=params), t.steps[1])), cell).problems
+    assert [(p.step, p.kind, p.parameter) for p in problems] == [(1, "too_high", "grip_force"),
+                                                                 (1, "too_high", "speed")]
+
+
+def test_the_values_of_one_step_in_units_that_do_not_fit_are_listed_by_parameter_name(cell: Cell) -> None:
+    t = task("pick-and-place")
+    params = {"speed": "50 kg", **t.steps[0].params, "grip_force": "30 m"}  # written speed first
+    problems = service.check(replace(t, steps=(replace(t.steps[0], params=params), t.steps[1])), cell).problems
+    assert [(p.step, p.kind, p.parameter) for p in problems] == [(1, "bad_unit", "grip_force"),
+                                                                 (1, "bad_unit", "speed")]

@@ -18,7 +18,7 @@ from async_upnp_client.client import UpnpAction, UpnpDevice, UpnpService, UpnpSt
 from async_upnp_client.client_factory import UpnpFactory
 from async_upnp_client.const import HttpRequest
 from async_upnp_client.event_handler import default_on_pre_notify
-from async_upnp_client.exceptions import UpnpValueError
+from async_upnp_client.exceptions import UpnpConnectionTimeoutError, UpnpValueError
 from async_upnp_client.utils import get_local_ip
 
 from plugnproduce.errors import ProtocolError, ProtocolTimeout, RemoteError
@@ -60,6 +60,8 @@ async def load_device(location: str, requester: TrustedRequester, what: str, tim
                 return await UpnpFactory(requester).async_create_device(location)
         except (KeyError, ValueError) as exc:  # a malformed description (defusedxml refusals are ValueErrors)
             raise RemoteError(f"reading the description of {what}: malformed description ({reason(exc)})") from exc
+        except (UpnpConnectionTimeoutError, TimeoutError) as exc:  # the wait a user may lengthen: say how long
+            raise ProtocolTimeout(f"reading the description of {what}: no answer within {timeout:g} s") from exc
 
 
 class UpnpDeviceClient:

@@ -77,9 +77,13 @@ def _fixpoint(task: Task, loop: Loop, result: CheckResult) -> Iterator[Problem]:
 
 def _exits(task: Task, loop: Loop, knowledge: Knowledge, check: Check,
            paths: list[Path]) -> Iterator[Problem]:
-    """Check the steps after the loop from where each step that can end the loop leaves the devices."""
-    rest = tuple(i for i in paths[0].positions if i > loop.last)
-    if not rest:
+    """Check the steps after the loop, on each path through them, from where each step that can end the loop
+    leaves the devices."""
+    rests: dict[tuple[int, ...], Path] = {}
+    for path in paths:  # a path's rest: its positions after the loop (the first path of each rest names it)
+        rests.setdefault(tuple(i for i in path.positions if i > loop.last), path)
+    rests.pop((), None)
+    if not rests:
         return
     assert loop.until is not None
     until = loop.until
@@ -88,11 +92,26 @@ def _exits(task: Task, loop: Loop, knowledge: Knowledge, check: Check,
         if process is None or not any(loop_ending(task, step.index, o, knowledge.taxonomy) == loop
                                       for o in process.outcomes):
             continue
-        route = tuple(i for i in covering(paths, step.index).positions if i <= step.index) + rest
-        straight = dataclasses.replace(task, steps=tuple(dataclasses.replace(task.steps[p - 1], index=i + 1)
-                                                         for i, p in enumerate(route)),
-                                       loops=(), branches=(), repeat=1)
+        head = tuple(i for i in covering(paths, step.index).positions if i <= step.index)
         label = f"loop ended on {local_name(until)} at step {step.index} ({task.path(step.index)})"
-        for problem in check(straight).problems:
-            if problem.step > len(route) - len(rest) and problem.kind != "bad_link":
-                yield _named(renumbered(problem, route), label)
+        seen: set[tuple[int, str, str]] = set()  # a problem of this exit found again on another path
+        for rest, path in rests.items():
+            yield from _exit_problems(task, loop, check, head + rest, len(head), path, label, seen)
+
+
+def _exit_problems(task: Task, loop: Loop, check: Check, route: tuple[int, ...], ended: int, path: Path,
+                   label: str, seen: set[tuple[int, str, str]]) -> Iterator[Problem]:
+    """The problems of the steps after the loop on ``route``, the loop ended at its position ``ended``; each once."""
+    straight = dataclasses.replace(task, steps=tuple(dataclasses.replace(task.steps[p - 1], index=i + 1)
+                                                     for i, p in enumerate(route)),
+                                   loops=(), branches=(), repeat=1)
+    for problem in check(straight).problems:
+        if problem.step <= ended or problem.kind == "bad_link":
+            continue
+        found = renumbered(problem, route)
+        key = (found.step, found.kind, found.text)
+        if key in seen:
+            continue
+        seen.add(key)
+        on = path.label(task, found.step) if path.branch is not None and path.branch.step > loop.last else None
+        yield _named(found, f"{label}, {on}" if on else label)
