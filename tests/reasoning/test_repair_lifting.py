@@ -15,7 +15,8 @@ from plugnproduce.cli import app
 from plugnproduce.description.model import Task
 from plugnproduce.description.taskfile import parse_task
 from plugnproduce.reasoning import Repair
-from tests.reasoning.conftest import BIN_PICKING, TASKS
+from plugnproduce.reasoning.repairs.lifting import UNROLLS
+from tests.reasoning.conftest import BIN_PICKING, DESCRIPTIONS, TASKS
 
 UNTIL_EMPTY = (TASKS / "bin-picking-until-empty.yaml").read_text(encoding="utf-8")
 NO_PLACE = UNTIL_EMPTY[: UNTIL_EMPTY.index("        - command: place")]  # the body never lets the part go
@@ -154,3 +155,92 @@ def test_a_loop_long_enough_to_be_repaired_window_by_window_keeps_its_loop(tmp_p
     [loop] = repairs[0].task.loops
     assert _commands(repairs[0].task, loop.entry, loop.first - 1).count("open-gripper") == 1
     assert service.check(repairs[0].task, BIN_PICKING).plausible
+
+
+# ---- each edit of a loop body's two copies reaches the written step, and the copies' edits are united
+
+def _with(repairs: list[Repair], *edits: tuple[str, int | None, str | None]) -> Repair:
+    """The repair whose edits are exactly these (kind, step, device), in the order the repair lists them."""
+    return next(r for r in repairs if [(e.kind, e.step, e.device) for e in r.edits] == list(edits))
+
+
+def _written(r: Repair) -> tuple[list[str], list[tuple[int, int, int]]]:
+    return [s.command for s in r.task.steps], [(lp.entry, lp.first, lp.last) for lp in r.task.loops]
+
+
+THREE = ["localize-part", "pick", "place"]
+TWO_GRIPPERS = """cell: two-grippers
+devices:
+""" + "".join(f"  - {DESCRIPTIONS / 'devices' / n}.ttl\n" for n in ("robot", "gripper", "magnetic-gripper",
+                                                                      "sensor3d", "binpicking-pc"))
+
+
+def test_a_role_rebound_in_both_iterations_is_rebound_in_the_written_step(tmp_path: Path) -> None:
+    path = _file(tmp_path, UNTIL_EMPTY.replace("gripper: gripper}", "gripper: sensor3d}"))
+    repairs = service.repair(path, BIN_PICKING, top=8)
+    r = _with(repairs, ("rebind", 2, "gripper"), ("rebind", 5, "gripper"))
+    assert r.unrolls is None and _written(r) == (THREE * 2, [(1, 4, 6)])
+    assert r.task.steps[1].bind == r.task.steps[4].bind == {"robot": "robot", "gripper": "gripper"}
+    assert service.check(r.task, BIN_PICKING).plausible
+    # one iteration rebinds the pick, the other removes it and closes the gripper instead: removed from the body
+    r = _with(repairs, ("rebind", 2, "gripper"), ("remove", 5, None), ("insert", 6, None))
+    assert r.unrolls is None and _written(r) == (["localize-part", "close-gripper", "place"] * 2, [(1, 4, 6)])
+
+
+def test_a_step_after_the_loop_is_removed_and_the_loop_stays_as_written(tmp_path: Path) -> None:
+    path = _file(tmp_path, UNTIL_EMPTY + "  - command: open-gripper\n")  # the place left the gripper open
+    repairs = service.repair(path, BIN_PICKING, top=4)
+    r = _with(repairs, ("remove", 7, None))
+    assert r.unrolls is None and _written(r) == (THREE * 2, [(1, 4, 6)])
+    r = _with(repairs, ("insert", 7, None))
+    assert r.unrolls is None and _written(r) == (THREE * 2 + ["close-gripper", "open-gripper"], [(1, 4, 6)])
+
+
+def test_the_first_step_removed_before_a_loop_leaves_the_loop(tmp_path: Path) -> None:
+    repairs = service.repair(_file(tmp_path, CLOSED_FIRST), BIN_PICKING, top=8)
+    r = _with(repairs, ("remove", 1, None))
+    assert r.unrolls is None and _written(r) == (THREE * 2, [(1, 4, 6)])
+    # the first iteration swaps, the second opens before its pick: no written placement says that
+    r = _with(repairs, ("swap", 3, None), ("insert", 6, None))
+    assert r.unrolls is not None and r.task.loops == ()
+
+
+def test_iterations_binding_a_role_to_different_devices_keep_their_flat_steps(tmp_path: Path) -> None:
+    cell = _file(tmp_path, TWO_GRIPPERS).rename(tmp_path / "two-grippers.yaml")
+    path = _file(tmp_path, UNTIL_EMPTY.replace("bind: {robot: robot, gripper: gripper}", "bind: {robot: robot}"))
+    repairs = service.repair(path, cell, top=8)
+    same = _with(repairs, *(("bind", i, "gripper") for i in (2, 3, 5, 6)))
+    assert same.unrolls is None and _written(same) == (THREE * 2, [(1, 4, 6)])
+    r = _with(repairs, ("bind", 2, "magnetic-gripper"), ("reset", 2, None), ("bind", 3, "magnetic-gripper"),
+              ("bind", 5, "gripper"), ("bind", 6, "gripper"))
+    assert r.unrolls == UNROLLS + "the iterations of the loop repair step 2 (pick) differently"
+    assert r.task.loops == () and [s.bind.get("gripper") for s in r.task.steps] == [
+        None, "magnetic-gripper", "magnetic-gripper", None, "gripper", "gripper"]
+
+
+def test_a_rebinding_of_one_iteration_is_checked_for_every_iteration(tmp_path: Path) -> None:
+    """The first iteration picks with the magnetic gripper and the second with the gripper: in the written loop the
+    magnetic gripper would pick twice without letting go, which the check of the written task says."""
+    cell = _file(tmp_path, TWO_GRIPPERS).rename(tmp_path / "two-grippers.yaml")
+    repairs = service.repair(_file(tmp_path, NO_PLACE), cell, top=10)
+    r = _with(repairs, ("rebind", 2, "magnetic-gripper"), ("reset", 2, None))
+    assert (r.unrolls or "").startswith(UNROLLS + "kept in the loop or branch it is not plausible (loop iteration 2 "
+                                        "and later: step 4 (pick): device 'magnetic-gripper' (role 'gripper')")
+
+
+def test_a_step_one_iteration_removes_is_removed_from_the_loop_body(tmp_path: Path) -> None:
+    path = _file(tmp_path, UNTIL_EMPTY.replace("exposure: 25", "exposure: 5000"))
+    repairs = service.repair(path, BIN_PICKING, top=8)
+    r = _with(repairs, ("reset", 1, None), ("reset", 4, None))
+    assert r.unrolls is None and _written(r) == (THREE * 2, [(1, 4, 6)]) and "exposure" not in r.task.steps[0].params
+    r = _with(repairs, ("reset", 1, None), ("remove", 4, None))  # the body would lose the step that ends the loop
+    assert r.unrolls is not None and "no step of its body can end with that outcome" in r.unrolls
+
+
+def test_the_edits_after_a_removed_step_reach_their_written_steps(tmp_path: Path) -> None:
+    path = _file(tmp_path, UNTIL_EMPTY.replace("grip_force: 45", "grip_force: 5000").replace("speed: 80", "speed: 150"))
+    repairs = service.repair(path, BIN_PICKING, top=10)
+    r = _with(repairs, ("insert", 2, None), ("remove", 2, None), ("reset", 3, None), ("reset", 5, None),
+              ("reset", 6, None))
+    assert r.unrolls is None and _written(r) == (["localize-part", "close-gripper", "place"] * 2, [(1, 4, 6)])
+    assert "speed" not in r.task.steps[2].params  # the place runs at its default speed
