@@ -17,6 +17,7 @@ from plugnproduce.description.taskfile import parse_task
 from plugnproduce.reasoning import Repair
 from plugnproduce.reasoning.repairs.lifting import UNROLLS
 from tests.reasoning.conftest import BIN_PICKING, DESCRIPTIONS, TASKS
+from tests.reasoning.test_nested_loop_check import REGRIP
 
 UNTIL_EMPTY = (TASKS / "bin-picking-until-empty.yaml").read_text(encoding="utf-8")
 NO_PLACE = UNTIL_EMPTY[: UNTIL_EMPTY.index("        - command: place")]  # the body never lets the part go
@@ -244,3 +245,45 @@ def test_the_edits_after_a_removed_step_reach_their_written_steps(tmp_path: Path
               ("reset", 6, None))
     assert r.unrolls is None and _written(r) == (["localize-part", "close-gripper", "place"] * 2, [(1, 4, 6)])
     assert "speed" not in r.task.steps[2].params  # the place runs at its default speed
+
+
+def test_swaps_in_both_iterations_are_made_in_the_loop_body(tmp_path: Path) -> None:
+    path = _file(tmp_path, UNTIL_EMPTY + "  - command: open-gripper\n")
+    r = _with(service.repair(path, BIN_PICKING, top=16), ("insert", 1, None), ("swap", 2, None), ("swap", 5, None))
+    assert r.unrolls is None
+    assert _written(r) == (["close-gripper", *["localize-part", "place", "pick"] * 2, "open-gripper"], [(2, 5, 7)])
+
+
+BRANCH_STEPS = ["localize-part", "pick", "place", "move-to", "scan-bin"]
+
+
+def test_a_step_removed_from_a_branch_leaves_the_branches_and_what_follows(tmp_path: Path) -> None:
+    repairs = service.repair(_file(tmp_path, TWO_PICKS_IN_A_BRANCH), BIN_PICKING, top=6)
+    r = _with(repairs, ("remove", 2, None))
+    assert r.unrolls is None and [s.command for s in r.task.steps] == BRANCH_STEPS
+    assert [(b.outcome.rsplit("#")[1], b.step, b.first, b.last) for b in r.task.branches] == [
+        ("PartFound", 1, 2, 3), ("NoPartFound", 1, 4, 4)]
+    r = _with(repairs, ("swap", 1, None), ("insert", 2, None))  # the localize would go into its own branch
+    assert r.unrolls == UNROLLS + "it swaps steps that are not neighbours in one list of the task file"
+    assert r.task.branches == () and [s.command for s in r.task.steps][:3] == ["pick", "open-gripper", "localize-part"]
+
+
+def test_a_repair_removing_the_step_branches_hang_on_keeps_its_flat_steps(tmp_path: Path) -> None:
+    path = _file(tmp_path, TWO_PICKS_IN_A_BRANCH.replace("exposure: 25", "exposure: 5000"))
+    r = _with(service.repair(path, BIN_PICKING, top=6), ("remove", 1, None), ("insert", 3, None))
+    assert r.unrolls == UNROLLS + "it removes step 1, whose branches would lose their step"
+    assert r.task.branches == () and [s.command for s in r.task.steps] == ["pick", "open-gripper", *BRANCH_STEPS[1:]]
+
+
+def test_a_repair_of_a_task_with_a_loop_in_a_loop_keeps_its_flat_steps(tmp_path: Path) -> None:
+    r = service.repair(_file(tmp_path, REGRIP), BIN_PICKING)[0]
+    assert r.unrolls == UNROLLS + "the task has a loop inside a loop" and r.task.loops == ()
+
+
+def test_a_loop_repaired_with_a_device_bought_from_the_catalogue_keeps_its_loop(tmp_path: Path) -> None:
+    cell = tmp_path / "no-gripper.yaml"
+    cell.write_text("cell: no-gripper\ndevices:\n" + "".join(
+        f"  - {DESCRIPTIONS / 'devices' / n}.ttl\n" for n in ("robot", "sensor3d", "binpicking-pc")), encoding="utf-8")
+    repairs = service.repair(_file(tmp_path, UNTIL_EMPTY), cell, DESCRIPTIONS / "devices", top=3)
+    r = _with(repairs, ("add", None, "gripper"))
+    assert r.added_devices == ("gripper",) and r.unrolls is None and _written(r) == (THREE * 2, [(1, 4, 6)])
