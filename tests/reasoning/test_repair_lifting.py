@@ -287,3 +287,19 @@ def test_a_loop_repaired_with_a_device_bought_from_the_catalogue_keeps_its_loop(
     repairs = service.repair(_file(tmp_path, UNTIL_EMPTY), cell, DESCRIPTIONS / "devices", top=3)
     r = _with(repairs, ("add", None, "gripper"))
     assert r.added_devices == ("gripper",) and r.unrolls is None and _written(r) == (THREE * 2, [(1, 4, 6)])
+
+
+def test_steps_inserted_in_two_places_go_to_their_written_places(tmp_path: Path) -> None:
+    """The gripper is closed before the loop and nothing in the body lets go: each iteration needs it opened."""
+    path = _file(tmp_path, CLOSED_FIRST[: CLOSED_FIRST.index("        - command: place")])
+    repairs = service.repair(path, BIN_PICKING, top=10)
+    r = _with(repairs, ("insert", 2, None), ("insert", 4, None))  # before each iteration's localize: one step
+    assert r.unrolls is None
+    assert _written(r) == (["close-gripper", *["open-gripper", "localize-part", "pick"] * 2], [(2, 5, 7)])
+    r = next(r for r in repairs if [e.text for e in r.edits] == [
+        "insert open-gripper before step 2 (localize-part)", "insert place before step 4 (localize-part)"])
+    assert r.unrolls is None  # the open before the loop, the place at the end of its body
+    assert _written(r) == (["close-gripper", "open-gripper", *["localize-part", "pick", "place"] * 2], [(3, 6, 8)])
+    r = next(r for r in repairs if [e.text for e in r.edits] == [
+        "insert place before step 3 (pick)", "insert open-gripper before step 5 (pick)"])
+    assert r.unrolls == UNROLLS + "the loop's iterations repair it differently"  # place or open before the pick
