@@ -263,6 +263,9 @@ def test_a_step_removed_from_a_branch_leaves_the_branches_and_what_follows(tmp_p
     assert r.unrolls is None and [s.command for s in r.task.steps] == BRANCH_STEPS
     assert [(b.outcome.rsplit("#")[1], b.step, b.first, b.last) for b in r.task.branches] == [
         ("PartFound", 1, 2, 3), ("NoPartFound", 1, 4, 4)]
+    r = _with(repairs, ("swap", 3, None))  # made in the branch, whose end then differs from the other branch's
+    assert (r.unrolls or "").startswith(UNROLLS + "kept in the loop or branch it is not plausible (branch NoPartFound "
+                                        "at step 1: device gripper is left in state 'open', but branch PartFound")
     r = _with(repairs, ("swap", 1, None), ("insert", 2, None))  # the localize would go into its own branch
     assert r.unrolls == UNROLLS + "it swaps steps that are not neighbours in one list of the task file"
     assert r.task.branches == () and [s.command for s in r.task.steps][:3] == ["pick", "open-gripper", "localize-part"]
