@@ -146,6 +146,9 @@ def test_a_library_task_with_its_own_outcome_keeps_its_loop_and_branches(tmp_pat
         found = next(b for b in r.task.branches if b.outcome.endswith("#PartFound"))
         assert _commands(r.task, found.first, found.last) == ["pick", "open-gripper"]
         assert len(r.task.loops) == 1 and service.check(r.task, BIN_PICKING, knowledge).plausible
+        assert [(lp.entry, lp.first, lp.last) for lp in r.task.loops] == [(1, 5, 8)]
+        assert [(b.outcome.rsplit("#")[1], b.step, b.first, b.last) for b in r.task.branches] == [
+            ("PartFound", 1, 2, 3), ("PartOccluded", 1, 4, 4), ("PartFound", 5, 6, 7), ("PartOccluded", 5, 8, 8)]
 
 
 def test_a_loop_long_enough_to_be_repaired_window_by_window_keeps_its_loop(tmp_path: Path) -> None:
@@ -306,3 +309,15 @@ def test_steps_inserted_in_two_places_go_to_their_written_places(tmp_path: Path)
     r = next(r for r in repairs if [e.text for e in r.edits] == [
         "insert place before step 3 (pick)", "insert open-gripper before step 5 (pick)"])
     assert r.unrolls == UNROLLS + "the loop's iterations repair it differently"  # place or open before the pick
+
+
+def test_a_step_inserted_before_a_branching_step_moves_its_branches(tmp_path: Path) -> None:
+    text = TWO_PICKS_IN_A_BRANCH.replace("steps:\n  - name: localize", "steps:\n  - command: close-gripper\n  - name: localize")
+    repairs = service.repair(_file(tmp_path, text), BIN_PICKING, top=6)
+    r = next(r for r in repairs if [e.text for e in r.edits] == [
+        "insert open-gripper before step 2 (localize-part)", "insert open-gripper before step 4 (pick)"])
+    assert r.unrolls is None and [s.command for s in r.task.steps] == [
+        "close-gripper", "open-gripper", "localize-part", "pick", "open-gripper", "pick", "place", "move-to", "scan-bin"]
+    assert [(b.outcome.rsplit("#")[1], b.step, b.first, b.last) for b in r.task.branches] == [
+        ("PartFound", 3, 4, 7), ("NoPartFound", 3, 8, 8)]
+    assert service.check(r.task, BIN_PICKING).plausible
