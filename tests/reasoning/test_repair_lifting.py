@@ -184,6 +184,9 @@ def test_a_role_rebound_in_both_iterations_is_rebound_in_the_written_step(tmp_pa
     repairs = service.repair(path, BIN_PICKING, top=8)
     r = _with(repairs, ("rebind", 2, "gripper"), ("rebind", 5, "gripper"))
     assert r.unrolls is None and _written(r) == (THREE * 2, [(1, 4, 6)])
+    assert (r.task.name, r.task.file, r.task.description) == (
+        "bin-picking-until-empty", str(path), "Localise, pick and place parts until the bin-picking PC finds the bin "
+        "empty.")
     assert r.task.steps[1].bind == r.task.steps[4].bind == {"robot": "robot", "gripper": "gripper"}
     assert service.check(r.task, BIN_PICKING).plausible
     # one iteration rebinds the pick, the other removes it and closes the gripper instead: removed from the body
@@ -267,6 +270,8 @@ def test_a_step_removed_from_a_branch_leaves_the_branches_and_what_follows(tmp_p
     assert [(b.outcome.rsplit("#")[1], b.step, b.first, b.last) for b in r.task.branches] == [
         ("PartFound", 1, 2, 3), ("NoPartFound", 1, 4, 4)]
     r = _with(repairs, ("swap", 3, None))  # made in the branch, whose end then differs from the other branch's
+    assert r.task.branches == () and [s.command for s in r.task.steps] == [
+        "localize-part", "pick", "place", "pick", "move-to", "scan-bin"]
     assert (r.unrolls or "").startswith(UNROLLS + "kept in the loop or branch it is not plausible (branch NoPartFound "
                                         "at step 1: device gripper is left in state 'open', but branch PartFound")
     r = _with(repairs, ("swap", 1, None), ("insert", 2, None))  # the localize would go into its own branch
@@ -321,3 +326,10 @@ def test_a_step_inserted_before_a_branching_step_moves_its_branches(tmp_path: Pa
     assert [(b.outcome.rsplit("#")[1], b.step, b.first, b.last) for b in r.task.branches] == [
         ("PartFound", 3, 4, 7), ("NoPartFound", 3, 8, 8)]
     assert service.check(r.task, BIN_PICKING).plausible
+
+
+def test_a_task_without_loops_or_branches_keeps_its_repeat(tmp_path: Path) -> None:
+    path = _file(tmp_path, "task: squeeze\nrepeat: 2\nsteps:\n  - command: close-gripper\n    params: {grip_force: 5000}\n"
+                           "  - command: open-gripper\n")
+    r = _with(service.repair(path, BIN_PICKING), ("reset", 1, None), ("reset", 3, None))
+    assert r.unrolls is None and r.task.repeat == 2 and r.task.steps[0].params == {}
