@@ -323,3 +323,58 @@ def test_a_value_outside_the_process_range_is_implausible_in_the_batch_as_in_che
     checked = service.check(the_task, service.cell(DESCRIPTIONS / "cells" / "bin-picking.yaml"))
     assert [p.kind for p in checked.problems] == [kind]
     assert row.plausible == () and not checked.plausible
+
+
+CLOSE_TWICE = ("task: close-twice\nsteps:\n  - command: close-gripper\n    params: {grip_force: 30}\n"
+               "  - command: close-gripper\n    params: {grip_force: 30}\n")
+
+
+def test_a_device_left_in_a_state_its_next_role_cannot_start_from_is_named_as_check_names_it(tmp_path: Path) -> None:
+    """The second close finds the gripper closed: the batch says so as check does (wrong state, not stuck), and no
+    purchase cures it."""
+    the_task = service.task(write(tmp_path, "close-twice.yaml", CLOSE_TWICE))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    [problem] = service.check(the_task, cell).problems
+    assert (problem.step, problem.kind, problem.device) == (2, "wrong_state", "gripper")
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.options == ()
+    assert row.purchase.impossible == ("step 2 of close-twice: device gripper is not in the state role gripper "
+                                       "starts from; adding devices cannot cure it")
+
+
+def _jammed_robot(library: Path) -> None:
+    """The built-in robot as ``jammed-robot``, written outside the package: from each state it idles in, the first
+    MoveTo of its chart (in the order code generation ranks them) goes to a state it never leaves."""
+    builtin = service.builtin("devices")
+    (library / "devices").mkdir(parents=True)
+    ttl = (builtin / "robot.ttl").read_text(encoding="utf-8").replace("dev:robot", "dev:jammed-robot")
+    (library / "devices" / "jammed-robot.ttl").write_text(ttl.replace("<robot.scxml>", "<jammed-robot.scxml>"),
+                                                          encoding="utf-8")
+    chart = (builtin / "robot.scxml").read_text(encoding="utf-8").replace('name="robot"', 'name="jammed-robot"')
+    jam = '    <transition event="xirp.request.MoveTo" target="blocked" pnp:accepts="TargetPose Speed"/>\n'
+    for state in ("home", "at_pose"):
+        at = chart.index("\n", chart.index(f'<state id="{state}"')) + 1
+        chart = chart[:at] + jam + chart[at:]
+    chart = chart.replace("</scxml>", '  <state id="blocked" pnp:concept="Moving"/>\n</scxml>')
+    (library / "devices" / "jammed-robot.scxml").write_text(chart, encoding="utf-8")
+
+
+def test_a_device_that_can_walk_a_role_only_by_a_way_its_chart_does_not_take_is_stuck_in_the_batch_as_in_check(
+        tmp_path: Path) -> None:
+    """The jammed robot has the skill and a way through the robot role's region, so it may play it; but the way its
+    chart takes ends where it never leaves, from every state it starts in. Check says stuck; so does the batch,
+    step 2 (the move after it) included, and no purchase cures it."""
+    _jammed_robot(tmp_path)
+    k = service.knowledge((tmp_path,))
+    the_task = task("pick-and-place")
+    for devices, problems in ((("jammed-robot", "gripper"), [(1, "stuck", "jammed-robot")]),
+                              (("robot", "gripper"), [])):
+        cell = Cell("c", tuple(d for d in k.devices if d.id in devices))
+        assert [(p.step, p.kind, p.device) for p in service.check(the_task, cell, k).problems] == problems
+    jammed, working = service.batch([Configuration("jammed", ("jammed-robot", "gripper")),
+                                     Configuration("working", ("robot", "gripper"))], list(k.devices), [the_task],
+                                    workers=1, knowledge=k)
+    assert working.plausible == ("pick-and-place",) and jammed.plausible == ()
+    assert jammed.purchase is not None and jammed.purchase.impossible == (
+        "step 1 of pick-and-place: device jammed-robot cannot play role robot from the state it is in; adding devices "
+        "cannot cure it")
