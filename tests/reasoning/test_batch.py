@@ -62,6 +62,37 @@ def test_alternatives_come_cheapest_first(tmp_path: Path) -> None:
     assert row.purchase.options == ((("scara",), cost("scara")), (("cobot",), cost("cobot")),
                                     (("robot",), cost("robot")))
     assert cost("scara") < cost("cobot") < cost("robot")
+    assert row.to_csv()[-1] == f"scara={cost('scara')} | cobot={cost('cobot')} | robot={cost('robot')}"
+
+
+def test_the_csv_purchase_column_names_each_set_with_its_cost_or_what_to_do_instead() -> None:
+    configs = [Configuration("paper", PAPER), Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d")),
+               Configuration("sensing-only", ("binpicking-pc", "sensor3d")),
+               Configuration("two-grippers", ("gripper", "magnetic-gripper", "robot"))]
+    assert [r.to_csv()[-1] for r in rows(configs)] == [
+        "", f"gripper={cost('gripper')}", f"gripper+robot={cost('gripper', 'robot')}",
+        "ambiguous: step 2 of bin-picking: several devices can play role gripper; bind step 2's role gripper to one "
+        "of them"]
+
+
+FAR = ("task: far\nsteps:\n  - command: pick-and-place\n    params:\n"
+       "      pick_pose: [0.35, 0.15, 0.04, 0, 180, 0]\n      place_pose: [1.48, 0.0, 0.08, 0, 180, 0]\n"
+       "      retract_pose: [0.30, 0.00, 0.30, 0, 180, 0]\n      grip_force: 30\n")
+"""A place 1.48 m from the robot's base: beyond every catalogue robot's reach (the scara's 0.6 m is the first tried)."""
+
+
+@pytest.mark.parametrize("devices, added", [(("gripper",), "scara"),
+                                            (("binpicking-pc", "sensor3d"), "magnetic-gripper+scara")])
+def test_when_no_set_of_catalogue_devices_helps_the_answer_names_the_cheapest_one_tried(
+        tmp_path: Path, devices: tuple[str, ...], added: str) -> None:
+    far = service.task(write(tmp_path, "far.yaml", FAR))
+    (row,) = service.batch([Configuration("c", devices)], None, [far], workers=1, top=3)
+    why = (f"no set of catalogue devices makes every task plausible; e.g. adding {added}: step 1 of far: device "
+           "scara (role robot) refuses a value sent to it by its own limits: parameter place_pose = "
+           "[1.48, 0.0, 0.08, 0, 180, 0] goes with request MoveTo, which reaches at most 0.6 m from its base; the "
+           "pose is 1.48 m away")
+    assert row.outcome == "impossible" and row.to_json()["purchase"] == {"options": [], "impossible": why}
+    assert row.to_csv()[-1] == f"impossible: {why}"
 
 
 def test_a_robot_whose_own_limits_refuse_the_tasks_values_is_not_bought() -> None:
