@@ -93,9 +93,9 @@ def test_a_link_on_a_parameter_the_process_does_not_declare_is_an_unknown_parame
            "      pick_pose: {from: localize, output: part_pose}\n      approach: {from: localize, output: part_pose}\n"
     result, path = checked(tmp_path, text)
     assert not result.plausible
-    assert [(p.step, p.kind, p.parameter, p.where.line, p.text) for p in result.problems] == [
-        (2, "unknown_param", "approach", line_of(path, "approach:"), "step 2 (pick): parameter approach is not "
-         "declared by pick (its parameters: grip_force, lift_pose, pick_pose, speed)")]
+    assert [(p.step, p.command, p.kind, p.parameter, p.where.line, p.text) for p in result.problems] == [
+        (2, "pick", "unknown_param", "approach", line_of(path, "approach:"), "step 2 (pick): parameter approach is "
+         "not declared by pick (its parameters: grip_force, lift_pose, pick_pose, speed)")]
 
 
 def test_a_wrong_link_is_found_after_an_unknown_command_and_beside_an_unknown_parameter(tmp_path: Path) -> None:
