@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from plugnproduce import service
-from plugnproduce.batch import Configuration, batches, engine, generate, read_configurations
+from plugnproduce.batch import BatchRow, Configuration, batches, engine, generate, purchases, read_configurations
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
 from tests.reasoning.conftest import DESCRIPTIONS, task, write
@@ -49,19 +49,85 @@ def test_two_missing_devices_are_bought_together() -> None:
     assert row.purchase.options[0] == (("gripper", "robot"), cost("gripper", "robot"))
 
 
-def test_alternatives_come_cheapest_first(tmp_path: Path) -> None:
-    within_every_robot = tmp_path / "pick-and-place.yaml"  # within the scara's reach and the cobot's speed
-    within_every_robot.write_text(
-        "task: pick-and-place\nsteps:\n  - command: pick-and-place\n    params:\n"
-        "      pick_pose: [0.35, 0.15, 0.04, 0, 180, 0]\n      place_pose: [0.45, -0.25, 0.08, 0, 180, 0]\n"
-        "      retract_pose: [0.30, 0.00, 0.30, 0, 180, 0]\n      grip_force: 30\n"
-        "  - command: move-to\n    params: {target_pose: [0.30, 0.00, 0.50, 0, 180, 0], speed: 50}\n")
+WITHIN_EVERY_ROBOT = (  # within the scara's reach and the cobot's speed
+    "task: pick-and-place\nsteps:\n  - command: pick-and-place\n    params:\n"
+    "      pick_pose: [0.35, 0.15, 0.04, 0, 180, 0]\n      place_pose: [0.45, -0.25, 0.08, 0, 180, 0]\n"
+    "      retract_pose: [0.30, 0.00, 0.30, 0, 180, 0]\n      grip_force: 30\n"
+    "  - command: move-to\n    params: {target_pose: [0.30, 0.00, 0.50, 0, 180, 0], speed: 50}\n")
+
+
+def _gripper_only(tmp_path: Path, text: str, top: int) -> BatchRow:
     (row,) = service.batch([Configuration("gripper-only", ("gripper",))], None,
-                           [service.task(within_every_robot)], workers=1, top=3)
+                           [service.task(write(tmp_path, "task.yaml", text))], workers=1, top=top)
+    return row
+
+
+def test_alternatives_come_cheapest_first(tmp_path: Path) -> None:
+    row = _gripper_only(tmp_path, WITHIN_EVERY_ROBOT, 3)
     assert row.purchase is not None
     assert row.purchase.options == ((("scara",), cost("scara")), (("cobot",), cost("cobot")),
                                     (("robot",), cost("robot")))
     assert cost("scara") < cost("cobot") < cost("robot")
+    assert row.to_csv()[-1] == f"scara={cost('scara')} | cobot={cost('cobot')} | robot={cost('robot')}"
+
+
+@pytest.mark.parametrize("top", [1, 2])
+def test_only_the_top_cheapest_alternatives_are_given(tmp_path: Path, top: int) -> None:
+    row = _gripper_only(tmp_path, WITHIN_EVERY_ROBOT, top)
+    assert row.purchase is not None
+    assert row.purchase.options == ((("scara",), cost("scara")), (("cobot",), cost("cobot")))[:top]
+
+
+@pytest.mark.parametrize("limit, bought", [(1, None), (2, "scara")])
+def test_the_search_for_a_purchase_stops_after_its_limit_of_candidate_sets(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, limit: int, bought: str | None) -> None:
+    """The candidates in order: the empty set (which fills no role), then the scara, the cheapest robot."""
+    monkeypatch.setattr(purchases, "LIMIT", limit)
+    row = _gripper_only(tmp_path, WITHIN_EVERY_ROBOT, 1)
+    assert row.purchase is not None
+    if bought is None:
+        assert row.purchase.to_json() == {"options": [], "impossible": "no purchase found among the first 1 "
+                                                                         "candidate sets (search stopped)"}
+    else:
+        assert row.purchase.options == (((bought,), cost(bought)),)
+
+
+def test_a_search_that_would_end_without_a_purchase_still_stops_at_its_limit(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(purchases, "LIMIT", 2)
+    row = _gripper_only(tmp_path, FAR, 1)
+    assert row.outcome == "impossible" and row.purchase is not None
+    assert row.purchase.impossible == "no purchase found among the first 2 candidate sets (search stopped)"
+
+
+def test_the_csv_purchase_column_names_each_set_with_its_cost_or_what_to_do_instead() -> None:
+    configs = [Configuration("paper", PAPER), Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d")),
+               Configuration("sensing-only", ("binpicking-pc", "sensor3d")),
+               Configuration("two-grippers", ("gripper", "magnetic-gripper", "robot"))]
+    assert [r.to_csv()[-1] for r in rows(configs)] == [
+        "", f"gripper={cost('gripper')}", f"gripper+robot={cost('gripper', 'robot')}",
+        "ambiguous: step 2 of bin-picking: several devices can play role gripper; bind step 2's role gripper to one "
+        "of them"]
+
+
+FAR = ("task: far\nsteps:\n  - command: pick-and-place\n    params:\n"
+       "      pick_pose: [0.35, 0.15, 0.04, 0, 180, 0]\n      place_pose: [1.48, 0.0, 0.08, 0, 180, 0]\n"
+       "      retract_pose: [0.30, 0.00, 0.30, 0, 180, 0]\n      grip_force: 30\n")
+"""A place 1.48 m from the robot's base: beyond every catalogue robot's reach (the scara's 0.6 m is the first tried)."""
+
+
+@pytest.mark.parametrize("devices, added", [(("gripper",), "scara"),
+                                            (("binpicking-pc", "sensor3d"), "magnetic-gripper+scara")])
+def test_when_no_set_of_catalogue_devices_helps_the_answer_names_the_cheapest_one_tried(
+        tmp_path: Path, devices: tuple[str, ...], added: str) -> None:
+    far = service.task(write(tmp_path, "far.yaml", FAR))
+    (row,) = service.batch([Configuration("c", devices)], None, [far], workers=1, top=3)
+    why = (f"no set of catalogue devices makes every task plausible; e.g. adding {added}: step 1 of far: device "
+           "scara (role robot) refuses a value sent to it by its own limits: parameter place_pose = "
+           "[1.48, 0.0, 0.08, 0, 180, 0] goes with request MoveTo, which reaches at most 0.6 m from its base; the "
+           "pose is 1.48 m away")
+    assert row.outcome == "impossible" and row.to_json()["purchase"] == {"options": [], "impossible": why}
+    assert row.to_csv()[-1] == f"impossible: {why}"
 
 
 def test_a_robot_whose_own_limits_refuse_the_tasks_values_is_not_bought() -> None:

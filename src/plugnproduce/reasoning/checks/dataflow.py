@@ -48,7 +48,8 @@ def link_problems(task: Task, knowledge: Knowledge) -> Iterator[Problem]:
             continue  # an unknown command is a problem of its own
         for name, link in sorted(step.links().items()):
             if name not in {p.name for p in process.parameters}:
-                continue  # an unknown parameter is a problem of its own
+                yield _undeclared(task, step, name, process)
+                continue
             named = _named_before(one_round, step)
             text, iris = _link_text(step, link, named, knowledge, process.parameter(name))
             text = text or _on_every_path(task, step, name, link, named)
@@ -56,6 +57,15 @@ def link_problems(task: Task, knowledge: Knowledge) -> Iterator[Problem]:
                 where = task.where(step, name)
                 yield Problem(step.index, step.command, "bad_link", Reason("bad_link", text, iris, (where,)), where,
                               parameter=name)
+
+
+def _undeclared(task: Task, step: Step, name: str, process: ProcessDescription) -> Problem:
+    """A link on a parameter the step's process does not declare (as params.lp finds a value on one)."""
+    names = ", ".join(p.name for p in process.parameters)
+    text = (f"step {step.index} ({step.command}): parameter {name} is not declared by {process.id} "
+            f"(its parameters: {names})")
+    where = task.where(step, name)
+    return Problem(step.index, step.command, "unknown_param", Reason("unknown_param", text), where, parameter=name)
 
 
 def _named_before(steps: tuple[Step, ...], step: Step) -> dict[str, Step]:
@@ -139,7 +149,8 @@ def unreported(task: Task, cell: Cell, steps: tuple[StepCheck, ...],
                     link.output not in {o.name for o in process.outputs}:
                 continue  # a link problem of its own
             role = process.output(link.output).role
-            device = devices.get(steps[source.index - 1].bindings.get(role, ""))
+            bound = steps[source.index - 1].bindings  # without the role: no device plays it, a finding of its own
+            device = devices.get(bound[role]) if role in bound else None
             if device is None or reports(device, link.output):
                 continue
             text = (f"step {step.index} ({step.command}): parameter {name} takes {link.output} from {link.step}, "
