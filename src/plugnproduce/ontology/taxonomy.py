@@ -12,10 +12,11 @@ import io
 import json
 import tempfile
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.errors import OntologyError
 from plugnproduce.ontology.iris import PNP_IRI, local_name
 from plugnproduce.ontology.sources import folder_files
