@@ -74,13 +74,13 @@ def code_digest() -> str:
     it all would cost more than it saves); looked at once per process. What is kept from the code's work is named
     by it, so another version of the code never reads it."""
     h = hashlib.sha256(f"{sys.version}\0".encode())
-    here = Path(__file__).parent
+    here = os.path.dirname(__file__)
     for folder, dirs, names in os.walk(here):
         dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        inside = folder[len(here):].lstrip(os.sep)  # the folder relative to the package (os.path.relpath, cheaper)
         for name in sorted(n for n in names if n.endswith(".py")):
             stat = os.stat(os.path.join(folder, name))
-            h.update(f"{os.path.relpath(os.path.join(folder, name), here)}\0{stat.st_size}\0{stat.st_mtime_ns}\0"
-                     .encode())
+            h.update(f"{os.path.join(inside, name)}\0{stat.st_size}\0{stat.st_mtime_ns}\0".encode())
     return h.hexdigest()
 
 
