@@ -5,8 +5,8 @@
 CPU time (user+sys of the child, ``resource.getrusage(RUSAGE_CHILDREN)``) and wall time of
 ``pnp --help``, importing the reasoning layer (which loads none of its parts until used), ``pnp validate`` of a
 device, a warm ``pnp capabilities`` on the bin-picking
-cell and ``pnp check`` of the bin-picking task (warm: the help, units, taxonomy and loaded knowledge kept in the
-user's cache folder by a first run), each against a bare ``python -c pass``
+cell and ``pnp check`` of the bin-picking task (warm: the help, units, taxonomy and loaded knowledge kept in a
+cache folder of the bench's own by a first run), each against a bare ``python -c pass``
 measured in the same run, interleaved (so a burst of load hits every command alike). Targets,
 in CPU time: ``--help`` ≤ 3×, warm ``capabilities`` ≤ 10×, ``check`` ≤ 15× ``python -c pass``.
 The commands run as ``python -m plugnproduce`` with the interpreter running this script, so no
@@ -19,9 +19,11 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -41,9 +43,15 @@ TARGETS = {"pnp --help": 3.0, "pnp capabilities (warm)": 10.0, "pnp check bin-pi
 """Most CPU time, as a multiple of ``python -c pass``'s."""
 
 
+CACHE = tempfile.mkdtemp(prefix="pnp-bench-cache-")
+"""The cache folder of the measured commands: their own, so that warm means kept by this bench's first run, not
+left or evicted by whatever else runs as the same user (each kind of kept file is bounded in number)."""
+
+
 def _env() -> dict[str, str]:
     env = dict(os.environ)
     env.pop("PYTHONDONTWRITEBYTECODE", None)  # warm means as installed: byte code written once, then read
+    env["XDG_CACHE_HOME"] = CACHE
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "src"), env.get("PYTHONPATH", "")) if p)
     return env
 
@@ -107,4 +115,7 @@ if __name__ == "__main__":
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--slowest", type=int, default=12)
     options = parser.parse_args()
-    main(options.rounds, options.slowest)
+    try:
+        main(options.rounds, options.slowest)
+    finally:
+        shutil.rmtree(CACHE, ignore_errors=True)

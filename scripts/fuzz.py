@@ -47,7 +47,7 @@ sys.path.insert(0, str(ROOT / "tests" / "fuzz"))
 
 import fuzzing  # noqa: E402  (the shared targets live beside the tests)
 
-from plugnproduce.cli.app import quiet_library_chatter  # noqa: E402
+from plugnproduce.cli.application import quiet_library_chatter  # noqa: E402
 
 WEIGHTS = {"turtle": 14, "chart": 14, "task": 14, "cell": 8, "xirp": 30, "served": 8, "reference": 4, "hmi": 8,
            "upnp": 6, "ssdp": 6}

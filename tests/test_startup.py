@@ -188,3 +188,34 @@ def test_a_warm_capabilities_or_check_loads_nothing_it_has_no_use_for(tmp_path: 
     loaded = set(out.rsplit("loaded: ", 1)[1].split())
     assert sorted(h for h in NOT_FOR_A_WARM_ANSWER if h in loaded) == []  # a check's cycle time estimate (which
     # follows the specific process charts code generation builds) is read back too
+
+
+NOT_FOR_THE_CONSOLE_SCRIPT = ("plugnproduce.cli.devices", "plugnproduce.cli.serve", "plugnproduce.cli.run",
+                              "plugnproduce.cli.validate", "plugnproduce.cli.generate", "plugnproduce.cli.verify",
+                              "plugnproduce.cli.knowledge", "plugnproduce.cli.plan", "plugnproduce.cli.teach",
+                              "plugnproduce.cli.resume", "plugnproduce.cli.runs", "plugnproduce.cli.draw", "socket",
+                              "csv", "tempfile", "platformdirs", *NOT_FOR_A_WARM_ANSWER)
+"""What ``pnp capabilities`` and ``pnp check`` from files seen before have no use for, run as the console script: the
+modules of the other commands (and what they import), the platform's folder names (the cache folder is named by
+the rule platformdirs follows) and a temporary file's names (nothing is written)."""
+
+
+@pytest.mark.parametrize("args", [("capabilities", "--cell", "descriptions/cells/bin-picking.yaml"),
+                                  ("check", "descriptions/tasks/bin-picking.yaml", "--cell",
+                                   "descriptions/cells/bin-picking.yaml")])
+def test_the_console_script_imports_only_the_command_it_runs(tmp_path: Path, args: tuple[str, ...]) -> None:
+    """``pnp`` imports the module of the command it runs, and makes the methods of only the dataclasses the answer
+    uses: none of the SCXML model's, though the devices read back hold their charts."""
+    code = (f"import sys\nsys.argv = ['pnp', *{list(args)!r}]\nfrom plugnproduce.__main__ import run\n"
+            "try:\n    run()\n    code = 0\nexcept SystemExit as exc:\n    code = exc.code or 0\nprint('exit', code)\n"
+            "from plugnproduce.statechart import model\n"
+            "made = [n for n, c in vars(model).items() if isinstance(c, type) and '__dataclass_params__' in vars(c)]\n"
+            "print('made: ' + ' '.join(made))\nprint('loaded: ' + ' '.join(sorted(sys.modules)))")
+    _run(code, tmp_path)  # the first answer keeps what the next reads back
+    out = _run(code, tmp_path)
+    answer = "9 of 12 process commands offered" if args[0] == "capabilities" else "bin-picking: plausible"
+    assert answer in out and "exit 0" in out
+    loaded = set(out.rsplit("loaded: ", 1)[1].split())
+    assert "plugnproduce.cli.reasoning" in loaded
+    assert sorted(m for m in NOT_FOR_THE_CONSOLE_SCRIPT if m in loaded) == []
+    assert out.split("made:", 1)[1].split("\n", 1)[0].split() == []

@@ -19,8 +19,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
-import platformdirs
-
 T = TypeVar("T")
 
 APP = "plugnproduce"
@@ -30,14 +28,28 @@ RUNS_VARIABLE = "PNP_RUNS"
 
 
 def cache_folder() -> Path:
-    """The user's cache folder for plugnproduce."""
+    """The user's cache folder for plugnproduce.
+
+    On Linux platformdirs names it from ``XDG_CACHE_HOME`` (when absolute) or ``~/.cache``; that rule is followed
+    here without importing platformdirs, which costs every command that reads its cache a few per cent of a warm
+    answer (``tests/test_folders.py`` holds the two to the same answer). Elsewhere, platformdirs answers.
+    """
+    if sys.platform.startswith("linux"):
+        xdg = os.environ.get("XDG_CACHE_HOME", "")
+        return Path(xdg if os.path.isabs(xdg) else os.path.expanduser("~/.cache")) / APP
+    import platformdirs
+
     return Path(platformdirs.user_cache_dir(APP))
 
 
 def runs_folder() -> Path:
     """Where run journals go unless told otherwise: ``PNP_RUNS``, else ``runs`` in the user's state folder."""
     given = os.environ.get(RUNS_VARIABLE)
-    return Path(given) if given else Path(platformdirs.user_state_dir(APP)) / "runs"
+    if given:
+        return Path(given)
+    import platformdirs
+
+    return Path(platformdirs.user_state_dir(APP)) / "runs"
 
 
 def keep_newest(path: Path, data: bytes, keep: int) -> None:
@@ -62,13 +74,13 @@ def code_digest() -> str:
     it all would cost more than it saves); looked at once per process. What is kept from the code's work is named
     by it, so another version of the code never reads it."""
     h = hashlib.sha256(f"{sys.version}\0".encode())
-    here = Path(__file__).parent
+    here = os.path.dirname(__file__)
     for folder, dirs, names in os.walk(here):
         dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        inside = folder[len(here):].lstrip(os.sep)  # the folder relative to the package (os.path.relpath, cheaper)
         for name in sorted(n for n in names if n.endswith(".py")):
             stat = os.stat(os.path.join(folder, name))
-            h.update(f"{os.path.relpath(os.path.join(folder, name), here)}\0{stat.st_size}\0{stat.st_mtime_ns}\0"
-                     .encode())
+            h.update(f"{os.path.join(inside, name)}\0{stat.st_size}\0{stat.st_mtime_ns}\0".encode())
     return h.hexdigest()
 
 

@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from plugnproduce import service
 from plugnproduce.cli import app
-from plugnproduce.cli.app import BUG, bug_log
+from plugnproduce.cli.application import BUG, bug_log
 
 runner = CliRunner()
 CELL = str(service.builtin("cells", "bin-picking.yaml"))

@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 import plugnproduce
 from plugnproduce.cli import app
-from plugnproduce.cli.app import _app_for
+from plugnproduce.cli.application import _app_for
 
 ROOT = Path(__file__).resolve().parents[2]
 CELL = ROOT / "descriptions" / "cells" / "bin-picking.yaml"
@@ -50,3 +50,20 @@ def test_the_console_script_answers_as_the_whole_command_line(args: list[str]) -
     alone = subprocess.run([sys.executable, "-m", "plugnproduce", *args], env=env, capture_output=True, text=True,
                            timeout=300, check=False)
     assert (alone.returncode, alone.stdout) == (whole.exit_code, whole.stdout)
+
+
+def test_the_console_script_imports_the_module_that_registers_the_command_it_runs() -> None:
+    """``pnp`` imports only the module :data:`~plugnproduce.cli.application.COMMANDS` names for the command: each
+    command and group is registered by that module, and every module of the command line is in the list the help
+    imports."""
+    from typer.main import get_command_name
+
+    from plugnproduce.cli import application
+
+    registered = {c.name or get_command_name(c.callback.__name__): c.callback.__module__
+                  for c in app.registered_commands if c.callback is not None}
+    registered |= {g.name: g.typer_instance.registered_commands[0].callback.__module__
+                   for g in app.registered_groups if g.name and g.typer_instance}
+    assert registered == {name: f"plugnproduce.cli.{m}" for name, m in application.COMMANDS.items()}
+    modules = {p.stem for p in Path(application.__file__).parent.glob("*.py")} - {"__init__", "application"}
+    assert sorted(application.COMMAND_MODULES) == sorted(modules)

@@ -4,18 +4,24 @@ Exit codes: 0 done/ok; 1 a finding (invalid, infeasible, implausible, refuted, f
 2 bad input or usage, reported as one ``file:line: message`` line, never a traceback;
 3 no answer within a budget (``pnp verify`` inconclusive); 4 a bug of pnp itself (one line saying so,
 the traceback in ``~/.local/state/plugnproduce/bugs.log``).
-Each command module registers its commands on :data:`app`.
+Each command module registers its commands on the application (:mod:`plugnproduce.cli.application`). The console
+script (:func:`main`) imports only the module of the command it runs; :data:`app`, asked for, has every command.
 """
 
 from __future__ import annotations
 
-from plugnproduce.cli.app import app, main
+from typing import TYPE_CHECKING
 
-# Command modules register themselves on import.
-from plugnproduce.cli import draw, validate  # noqa: E402,F401  isort: skip
-from plugnproduce.cli import generate, reasoning  # noqa: E402,F401  isort: skip
-from plugnproduce.cli import devices, run, serve  # noqa: E402,F401  isort: skip
-from plugnproduce.cli import runs, verify  # noqa: E402,F401  isort: skip
-from plugnproduce.cli import knowledge, plan, resume, teach  # noqa: E402,F401  isort: skip
+from plugnproduce.cli.application import commands, main
+
+if TYPE_CHECKING:
+    from plugnproduce.cli.application import app
+
+
+def __getattr__(name: str) -> object:  # PEP 562: the whole application, its command modules imported on first use
+    if name == "app":
+        return commands()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["app", "main"]

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import (
+from plugnproduce.cli.application import (
     INTERFACE_OPTION,
     JSON_OPTION,
     app,

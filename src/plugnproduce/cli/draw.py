@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from plugnproduce.cli.app import app, boundary
+from plugnproduce.cli.application import app, boundary
 
 
 @app.command()

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json, fail, knowledge
+from plugnproduce.cli.application import JSON_OPTION, app, boundary, emit_json, fail, knowledge
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:

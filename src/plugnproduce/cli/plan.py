@@ -12,7 +12,15 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import DISCOVERY_OPTION, INTERFACE_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
+from plugnproduce.cli.application import (
+    DISCOVERY_OPTION,
+    INTERFACE_OPTION,
+    JSON_OPTION,
+    app,
+    boundary,
+    emit_json,
+    knowledge,
+)
 from plugnproduce.cli.reasoning import CELL_OPTION, LIVE_OPTION, _cell
 from plugnproduce.lazy import lazy_module
 

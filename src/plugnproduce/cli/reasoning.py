@@ -7,7 +7,6 @@ task, process not offered, no repair found); 2 bad input, one ``file:line: messa
 from __future__ import annotations
 
 import contextlib
-import csv
 import dataclasses
 import json
 import sys
@@ -17,7 +16,7 @@ from typing import TYPE_CHECKING, TextIO
 
 import typer
 
-from plugnproduce.cli.app import (
+from plugnproduce.cli.application import (
     DISCOVERY_OPTION,
     INTERFACE_OPTION,
     JSON_OPTION,
@@ -369,6 +368,8 @@ def batch(
     with contextlib.ExitStack() as stack:
         out = stack.enter_context(output.open("w", encoding="utf-8", newline="")) if output else sys.stdout
         if as_csv:
+            import csv
+
             csv.writer(out, lineterminator="\n").writerow(service.BATCH_CSV_HEADER)
         tally: dict[str, int] = {}
         written = _write(lambda progress: service.batch_report_from(

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
+from plugnproduce.cli.application import DISCOVERY_OPTION, JSON_OPTION, app, boundary, emit_json, knowledge
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:

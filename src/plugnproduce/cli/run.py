@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import (
+from plugnproduce.cli.application import (
     DISCOVERY_OPTION,
     INTERFACE_OPTION,
     JSON_OPTION,

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import JSON_OPTION, app, boundary, emit_json
+from plugnproduce.cli.application import JSON_OPTION, app, boundary, emit_json
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:

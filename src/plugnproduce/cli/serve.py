@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from plugnproduce.cli.app import INTERFACE_OPTION, app, boundary, fail, interface_address, knowledge
+from plugnproduce.cli.application import INTERFACE_OPTION, app, boundary, fail, interface_address, knowledge
 from plugnproduce.lazy import lazy_module
 
 if TYPE_CHECKING:

@@ -9,7 +9,7 @@ in the task file and one set of device states a check can name.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from plugnproduce.deferred import dataclass
 
 
 def _local(iri: str) -> str:

@@ -11,9 +11,10 @@ finding can say where it rests.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import TYPE_CHECKING, Literal
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.flow import Branch as Branch
 from plugnproduce.description.flow import Loop as Loop
 from plugnproduce.description.tasks import Link as Link
@@ -158,6 +159,11 @@ class DeviceDescription:
     """The safe-stop transitions (a request annotated ``pnp:SafeStop``): sent only to stop the device,
     never planned with, so they are not among :attr:`transitions`."""
 
+    def __hash__(self) -> int:
+        """Of its names, chart file and initial state only: equal devices hash alike, and a fact cache keyed by a
+        device does not walk its states and transitions (nor make their classes' methods) at every look-up."""
+        return hash((self.id, self.iri, self.chart_file, self.initial, self.reported_state))
+
     def stop_from(self, state_id: str) -> ChartTransition | None:
         """The safe-stop request the device takes in state ``state_id``, if it takes one there."""
         return next((t for t in self.stops if t.source == state_id and t.request is not None), None)
@@ -277,6 +283,11 @@ class ProcessDescription:
     """The parsed General Process State Chart."""
     outputs: tuple[Output, ...] = ()
     """The values the process gives back, which later steps of a task may take as parameters."""
+
+    def __hash__(self) -> int:
+        """Of its names and chart file only: equal processes hash alike, and a fact cache keyed by the processes
+        does not walk their roles and parameters at every look-up."""
+        return hash((self.id, self.iri, self.chart_file))
 
     def role(self, name: str) -> Role:
         """The role called ``name``."""

@@ -9,8 +9,8 @@ under its own, and goes on ``while`` one does. The same findings serve ``pnp val
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.flow import Branch, Loop
 from plugnproduce.description.model import ProcessDescription, Task
 from plugnproduce.ontology.iris import concept_iri, local_name

@@ -22,9 +22,9 @@ from __future__ import annotations
 import heapq
 import itertools
 from collections.abc import Hashable, Mapping
-from dataclasses import dataclass
 from typing import TypeVar
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import ChartState, ChartTransition, DeviceDescription
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.ontology.taxonomy import Taxonomy

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.flow import Branch, Loop, enclosing, outermost_first, path_name
 from plugnproduce.description.where import Where
 

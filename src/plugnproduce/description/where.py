@@ -3,7 +3,7 @@ so that a finding can say where it is."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from plugnproduce.deferred import dataclass
 
 
 @dataclass(frozen=True)

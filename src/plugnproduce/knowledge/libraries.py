@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.errors import DescriptionError, OntologyError, UnknownName
 from plugnproduce.ontology.iris import PNP_IRI

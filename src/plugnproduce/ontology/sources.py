@@ -18,11 +18,11 @@ import hashlib
 import io
 import warnings
 from collections.abc import Iterable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import unquote, urljoin, urlparse
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.errors import DescriptionError, HostileInputError, UnreadableError, tidy
 
 if TYPE_CHECKING:  # the parsers are imported when a file is read: listing the files needs none of them

@@ -10,12 +10,12 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-import tempfile
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.errors import OntologyError
 from plugnproduce.ontology.iris import PNP_IRI, local_name
 from plugnproduce.ontology.sources import folder_files
@@ -224,6 +224,8 @@ def classify(g: rdflib.Graph, digest: str = "") -> Taxonomy:
     merged = g + cap
     merged.remove((None, OWL.imports, None))  # the files are merged already; owlready2 would fetch imports
     nt = merged.serialize(format="nt", encoding="utf-8")
+    import tempfile  # only reasoning needs a folder of its own: a closure read back needs none
+
     world = owlready2.World()
     try:
         onto = world.get_ontology(PNP_IRI.rstrip("#")).load(fileobj=io.BytesIO(nt), format="ntriples")

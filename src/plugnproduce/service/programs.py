@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.knowledge import Knowledge

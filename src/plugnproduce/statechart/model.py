@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import TypeAlias
+
+from plugnproduce.deferred import dataclass
 
 SCXML_NS = "http://www.w3.org/2005/07/scxml"
 """The SCXML namespace."""

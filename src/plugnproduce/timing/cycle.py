@@ -4,8 +4,10 @@ code generation)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
+
+from plugnproduce.deferred import dataclass
 
 
 @dataclass(frozen=True)

@@ -16,8 +16,8 @@ contract; without it, the value is checked at run time only.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import Command, DeviceDescription, Where
 from plugnproduce.description.quantities.units import unit_known
 from plugnproduce.errors import DescriptionError

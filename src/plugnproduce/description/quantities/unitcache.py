@@ -20,7 +20,6 @@ import hashlib
 import importlib.machinery
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -138,6 +137,8 @@ class UnitTable:
             self._factors = {**other._factors, **self._factors}
         text = json.dumps({"format": FORMAT, "units": sorted(self._units), "factors": self._factors},
                           sort_keys=True)
+        import tempfile  # only writing the table needs it: reading it back does not
+
         with contextlib.suppress(OSError):  # a cache that cannot be written only costs time
             self.path.parent.mkdir(parents=True, exist_ok=True)
             fd, tmp = tempfile.mkstemp(prefix=".units-", dir=self.path.parent)

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 from functools import cache
 from typing import TYPE_CHECKING
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.quantities.unitcache import Incompatible, UnitTable, table_file
 from plugnproduce.errors import PlugNProduceError
 from plugnproduce.lazy import lazy_module

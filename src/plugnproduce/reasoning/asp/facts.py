@@ -12,10 +12,11 @@ agree with the code that will run.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from decimal import Decimal, InvalidOperation
 from typing import TYPE_CHECKING
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
 from plugnproduce.description.paths import NoPath, find_path, in_concept
 from plugnproduce.description.quantities.contracts import KINDS

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Mapping
-from dataclasses import dataclass
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Task, Where
 from plugnproduce.ontology.iris import PNP_IRI
 from plugnproduce.ontology.taxonomy import Taxonomy

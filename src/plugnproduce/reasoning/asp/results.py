@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import Task, Where, plain_value
 
 _CURIE = re.compile(r" \((?:[A-Za-z][\w-]*:[\w-]+|https?://[^)\s]+)\)")

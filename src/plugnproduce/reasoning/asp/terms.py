@@ -118,6 +118,18 @@ def _init(names: tuple[str, ...]) -> Callable[..., None]:
     return scope["__init__"]  # type: ignore[no-any-return]
 
 
+def _first_init(owner: type[Atom], names: tuple[str, ...]) -> Callable[..., None]:
+    """A stand-in ``__init__`` that compiles the predicate's own (:func:`_init`) when it is first called: a command
+    declares some seventy predicates and makes atoms of a few."""
+
+    def __init__(self: Atom, *args: Any, **kwargs: Any) -> None:
+        if owner.__dict__["__init__"] is __init__:
+            owner.__init__ = _init(names)  # type: ignore[method-assign]
+        owner.__init__(self, *args, **kwargs)
+
+    return __init__
+
+
 def _values(names: tuple[str, ...]) -> Callable[[Any], tuple[Any, ...]]:
     if len(names) > 1:
         return operator.attrgetter(*names)
@@ -143,10 +155,11 @@ def predicate(name: str) -> Callable[[type[A]], type[A]]:
         except KeyError as exc:
             raise EncodingError(f"predicate {name}: unsupported field type {exc.args[0]!r}") from exc
         namespace = {k: v for k, v in cls.__dict__.items() if k not in ("__dict__", "__weakref__")}
-        namespace.update(__slots__=names, __match_args__=names, __init__=_init(names), _fields=names,
+        namespace.update(__slots__=names, __match_args__=names, _fields=names,
                          _values=staticmethod(_values(names)), asp=name,
                          _encoders=tuple(c[0] for c in codecs), _decoders=tuple(c[1] for c in codecs))
         data = cast("type[A]", type(cls.__name__, cls.__bases__, namespace))
+        data.__init__ = _first_init(data, names)  # type: ignore[method-assign]
         key = (name, len(names))
         if key in _REGISTRY:
             raise EncodingError(f"predicate {name}/{len(names)} declared twice")

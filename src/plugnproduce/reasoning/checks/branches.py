@@ -22,9 +22,10 @@ from __future__ import annotations
 import dataclasses
 import re
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import TYPE_CHECKING
 
+from plugnproduce.deferred import dataclass
 from plugnproduce.description.flow import Branch
 from plugnproduce.description.model import Task, Where
 from plugnproduce.description.outcomes import branch_of, ending_loop
