@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from plugnproduce import service
+from tests.executor.test_run_until_empty import SPEED
 
 TASK = service.builtin("tasks", "bin-picking-then-home.yaml")
 
@@ -23,7 +24,8 @@ def journal_of(path: Path) -> list[dict[str, Any]]:
 
 def test_parts_are_picked_while_found_and_the_robot_goes_home_when_the_bin_is_empty(tmp_path: Path) -> None:
     journal = tmp_path / "run.jsonl"
-    result = pnp("run", str(TASK), "--sim", "--bin-parts", "3", "--bin-seed", "4", "--journal", str(journal))
+    result = pnp("run", str(TASK), "--sim", "--bin-parts", "3", "--bin-seed", "4", "--speed", SPEED,
+                 "--journal", str(journal))
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr
     records = journal_of(journal)
     branches = [(r["step"], r["outcome"], r["branch"]) for r in records if r["kind"] == "branch"]

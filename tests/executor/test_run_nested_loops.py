@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from plugnproduce import service
-from tests.executor.test_run_until_empty import journal_of, pnp
+from tests.executor.test_run_until_empty import SPEED, journal_of, pnp
 
 TASK = service.builtin("tasks", "bin-picking-in-rounds.yaml")
 ROUND_1 = [1, 4, 4]
@@ -35,7 +35,7 @@ def rounds_of(journal: Path) -> list[list[int]]:
 def test_each_round_picks_up_to_three_parts_and_goes_home(tmp_path: Path, parts: int, seed: int,
                                                           expected: list[list[int]]) -> None:
     journal = tmp_path / "run.jsonl"
-    result = pnp("run", str(TASK), "--sim", "--bin-parts", str(parts), "--bin-seed", str(seed),
+    result = pnp("run", str(TASK), "--sim", "--bin-parts", str(parts), "--bin-seed", str(seed), "--speed", SPEED,
                  "--journal", str(journal))
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr
     assert rounds_of(journal) == expected
@@ -67,7 +67,7 @@ def test_a_loop_whose_body_ends_with_an_inner_loop_runs_every_iteration_of_both(
     does the outer loop count an iteration (deciding the other way round ends an inner loop one step early)."""
     task, journal = tmp_path / "nested.yaml", tmp_path / "run.jsonl"
     task.write_text(NESTED.format(outer=outer, inner=inner), encoding="utf-8")
-    result = pnp("run", str(task), "--sim", "--journal", str(journal))
+    result = pnp("run", str(task), "--sim", "--speed", SPEED, "--journal", str(journal))
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr
     records = journal_of(journal)
     steps = [r["step"] for r in records if r["kind"] == "step"]
