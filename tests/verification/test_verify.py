@@ -99,6 +99,7 @@ async def test_the_seeded_deadlock_is_not_hit_by_a_simulated_run(tmp_path: Path)
 def test_the_counterexample_is_the_shortest(tmp_path: Path) -> None:
     cell = seeded_cell(tmp_path, napping_gripper())
     code, answer = verify_json(str(TASK), "--cell", str(cell))
+    assert (answer["states"], answer["transitions"]) == (21, 32)  # explored before the refusal was found
     assert code == 1 and answer["trace"][-1]["step"] == ("gripper receives xirp.request.Close in state standby, "
                                                          "which has no transition for it")
     result = service.verify(TASK, cell)
