@@ -140,3 +140,25 @@ def test_a_long_task_is_repaired_in_a_cell_with_a_device_that_lacks_an_argument(
     best = service.repair(task, with_vacuum, top=1)[0]
     assert best.cost == whole(task, with_vacuum)[0].cost
     assert service.check(best.task, with_vacuum).plausible
+
+
+@pytest.mark.parametrize("top", [3, 5])
+def test_a_windows_further_repairs_solved_when_wanted_are_those_solved_at_once(
+        cell: Cell, top: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each window's best two repairs are solved at once, the rest only for a window the k-best combinations reach:
+    those are solved entering the window as it was entered then, and give the repairs all solved at once give."""
+    task = faulty_task(60, 6, 3, varied=True)
+    solved: list[int] = []
+    optimise = windows.solver.optimise
+
+    def counted(*args: object, **kwargs: object) -> object:
+        solved.append(int(args[2]))  # type: ignore[call-overload]
+        return optimise(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(windows.solver, "optimise", counted)
+    later = windowed(task, cell, top=top)
+    assert solved.count(windows.FIRST) >= 3 and solved.count(top) >= 1  # some windows asked again for all
+    monkeypatch.setattr(windows, "FIRST", top)
+    at_once = windowed(task, cell, top=top)
+    assert [(r.cost, r.edits, r.task) for r in later] == [(r.cost, r.edits, r.task) for r in at_once]
+    assert len(later) == top

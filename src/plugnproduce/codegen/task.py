@@ -147,9 +147,11 @@ def _produces(task: Task, step: Step, process: ProcessDescription,
               consumed: dict[str, set[str]]) -> tuple[tuple[str, str, str], ...]:
     """(role, output, variable) of each output of this step that a later step takes, and of the
     outcome when a loop of the task ends or goes on on it, or the step has branches."""
-    wanted = consumed.get(step.name or "", set())
+    wanted = consumed.get(step.name or "")
     out = tuple((o.role, o.name, output_variable(step.name or "", o.name))
-                for o in process.outputs if o.name in wanted)
+                for o in process.outputs if o.name in wanted) if wanted else ()
+    if not task.loops and not task.branches:  # the usual straight task: no outcome kept
+        return out
     role = process.outcome_role()
     if role is not None and task.loops and any(lp.until or lp.while_outcome for lp in task.loops_at(step.index)):
         out += ((role.name, "outcome", OUTCOME),)

@@ -267,7 +267,7 @@ def _step_entry(task: Task, s: Step) -> dict[str, object]:
         entry["bind"] = dict(s.bind)
     if s.params:
         entry["params"] = {n: plain_value(v) for n, v in s.params.items()}
-    branches = task.branches_of(s.index)
+    branches = task.branches_of(s.index) if task.branches else ()
     if branches:
         entry["on"] = {concept_value(b.outcome): _entries(task, b.first, b.last) for b in branches}
     return entry
@@ -291,13 +291,13 @@ def _entries(task: Task, start: int, end: int) -> list[dict[str, object]]:
     out: list[dict[str, object]] = []
     i = start
     while i <= end:
-        loop = task.loop_starting(i, end)
+        loop = task.loop_starting(i, end) if task.loops else None
         if loop is not None:
             out.append({"loop": _loop_entry(task, loop)})
             i = loop.last + 1
             continue
         out.append(_step_entry(task, task.steps[i - 1]))
-        i = max([i, *(b.last for b in task.branches_of(i))]) + 1
+        i = max([i, *(b.last for b in task.branches_of(i))]) + 1 if task.branches else i + 1
     return out
 
 

@@ -157,7 +157,9 @@ def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path
     from plugnproduce.timing.tasks import task_cycle_time
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
-    bought = {d.id: d for d in (k.devices if catalogue_or_folder is None else _devices(catalogue_or_folder, k))}
+    bought: dict[str, DeviceDescription] = {}  # read only when a repair buys a device (the libraries' are many)
+    if any(r.repair.added_devices for r in repairs):
+        bought = {d.id: d for d in (k.devices if catalogue_or_folder is None else _devices(catalogue_or_folder, k))}
     out: list[CycleTime | None] = []
     memo = StepMemo()
     for r in repairs:

@@ -35,6 +35,7 @@ class StepMemo:
     def __init__(self) -> None:
         self._seen: dict[Hashable, tuple[float, tuple[str, ...], tuple[tuple[str, _TimerState], ...]]] = {}
         self._shapes: dict[Hashable, int] = {}
+        self._devices: dict[int, tuple[str, ...]] = {}  # a shape's devices, in the order of its regions
         self._kept: dict[int, object] = {}  # what a key names by identity stays alive, so no id is reused
 
     def shape(self, chart: StepChart) -> int:
@@ -48,9 +49,11 @@ class StepMemo:
     def seconds(self, chart: StepChart, timers: Mapping[str, DeviceTimer], notes: list[str],
                 shape: int) -> float:
         """The step's seconds, leaving its devices' timers and ``notes`` as estimating it would."""
-        devices = tuple(dict.fromkeys(r.device.id for r in chart.regions))
-        key = (shape, repr(sorted(step_values(chart.step, chart.process).items())),
-               tuple((d, repr(timers[d].state())) for d in devices))
+        devices = self._devices.get(shape)
+        if devices is None:
+            devices = self._devices[shape] = tuple(dict.fromkeys(r.device.id for r in chart.regions))
+        # the step's values are its process's defaults (the shape names the process) updated with its own
+        key = (shape, repr(sorted(chart.step.params.items())), tuple((d, repr(timers[d].state())) for d in devices))
         if (seen := self._seen.get(key)) is None:
             said: list[str] = []
             seconds = _step_seconds(chart, timers, said)

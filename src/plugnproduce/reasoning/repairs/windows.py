@@ -47,14 +47,14 @@ hundredth; the device sets they would buy (each, and all together) are then trie
 additions to the cell, priced in full once, and the cheapest total (or none bought) wins. This is
 optimal over those purchases, not proven optimal over every subset of the catalogue.
 The ``top`` best repairs combine the windows' own best repairs (k-best sums, distinct because
-the windows are).
+the windows are); a window's third and later repairs are solved only when the sums reach them.
 """
 
 from __future__ import annotations
 
 import heapq
 from collections import defaultdict
-from collections.abc import Hashable, Iterable, Sequence
+from collections.abc import Callable, Hashable, Iterable, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -81,6 +81,9 @@ their next-best repairs then follow the whole-task order exactly."""
 MARGIN = 2
 """Unbroken steps first added on each side of a problem's span."""
 
+FIRST = 2
+"""Repairs of each window solved at once; the next ones only for a window whose second is in a combination."""
+
 
 @dataclass(frozen=True, order=True)
 class Window:
@@ -106,10 +109,31 @@ class _Part:
     device's limit the value broke)."""
 
 
-def k_best(options: Sequence[Sequence[_Part]], k: int) -> list[tuple[_Part, ...]]:
+class _Parts:
+    """A window's repairs, cheapest first: its best two solved at once, the rest only when :func:`k_best` reaches
+    them (the third of a window is wanted only when its second is in a combination already)."""
+
+    def __init__(self, first: list[_Part], rest: Callable[[], list[_Part]] | None):
+        self.parts, self._rest = first, rest
+
+    def has(self, i: int) -> bool:
+        """Whether the window has an ``i``-th repair (0-based), solving for the rest the first time it is asked."""
+        if i >= len(self.parts) and self._rest is not None:
+            self.parts, self._rest = self._rest(), None
+        return i < len(self.parts)
+
+    def __getitem__(self, i: int) -> _Part:
+        return self.parts[i]
+
+
+def k_best(options: Sequence[Sequence[_Part] | _Parts], k: int) -> list[tuple[_Part, ...]]:
     """The ``k`` cheapest ways to pick one part per window (each window's parts sorted by cost)."""
     def total(ix: tuple[int, ...]) -> int:
         return sum(options[w][i].cost for w, i in enumerate(ix))
+
+    def has(w: int, i: int) -> bool:
+        parts = options[w]
+        return parts.has(i) if isinstance(parts, _Parts) else i < len(parts)
 
     first = (0,) * len(options)
     heap, seen = [(total(first), first)], {first}
@@ -119,7 +143,7 @@ def k_best(options: Sequence[Sequence[_Part]], k: int) -> list[tuple[_Part, ...]
         out.append(tuple(options[w][i] for w, i in enumerate(ix)))
         for w in range(len(ix)):
             nxt = ix[:w] + (ix[w] + 1,) + ix[w + 1:]
-            if nxt[w] < len(options[w]) and nxt not in seen:
+            if nxt not in seen and has(w, nxt[w]):
                 seen.add(nxt)
                 heapq.heappush(heap, (total(nxt), nxt))
     return out
@@ -298,16 +322,24 @@ class _Solver:
         cell = Cell(self.cell.name, self.cell.devices + added, self.cell.file)
         price = sum(repairs.add_cost(self.costs, d) for d in added)
         names = tuple(d.id for d in added)
-        per_window: list[list[_Part]] = []
+        per_window: list[_Parts] = []
         carried: dict[str, str] = {}
         for w in wins:
-            models = self.solve(w, cell, (), carried, self.top)
+            first = min(self.top, FIRST)
+            models = self.solve(w, cell, (), carried, first)
+            if len(models) < first < self.top:  # fewer than asked: the whole answer judges how many there are
+                first, models = self.top, self.solve(w, cell, (), carried, self.top)
             if not models:
                 return []
-            parts = [self.part(w, m) for m in models]
+            rest = None if first == self.top else self._rest(w, cell, dict(carried))
+            per_window.append(_Parts([self.part(w, m) for m in models], rest))
             carried.update(self._carried(w, models[0]))
-            per_window.append(parts)
         return [(price + sum(p.cost for p in combo), combo, names) for combo in k_best(per_window, self.top)]
+
+    def _rest(self, w: Window, cell: Cell, carried: dict[str, str]) -> Callable[[], list[_Part]]:
+        """All ``top`` repairs of window ``w``, entering it as it did (its first ones are those solved before:
+        the solver finds them in the same order)."""
+        return lambda: [self.part(w, m) for m in self.solve(w, cell, (), carried, self.top)]
 
     def solve(self, w: Window, cell: Cell, extra: Sequence[DeviceDescription], carried: dict[str, str],
               top: int, costs: RepairCosts | None = None) -> list[Model]:
