@@ -444,3 +444,22 @@ def test_a_device_that_can_walk_a_role_only_by_a_way_its_chart_does_not_take_is_
     assert jammed.purchase is not None and jammed.purchase.impossible == (
         "step 1 of pick-and-place: device jammed-robot cannot play role robot from the state it is in; adding devices "
         "cannot cure it")
+
+
+def test_a_role_no_catalogue_device_can_play_is_named_whichever_devices_the_configuration_holds() -> None:
+    small = [d for d in service.catalogue() if d.id in ("robot", "sensor3d", "binpicking-pc")]
+    for devices in (("robot",), ("binpicking-pc", "robot", "sensor3d")):
+        (row,) = service.batch([Configuration("no-grippers", devices)], small, [task("pick-and-place")], workers=1)
+        assert row.plausible == () and row.purchase is not None and row.purchase.options == ()
+        assert (row.purchase.impossible or "").startswith(
+            "step 1 of pick-and-place: no device can play role gripper, and no catalogue device can"), devices
+
+
+def test_a_device_named_for_a_role_it_cannot_play_is_named_as_check_names_it(tmp_path: Path) -> None:
+    the_task = service.task(write(tmp_path, "robot-grips.yaml", "task: robot-grips\nsteps:\n  - command: close-gripper\n"
+                                  "    bind: {gripper: robot}\n    params: {grip_force: 30}\n"))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "cannot_play")]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of robot-grips: device robot named for role gripper cannot play it; adding devices cannot cure it")
