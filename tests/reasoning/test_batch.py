@@ -41,6 +41,7 @@ def test_the_cheapest_device_to_add_is_named_with_its_cost() -> None:
     (row,) = rows([Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d"))])
     assert row.plausible == ()
     assert row.purchase is not None and row.purchase.options == ((("gripper",), cost("gripper")),)
+    assert row.to_json()["purchase"] == {"options": [{"add": ["gripper"], "cost": cost("gripper")}]}
 
 
 def test_two_missing_devices_are_bought_together() -> None:
