@@ -390,3 +390,12 @@ def test_a_value_outside_the_process_range_is_implausible_in_the_batch_as_in_che
     checked = service.check(the_task, service.cell(DESCRIPTIONS / "cells" / "bin-picking.yaml"))
     assert [p.kind for p in checked.problems] == [kind]
     assert row.plausible == () and not checked.plausible
+
+
+def test_a_finding_of_the_full_check_the_batch_has_no_words_for_is_named_by_its_kind(tmp_path: Path) -> None:
+    linked = service.task(write(tmp_path, "hi.yaml", "task: hi\nsteps:\n  - name: localize\n    command: localize-part\n"
+                                "  - command: pick\n    params:\n      pick_pose: {from: localize, output: part_pose}\n"
+                                "      grip_force: 1000\n"))
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [linked], workers=1)
+    assert row.to_json()["purchase"] == {"options": [], "impossible": "step 2 of hi: a finding of kind too_high (pnp "
+                                                                      "check says why); adding devices cannot cure it"}
