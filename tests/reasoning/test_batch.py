@@ -399,3 +399,12 @@ def test_a_finding_of_the_full_check_the_batch_has_no_words_for_is_named_by_its_
     (row,) = service.batch([Configuration("paper", PAPER)], None, [linked], workers=1)
     assert row.to_json()["purchase"] == {"options": [], "impossible": "step 2 of hi: a finding of kind too_high (pnp "
                                                                       "check says why); adding devices cannot cure it"}
+
+
+def test_a_device_the_task_names_that_no_catalogue_holds_cannot_be_bought(tmp_path: Path) -> None:
+    own = service.task(write(tmp_path, "own.yaml", "task: own-gripper\nsteps:\n  - command: close-gripper\n"
+                                                   "    bind: {gripper: my-gripper}\n"))
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [own], workers=1)
+    assert row.to_json()["purchase"] == {"options": [], "impossible": "step 1 of own-gripper: device my-gripper named "
+                                                                      "for role gripper is not in the cell; it is not "
+                                                                      "in the catalogue"}
