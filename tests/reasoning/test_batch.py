@@ -41,6 +41,7 @@ def test_the_cheapest_device_to_add_is_named_with_its_cost() -> None:
     (row,) = rows([Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d"))])
     assert row.plausible == ()
     assert row.purchase is not None and row.purchase.options == ((("gripper",), cost("gripper")),)
+    assert row.to_json()["purchase"] == {"options": [{"add": ["gripper"], "cost": cost("gripper")}]}
 
 
 def test_two_missing_devices_are_bought_together() -> None:
@@ -463,3 +464,19 @@ def test_a_device_named_for_a_role_it_cannot_play_is_named_as_check_names_it(tmp
     (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
     assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
         "step 1 of robot-grips: device robot named for role gripper cannot play it; adding devices cannot cure it")
+def test_a_finding_of_the_full_check_the_batch_has_no_words_for_is_named_by_its_kind(tmp_path: Path) -> None:
+    linked = service.task(write(tmp_path, "hi.yaml", "task: hi\nsteps:\n  - name: localize\n    command: localize-part\n"
+                                "  - command: pick\n    params:\n      pick_pose: {from: localize, output: part_pose}\n"
+                                "      grip_force: 1000\n"))
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [linked], workers=1)
+    assert row.to_json()["purchase"] == {"options": [], "impossible": "step 2 of hi: a finding of kind too_high (pnp "
+                                                                      "check says why); adding devices cannot cure it"}
+
+
+def test_a_device_the_task_names_that_no_catalogue_holds_cannot_be_bought(tmp_path: Path) -> None:
+    own = service.task(write(tmp_path, "own.yaml", "task: own-gripper\nsteps:\n  - command: close-gripper\n"
+                                                   "    bind: {gripper: my-gripper}\n"))
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [own], workers=1)
+    assert row.to_json()["purchase"] == {"options": [], "impossible": "step 1 of own-gripper: device my-gripper named "
+                                                                      "for role gripper is not in the cell; it is not "
+                                                                      "in the catalogue"}
