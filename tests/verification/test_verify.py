@@ -180,7 +180,8 @@ def test_the_arguments_a_program_sends_are_held_to_the_devices_terms() -> None:
 def test_a_value_the_process_takes_but_the_device_does_not_is_refuted_as_the_run_would_refuse_it(
         tmp_path: Path) -> None:
     # the process's grip_force is a decimal, this gripper's Close takes a whole number of newtons: the executor
-    # refuses to send 45.5 (a contract fault at step 1), so verification must not call the program proved
+    # refuses to send 45.5 (a contract fault at step 1). The check tells of it in the task; a program that sends
+    # it all the same is never called proved
     cell = seeded_cell(tmp_path, (D / "devices" / "gripper.scxml").read_text(encoding="utf-8"))
     description = tmp_path / "devices" / "gripper.ttl"
     description.write_text(description.read_text(encoding="utf-8").replace(
@@ -188,8 +189,12 @@ def test_a_value_the_process_takes_but_the_device_does_not_is_refuted_as_the_run
         "pnp:quantity pnp:GripForce ;\n    pnp:datatype xsd:integer ;"), encoding="utf-8")
     task = tmp_path / "whole-newtons.yaml"
     task.write_text(TASK.read_text(encoding="utf-8").replace("grip_force: 45", "grip_force: 45.5"), encoding="utf-8")
-    assert service.check(task, cell).plausible
-    result = service.verify(task, cell)
+    (finding,) = service.check(task, cell).problems
+    assert finding.kind == "device_limit" and finding.text.endswith("takes a whole number; the value is 45.5")
+    generated = service.generate(TASK, cell).task  # 45 N: plausible; then made to send 45.5
+    chart = generated.task_chart().replace(b'name="GripForce" expr="45"', b'name="GripForce" expr="45.5"')
+    assert chart != generated.task_chart()
+    result = verify(dataclasses.replace(generated, chart=parse_chart(chart, "task.scxml")), service.cell(cell))
     assert result.verdict == "refuted"
     assert result.problem == ("device gripper: xirp.request.Close argument GripForce is 45.5, beyond the device's "
                               "contract: it takes a whole number; the value is 45.5")

@@ -176,6 +176,9 @@ def _beyond_own_range(value: object, par: Parameter) -> bool:
 
 def _beyond(value: object, par: Parameter, contract: Argument) -> str | None:
     """Why ``value`` (in the parameter's unit) breaks the device's contract, or None if it keeps it
-    (the one definition, :func:`plugnproduce.description.quantities.contracts.breach`; the type check tells of a
-    wrong type)."""
-    return breach(value, par.unit, contract, types=False)
+    (the one definition, :func:`plugnproduce.description.quantities.contracts.breach`). A number the process
+    takes is held to the device's own datatype too, as the executor holds it (a whole number for an
+    ``xsd:integer`` argument: 45.5 N never goes to a gripper that takes whole newtons); a value of the wrong
+    type for the process itself is the type check's to tell of."""
+    number = _numeric(par) and isinstance(value, int | float) and not isinstance(value, bool)
+    return breach(value, par.unit, contract, types=number)
