@@ -6,6 +6,7 @@ What ``pnp check`` calls plausible the run must hold: the executor refuses to se
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 from pathlib import Path
 
@@ -15,6 +16,13 @@ from typer.testing import CliRunner
 from plugnproduce import service
 from plugnproduce.batch import Configuration
 from plugnproduce.cli import app
+from plugnproduce.description.model import Argument
+from plugnproduce.description.quantities.contracts import XSD
+from plugnproduce.description.quantities.ranges import OutputRange
+from plugnproduce.description.tasks import Link
+from plugnproduce.executor.monitor import Breach, Monitor
+from plugnproduce.ontology.iris import PNP_IRI
+from plugnproduce.reasoning.checks.linksafety import _unproven
 from tests.conftest import edit
 from tests.reasoning.conftest import DESCRIPTIONS, write
 
@@ -114,3 +122,24 @@ def test_repair_resets_the_fraction_to_the_default_the_device_takes(builtin_cell
     assert all(e.text.endswith(f"reset parameter grip_force to its default 40 (device 'gripper' {WHOLE})")
                for e in best.edits)
     assert service.check(best.task, builtin_cell).plausible
+
+
+def test_a_linked_value_is_left_to_the_run_for_a_device_that_takes_whole_numbers() -> None:
+    # no device declares that an output it reports is whole, so a linked value's datatype is known only at run
+    # time, where the executor's monitor refuses a fraction (tests/executor/test_monitor.py); the check says so
+    whole = Argument("Close", PNP_IRI + "GripForce", datatype=XSD + "integer", unit="N", minimum=10, maximum=60)
+    reported = OutputRange("force", unit="N", minimum=20, maximum=40)
+    link = Link("measure", "force")
+    assert _unproven([whole], reported, link, "gripper", "scale") == (
+        "gripper takes a whole number; scale does not promise one for force")
+    decimal = dataclasses.replace(whole, datatype=XSD + "decimal")
+    assert _unproven([decimal], reported, link, "gripper", "scale").startswith("proven: ")
+
+
+def test_the_run_refuses_a_fraction_known_only_at_run_time(builtin_cell: Path) -> None:
+    # what a link brings (an earlier step's output) the monitor holds to the datatype before the request goes out
+    monitor = Monitor(service.generate(DESCRIPTIONS / "tasks" / "bin-picking.yaml", builtin_cell).task,
+                      service.cell(builtin_cell))
+    refused = monitor.check(1, "gripper", "Close", {"GripForce": 45.5}, {})
+    assert isinstance(refused, Breach) and refused.why == WHOLE
+    assert monitor.check(1, "gripper", "Close", {"GripForce": 45}, {}) == {"GripForce": 45}

@@ -14,6 +14,7 @@ from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING
 
 from plugnproduce.description.model import Argument, Cell, Link, ProcessDescription, Step, Task
+from plugnproduce.description.quantities.contracts import kind_of
 from plugnproduce.description.quantities.ranges import OutputRange, output_ranges
 from plugnproduce.description.quantities.units import UnitError, convert, reach_length
 from plugnproduce.reasoning.asp.results import CheckResult, LinkSafety
@@ -62,6 +63,8 @@ def _source(task: Task, step: Step, link: Link) -> Step | None:
 def _unproven(contracts: list[Argument], declared: OutputRange | None, link: Link, device: str,
               reporter: str) -> str:
     """Why the link's value is not proven within every contract, or ``proven: …`` with the proof."""
+    if any(kind_of(c.datatype) == "integer" for c in contracts):  # no device declares its outputs whole
+        return f"{device} takes a whole number; {reporter} does not promise one for {link.output}"
     limited = [c for c in contracts if c.reach is not None or c.minimum is not None or c.maximum is not None]
     if not limited:
         return f"proven: {device} sets no limits on it; its type and size are checked at run time"
