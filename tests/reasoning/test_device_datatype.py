@@ -7,6 +7,7 @@ What ``pnp check`` calls plausible the run must hold: the executor refuses to se
 from __future__ import annotations
 
 import dataclasses
+import re
 import shutil
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from plugnproduce import service
 from plugnproduce.batch import Configuration
 from plugnproduce.cli import app
 from plugnproduce.description.model import Argument
-from plugnproduce.description.quantities.contracts import XSD
+from plugnproduce.description.quantities.contracts import XSD, breach, in_contract_unit
 from plugnproduce.description.quantities.ranges import OutputRange
 from plugnproduce.description.tasks import Link
 from plugnproduce.executor.monitor import Breach, Monitor
@@ -143,3 +144,36 @@ def test_the_run_refuses_a_fraction_known_only_at_run_time(builtin_cell: Path) -
     refused = monitor.check(1, "gripper", "Close", {"GripForce": 45.5}, {})
     assert isinstance(refused, Breach) and refused.why == WHOLE
     assert monitor.check(1, "gripper", "Close", {"GripForce": 45}, {}) == {"GripForce": 45}
+
+
+@pytest.fixture()
+def decanewton_cell(builtin_cell: Path) -> Path:
+    """The bin-picking cell whose gripper's Close takes whole decanewtons (2 to 10 daN): 45 N is 4.5 daN."""
+    edit(builtin_cell.parent.parent / "devices" / "gripper.ttl",
+         'pnp:unit "N" ;\n    pnp:minValue 20 ; pnp:maxValue 100 .',
+         'pnp:unit "daN" ;\n    pnp:minValue 2 ; pnp:maxValue 10 .')
+    return builtin_cell
+
+
+def test_a_whole_number_of_newtons_that_is_a_fraction_of_the_devices_unit_is_refused(
+        decanewton_cell: Path, tmp_path: Path) -> None:
+    # 45 N is whole, but goes out as 4.5 daN to an argument that takes whole decanewtons
+    task = _bin_picking(tmp_path, "45")
+    result = CliRunner().invoke(app, ["check", str(task), "--cell", str(decanewton_cell)])
+    assert result.exit_code == 1, result.stdout
+    assert ("parameter grip_force = 45 N goes to device 'gripper' with request Close, which takes a whole number "
+            "of daN; the value is 45 N (4.5 daN)") in result.stdout
+    assert service.check(_bin_picking(tmp_path, "40"), decanewton_cell).plausible
+
+
+def test_the_run_sends_a_converted_whole_number_as_one_and_refuses_a_fraction(decanewton_cell: Path,
+                                                                              tmp_path: Path) -> None:
+    generation = service.generation(_bin_picking(tmp_path, "40"), decanewton_cell)
+    chart = next(c.data for c in generation.charts if c.kind == "task").decode()
+    assert re.search(r'<send event="xirp.request.Close"[^>]*>\s*<param name="GripForce" expr="4"/>', chart), chart
+    monitor = Monitor(generation.generated.task, service.cell(decanewton_cell))
+    assert monitor.check(1, "gripper", "Close", {"GripForce": 4.0}, {}) == {"GripForce": 4}
+    # a value in newtons known only at run time (a link) is judged in the unit it goes out in
+    contract = service.cell(decanewton_cell).device("gripper").argument("Close", PNP_IRI + "GripForce")
+    assert breach(45, "N", contract) == "takes a whole number of daN; the value is 45 N (4.5 daN)"
+    assert breach(40, "N", contract) is None and in_contract_unit(40, "N", contract) == 4

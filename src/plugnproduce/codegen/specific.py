@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from plugnproduce.chartnames import STEP, VALUES
 from plugnproduce.description.model import ChartTransition, Command, DeviceDescription, ProcessDescription, Role
 from plugnproduce.description.paths import find_path
-from plugnproduce.description.quantities.contracts import in_unit
+from plugnproduce.description.quantities.contracts import in_contract_unit
 from plugnproduce.ontology.iris import concept_value, local_name
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.statechart.model import Final, Param, Send, State, Transition, pnp
@@ -170,7 +170,7 @@ def _request(
         if par.quantity in accepts:
             contract = device.argument(command.name, par.quantity)
             expr = (value.expr if isinstance(value, Varying | Flow)
-                    else literal(in_unit(value, par.unit, contract.unit)))
+                    else literal(in_contract_unit(value, par.unit, contract)))
             send.params.append(Param(name=local_name(par.quantity), expr=expr))
             given.add(par.quantity)
     for quantity in accepts:  # an argument the process does not supply takes the device's own default

@@ -21,7 +21,7 @@ from typing import Any
 from plugnproduce.chartnames import output_variable
 from plugnproduce.codegen.task import GeneratedTask, StepChart
 from plugnproduce.description.model import Argument, Cell, DeviceDescription, Link
-from plugnproduce.description.quantities.contracts import breach, in_unit, shorten
+from plugnproduce.description.quantities.contracts import breach, in_contract_unit, shorten
 from plugnproduce.ontology.iris import local_name
 
 
@@ -81,7 +81,7 @@ class Monitor:
             why = breach(params[name], source.unit, contract)
             if why is not None:
                 return Breach(name, params[name], source.text, why)
-            out[name] = in_unit(params[name], source.unit, contract.unit)
+            out[name] = in_contract_unit(params[name], source.unit, contract)
         return out
 
     def _step(self, step: int | None) -> StepChart | None:

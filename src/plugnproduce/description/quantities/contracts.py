@@ -60,7 +60,7 @@ def breach(value: object, unit: str, contract: Argument, *, types: bool = True) 
             return why
     if isinstance(value, bool) or not isinstance(value, int | float):
         return None
-    return _limit_breach(value, unit, contract)
+    return _limit_breach(value, unit, contract, whole=types and kind_of(contract.datatype) == "integer")
 
 
 def _pose_breach(position: tuple[float, float, float], unit: str, contract: Argument) -> str | None:
@@ -83,7 +83,9 @@ def _shown(distance: float) -> str:
     return f"{distance:.3g}" if distance < 1000 else f"{distance:.0f}"
 
 
-def _limit_breach(value: float, unit: str, contract: Argument) -> str | None:
+def _limit_breach(value: float, unit: str, contract: Argument, *, whole: bool = False) -> str | None:
+    """Why ``value`` (in ``unit``) is beyond the contract's limits, judged in the contract's unit; with ``whole``,
+    also a number that is whole only before its conversion (45 N is 4.5 daN)."""
     try:
         number = convert(float(value), unit, contract.unit)
     except UnitError as exc:
@@ -93,6 +95,8 @@ def _limit_breach(value: float, unit: str, contract: Argument) -> str | None:
         return f"takes a finite number; the value is {value!r}"
     shown_unit = f" {contract.unit}" if contract.unit else ""
     shown = f"{value:g} {unit}".strip() if unit != contract.unit else f"{number:g}{shown_unit}"
+    if whole and not number.is_integer():
+        return f"takes a whole number of {contract.unit}; the value is {shown} ({number:g} {contract.unit})"
     if contract.minimum is not None and number < contract.minimum:
         return f"takes at least {contract.minimum:g}{shown_unit}; the value is {shown}"
     if contract.maximum is not None and number > contract.maximum:
@@ -194,3 +198,12 @@ def in_unit(value: object, unit: str, to: str) -> object:
     if isinstance(value, bool) or not isinstance(value, int | float):
         return value
     return convert(float(value), unit, to)
+
+
+def in_contract_unit(value: object, unit: str, contract: Argument) -> object:
+    """A value in ``unit`` as it goes to ``contract``'s argument: in the argument's unit (:func:`in_unit`), and a
+    whole number written as one where the argument takes whole numbers (40 N as 4 daN, not 4.0)."""
+    out = in_unit(value, unit, contract.unit)
+    if kind_of(contract.datatype) == "integer" and isinstance(out, float) and out.is_integer():
+        return int(out)
+    return out
