@@ -27,6 +27,15 @@ _DEFERRED: dict[type, dict[str, Any]] = {}
 """The classes whose dataclass methods are not made yet, with the options they were declared with."""
 
 
+def make_all_classes() -> None:
+    """Make every class declared so far. A process that uses these classes from several threads (the HMI's
+    server) calls this before its threads start: while :func:`_make` puts a class's methods in place of its
+    stand-ins, the class briefly has neither, and another thread using it then would find ``object``'s."""
+    with _MADE:
+        for cls in list(_DEFERRED):
+            _make(cls)
+
+
 def _make(cls: type) -> None:
     """Make the dataclass methods of ``cls`` now (its bases' first, as :func:`dataclasses.dataclass` reads them)."""
     with _MADE:

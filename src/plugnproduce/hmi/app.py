@@ -63,6 +63,7 @@ def create_app(
     :mod:`plugnproduce.hmi.work`).
     """
     knowledge = knowledge or service.knowledge()
+    service.make_all_classes()  # before the server's threads use them (plugnproduce.deferred)
     devices = catalogue if catalogue is not None else service.catalogue(knowledge=knowledge)
     hub = Hub(source, runner, devices, knowledge)
     work = Work(limits or WorkLimits(), hub.knowledge, devices)

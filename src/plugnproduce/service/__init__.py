@@ -46,6 +46,7 @@ if TYPE_CHECKING:
     from plugnproduce.batch import generate as random_configurations
     from plugnproduce.codegen import GeneratedTask, ImplausibleStep
     from plugnproduce.codegen.outputs import GeneratedChart
+    from plugnproduce.deferred import make_all_classes
     from plugnproduce.description.flow import Loop
     from plugnproduce.description.model import (
         Cell,
@@ -129,6 +130,7 @@ else:
 
 _ELSEWHERE = {
     "Loop": "plugnproduce.description.flow",
+    "make_all_classes": "plugnproduce.deferred",
     **dict.fromkeys(("Cell", "DeviceDescription", "Link", "Output", "Parameter", "ProcessDescription", "Step",
                      "Task", "plain_value"), "plugnproduce.description.model"),
     "describe": "plugnproduce.executor.journal",
@@ -180,6 +182,7 @@ __all__ = [
     "BATCH_CSV_HEADER",
     "MAX_BYTES",
     "MAX_DIGITS",
+    "make_all_classes",
     "repair_cycle_times",
     "batch_cycle_times",
     "pareto_front",
