@@ -28,11 +28,11 @@ _DEFERRED: dict[type, dict[str, Any]] = {}
 
 
 def make_all_classes() -> None:
-    """Make every class declared so far. A process that uses these classes from several threads (the HMI's
+    """Make every class of this package declared so far. A process that uses them from several threads (the HMI's
     server) calls this before its threads start: while :func:`_make` puts a class's methods in place of its
     stand-ins, the class briefly has neither, and another thread using it then would find ``object``'s."""
     with _MADE:
-        for cls in list(_DEFERRED):
+        for cls in [c for c in _DEFERRED if c.__module__.startswith("plugnproduce.")]:
             _make(cls)
 
 
