@@ -276,7 +276,9 @@ def _prepare(guard: Guard, work: Path) -> None:
         # the plugin below empties the package's caches before each test, so that no value computed by
         # the unmutated code (a compiled expression, a checked name) hides the mutant.
         "process_isolation": "forkserver",
-        "timeout_multiplier": 3.0,
+        # generous: on a busy machine a mutant's tests take several times the clean run's estimate, and a
+        # survivor must not pass for a timeout
+        "timeout_multiplier": 8.0,
         "timeout_constant": 5.0,
         # the wording of an error is not a guard (the condition that raises it is): raise lines are not mutated
         "do_not_mutate_patterns": [r"^\s*raise\s"],
