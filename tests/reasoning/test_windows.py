@@ -1,4 +1,7 @@
-"""Repair window by window: the same optimal cost as repairing the whole task at once, on random tasks."""
+"""Repair window by window: the same optimal cost as repairing the whole task at once, on random tasks; and the repair
+users get (``pnp repair``, :func:`plugnproduce.reasoning.repair`): a task of at most ``WHOLE_UP_TO`` steps repaired
+whole, a longer one window by window, every setting of the call (catalogue, costs, insertion slots, most insertions,
+how many repairs) honoured both ways."""
 
 from __future__ import annotations
 
@@ -10,7 +13,9 @@ from hypothesis import strategies as st
 
 from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription, Step, Task
-from plugnproduce.reasoning import RepairCosts
+from plugnproduce.description.taskfile import parse_task
+from plugnproduce.reasoning import Repair, RepairCosts
+from plugnproduce.reasoning import repair as user_repair
 from plugnproduce.reasoning.repairs import repairs, windows
 from plugnproduce.reasoning.repairs.windows import Window
 from tests.reasoning.faulty_tasks import faulty_task
@@ -162,3 +167,111 @@ def test_a_windows_further_repairs_solved_when_wanted_are_those_solved_at_once(
     at_once = windowed(task, cell, top=top)
     assert [(r.cost, r.edits, r.task) for r in later] == [(r.cost, r.edits, r.task) for r in at_once]
     assert len(later) == top
+
+NOT_DROPPED = ("move-to", "swap", "force", "absent", "unknown")
+SHORT = faulty_task(20, 2, 0, kinds=NOT_DROPPED)
+"""40 steps: the third-best repair of the whole task (insert a place) is not the windows' (remove the bin-pick)."""
+LONG = faulty_task(24, 2, 3, kinds=NOT_DROPPED)
+"""48 steps: the third-best repair of the windows (insert a pick) is not the whole task's (insert a place)."""
+LONG_INSERT = faulty_task(24, 1, 3, kinds=("move-to",))
+"""48 steps: best repaired by inserting an open-gripper, else by removing a bin-pick."""
+
+
+def _answers(found: list[Repair]) -> list[tuple[float, list[str]]]:
+    return [(r.cost, [e.text for e in r.edits]) for r in found]
+
+
+def _inserts(found: list[Repair]) -> list[str]:
+    return [e.text for r in found for e in r.edits if e.kind == "insert"]
+
+
+def test_a_task_of_exactly_the_whole_limit_is_repaired_whole(cell: Cell) -> None:
+    assert len(SHORT.steps) == windows.WHOLE_UP_TO
+    got = _answers(service.repair(SHORT, cell, top=3))
+    assert got == _answers(repairs.repair(SHORT, cell, KNOWLEDGE, top=3))
+    assert got[2] == (4.0, ["insert place before step 28 (move-to)",
+                            "step 29 (bin-pick): reset parameter grip_force to its default 40"])
+    assert got != _answers(windows.windowed_repair(SHORT, cell, KNOWLEDGE, top=3))  # the two ways differ here
+
+
+def test_a_longer_task_is_repaired_window_by_window(cell: Cell) -> None:
+    assert len(LONG.steps) > windows.WHOLE_UP_TO
+    got = _answers(service.repair(LONG, cell, top=3))
+    assert got == _answers(windows.windowed_repair(LONG, cell, KNOWLEDGE, top=3))
+    assert got[2] == (6.0, ["step 18 (place): drop parameter grip_force (not declared)",
+                            "insert open-gripper before step 40 (bin-pick)", "insert pick before step 42 (place)"])
+    assert got != _answers(repairs.repair(LONG, cell, KNOWLEDGE, top=3))  # the two ways differ here
+
+
+def test_three_repairs_unless_asked_for_another_number(cell: Cell) -> None:
+    assert [r.rank for r in user_repair(SHORT, cell, KNOWLEDGE)] == [1, 2, 3]
+    assert [r.rank for r in user_repair(LONG, cell, KNOWLEDGE)] == [1, 2, 3]
+
+
+def test_no_insertion_when_none_is_allowed_short_or_long(cell: Cell) -> None:
+    for task in (SHORT, LONG_INSERT):
+        assert _inserts(windows.repair(task, cell, KNOWLEDGE, top=1))  # the best repair inserts a step
+        found = windows.repair(task, cell, KNOWLEDGE, top=1, max_inserts=0)
+        assert _inserts(found) == [] and found[0].cost == 4.0
+        assert service.check(found[0].task, cell).plausible
+
+
+def test_no_insertion_without_insertion_slots_short_or_long(cell: Cell) -> None:
+    for task, removed in ((SHORT, "remove step 29 (bin-pick)"), (LONG_INSERT, "remove step 17 (bin-pick)")):
+        found = windows.repair(task, cell, KNOWLEDGE, top=1, per_gap=0)
+        assert _answers(found) == [(4.0, [removed])]
+
+
+def test_the_users_costs_price_the_repair_short_or_long(cell: Cell) -> None:
+    costs = RepairCosts(insert=7, reset=3)
+    assert _answers(windows.repair(SHORT, cell, KNOWLEDGE, top=1, costs=costs)) == [
+        (4.0, ["remove step 29 (bin-pick)"])]
+    assert _answers(windows.repair(LONG, cell, KNOWLEDGE, top=1, costs=costs)) == [
+        (6.0, ["step 18 (place): drop parameter grip_force (not declared)",
+               "swap step 40 (bin-pick) with step 41 (place)"])]
+
+
+def _with_screw(task: Task) -> Task:
+    screws = "  - command: screw\n" * 2
+    return parse_task(f"task: screwed\nsteps:\n{_steps(task)}{screws}".encode(), "screwed.yaml")
+
+
+def _steps(task: Task) -> str:
+    return "".join(f"  - command: {st.command}\n" for st in task.steps)
+
+
+def test_a_device_of_the_catalogue_is_bought_short_or_long(cell: Cell, devices: list[DeviceDescription]) -> None:
+    """No screwdriver in the cell: two screw steps at the end of a short and of a long plausible task (buying a
+    screwdriver costs less than removing both)."""
+    for pairs in (10, 24):
+        task = _with_screw(faulty_task(pairs, 0, 1))
+        [best] = service.repair(task, cell, devices, top=1)
+        assert best.added_devices == ("screwdriver",) and best.cost == 5.14
+
+
+LOOP = """  - loop:
+      until: BinEmpty
+      max: 100
+      steps:
+        - name: localize
+          command: localize-part
+          params: {exposure: 25}
+        - command: pick
+          params:
+            pick_pose: {from: localize, output: part_pose}
+            grip_force: 45
+        - command: place
+        - command: screw
+"""
+
+
+def test_a_long_task_keeps_its_loop_with_the_device_bought_for_it(cell: Cell, devices: list[DeviceDescription]
+                                                                 ) -> None:
+    """42 bin-pick and place steps, then a loop that screws: the screwdriver bought, the loop written as it was."""
+    text = f"task: long-loop\nsteps:\n{_steps(faulty_task(21, 0, 1))}{LOOP}"
+    task = parse_task(text.encode(), "long-loop.yaml")
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    [best] = service.repair(task, cell, devices, top=1)
+    assert best.added_devices == ("screwdriver",) and best.unrolls is None
+    assert [(lp.entry, lp.first, lp.last) for lp in best.task.loops] == [(43, 47, 50)]
+    assert service.check(best.task, cell.with_device(next(d for d in devices if d.id == "screwdriver"))).plausible
