@@ -166,7 +166,7 @@ def test_a_windows_further_repairs_solved_when_wanted_are_those_solved_at_once(
     monkeypatch.setattr(windows, "FIRST", top)
     at_once = windowed(task, cell, top=top)
     assert [(r.cost, r.edits, r.task) for r in later] == [(r.cost, r.edits, r.task) for r in at_once]
-    assert len(later) == top
+    assert len({tuple(e.text for e in r.edits) for r in later}) == top  # distinct
 
 NOT_DROPPED = ("move-to", "swap", "force", "absent", "unknown")
 SHORT = faulty_task(20, 2, 0, kinds=NOT_DROPPED)
@@ -198,8 +198,12 @@ def test_a_longer_task_is_repaired_window_by_window(cell: Cell) -> None:
     assert len(LONG.steps) > windows.WHOLE_UP_TO
     got = _answers(service.repair(LONG, cell, top=3))
     assert got == _answers(windows.windowed_repair(LONG, cell, KNOWLEDGE, top=3))
-    assert got[2] == (6.0, ["step 18 (place): drop parameter grip_force (not declared)",
-                            "insert open-gripper before step 40 (bin-pick)", "insert pick before step 42 (place)"])
+    dropped = "step 18 (place): drop parameter grip_force (not declared)"
+    assert got == [(4.0, [dropped, "swap step 40 (bin-pick) with step 41 (place)"]),
+                   (5.0, [dropped, "insert open-gripper before step 40 (bin-pick)",
+                          "insert close-gripper before step 42 (place)"]),
+                   (6.0, [dropped, "insert open-gripper before step 40 (bin-pick)",
+                          "insert pick before step 42 (place)"])]
     assert got != _answers(repairs.repair(LONG, cell, KNOWLEDGE, top=3))  # the two ways differ here
 
 
@@ -275,3 +279,30 @@ def test_a_long_task_keeps_its_loop_with_the_device_bought_for_it(cell: Cell, de
     assert best.added_devices == ("screwdriver",) and best.unrolls is None
     assert [(lp.entry, lp.first, lp.last) for lp in best.task.loops] == [(43, 47, 50)]
     assert service.check(best.task, cell.with_device(next(d for d in devices if d.id == "screwdriver"))).plausible
+
+
+def test_a_window_with_a_single_repair_gives_that_one_however_many_are_asked(cell: Cell) -> None:
+    """A grip force out of range, no insertion slots, the window the bin-pick alone: removing the bin-pick would
+    leave the gripper open for the place after the window, so resetting the force is the only repair."""
+    task = faulty_task(25, 1, 0, kinds=("force",))
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=3, per_gap=0, margin=0)
+    assert _answers(found) == [(1.0, ["step 27 (bin-pick): reset parameter grip_force to its default 40"])]
+
+
+def test_every_combination_of_the_windows_repairs_when_fewer_than_asked(cell: Cell) -> None:
+    """Two places bound to a SCARA the cell lacks, no insertion slots: each window is repaired by rebinding its place
+    or removing it with its bin-pick, so there are four repairs, whatever the number asked."""
+    task = faulty_task(25, 2, 5, kinds=("absent",))
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=10, per_gap=0)
+    assert [r.cost for r in found] == [4.0, 10.0, 10.0, 16.0]
+    assert len({tuple(e.text for e in r.edits) for r in found}) == 4
+
+
+def test_a_window_leaves_the_devices_as_the_steps_after_it_expect(cell: Cell) -> None:
+    """Resetting the grip force dear, the window the bin-pick alone: removing the bin-pick (4) would leave the gripper
+    open for the place after the window; the repair closes it as well (6), and the task is plausible."""
+    task = faulty_task(25, 1, 0, kinds=("force",))
+    costs = RepairCosts(reset=10)
+    [best] = windows.windowed_repair(task, cell, KNOWLEDGE, top=1, costs=costs, margin=0)
+    assert _answers([best]) == [(6.0, ["insert close-gripper before step 27 (bin-pick)", "remove step 27 (bin-pick)"])]
+    assert service.check(best.task, cell).plausible
