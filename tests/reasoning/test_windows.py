@@ -58,6 +58,20 @@ def test_the_default_costs_keep_edits_local() -> None:
     assert windows.edits_stay_local(RepairCosts(), KNOWLEDGE.processes)
 
 
+@pytest.mark.parametrize("costs, local", [
+    (RepairCosts(remove=2, swap=2, rebind=2), True),  # as dear as the cheapest insertion (open-gripper: 1 + 1 role)
+    (RepairCosts(remove=1.9), False),
+    (RepairCosts(swap=1.9), False),
+    (RepairCosts(rebind=1.9), False),
+])
+def test_edits_stay_local_while_no_edit_is_cheaper_than_the_cheapest_insertion(costs: RepairCosts, local: bool) -> None:
+    assert windows.edits_stay_local(costs, KNOWLEDGE.processes) is local
+
+
+def test_with_no_process_to_insert_every_edit_stays_local() -> None:
+    assert windows.edits_stay_local(RepairCosts(remove=0.5), ()) is True
+
+
 def test_a_long_task_keeps_its_unbroken_steps_and_is_plausible_after(cell: Cell) -> None:
     task = faulty_task(300, 12, 7)
     best = windowed(task, cell)[0]
@@ -306,3 +320,10 @@ def test_a_window_leaves_the_devices_as_the_steps_after_it_expect(cell: Cell) ->
     [best] = windows.windowed_repair(task, cell, KNOWLEDGE, top=1, costs=costs, margin=0)
     assert _answers([best]) == [(6.0, ["insert close-gripper before step 27 (bin-pick)", "remove step 27 (bin-pick)"])]
     assert service.check(best.task, cell).plausible
+
+
+def test_a_long_task_plausible_as_written_needs_no_repair(cell: Cell) -> None:
+    task = faulty_task(25, 0, 1)
+    assert service.check(task, cell).plausible
+    assert service.repair(task, cell, top=3) == []
+    assert windows.windowed_repair(task, cell, KNOWLEDGE, top=3) == []
