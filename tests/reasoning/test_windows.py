@@ -312,14 +312,16 @@ def test_every_combination_of_the_windows_repairs_when_fewer_than_asked(cell: Ce
     assert len({tuple(e.text for e in r.edits) for r in found}) == 4
 
 
-def test_a_window_leaves_the_devices_as_the_steps_after_it_expect(cell: Cell) -> None:
+def test_a_window_leaves_the_devices_as_the_steps_after_it_expect(cell: Cell, device) -> None:
     """Resetting the grip force dear, the window the bin-pick alone: removing the bin-pick (4) would leave the gripper
-    open for the place after the window; the repair closes it as well (6), and the task is plausible."""
+    open for the place after the window; the repair closes it as well (6), and the task is plausible (in a cell with
+    a conveyor no step uses)."""
+    with_conveyor = cell.with_device(device("conveyor"))
     task = faulty_task(25, 1, 0, kinds=("force",))
     costs = RepairCosts(reset=10)
-    [best] = windows.windowed_repair(task, cell, KNOWLEDGE, top=1, costs=costs, margin=0)
+    [best] = windows.windowed_repair(task, with_conveyor, KNOWLEDGE, top=1, costs=costs, margin=0)
     assert _answers([best]) == [(6.0, ["insert close-gripper before step 27 (bin-pick)", "remove step 27 (bin-pick)"])]
-    assert service.check(best.task, cell).plausible
+    assert service.check(best.task, with_conveyor).plausible
 
 
 def test_a_long_task_plausible_as_written_needs_no_repair(cell: Cell) -> None:
