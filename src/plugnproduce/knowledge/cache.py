@@ -80,12 +80,24 @@ def cached_knowledge(libraries: Sequence[Library], load: Callable[[], Knowledge]
                              ValueError, IndexError):
         kept, outside = pickle.loads(path.read_bytes())  # noqa: S301 - the user's own cache folder, by content
         if isinstance(kept, Knowledge) and _unchanged(outside):
+            object.__setattr__(kept, "key", _own_key(key, outside))
             return kept
     knowledge = load()
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
-        data = pickle.dumps((knowledge, _outside(knowledge)), protocol=pickle.HIGHEST_PROTOCOL)
+        outside = _outside(knowledge)
+        object.__setattr__(knowledge, "key", _own_key(key, outside))
+        data = pickle.dumps((knowledge, outside), protocol=pickle.HIGHEST_PROTOCOL)
         folders.keep_newest(path, data, KEEP)
     return knowledge
+
+
+def _own_key(key: str, outside: dict[str, bytes]) -> str:
+    """The knowledge's own key (:attr:`~.libraries.Knowledge.key`): the digest of its libraries and of the content
+    of each chart it read outside them (which the digest alone does not name)."""
+    h = hashlib.sha256(key.encode())
+    for f, data in sorted(outside.items()):
+        h.update(f"\0{f}\0{len(data)}\0".encode() + data)
+    return h.hexdigest()[:32]
 
 
 def kept_files(folder: Path | None = None) -> Iterable[Path]:

@@ -68,12 +68,45 @@ def cached_device(path: str | Path, taxonomy: Taxonomy, folder: Path | None = No
                              ValueError, IndexError):
         device, chart = pickle.loads(kept.read_bytes())  # noqa: S301 - the user's own cache folder, by content
         if isinstance(device, DeviceDescription) and chart is not None and chart == _chart_digest(device):
-            return device
+            return _served(device, f"{h.hexdigest()}\0{chart}", kept.parent)
     device = read(p, taxonomy)
+    chart = _chart_digest(device)
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
-        folders.keep_newest(kept, pickle.dumps((device, _chart_digest(device)), protocol=pickle.HIGHEST_PROTOCOL),
-                            KEEP)
+        folders.keep_newest(kept, pickle.dumps((device, chart), protocol=pickle.HIGHEST_PROTOCOL), KEEP)
+    return device if chart is None else _served(device, f"{h.hexdigest()}\0{chart}", kept.parent)
+
+
+_SERVED: dict[int, tuple[DeviceDescription, str, Path]] = {}
+"""The devices :func:`cached_device` gave in this process, by identity: each with the digest of what it was read
+from (the code, taxonomy, description and chart) and its cache folder, for what is made of it to be kept
+(:func:`kept_facts`). By identity, not equality: a copy made by :func:`dataclasses.replace` is not among them."""
+
+
+def _served(device: DeviceDescription, key: str, folder: Path) -> DeviceDescription:
+    _SERVED[id(device)] = (device, key, folder)  # the device is held, so its id is not reused
     return device
+
+
+def kept_facts(device: DeviceDescription, knowledge: str | None, make: Callable[[], str]) -> str:
+    """``make()``: the ASP facts of ``device`` with the knowledge whose key (:attr:`~.libraries.Knowledge.key`) is
+    ``knowledge``, read back from the cache folder when kept there for the same device (as :func:`cached_device`
+    read it) and knowledge, else made, then kept. Made, and not kept, for a device :func:`cached_device` did not
+    give or knowledge without a key: what it was made from is not known by name."""
+    served = _SERVED.get(id(device))
+    if served is None or served[0] is not device or knowledge is None:
+        return make()
+    _, key, folder = served
+    name = hashlib.sha256(f"{FORMAT}\0{key}\0{knowledge}".encode()).hexdigest()[:32]
+    kept = folder / f"facts-{name}.pickle"
+    with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError,
+                             ValueError, IndexError):
+        named, text = pickle.loads(kept.read_bytes())  # noqa: S301 - the user's own cache folder, by content
+        if named == name and isinstance(text, str):
+            return text
+    text = make()
+    with contextlib.suppress(OSError, pickle.PicklingError):
+        folders.keep_newest(kept, pickle.dumps((name, text), protocol=pickle.HIGHEST_PROTOCOL), KEEP)
+    return text
 
 
 def device_reader(taxonomy: Taxonomy, folder: Path | None = None) -> Callable[[Path], DeviceDescription]:

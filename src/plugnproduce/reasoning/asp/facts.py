@@ -21,6 +21,7 @@ from plugnproduce.description.model import DeviceDescription, ProcessDescription
 from plugnproduce.description.paths import NoPath, find_path, in_concept
 from plugnproduce.description.quantities.contracts import KINDS
 from plugnproduce.errors import UnknownName
+from plugnproduce.knowledge.devicecache import kept_facts
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.terms import Atom, program
@@ -220,7 +221,8 @@ class FactBook:
         """ASP facts of one device (cached)."""
         text = self._devices.get(device)
         if text is None:
-            text = program(device_facts(device, self.taxonomy, self.processes))
+            text = kept_facts(device, self.knowledge.key,
+                              lambda: program(device_facts(device, self.taxonomy, self.processes)))
             self._devices[device] = text
         return text
 
