@@ -219,3 +219,19 @@ def test_the_console_script_imports_only_the_command_it_runs(tmp_path: Path, arg
     assert "plugnproduce.cli.reasoning" in loaded
     assert sorted(m for m in NOT_FOR_THE_CONSOLE_SCRIPT if m in loaded) == []
     assert out.split("made:", 1)[1].split("\n", 1)[0].split() == []
+
+
+def test_the_console_script_keeps_what_its_start_made_out_of_the_collectors_walks_and_still_collects() -> None:
+    """What importing the command line made (typer's classes, the commands) lives as long as the process: ``pnp``
+    freezes it, so that the cyclic collector does not walk it again in every full collection while a command
+    starts. The collector stays on: a cycle a command leaves behind is still collected."""
+    code = ("import gc, sys, weakref\nsys.argv = ['pnp', '--version']\nfrom plugnproduce.__main__ import run\n"
+            "try:\n    run()\nexcept SystemExit:\n    pass\n"
+            "import typer\nwalked = gc.get_objects()\n"
+            "print('walked', any(o is typer.Typer for o in walked), any(o is run for o in walked))\n"
+            "class Cycle:\n    pass\n"
+            "c = Cycle()\nc.me = c\ngone = weakref.ref(c)\ndel c, walked\ngc.collect()\n"
+            "print('collected', gc.isenabled(), gone() is None)")
+    out = _run(code)
+    assert "pnp (plugnproduce)" in out
+    assert "walked False False" in out and "collected True True" in out
