@@ -112,3 +112,19 @@ def kept(kind: str, source: Path, parse: Callable[[Path], T], fits: Callable[[ob
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
         keep_newest(path, pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL), KEEP_PARSED)
     return value
+
+
+def made_once(path: Path, make: Callable[[], str], keep: int) -> str:
+    """``make()``, read back from ``path`` when kept there, else made and kept there (with the newest ``keep`` of
+    its kind, :func:`keep_newest`). ``path`` is named by the digest of everything ``make`` depends on; a kept file
+    that cannot be read or is not what was kept is made again, and a folder that cannot be written costs only the
+    making. The folder is the user's own, so the pickle is as trusted as the user's files."""
+    with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError,
+                             ValueError, IndexError):
+        name, text = pickle.loads(path.read_bytes())  # noqa: S301 - the user's own cache folder, by content
+        if name == path.name and isinstance(text, str):
+            return text
+    text = make()
+    with contextlib.suppress(OSError, pickle.PicklingError):
+        keep_newest(path, pickle.dumps((path.name, text), protocol=pickle.HIGHEST_PROTOCOL), keep)
+    return text

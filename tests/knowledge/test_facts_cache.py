@@ -17,7 +17,7 @@ import pytest
 import plugnproduce
 from plugnproduce.description.loader import load_device
 from plugnproduce.knowledge import Knowledge, builtin_library, library_folders, load_knowledge
-from plugnproduce.knowledge.cache import cached_knowledge
+from plugnproduce.knowledge.cache import cached_knowledge, kept_for
 from plugnproduce.knowledge.devicecache import cached_device, kept_facts
 
 GLUE = Path(__file__).resolve().parents[1] / "data" / "libraries" / "glue-dispensing"
@@ -145,3 +145,17 @@ def test_a_damaged_kept_facts_file_is_made_again(library: Path, tmp_path: Path) 
     kept.write_bytes(b"not a pickle")
     assert kept_facts(device, k.key, makes) == makes.text and makes.count == 2
     assert kept_facts(device, k.key, makes) == makes.text and makes.count == 2
+
+
+def test_what_is_made_of_the_knowledge_alone_is_kept_under_its_key_in_its_cache_folder(library: Path,
+                                                                                      tmp_path: Path) -> None:
+    cache = tmp_path / "cache"
+    k, makes = _knowledge(library, cache), Makes("process(\"lay-bead\").\n")
+    assert kept_for(k, "processes", makes) == makes.text
+    assert kept_for(_knowledge(library, cache), "processes", makes) == makes.text and makes.count == 1
+    assert len(list(cache.glob("made-*.pickle"))) == 1
+    assert kept_for(k, "something else", makes) == makes.text and makes.count == 2
+    unkeyed = load_knowledge(k.libraries)
+    assert kept_for(unkeyed, "processes", makes) == makes.text and makes.count == 3
+    _edit(library / "processes" / "lay-bead.ttl", '"lay a glue bead"', '"lay a thin bead"')
+    assert kept_for(_knowledge(library, cache), "processes", makes) == makes.text and makes.count == 4

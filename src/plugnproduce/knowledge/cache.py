@@ -80,15 +80,39 @@ def cached_knowledge(libraries: Sequence[Library], load: Callable[[], Knowledge]
                              ValueError, IndexError):
         kept, outside = pickle.loads(path.read_bytes())  # noqa: S301 - the user's own cache folder, by content
         if isinstance(kept, Knowledge) and _unchanged(outside):
-            object.__setattr__(kept, "key", _own_key(key, outside))
-            return kept
+            return _keyed(kept, _own_key(key, outside), path.parent)
     knowledge = load()
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
         outside = _outside(knowledge)
-        object.__setattr__(knowledge, "key", _own_key(key, outside))
+        _keyed(knowledge, _own_key(key, outside), path.parent)
         data = pickle.dumps((knowledge, outside), protocol=pickle.HIGHEST_PROTOCOL)
         folders.keep_newest(path, data, KEEP)
     return knowledge
+
+
+_FOLDERS: dict[str, Path] = {}
+"""The cache folder of each knowledge key this process read or kept, where what is made of it is kept too."""
+
+
+def _keyed(knowledge: Knowledge, key: str, folder: Path) -> Knowledge:
+    object.__setattr__(knowledge, "key", key)  # set once, as it is read: the knowledge is frozen for everyone else
+    _FOLDERS[key] = folder
+    return knowledge
+
+
+KEEP_MADE = 64
+"""Texts made of knowledge alone (:func:`kept_for`) kept in the cache folder."""
+
+
+def kept_for(knowledge: Knowledge, what: str, make: Callable[[], str]) -> str:
+    """``make()``: a text made of ``knowledge``'s taxonomy and processes alone, which ``what`` names (the processes'
+    ASP facts), read back from the cache folder under the knowledge's key when kept there, else made and kept.
+    Made, and not kept, for knowledge without a key (:attr:`~.libraries.Knowledge.key`)."""
+    folder = _FOLDERS.get(knowledge.key) if knowledge.key is not None else None
+    if folder is None:
+        return make()
+    name = hashlib.sha256(f"{FORMAT}\0{knowledge.key}\0{what}".encode()).hexdigest()[:32]
+    return folders.made_once(folder / f"made-{name}.pickle", make, KEEP_MADE)
 
 
 def _own_key(key: str, outside: dict[str, bytes]) -> str:

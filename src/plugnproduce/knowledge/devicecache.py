@@ -97,16 +97,7 @@ def kept_facts(device: DeviceDescription, knowledge: str | None, make: Callable[
         return make()
     _, key, folder = served
     name = hashlib.sha256(f"{FORMAT}\0{key}\0{knowledge}".encode()).hexdigest()[:32]
-    kept = folder / f"facts-{name}.pickle"
-    with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError,
-                             ValueError, IndexError):
-        named, text = pickle.loads(kept.read_bytes())  # noqa: S301 - the user's own cache folder, by content
-        if named == name and isinstance(text, str):
-            return text
-    text = make()
-    with contextlib.suppress(OSError, pickle.PicklingError):
-        folders.keep_newest(kept, pickle.dumps((name, text), protocol=pickle.HIGHEST_PROTOCOL), KEEP)
-    return text
+    return folders.made_once(folder / f"facts-{name}.pickle", make, KEEP)
 
 
 def device_reader(taxonomy: Taxonomy, folder: Path | None = None) -> Callable[[Path], DeviceDescription]:
