@@ -5,10 +5,12 @@ answers as a command with nothing kept does. On a user library outside the packa
 
 from __future__ import annotations
 
+import gc
 import os
 import shutil
 import subprocess
 import sys
+import weakref
 from dataclasses import replace
 from pathlib import Path
 
@@ -159,3 +161,16 @@ def test_what_is_made_of_the_knowledge_alone_is_kept_under_its_key_in_its_cache_
     assert kept_for(unkeyed, "processes", makes) == makes.text and makes.count == 3
     _edit(library / "processes" / "lay-bead.ttl", '"lay a glue bead"', '"lay a thin bead"')
     assert kept_for(_knowledge(library, cache), "processes", makes) == makes.text and makes.count == 4
+
+
+def test_a_device_the_cache_gave_is_not_held_once_dropped(library: Path, tmp_path: Path) -> None:
+    """A long-running process (the HMI's server) reads a cell's devices for every request: what names them for
+    their facts must not keep them alive."""
+    cache = tmp_path / "cache"
+    k = _knowledge(library, cache)
+    device = cached_device(library / "devices" / "dispenser.ttl", k.taxonomy, cache)
+    kept_facts(device, k.key, Makes())
+    gone = weakref.ref(device)
+    del device
+    gc.collect()
+    assert gone() is None

@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import pickle
+import weakref
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -76,14 +77,17 @@ def cached_device(path: str | Path, taxonomy: Taxonomy, folder: Path | None = No
     return device if chart is None else _served(device, f"{h.hexdigest()}\0{chart}", kept.parent)
 
 
-_SERVED: dict[int, tuple[DeviceDescription, str, Path]] = {}
-"""The devices :func:`cached_device` gave in this process, by identity: each with the digest of what it was read
-from (the code, taxonomy, description and chart) and its cache folder, for what is made of it to be kept
-(:func:`kept_facts`). By identity, not equality: a copy made by :func:`dataclasses.replace` is not among them."""
+_SERVED: dict[int, tuple[weakref.ref[DeviceDescription], str, Path]] = {}
+"""The devices :func:`cached_device` gave in this process and still alive, by identity: each with the digest of
+what it was read from (the code, taxonomy, description and chart) and its cache folder, for what is made of it to
+be kept (:func:`kept_facts`). By identity, not equality: a copy made by :func:`dataclasses.replace` is not among
+them. Not held: a device's entry goes when the device does (before its id can name another object), so a
+long-running process that reads devices again and again keeps none of them."""
 
 
 def _served(device: DeviceDescription, key: str, folder: Path) -> DeviceDescription:
-    _SERVED[id(device)] = (device, key, folder)  # the device is held, so its id is not reused
+    at, served = id(device), _SERVED  # the dict itself, not the module's name for it: gone at interpreter exit
+    served[at] = (weakref.ref(device, lambda _: served.pop(at, None)), key, folder)
     return device
 
 
@@ -93,7 +97,7 @@ def kept_facts(device: DeviceDescription, knowledge: str | None, make: Callable[
     read it) and knowledge, else made, then kept. Made, and not kept, for a device :func:`cached_device` did not
     give or knowledge without a key: what it was made from is not known by name."""
     served = _SERVED.get(id(device))
-    if served is None or served[0] is not device or knowledge is None:
+    if served is None or served[0]() is not device or knowledge is None:
         return make()
     _, key, folder = served
     name = hashlib.sha256(f"{FORMAT}\0{key}\0{knowledge}".encode()).hexdigest()[:32]
