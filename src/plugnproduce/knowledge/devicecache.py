@@ -13,7 +13,6 @@ The folder is the user's own, so the pickle is as trusted as the user's files.
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import pickle
 import weakref
 from collections.abc import Callable, Iterable
@@ -22,6 +21,7 @@ from typing import TYPE_CHECKING
 
 from plugnproduce import folders
 from plugnproduce.description.model import DeviceDescription
+from plugnproduce.digests import sha256
 from plugnproduce.knowledge.cache import cache_folder, code_digest
 
 if TYPE_CHECKING:
@@ -42,7 +42,7 @@ def _read(path: Path) -> bytes | None:
 
 def _chart_digest(device: DeviceDescription) -> str | None:
     data = _read(Path(device.chart_file))
-    return None if data is None else hashlib.sha256(data).hexdigest()
+    return None if data is None else sha256(data).hexdigest()
 
 
 def _load_device(path: Path, taxonomy: Taxonomy) -> DeviceDescription:
@@ -62,7 +62,7 @@ def cached_device(path: str | Path, taxonomy: Taxonomy, folder: Path | None = No
     data = _read(p)
     if data is None:
         return read(p, taxonomy)
-    h = hashlib.sha256(f"{FORMAT}\0{code_digest()}\0{taxonomy.digest}\0{p}\0".encode())
+    h = sha256(f"{FORMAT}\0{code_digest()}\0{taxonomy.digest}\0{p}\0".encode())
     h.update(data)
     kept = (folder or cache_folder()) / f"device-{h.hexdigest()[:32]}.pickle"
     with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError,
@@ -100,7 +100,7 @@ def kept_facts(device: DeviceDescription, knowledge: str | None, make: Callable[
     if served is None or served[0]() is not device or knowledge is None:
         return make()
     _, key, folder = served
-    name = hashlib.sha256(f"{FORMAT}\0{key}\0{knowledge}".encode()).hexdigest()[:32]
+    name = sha256(f"{FORMAT}\0{key}\0{knowledge}".encode()).hexdigest()[:32]
     return folders.made_once(folder / f"facts-{name}.pickle", make, KEEP)
 
 
