@@ -329,3 +329,14 @@ def test_a_long_task_plausible_as_written_needs_no_repair(cell: Cell) -> None:
     assert service.check(task, cell).plausible
     assert service.repair(task, cell, top=3) == []
     assert windows.windowed_repair(task, cell, KNOWLEDGE, top=3) == []
+
+
+def test_the_next_best_repairs_with_a_catalogue_are_distinct_bought_or_not(cell: Cell,
+                                                                         devices: list[DeviceDescription]) -> None:
+    """Two screw steps far apart and a grip force out of range: buy a screwdriver, or remove both screws, or buy it
+    and repair the force otherwise; each once."""
+    task = _screws(faulty_task(25, 1, 5), (6, 42))
+    found = windowed(task, cell, devices, top=3)
+    assert [(r.cost, r.added_devices) for r in found] == [(6.14, ("screwdriver",)), (9.0, ()),
+                                                          (11.14, ("screwdriver",))]
+    assert len({tuple(e.text for e in r.edits) for r in found}) == 3
