@@ -224,6 +224,7 @@ def test_a_longer_task_is_repaired_window_by_window(cell: Cell) -> None:
 def test_three_repairs_unless_asked_for_another_number(cell: Cell) -> None:
     assert [r.rank for r in user_repair(SHORT, cell, KNOWLEDGE)] == [1, 2, 3]
     assert [r.rank for r in user_repair(LONG, cell, KNOWLEDGE)] == [1, 2, 3]
+    assert [r.rank for r in windows.windowed_repair(LONG, cell, KNOWLEDGE)] == [1, 2, 3]
 
 
 def test_no_insertion_when_none_is_allowed_short_or_long(cell: Cell) -> None:
