@@ -78,6 +78,18 @@ def test_each_server_has_its_own_copy(tmp_path: Path, kept_by_another: bytes) ->
         ua.AttributeIds.Value].value
 
 
+async def test_what_one_server_adds_is_not_in_the_next(tmp_path: Path, kept_by_another: bytes) -> None:
+    _kept_in(tmp_path, kept_by_another)
+    first = await space.new_server(tmp_path)
+    await first.register_namespace("urn:first")  # changes the namespace array's list in place
+    await first.nodes.objects.add_object(2, "OnlyInTheFirst")
+    second = await space.new_server(tmp_path)
+    assert "urn:first" in await first.get_namespace_array()
+    assert "urn:first" not in await second.get_namespace_array()
+    names = [(await c.read_browse_name()).Name for c in await second.nodes.objects.get_children()]
+    assert "Server" in names and "OnlyInTheFirst" not in names
+
+
 async def _served(server: Server) -> dict[str, Any]:
     """What a plain client browses and reads of the standard nodes."""
     server.set_endpoint("opc.tcp://127.0.0.1:0/space")
