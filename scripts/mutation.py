@@ -169,7 +169,7 @@ CORE = (
     *(Guard(f"verification-{name}", (_S + f"verification/{name}.py",),
             ("tests/verification/test_answers.py", "tests/verification/test_verify.py",
              "tests/verification/test_branch_verify.py", "tests/verification/test_nested_verify.py",
-             "tests/verification/test_hierarchical_verify.py"),
+             "tests/verification/test_hierarchical_verify.py", "tests/verification/test_device_ends.py"),
             deselect=(  # a run on the simulated cell (the executor's work) and pnp verify in a child process
                 "tests/verification/test_verify.py::test_the_seeded_deadlock_is_not_hit_by_a_simulated_run",
                 "tests/verification/test_nested_verify.py::"

@@ -1,0 +1,141 @@
+"""What ``pnp verify`` tells of devices its deadlock and refusal sentences meet less often: a device whose chart has
+ended (a top-level final state), a device deep inside a hierarchical chart, and a controller left waiting for two
+devices at once. Each program is generated on the cell as shipped and verified on a copy whose device chart was
+changed, as a device replaced by a differently behaving one would be."""
+
+from __future__ import annotations
+
+import dataclasses
+import shutil
+from pathlib import Path
+
+from plugnproduce import service
+from plugnproduce.statechart.io.reader import parse_chart
+from plugnproduce.verification import verify
+from tests.verification.test_verify import CELL, TASK, D, line_of, seeded_cell
+
+LIBRARIES = Path(__file__).parents[1] / "data" / "libraries"
+GRIPPER = (D / "devices" / "gripper.scxml").read_text(encoding="utf-8")
+CLOSED = '<state id="closed" pnp:concept="Closed">\n    <transition event="xirp.request.Open" target="opening"/>\n  </state>'
+ANSWERS_CLOSED = ('<transition event="motion.done" target="closed">\n      '
+                  '<send event="xirp.event.gripper_closed" type="xirp"/>\n    </transition>')
+
+
+def changed(text: str, old: str, new: str) -> str:
+    """``text`` with ``old`` (which must be there) replaced once by ``new``."""
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+def library_copy(tmp_path: Path, name: str) -> Path:
+    return Path(shutil.copytree(LIBRARIES / name, tmp_path / name))
+
+
+def test_a_device_whose_chart_ended_without_answering_is_a_deadlock_that_names_its_final_state(tmp_path: Path) -> None:
+    # the gripper closes into a top-level final state and never reports gripper_closed: its session has ended
+    chart = changed(GRIPPER, ANSWERS_CLOSED, '<transition event="motion.done" target="gone"/>')
+    chart = changed(chart, "</scxml>", '<final id="gone"/>\n</scxml>')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    assert result.verdict == "refuted"
+    assert result.problem == ("deadlock: the controller waits for gripper.xirp.event.gripper_closed and no device will "
+                              "send it (robot in at_pose, gripper in gone, sensor3d in captured, binpicking-pc in "
+                              "localized)")
+    file = tmp_path / "devices" / "gripper.scxml"
+    gone = line_of(file, 'target="gone"')
+    assert f"{file}:{gone}: gripper delay of motion.done passes: closing -> gone" in [str(s) for s in result.trace]
+
+
+def test_a_request_to_a_device_whose_chart_ended_is_refused_in_its_final_state_at_its_line(tmp_path: Path) -> None:
+    # the gripper reports gripper_closed and its chart ends in the final state closed: the place step's Open is refused
+    chart = changed(GRIPPER, CLOSED, '<final id="closed" pnp:concept="Closed"/>')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    assert result.verdict == "refuted"
+    assert result.problem == ("device gripper in state closed refuses xirp.request.Open: its chart has no "
+                              "transition for it there")
+    file = tmp_path / "devices" / "gripper.scxml"
+    final, closes = line_of(file, '<final id="closed"'), line_of(file, 'event="motion.done" target="closed"')
+    assert str(result.trace[-1]) == (f"{file}:{final}: gripper receives xirp.request.Open in state closed, "
+                                     "which has no transition for it")
+    assert f"{file}:{closes}: gripper delay of motion.done passes: closing -> closed" in [str(s) for s in result.trace]
+
+
+def test_a_deadlock_names_every_state_a_hierarchical_device_is_in(tmp_path: Path) -> None:
+    library = library_copy(tmp_path, "packml-screwing")
+    chart = library / "devices" / "packml-screwdriver.scxml"
+    chart.write_text(changed(chart.read_text(encoding="utf-8"), '<send event="xirp.event.screw_done" type="xirp"/>',
+                             ""), encoding="utf-8")  # it completes the screw but never says so
+    task, cell = library / "tasks" / "screw-twice.yaml", library / "cells" / "packml-screwing.yaml"
+    result = verify(service.generate(LIBRARIES / "packml-screwing" / "tasks" / "screw-twice.yaml",
+                                     LIBRARIES / "packml-screwing" / "cells" / "packml-screwing.yaml").task,
+                    service.cell(cell))
+    assert result.verdict == "refuted"
+    assert result.problem == ("deadlock: the controller waits for packml-screwdriver.xirp.event.screw_done and no "
+                              "device will send it (cobot in at_pose, packml-screwdriver in "
+                              "Abortable/Operating/Complete)")
+    assert result.trace[-1].where == f"{LIBRARIES / 'packml-screwing' / 'tasks' / 'screw-twice.yaml'}:" \
+                                     f"{line_of(task, 'command: screw')}"
+
+
+def test_a_controller_left_waiting_for_two_devices_names_both_events(tmp_path: Path) -> None:
+    # the second step moves the robot while the gripper opens: here neither answers
+    library = library_copy(tmp_path, "timed-cell")
+    robot, gripper = library / "devices" / "tc-robot.scxml", library / "devices" / "tc-gripper.scxml"
+    text = robot.read_text(encoding="utf-8")
+    at_pose = text.index('<state id="at_pose"')
+    robot.write_text(text[:at_pose] + changed(text[at_pose:], 'event="xirp.request.MoveTo" target="moving"',
+                                              'event="xirp.request.MoveTo" target="stalled"')
+                     .replace("</scxml>", '<state id="stalled" pnp:concept="Moving"/>\n</scxml>'), encoding="utf-8")
+    gripper.write_text(changed(gripper.read_text(encoding="utf-8"), '<send event="xirp.event.angle_set" type="xirp"/>',
+                               ""), encoding="utf-8")
+    shipped = LIBRARIES / "timed-cell"
+    generated = service.generate(shipped / "tasks" / "approach-while-opening.yaml",
+                                 shipped / "cells" / "timed-cell.yaml").task
+    result = verify(generated, service.cell(library / "cells" / "timed-cell.yaml"))
+    assert result.verdict == "refuted"
+    assert result.problem == ("deadlock: the controller waits for tc-gripper.xirp.event.angle_set or "
+                              "tc-robot.xirp.event.motion_done and no device will send it "
+                              "(tc-robot in stalled, tc-gripper in open)")
+
+
+def test_a_program_whose_plan_names_no_step_waits_for_nothing(tmp_path: Path) -> None:
+    task, cell = D / "tasks" / "pick-and-place.yaml", service.cell(CELL)
+    generated = service.generate(task, cell).task
+    chart = generated.task_chart()
+    broken = changed(chart.decode(), '<data id="pnp_plan">[1, 2, 0]</data>', '<data id="pnp_plan">[1, 9, 0]</data>')
+    result = verify(dataclasses.replace(generated, chart=parse_chart(broken.encode(), "task.scxml")), cell)
+    assert result.verdict == "refuted"
+    assert result.problem.startswith("deadlock: the controller waits for nothing and no device will send it (")
+
+
+def test_an_event_a_device_sends_itself_at_once_is_a_move_told_in_the_counterexample(tmp_path: Path) -> None:
+    # the gripper closes at once (no delay) and then ends in its final state closed: the place step's Open is refused
+    chart = changed(GRIPPER, '<send event="motion.done" delay="120ms"/></onentry>\n    <transition event="motion.done" '
+                    'target="closed">', '<send event="motion.done"/></onentry>\n    <transition event="motion.done" '
+                    'target="closed">')
+    chart = changed(chart, CLOSED, '<final id="closed" pnp:concept="Closed"/>')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    assert result.problem == ("device gripper in state closed refuses xirp.request.Open: its chart has no "
+                              "transition for it there")
+    file = tmp_path / "devices" / "gripper.scxml"
+    close, closes = line_of(file, 'event="xirp.request.Close"'), line_of(file, 'event="motion.done" target="closed"')
+    assert [str(s) for s in result.trace[10:13]] == [
+        f"{file}:{close}: gripper receives xirp.request.Close: open -> closing",
+        f"{file}:{closes}: gripper takes motion.done: closing -> closed",
+        f"{TASK}:6: controller receives gripper.xirp.event.gripper_closed; sends xirp.request.MoveTo to robot"]
+
+
+def test_a_device_that_answers_at_once_interleaves_with_the_others_as_one_whose_motion_takes_time(
+        tmp_path: Path) -> None:
+    # the robot moves while the gripper opens; this robot's motion ends at once (an event it sends itself without
+    # delay): the gripper may still take its request or its delay before the robot takes that event
+    shipped = LIBRARIES / "timed-cell"
+    generated = service.generate(shipped / "tasks" / "approach-while-opening.yaml",
+                                 shipped / "cells" / "timed-cell.yaml").task
+    timed = verify(generated, service.cell(shipped / "cells" / "timed-cell.yaml"))
+    library = library_copy(tmp_path, "timed-cell")
+    robot = library / "devices" / "tc-robot.scxml"
+    robot.write_text(changed(robot.read_text(encoding="utf-8"), '<send id="moving_motion" event="motion.done" '
+                             'delay="250ms"/>', '<send id="moving_motion" event="motion.done"/>'), encoding="utf-8")
+    at_once = verify(generated, service.cell(library / "cells" / "timed-cell.yaml"))
+    assert at_once.verdict == timed.verdict == "proved"
+    assert (at_once.states, at_once.transitions) == (timed.states, timed.transitions) == (34, 51)
