@@ -139,3 +139,16 @@ def test_a_device_that_answers_at_once_interleaves_with_the_others_as_one_whose_
     at_once = verify(generated, service.cell(library / "cells" / "timed-cell.yaml"))
     assert at_once.verdict == timed.verdict == "proved"
     assert (at_once.states, at_once.transitions) == (timed.states, timed.transitions) == (34, 51)
+
+
+def test_an_event_a_device_sends_as_it_starts_is_told_as_that_devices(tmp_path: Path) -> None:
+    # the gripper (the second device of the cell) says it is ready as it starts; the controller does not wait for it
+    chart = changed(GRIPPER, '<state id="open" pnp:concept="Open">', '<state id="open" pnp:concept="Open">\n    '
+                    '<onentry><send event="xirp.event.ready" type="xirp"/></onentry>')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    assert result.verdict == "refuted"
+    assert result.problem == ("the controller does not wait for gripper.xirp.event.ready where it is: the run would "
+                              "stop with a fault")
+    assert [str(s) for s in result.trace] == [
+        f"{TASK}:6: controller starts the task; sends upnp.request.Capture to sensor3d",
+        f"{TASK}:6: controller receives gripper.xirp.event.ready"]

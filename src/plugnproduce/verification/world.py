@@ -129,11 +129,10 @@ class ClosedWorld:
         """The initial world: every session started."""
         self.controller.start()
         requests = self._requests([[] for _ in self.devices])
-        for session in self.sessions:
-            session.start()
         events: list[list[Message]] = [[] for _ in self.devices]
-        for i, _ in enumerate(self.sessions):
-            self._device_events(i, events)
+        for i, session in enumerate(self.sessions):
+            session.start()
+            self._device_events(i, events)  # what it sent as it started, on its own channel
         world = self._world(take(self.controller, self._vars),
                             tuple(take(s, v) for s, v in zip(self.sessions, self._device_vars, strict=True)),
                             requests, events)
