@@ -152,3 +152,39 @@ def test_an_event_a_device_sends_as_it_starts_is_told_as_that_devices(tmp_path: 
     assert [str(s) for s in result.trace] == [
         f"{TASK}:6: controller starts the task; sends upnp.request.Capture to sensor3d",
         f"{TASK}:6: controller receives gripper.xirp.event.ready"]
+
+
+def test_a_request_a_nested_state_refuses_is_told_at_the_innermost_states_line(tmp_path: Path) -> None:
+    # this screwdriver cannot be reset from Complete: the second screw's Reset, sent with its Start, is refused
+    shipped = LIBRARIES / "packml-screwing"
+    task = shipped / "tasks" / "screw-twice.yaml"
+    generated = service.generate(task, shipped / "cells" / "packml-screwing.yaml").task
+    library = library_copy(tmp_path, "packml-screwing")
+    chart = library / "devices" / "packml-screwdriver.scxml"
+    chart.write_text(changed(chart.read_text(encoding="utf-8"), '<state id="Complete" pnp:concept="Fastened">\n        '
+                             '<transition event="xirp.request.Reset" target="Idle"/>\n      </state>',
+                             '<state id="Complete" pnp:concept="Fastened"/>'), encoding="utf-8")
+    result = verify(generated, service.cell(library / "cells" / "packml-screwing.yaml"))
+    assert result.problem == ("device packml-screwdriver in state Abortable/Operating/Complete refuses "
+                              "xirp.request.Reset: its chart has no transition for it there")
+    second, complete = line_of(task, "command: screw") + 2, line_of(chart, '<state id="Complete"')
+    assert [str(s) for s in result.trace[-2:]] == [
+        f"{task}:{second}: controller receives cobot.xirp.event.motion_done; sends xirp.request.Reset to "
+        "packml-screwdriver, xirp.request.Start to packml-screwdriver",
+        f"{chart}:{complete}: packml-screwdriver receives xirp.request.Reset in state "
+        "Abortable/Operating/Complete, which has no transition for it"]
+
+
+def test_a_device_of_one_state_refuses_at_that_states_line(tmp_path: Path) -> None:
+    # a gripper replaced by one that answers Close at once and stays where it is: the place step's Open is refused
+    chart = GRIPPER[:GRIPPER.index('  <state id="open"')] + (
+        '  <state id="open" pnp:concept="Open">\n'
+        '    <transition event="xirp.request.SetAngle" pnp:accepts="OpeningAngle">'
+        '<send event="xirp.event.angle_set" type="xirp"/></transition>\n'
+        '    <transition event="xirp.request.Close" pnp:accepts="GripForce">'
+        '<send event="xirp.event.gripper_closed" type="xirp"/></transition>\n'
+        '  </state>\n</scxml>\n')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    file = tmp_path / "devices" / "gripper.scxml"
+    assert str(result.trace[-1]) == (f"{file}:{line_of(file, '<state id=')}: gripper receives xirp.request.Open in "
+                                     "state open, which has no transition for it")
