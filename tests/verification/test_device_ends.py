@@ -188,3 +188,19 @@ def test_a_device_of_one_state_refuses_at_that_states_line(tmp_path: Path) -> No
     file = tmp_path / "devices" / "gripper.scxml"
     assert str(result.trace[-1]) == (f"{file}:{line_of(file, '<state id=')}: gripper receives xirp.request.Open in "
                                      "state open, which has no transition for it")
+
+
+def test_a_first_step_that_starts_two_devices_tells_both_requests_as_the_task_starts(tmp_path: Path) -> None:
+    shipped = LIBRARIES / "timed-cell"
+    task = tmp_path / "open-on-the-way.yaml"
+    task.write_text("task: open-on-the-way\nsteps:\n  - command: approach-and-open\n    params: {target_pose: "
+                    "[0.40, 0.30, 0.00, 0, 180, 0], speed: 80, opening_angle: 40}\n", encoding="utf-8")
+    generated = service.generate(task, shipped / "cells" / "timed-cell.yaml").task
+    library = library_copy(tmp_path, "timed-cell")
+    gripper = library / "devices" / "tc-gripper.scxml"
+    gripper.write_text(changed(gripper.read_text(encoding="utf-8"), '<send event="xirp.event.angle_set" type="xirp"/>',
+                               ""), encoding="utf-8")  # it sets the angle but never says so
+    result = verify(generated, service.cell(library / "cells" / "timed-cell.yaml"))
+    assert result.problem.startswith("deadlock: the controller waits for tc-gripper.xirp.event.angle_set and")
+    assert str(result.trace[0]) == (f"{task}:3: controller starts the task; sends xirp.request.MoveTo to tc-robot, "
+                                    "xirp.request.SetAngle to tc-gripper")
