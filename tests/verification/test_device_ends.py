@@ -204,3 +204,20 @@ def test_a_first_step_that_starts_two_devices_tells_both_requests_as_the_task_st
     assert result.problem.startswith("deadlock: the controller waits for tc-gripper.xirp.event.angle_set and")
     assert str(result.trace[0]) == (f"{task}:3: controller starts the task; sends xirp.request.MoveTo to tc-robot, "
                                     "xirp.request.SetAngle to tc-gripper")
+
+
+def test_a_counterexample_in_a_later_round_is_told_at_that_rounds_step(tmp_path: Path) -> None:
+    # a gripper that wears out: once opened again it refuses to close, so the second round's bin-pick fails
+    chart = changed(GRIPPER, '<transition event="motion.done" target="open">\n      '
+                    '<send event="xirp.event.gripper_opened" type="xirp"/>',
+                    '<transition event="motion.done" target="worn">\n      '
+                    '<send event="xirp.event.gripper_opened" type="xirp"/>')
+    chart = changed(chart, "</scxml>", '  <state id="worn" pnp:concept="Open"/>\n</scxml>')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    assert result.problem == ("device gripper in state worn refuses xirp.request.Close: its chart has no transition "
+                              "for it there")
+    bin_pick, place = line_of(TASK, "command: bin-pick"), line_of(TASK, "command: place")
+    sent = [s for s in result.trace if "; sends xirp.request" in s.text and "to gripper" in s.text]
+    assert [(s.where, s.text.rsplit("; sends ", 1)[1]) for s in sent] == [
+        (f"{TASK}:{bin_pick}", "xirp.request.Close to gripper"), (f"{TASK}:{place}", "xirp.request.Open to gripper"),
+        (f"{TASK}:{bin_pick}", "xirp.request.Close to gripper")]
