@@ -221,3 +221,30 @@ def test_a_counterexample_in_a_later_round_is_told_at_that_rounds_step(tmp_path:
     assert [(s.where, s.text.rsplit("; sends ", 1)[1]) for s in sent] == [
         (f"{TASK}:{bin_pick}", "xirp.request.Close to gripper"), (f"{TASK}:{place}", "xirp.request.Open to gripper"),
         (f"{TASK}:{bin_pick}", "xirp.request.Close to gripper")]
+
+
+def test_a_device_chart_that_never_settles_is_refuted_naming_the_device(tmp_path: Path) -> None:
+    # on Close this gripper dithers between two states by eventless transitions: its session stops with an error
+    chart = changed(GRIPPER, 'event="xirp.request.Close" target="closing"', 'event="xirp.request.Close" target="dither"')
+    chart = changed(chart, "</scxml>", '  <state id="dither" pnp:concept="Closing"><transition target="dather"/></state>\n'
+                    '  <state id="dather" pnp:concept="Closing"><transition target="dither"/></state>\n</scxml>')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    assert result.verdict == "refuted"
+    assert result.problem == ("device gripper: gripper found no stable configuration after 100000 microsteps: its "
+                              "eventless transitions or internal events run in a cycle")
+    file = tmp_path / "devices" / "gripper.scxml"
+    close = line_of(file, 'target="dither"')
+    assert str(result.trace[-1]) == f"{file}:{close}: gripper receives xirp.request.Close: open -> dither"
+
+
+def test_a_task_chart_that_never_settles_is_refuted_as_the_task_charts_error() -> None:
+    task, cell = D / "tasks" / "pick-and-place.yaml", service.cell(CELL)
+    generated = service.generate(task, cell).task
+    chart = changed(generated.task_chart().decode(), 'cond="pnp_plan[pnp_step] == 0" target="done"',
+                    'cond="pnp_plan[pnp_step] == 0" target="next_step"')  # after the last step: round and round
+    result = verify(dataclasses.replace(generated, chart=parse_chart(chart.encode(), "task.scxml")), cell)
+    assert result.verdict == "refuted"
+    assert result.problem == ("the task chart: task-pick-and-place found no stable configuration after 100000 "
+                              "microsteps: its eventless transitions or internal events run in a cycle")
+    assert str(result.trace[-1]) == f"{task}:{line_of(task, 'command: move-to')}: controller receives " \
+                                    "robot.xirp.event.motion_done"
