@@ -248,3 +248,39 @@ def test_a_task_chart_that_never_settles_is_refuted_as_the_task_charts_error() -
                               "microsteps: its eventless transitions or internal events run in a cycle")
     assert str(result.trace[-1]) == f"{task}:{line_of(task, 'command: move-to')}: controller receives " \
                                     "robot.xirp.event.motion_done"
+
+
+SENSOR = (D / "devices" / "sensor3d.scxml").read_text(encoding="utf-8")
+
+
+def racing_sensor(tmp_path: Path, answer: str) -> Path:
+    """The bin-picking cell with a 3D sensor whose capture ends in one of two ways, whichever of its two delays passes
+    first: captured with CaptureDone, or captured with ``answer``; the cell file's path."""
+    cell = seeded_cell(tmp_path, (D / "devices" / "gripper.scxml").read_text(encoding="utf-8"))
+    (tmp_path / "devices" / "sensor3d.scxml").write_text(changed(
+        SENSOR, '    <onentry><send event="capture.done" delay="180ms"/></onentry>',
+        '    <onentry><send id="done" event="capture.done" delay="180ms"/>'
+        '<send id="dark" event="capture.dark" delay="200ms"/></onentry>\n'
+        '    <onexit><cancel sendid="done"/><cancel sendid="dark"/></onexit>\n'
+        f'    <transition event="capture.dark" target="captured">{answer}</transition>'), encoding="utf-8")
+    return cell
+
+
+def test_two_answers_that_differ_only_in_their_name_are_both_explored(tmp_path: Path) -> None:
+    # either way the sensor ends in captured with nothing left to do: only the event on its way tells them apart
+    cell = racing_sensor(tmp_path, '<send event="upnp.event.TooDark" type="upnp"/>')
+    result = verify(service.generate(TASK, CELL).task, service.cell(cell))
+    assert result.verdict == "refuted"
+    assert result.problem == ("the controller does not wait for sensor3d.upnp.event.TooDark where it is: the run "
+                              "would stop with a fault")
+
+
+def test_two_answers_that_differ_only_in_their_data_are_two_configurations(tmp_path: Path) -> None:
+    cell = racing_sensor(tmp_path, '<send event="upnp.event.CaptureDone" type="upnp"><param name="Quality" '
+                                   "expr=\"'dark'\"/></send>")
+    result = verify(service.generate(TASK, CELL).task, service.cell(cell))
+    assert result.verdict == "proved"
+    # three more configurations and six more moves than with the shipped sensor (73, 75): in each of the three rounds,
+    # the dark answer on its way is a configuration of its own, reached by the dark delay passing and left by the
+    # controller receiving it
+    assert (result.states, result.transitions) == (76, 81)
