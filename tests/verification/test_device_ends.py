@@ -284,3 +284,16 @@ def test_two_answers_that_differ_only_in_their_data_are_two_configurations(tmp_p
     # the dark answer on its way is a configuration of its own, reached by the dark delay passing and left by the
     # controller receiving it
     assert (result.states, result.transitions) == (76, 81)
+
+
+def test_a_device_chart_that_reads_a_requests_arguments_is_given_them(tmp_path: Path) -> None:
+    # this gripper only closes with more than 40 N (less would not hold the part): 45 N is proved, 35 N refused
+    chart = changed(GRIPPER, 'event="xirp.request.Close" target="closing"',
+                    'event="xirp.request.Close" cond="_event.data[\'GripForce\'] &gt; 40" target="closing"')
+    cell = service.cell(seeded_cell(tmp_path, chart))
+    assert verify(service.generate(TASK, CELL).task, cell).verdict == "proved"
+    gentle = tmp_path / "gentle.yaml"
+    gentle.write_text(changed(TASK.read_text(encoding="utf-8"), "grip_force: 45", "grip_force: 35"), encoding="utf-8")
+    result = verify(service.generate(gentle, CELL).task, cell)
+    assert result.problem == ("device gripper in state open refuses xirp.request.Close: its chart has no transition "
+                              "for it there")
