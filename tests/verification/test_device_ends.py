@@ -11,7 +11,9 @@ from pathlib import Path
 
 from plugnproduce import service
 from plugnproduce.statechart.io.reader import parse_chart
+from plugnproduce.statechart.runtime.events import EventData
 from plugnproduce.verification import verify
+from plugnproduce.verification.world import ClosedWorld, Message, Move, Violation
 from tests.verification.test_verify import CELL, TASK, D, line_of, seeded_cell
 
 LIBRARIES = Path(__file__).parents[1] / "data" / "libraries"
@@ -297,3 +299,18 @@ def test_a_device_chart_that_reads_a_requests_arguments_is_given_them(tmp_path: 
     result = verify(service.generate(gentle, CELL).task, cell)
     assert result.problem == ("device gripper in state open refuses xirp.request.Close: its chart has no transition "
                               "for it there")
+
+
+def test_a_request_with_two_problems_names_both(tmp_path: Path) -> None:
+    # a gripper whose Close takes an opening angle too, sent a Close with neither argument
+    chart = changed(GRIPPER, 'pnp:accepts="GripForce"', 'pnp:accepts="GripForce OpeningAngle"')
+    cell = service.cell(seeded_cell(tmp_path, chart))
+    world = ClosedWorld(service.generate(TASK, CELL).task, cell)
+    initial, _ = world.start()
+    requests = list(initial.requests)
+    requests[world.devices_index("gripper")] = (Message("xirp.request.Close", EventData({})),)
+    sent = dataclasses.replace(initial, requests=tuple(requests))
+    _, violation = world.apply(sent, Move("request", "gripper", name="xirp.request.Close"))
+    assert violation == Violation("argument", "device gripper: xirp.request.Close lacks the argument GripForce that "
+                                              "its transition accepts; lacks the argument OpeningAngle that its "
+                                              "transition accepts")
