@@ -314,3 +314,16 @@ def test_a_request_with_two_problems_names_both(tmp_path: Path) -> None:
     assert violation == Violation("argument", "device gripper: xirp.request.Close lacks the argument GripForce that "
                                               "its transition accepts; lacks the argument OpeningAngle that its "
                                               "transition accepts")
+
+
+def test_a_localizer_that_reports_no_outcome_fails_a_task_that_branches_on_it(tmp_path: Path) -> None:
+    # the task goes home when the bin is empty: it reads the outcome the localizer's answer reports, and this one
+    # reports none (the run's task chart then stops in failed)
+    cell = seeded_cell(tmp_path, GRIPPER)
+    pc = tmp_path / "devices" / "binpicking-pc.scxml"
+    pc.write_text(changed(pc.read_text(encoding="utf-8"), '<param name="outcome" expr="outcome"/>', ""),
+                  encoding="utf-8")
+    then_home = D / "tasks" / "bin-picking-then-home.yaml"
+    result = verify(service.generate(then_home, CELL).task, service.cell(cell))
+    assert result.problem == "the task ends in failed, not done"
+    assert result.trace[-1].text == "controller receives binpicking-pc.upnp.event.PartLocalized"
