@@ -327,3 +327,11 @@ def test_a_localizer_that_reports_no_outcome_fails_a_task_that_branches_on_it(tm
     result = verify(service.generate(then_home, CELL).task, service.cell(cell))
     assert result.problem == "the task ends in failed, not done"
     assert result.trace[-1].text == "controller receives binpicking-pc.upnp.event.PartLocalized"
+
+
+def test_a_transition_written_for_two_requests_takes_either(tmp_path: Path) -> None:
+    # the gripper opens on Open or Release, one transition for both (a request of no arguments)
+    chart = changed(GRIPPER, 'event="xirp.request.Open" target="opening"',
+                    'event="xirp.request.Open xirp.request.Release" target="opening"')
+    result = verify(service.generate(TASK, CELL).task, service.cell(seeded_cell(tmp_path, chart)))
+    assert (result.verdict, result.states, result.transitions) == ("proved", 73, 75)
