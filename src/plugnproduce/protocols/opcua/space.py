@@ -5,14 +5,14 @@ Server object, its status, the types), which costs one to two seconds of CPU per
 device and each Local Discovery Server pays it, so a mixed cell starts seconds later than it needs to. asyncua's
 own remedy (a ``shelve`` file) needs a dbm module that not every Python has.
 
-Here the standard nodes are built once and kept as a pickle in the user's cache folder
-(``opcuaspace-KEY.pickle``), named by asyncua's version and where it is installed and by the Python version, so
-another asyncua or Python never reads it. A process reads the file once and gives each server it starts its own
-copy (about a sixth of the build's CPU time: the nodes' immutable parts, such as status codes and node ids, are
-kept once per copy rather than once per use, which also leaves the garbage collector less to walk); a file that cannot be read, is too large or does not hold a standard address space is built again and
-rewritten (whole and at once: a process starting beside it reads the old file or the new one). The folder is the
-user's own (as for the parsed knowledge), so the pickle is as trusted as the user's files. A folder that cannot be
-written only costs the next start the build.
+Here the standard nodes are built once and kept as a pickle in the user's cache folder (``opcuaspace-KEY.pickle``),
+named by asyncua's version and where it is installed and by the Python version, so another asyncua or Python never
+reads it. A process reads the file once and gives each server it starts its own copy (about a sixth of the build's
+CPU time: the nodes' immutable parts, such as status codes and node ids, are kept once per copy rather than once per
+use, which also leaves the garbage collector less to walk); a file that cannot be read, is too large or does not
+hold a standard address space is built again and rewritten (whole and at once: a process starting beside it reads
+the old file or the new one). The folder is the user's own (as for the parsed knowledge), so the pickle is as
+trusted as the user's files. A folder that cannot be written only costs the next start the build.
 """
 
 from __future__ import annotations
