@@ -22,13 +22,10 @@ import copyreg
 import dataclasses
 import enum
 import functools
-import gc
-import hashlib
 import io
 import os
 import pickle
 import sys
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +36,8 @@ from asyncua.server.internal_server import InternalServer
 from asyncua.server.standard_address_space import standard_address_space
 
 from plugnproduce import folders
+from plugnproduce.collector import paused
+from plugnproduce.digests import sha256
 
 FORMAT = 4
 """The layout of what is kept; another layout is another file name."""
@@ -56,31 +55,18 @@ _kept: dict[Path, bytes] = {}
 """Per cache file, the pickled standard nodes this process read or built (each server unpickles its own copy)."""
 
 
-@contextlib.contextmanager
-def _no_collection() -> Iterator[None]:
-    """Python's cyclic garbage collector paused while some hundred thousand objects are made at once: each of its
-    collections would walk them all (it halves the build and makes a read eight times quicker); never any garbage."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
-
-
 def kept_file(folder: Path | None = None) -> Path:
     """The cache file of the standard address space for the installed asyncua and this Python."""
     source = standard_address_space.__file__ or ""
     stamp = f"{FORMAT}\0{sys.version}\0{asyncua.__version__}\0{source}\0{os.stat(source).st_mtime_ns}"
-    key = hashlib.sha256(stamp.encode()).hexdigest()[:16]
+    key = sha256(stamp.encode()).hexdigest()[:16]
     return (folder or folders.cache_folder()) / f"opcuaspace-{key}.pickle"
 
 
 def _built() -> dict[ua.NodeId, NodeData]:
     """The standard nodes, built as asyncua builds them (from the code it generated from the OPC UA node set)."""
     space = AddressSpace()
-    with _no_collection():
+    with paused():
         standard_address_space.fill_address_space(NodeManagementService(space))
     nodes: dict[ua.NodeId, NodeData] = space._nodes
     return nodes
@@ -140,7 +126,7 @@ def _shared(value: Any, one: dict[tuple[type, str], Any]) -> Any:
 
 def _dumps(nodes: dict[ua.NodeId, NodeData]) -> bytes:
     out = io.BytesIO()
-    with _no_collection():
+    with paused():
         _Pickler(out, protocol=pickle.HIGHEST_PROTOCOL).dump(_shared(nodes, {}))
     return out.getvalue()
 
@@ -158,7 +144,7 @@ def _read(path: Path) -> tuple[bytes, dict[ua.NodeId, NodeData]] | None:
         if path.stat().st_size > MAX_BYTES:
             return None
         data = path.read_bytes()
-        with _no_collection():
+        with paused():
             nodes = pickle.loads(data)  # noqa: S301 - the user's own cache folder, named by the asyncua it holds
     except Exception:  # noqa: BLE001 - a kept file that cannot be read, whatever the reason, is built again
         return None
@@ -171,7 +157,7 @@ def standard_nodes(folder: Path | None = None) -> dict[ua.NodeId, NodeData]:
     path = kept_file(folder)
     data = _kept.get(path)
     if data is not None:
-        with _no_collection():
+        with paused():
             return pickle.loads(data)  # type: ignore[no-any-return]  # noqa: S301 - pickled by this process
     found = _read(path)
     if found is not None:
