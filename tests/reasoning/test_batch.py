@@ -13,6 +13,7 @@ from plugnproduce import service
 from plugnproduce.batch import BatchRow, Configuration, batches, engine, generate, purchases, read_configurations
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
+from plugnproduce.reasoning import CheckResult
 from tests.reasoning.conftest import DESCRIPTIONS, task, write
 
 PAPER = ("binpicking-pc", "gripper", "robot", "sensor3d")
@@ -480,3 +481,41 @@ def test_a_device_the_task_names_that_no_catalogue_holds_cannot_be_bought(tmp_pa
     assert row.to_json()["purchase"] == {"options": [], "impossible": "step 1 of own-gripper: device my-gripper named "
                                                                       "for role gripper is not in the cell; it is not "
                                                                       "in the catalogue"}
+
+
+# ---- the batch binds each step's roles as check binds them
+
+PICK_WITH_THE_GRIPPER = ("task: pick-with-the-gripper\nsteps:\n  - command: pick\n    bind: {gripper: gripper}\n"
+                         "    params: {pick_pose: [0.35, 0.15, 0.04, 0, 180, 0], grip_force: 30}\n")
+LOCALIZE = "task: localize\nsteps:\n  - command: localize-part\n    params: {exposure: 25, part_type: bracket}\n"
+
+
+def _check_and_batch(tmp_path: Path, text: str, devices: tuple[str, ...]) -> tuple[CheckResult, BatchRow]:
+    the_task = service.task(write(tmp_path, "task.yaml", text))
+    cell = Cell("c", tuple(d for d in service.catalogue() if d.id in devices))
+    (row,) = service.batch([Configuration("c", devices)], None, [the_task], workers=1)
+    return service.check(the_task, cell), row
+
+
+def test_a_role_left_to_the_configuration_after_a_named_one_is_bound_as_check_binds_it(tmp_path: Path) -> None:
+    """The pick names its gripper (its first role: roles go in name order) and leaves its robot to the
+    configuration: without a robot, or with two, the batch says what check says."""
+    checked, row = _check_and_batch(tmp_path, PICK_WITH_THE_GRIPPER, ("gripper",))
+    assert [(p.step, p.kind) for p in checked.problems] == [(1, "no_device")]
+    assert row.plausible == () and row.purchase is not None and row.purchase.options[0][0] == ("scara",)
+    checked, row = _check_and_batch(tmp_path, PICK_WITH_THE_GRIPPER, ("cobot", "gripper", "robot"))
+    assert [(p.step, p.kind) for p in checked.problems] == [(1, "ambiguous")]
+    assert row.plausible == () and row.purchase is not None and row.purchase.ambiguous == (
+        "step 1 of pick-with-the-gripper: several devices can play role robot; bind step 1's role robot to one of "
+        "them")
+    checked, row = _check_and_batch(tmp_path, PICK_WITH_THE_GRIPPER, ("gripper", "robot"))
+    assert checked.plausible and row.plausible == ("pick-with-the-gripper",) and row.purchase is None
+
+
+def test_the_lone_player_of_a_role_is_bound_when_it_is_the_catalogues_first_device(tmp_path: Path) -> None:
+    """The bin-picking PC comes first in the catalogue (its lowest bit): as the one localizer of the configuration
+    it plays the role, as check says; it is not taken for several."""
+    assert min(d.id for d in service.catalogue()) == "binpicking-pc"
+    checked, row = _check_and_batch(tmp_path, LOCALIZE, ("binpicking-pc", "sensor3d"))
+    assert checked.plausible and checked.steps[0].bindings == {"localizer": "binpicking-pc", "sensor": "sensor3d"}
+    assert row.plausible == ("localize",) and row.purchase is None
