@@ -487,7 +487,7 @@ def test_a_device_the_task_names_that_no_catalogue_holds_cannot_be_bought(tmp_pa
 
 PICK_WITH_THE_GRIPPER = ("task: pick-with-the-gripper\nsteps:\n  - command: pick\n    bind: {gripper: gripper}\n"
                          "    params: {pick_pose: [0.35, 0.15, 0.04, 0, 180, 0], grip_force: 30}\n")
-LOCALIZE = "task: localize\nsteps:\n  - command: localize-part\n    params: {exposure: 25, part_type: bracket}\n"
+LOCALIZE_ANY = "task: localize\nsteps:\n  - command: localize-part\n    params: {exposure: 25, part_type: bracket}\n"
 
 
 def _check_and_batch(tmp_path: Path, text: str, devices: tuple[str, ...]) -> tuple[CheckResult, BatchRow]:
@@ -516,6 +516,16 @@ def test_the_lone_player_of_a_role_is_bound_when_it_is_the_catalogues_first_devi
     """The bin-picking PC comes first in the catalogue (its lowest bit): as the one localizer of the configuration
     it plays the role, as check says; it is not taken for several."""
     assert min(d.id for d in service.catalogue()) == "binpicking-pc"
-    checked, row = _check_and_batch(tmp_path, LOCALIZE, ("binpicking-pc", "sensor3d"))
+    checked, row = _check_and_batch(tmp_path, LOCALIZE_ANY, ("binpicking-pc", "sensor3d"))
     assert checked.plausible and checked.steps[0].bindings == {"localizer": "binpicking-pc", "sensor": "sensor3d"}
     assert row.plausible == ("localize",) and row.purchase is None
+
+
+def test_a_configuration_offers_the_processes_the_reasoner_says_it_offers() -> None:
+    """Each configuration's offered processes are those ``pnp capabilities`` lists for it as a cell."""
+    configs = [Configuration("gripper", ("gripper",)), Configuration("sensing", ("binpicking-pc", "sensor3d")),
+               Configuration("arm", ("robot", "screwdriver")), Configuration("paper", PAPER)]
+    found = rows(configs)
+    k = service.knowledge()
+    assert [r.offered for r in found] == [o for o, _ in _reasoner(configs, tasks(), k)]
+    assert found[0].offered == ("close-gripper", "open-gripper")
