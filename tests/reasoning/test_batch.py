@@ -529,3 +529,108 @@ def test_a_configuration_offers_the_processes_the_reasoner_says_it_offers() -> N
     k = service.knowledge()
     assert [r.offered for r in found] == [o for o, _ in _reasoner(configs, tasks(), k)]
     assert found[0].offered == ("close-gripper", "open-gripper")
+
+
+# ---- a device that plays two roles of one step plays them in role order, the second from where the first left it
+
+GRIP_AND_GO = """<?xml version="1.0" encoding="UTF-8"?>
+<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:pnp="http://plugnproduce.org/ontology#"
+       version="1.0" name="grip-and-go" initial="grip-and-go">
+  <parallel id="grip-and-go">
+    <state id="gripper" pnp:role="gripper" initial="gripper_open">
+      <final id="gripper_open" pnp:concept="Open"/>
+    </state>
+    <state id="robot" pnp:role="robot" initial="robot_holding">
+      <state id="robot_holding" pnp:concept="GripperState">
+        <transition cond="In('gripper_open')" target="robot_moving"/>
+      </state>
+      <final id="robot_moving" pnp:concept="Moving"/>
+    </state>
+  </parallel>
+</scxml>
+"""
+GRIP_AND_GO_TTL = """@prefix pnp:  <http://plugnproduce.org/ontology#> .
+@prefix proc: <http://plugnproduce.org/processes/> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+
+proc:grip-and-go a pnp:MotionProcess ;
+    rdfs:label "grip and go" ;
+    pnp:generalChart <grip-and-go.scxml> ;
+    pnp:hasRole proc:grip-and-go-robot , proc:grip-and-go-gripper .
+
+proc:grip-and-go-robot a pnp:Role ; pnp:roleName "robot" ; pnp:requiresSkill pnp:CanMove .
+proc:grip-and-go-gripper a pnp:Role ; pnp:roleName "gripper" ; pnp:requiresSkill pnp:CanGrip .
+"""
+
+
+def _grip_arm(name: str, initial: str) -> tuple[str, str]:
+    """A device that grips and moves: from ``open`` it goes nowhere, from ``ajar`` (also open) it closes, and only
+    closed it moves."""
+    ttl = (f"@prefix pnp: <http://plugnproduce.org/ontology#> .\n@prefix dev: <http://plugnproduce.org/devices/> .\n"
+           f"dev:{name} a pnp:Robot ; pnp:hasSkill pnp:CanGrip , pnp:CanMove ; pnp:protocol pnp:XIRP ;\n"
+           f"    pnp:endpoint \"xirp://127.0.0.1:0\" ; pnp:stateChart <{name}.scxml> ; pnp:commandTimeout 2.0 ;\n"
+           f"    pnp:cost 5000 .\n")
+    chart = f"""<?xml version="1.0" encoding="UTF-8"?>
+<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:pnp="http://plugnproduce.org/ontology#"
+       version="1.0" name="{name}" initial="{initial}">
+  <state id="idle" pnp:concept="Idle">
+    <transition event="xirp.request.Open" target="open"/>
+  </state>
+  <state id="open" pnp:concept="Open"/>
+  <state id="ajar" pnp:concept="Open">
+    <transition event="xirp.request.Close" target="closed"/>
+  </state>
+  <state id="closed" pnp:concept="Closed">
+    <transition event="xirp.request.Move" target="moving"/>
+  </state>
+  <state id="moving" pnp:concept="Moving">
+    <onentry><send event="motion.done" delay="100ms"/></onentry>
+    <transition event="motion.done" target="at_pose"/>
+  </state>
+  <state id="at_pose" pnp:concept="AtPose">
+    <transition event="xirp.request.Home" target="idle"/>
+  </state>
+</scxml>
+"""
+    return ttl, chart
+
+
+def _grip_arms(library: Path) -> service.Knowledge:
+    (library / "processes").mkdir(parents=True)
+    (library / "processes" / "grip-and-go.scxml").write_text(GRIP_AND_GO, encoding="utf-8")
+    (library / "processes" / "grip-and-go.ttl").write_text(GRIP_AND_GO_TTL, encoding="utf-8")
+    (library / "devices").mkdir()
+    for name, initial in (("idle-arm", "idle"), ("ajar-arm", "ajar")):
+        ttl, chart = _grip_arm(name, initial)
+        (library / "devices" / f"{name}.ttl").write_text(ttl, encoding="utf-8")
+        (library / "devices" / f"{name}.scxml").write_text(chart, encoding="utf-8")
+    return service.knowledge((library,))
+
+
+def _both_roles(tmp_path: Path, device: str) -> tuple[CheckResult, BatchRow]:
+    k = _grip_arms(tmp_path / "library")
+    the_task = service.task(write(tmp_path, "task.yaml", "task: grip-and-go\nsteps:\n  - command: grip-and-go\n"
+                                                         f"    bind: {{gripper: {device}, robot: {device}}}\n"))
+    cell = Cell("c", tuple(d for d in k.devices if d.id == device))
+    (row,) = service.batch([Configuration("c", (device,))], [d for d in k.devices if d.id == device], [the_task],
+                           workers=1, knowledge=k)
+    return service.check(the_task, cell, k), row
+
+
+def test_a_device_whose_first_role_starts_wrong_plays_its_second_from_where_the_first_recovers(tmp_path: Path) -> None:
+    """The idle arm is not open for the gripper role (its first, in name order), which leaves it where the role ends
+    from an open state (``open``); from there the robot role has no way on. Check names the stuck robot role first;
+    so does the batch, and no purchase cures it."""
+    checked, row = _both_roles(tmp_path, "idle-arm")
+    assert [(p.step, p.kind, p.role) for p in checked.problems] == [(1, "stuck", "robot"), (1, "wrong_state", "gripper")]
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of grip-and-go: device idle-arm cannot play role robot from the state it is in; adding devices "
+        "cannot cure it")
+
+
+def test_a_device_plays_its_second_role_from_where_its_first_left_it(tmp_path: Path) -> None:
+    """The ajar arm plays the gripper role where it is (``ajar``, not the other open state), and from there the robot
+    role closes and moves it: plausible in check and in the batch."""
+    checked, row = _both_roles(tmp_path, "ajar-arm")
+    assert checked.plausible and checked.problems == ()
+    assert row.plausible == ("grip-and-go",) and row.purchase is None
