@@ -165,7 +165,8 @@ CORE = (
           deselect=(*_BATCH_WORKERS,  # they compare offered and plausible only, never a purchase
                     "tests/reasoning/test_batch.py::test_answers_agree_with_the_full_reasoner_on_random_configurations")),
     Guard("reasoning-windows", (_S + "reasoning/repairs/windows.py",), ("tests/reasoning/test_windows.py",)),
-    Guard("reasoning-lifting", (_S + "reasoning/repairs/lifting.py",), ("tests/reasoning/test_repair_lifting.py",)),
+    Guard("reasoning-lifting", (_S + "reasoning/repairs/lifting.py",),
+          ("tests/reasoning/test_repair_lifting_placements.py", "tests/reasoning/test_repair_lifting.py")),
     Guard("executor-links", (_S + "executor/links.py",), ("tests/executor/test_links.py",)),
     Guard("executor-values", (_S + "executor/values.py",), ("tests/executor/test_values.py",)),
     *(Guard(f"verification-{name}", (_S + f"verification/{name}.py",),
