@@ -5,7 +5,9 @@ from __future__ import annotations
 import copy
 import dataclasses
 import pickle
+import sys
 import threading
+import types
 
 import pytest
 
@@ -153,3 +155,18 @@ def test_make_all_classes_makes_every_class_of_the_package_before_threads_use_th
         assert isinstance(cls.__dict__["__dataclass_fields__"], dict)
         assert cls.__dict__["__init__"].__qualname__ == f"{cls.__qualname__}.__init__"
     assert "__dataclass_params__" not in point.__dict__
+
+
+def test_a_class_of_the_package_declared_after_make_all_classes_is_made_at_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    from plugnproduce import service
+
+    service.make_all_classes()
+    module = types.ModuleType("plugnproduce.late")  # a module first imported by one of the server's threads
+    monkeypatch.setitem(sys.modules, module.__name__, module)
+    module.dataclass = dataclass  # type: ignore[attr-defined]
+    exec("@dataclass(frozen=True)\nclass Late:\n    x: int\n", module.__dict__)  # noqa: S102 - a fixed declaration
+    late = module.Late  # type: ignore[attr-defined]
+    assert isinstance(late.__dict__["__dataclass_fields__"], dict)  # no stand-in for another thread to find gone
+    assert late(1) == late(1) and repr(late(2)) == "Late(x=2)"
+    user = _frozen_class()  # the user's own classes are still made on their first use
+    assert "__dataclass_params__" not in user.__dict__

@@ -27,13 +27,24 @@ _DEFERRED: dict[type, dict[str, Any]] = {}
 """The classes whose dataclass methods are not made yet, with the options they were declared with."""
 
 
+_AT_ONCE = False
+"""Set by :func:`make_all_classes`: from then on a class of this package is made when it is declared."""
+
+
 def make_all_classes() -> None:
-    """Make every class of this package declared so far. A process that uses them from several threads (the HMI's
-    server) calls this before its threads start: while :func:`_make` puts a class's methods in place of its
-    stand-ins, the class briefly has neither, and another thread using it then would find ``object``'s."""
+    """Make every class of this package declared so far, and from then on each one as it is declared. A process
+    that uses them from several threads (the HMI's server) calls this before its threads start: while :func:`_make`
+    puts a class's methods in place of its stand-ins, the class briefly has neither, and another thread using it
+    then would find ``object``'s (a module first imported by one of those threads declares its classes there)."""
+    global _AT_ONCE  # noqa: PLW0603 - the process's one switch, set once
     with _MADE:
-        for cls in [c for c in _DEFERRED if c.__module__.startswith("plugnproduce.")]:
+        _AT_ONCE = True
+        for cls in [c for c in _DEFERRED if _ours(c)]:
             _make(cls)
+
+
+def _ours(cls: type) -> bool:
+    return cls.__module__.startswith("plugnproduce.")
 
 
 def _make(cls: type) -> None:
@@ -99,11 +110,12 @@ def dataclass(cls: type[T] | None = None, /, **options: Any) -> Any:
     (:func:`dataclasses.fields`, :func:`~dataclasses.replace`, :func:`~dataclasses.asdict`, a subclass's
     declaration) makes them, and from then on the class is exactly the dataclass. An instance read back by
     :mod:`pickle` needs none of them. ``slots=True`` makes a new class, so such a class is made at once. Type
-    checkers see a dataclass (:func:`typing.dataclass_transform`).
+    checkers see a dataclass (:func:`typing.dataclass_transform`). After :func:`make_all_classes`, a class of this
+    package is made at once.
     """
 
     def wrap(c: type[T]) -> type[T]:
-        if options.get("slots"):
+        if options.get("slots") or (_AT_ONCE and _ours(c)):
             import dataclasses
 
             return dataclasses.dataclass(c, **options)

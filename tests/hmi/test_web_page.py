@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 import yaml
-from playwright.sync_api import Page, expect
+from playwright.sync_api import Page, Route, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 from plugnproduce import service
@@ -169,6 +169,27 @@ def test_steps_are_reordered_and_removed_from_the_keyboard(page: Page) -> None:
 
 SLOW_GRIPPER = "gripper:delay-event:gripper_closed:1"
 """The simulated gripper reports closed a second late (within its 2 s timeout): time to watch the run."""
+
+
+def test_a_check_still_running_when_an_import_fails_does_not_hide_the_import_s_error(page: Page) -> None:
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "bin-picking.yaml")))
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    expect(page.locator("#verdict")).to_have_attribute("aria-busy", "false")
+    steps = page.locator("#steps li.step").count()
+    held: list[Route] = []
+    page.route("**/api/task/repair", lambda route: held.append(route))  # the next check stays in flight until released
+    page.locator("#check").click()
+    expect(page.locator("#verdict")).to_have_attribute("aria-busy", "true")
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "bin-picking-in-rounds.yaml")))
+    refused = ("This task has a loop inside a loop: the editor builds loops of the task's steps only; edit that task "
+               "file by hand.")
+    expect(page.locator("#verdict .error")).to_have_text(refused)
+    assert len(held) == 1
+    held[0].continue_()  # the check's answer (plausible) comes after the import's refusal
+    expect(page.locator("#verdict")).to_have_attribute("aria-busy", "false")  # and has been read
+    expect(page.locator("#verdict .error")).to_have_text(refused)
+    expect(page.locator("#verdict .ok")).to_have_count(0)
+    expect(page.locator("#steps li.step")).to_have_count(steps)  # the task as it was
 
 
 @pytest.mark.parametrize("served", [SLOW_GRIPPER], indirect=True)

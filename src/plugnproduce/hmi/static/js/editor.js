@@ -14,6 +14,13 @@ import { taskItems } from "./tasklist.js";
 
 let checkTimer = null;
 let checkSeq = 0;
+let checksInFlight = 0;
+
+/** Count a check sent (+1) or answered (-1): the verdict is busy while any is in flight. */
+function checking(delta) {
+  checksInFlight += delta;
+  $("#verdict").setAttribute("aria-busy", String(checksInFlight > 0));
+}
 
 /** Change the task, remember it, re-render and re-check. */
 export function setTask(task, message) {
@@ -240,6 +247,7 @@ export async function check() {
     renderCheck();
     return;
   }
+  checking(+1);
   try {
     const result = await post("/api/task/repair", taskBody());
     if (seq === checkSeq) state.check = result;
@@ -250,12 +258,22 @@ export async function check() {
     renderTask();
     changed("check", state.check);
   }
+  checking(-1);
 }
 
 /** Check again shortly (after an edit, or when the cell changed). */
 export function scheduleCheck() {
   clearTimeout(checkTimer);
+  ++checkSeq; // a check still in flight is about the task as it was: its answer is not shown
   checkTimer = setTimeout(check, 250);
+}
+
+/** Show an error in the verdict's place, until the next edit or check: no earlier check's answer replaces it. */
+function showError(message) {
+  clearTimeout(checkTimer);
+  ++checkSeq;
+  state.check = { error: message };
+  renderCheck();
 }
 
 async function exportYaml() {
@@ -268,8 +286,7 @@ async function exportYaml() {
     a.remove();
     setTimeout(() => URL.revokeObjectURL(url), 1000);
   } catch (err) {
-    state.check = { error: err.message };
-    renderCheck();
+    showError(err.message);
   }
 }
 
@@ -281,8 +298,7 @@ async function importYaml(file) {
     const loaded = editorTask(task);
     setTask(loaded, `Task ${task.name} imported with ${loaded.steps.length} steps.`);
   } catch (err) {
-    state.check = { error: err.message };
-    renderCheck();
+    showError(err.message);
   }
 }
 
