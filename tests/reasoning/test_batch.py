@@ -529,6 +529,9 @@ def test_a_configuration_offers_the_processes_the_reasoner_says_it_offers() -> N
     k = service.knowledge()
     assert [r.offered for r in found] == [o for o, _ in _reasoner(configs, tasks(), k)]
     assert found[0].offered == ("close-gripper", "open-gripper")
+    f = engine(service.catalogue(), tasks(), k).feasibility  # asked without the roles filled: it finds them itself
+    assert [f.offered(sum(f.abilities.bit(d) for d in c.devices)) for c in configs] == [
+        r.offered for r in found]
 
 
 # ---- a device that plays two roles of one step plays them in role order, the second from where the first left it
