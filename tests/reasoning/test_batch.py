@@ -637,3 +637,76 @@ def test_a_device_plays_its_second_role_from_where_its_first_left_it(tmp_path: P
     checked, row = _both_roles(tmp_path, "ajar-arm")
     assert checked.plausible and checked.problems == ()
     assert row.plausible == ("grip-and-go",) and row.purchase is None
+
+
+# ---- an odd cycle of roles: three roles, each playable by two of three devices, and no set fills each once
+
+TRIO = """<?xml version="1.0" encoding="UTF-8"?>
+<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:pnp="http://plugnproduce.org/ontology#"
+       version="1.0" name="trio" initial="trio">
+  <parallel id="trio">
+    <state id="grip" pnp:role="grip" initial="grip_any"><final id="grip_any" pnp:concept="StateConcept"/></state>
+    <state id="move" pnp:role="move" initial="move_any"><final id="move_any" pnp:concept="StateConcept"/></state>
+    <state id="sense" pnp:role="sense" initial="sense_any"><final id="sense_any" pnp:concept="StateConcept"/></state>
+  </parallel>
+</scxml>
+"""
+TRIO_TTL = """@prefix pnp:  <http://plugnproduce.org/ontology#> .
+@prefix proc: <http://plugnproduce.org/processes/> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+
+proc:trio a pnp:MotionProcess ;
+    rdfs:label "trio" ;
+    pnp:generalChart <trio.scxml> ;
+    pnp:hasRole proc:trio-grip , proc:trio-move , proc:trio-sense .
+
+proc:trio-grip a pnp:Role ; pnp:roleName "grip" ; pnp:requiresSkill pnp:CanGrip .
+proc:trio-move a pnp:Role ; pnp:roleName "move" ; pnp:requiresSkill pnp:CanMove .
+proc:trio-sense a pnp:Role ; pnp:roleName "sense" ; pnp:requiresSkill pnp:CanSense3D .
+"""
+STATES = {"CanGrip": (("open", "Open"), ("closed", "Closed")), "CanMove": (("idle", "Idle"), ("at_pose", "AtPose")),
+          "CanSense3D": (("ready", "SensorReady"), ("captured", "Captured"))}
+
+
+def _two_skills(library: Path, name: str, skills: tuple[str, str], cost: int) -> None:
+    """A device of two skills whose chart goes round the states each skill needs, by a request each."""
+    states = [s for skill in skills for s in STATES[skill]]
+    body = "".join(f'  <state id="{x}" pnp:concept="{c}">\n    <transition event="xirp.request.Next" '
+                   f'target="{states[(n + 1) % len(states)][0]}"/>\n  </state>\n' for n, (x, c) in enumerate(states))
+    (library / "devices" / f"{name}.scxml").write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n<scxml xmlns="http://www.w3.org/2005/07/scxml" '
+        f'xmlns:pnp="http://plugnproduce.org/ontology#"\n       version="1.0" name="{name}" initial="{states[0][0]}">\n'
+        f"{body}</scxml>\n", encoding="utf-8")
+    (library / "devices" / f"{name}.ttl").write_text(
+        f"@prefix pnp: <http://plugnproduce.org/ontology#> .\n@prefix dev: <http://plugnproduce.org/devices/> .\n"
+        f"dev:{name} a pnp:Robot ; pnp:hasSkill pnp:{skills[0]} , pnp:{skills[1]} ; pnp:protocol pnp:XIRP ;\n"
+        f'    pnp:endpoint "xirp://127.0.0.1:0" ; pnp:stateChart <{name}.scxml> ; pnp:commandTimeout 2.0 ;\n'
+        f"    pnp:cost {cost} .\n", encoding="utf-8")
+
+
+def test_an_odd_cycle_of_roles_has_no_purchase_and_the_search_says_so_when_it_runs_out(tmp_path: Path) -> None:
+    """Each pair of the three devices shares a role, so every set fills some role twice or leaves one empty: check
+    finds every set of them wanting, and the batch, having looked at each, says that no set makes the task
+    plausible (with no example: no set fills each role once)."""
+    library = tmp_path / "library"
+    (library / "processes").mkdir(parents=True)
+    (library / "processes" / "trio.scxml").write_text(TRIO, encoding="utf-8")
+    (library / "processes" / "trio.ttl").write_text(TRIO_TTL, encoding="utf-8")
+    (library / "devices").mkdir()
+    for name, skills, price in (("grip-move", ("CanGrip", "CanMove"), 100), ("move-sense", ("CanMove", "CanSense3D"),
+                                                                              200),
+                                ("sense-grip", ("CanSense3D", "CanGrip"), 300)):
+        _two_skills(library, name, skills, price)
+    k = service.knowledge((library,))
+    own = [d for d in k.devices if d.id in ("grip-move", "move-sense", "sense-grip")]
+    the_task = service.task(write(tmp_path, "trio.yaml", "task: trio\nsteps:\n  - command: trio\n"))
+    for size in range(4):
+        for chosen in itertools.combinations(own, size):
+            assert not service.check(the_task, Cell("c", chosen), k).plausible, chosen
+    (row,) = service.batch([Configuration("empty", ())], own, [the_task], workers=1, knowledge=k)
+    assert row.outcome == "impossible" and row.purchase is not None
+    assert row.purchase.impossible == "no set of catalogue devices makes every task plausible"
+    (row,) = service.batch([Configuration("one", ("grip-move",))], own, [the_task], workers=1, knowledge=k)
+    assert row.purchase is not None and row.purchase.impossible == (  # the search fills the sense role only
+        "no set of catalogue devices makes every task plausible; e.g. adding move-sense: step 1 of trio: several "
+        "devices can play role move")
