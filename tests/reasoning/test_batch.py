@@ -710,3 +710,36 @@ def test_an_odd_cycle_of_roles_has_no_purchase_and_the_search_says_so_when_it_ru
     assert row.purchase is not None and row.purchase.impossible == (  # the search fills the sense role only
         "no set of catalogue devices makes every task plausible; e.g. adding move-sense: step 1 of trio: several "
         "devices can play role move")
+
+
+# ---- answers are remembered by what they depend on, and only by that
+
+def _together_and_alone(the_task: Task, configs: list[Configuration]) -> tuple[list[BatchRow], list[BatchRow]]:
+    together = list(service.batch(configs, None, [the_task], workers=1))
+    alone = [row for c in configs for row in service.batch([c], None, [the_task], workers=1)]
+    return together, alone
+
+
+def test_a_configuration_is_answered_in_a_batch_as_alone_whether_the_device_a_task_names_is_there(
+        tmp_path: Path) -> None:
+    """The task names the robot for the gripper role: with the robot, it cannot play it; without, it is absent."""
+    the_task = service.task(write(tmp_path, "robot-grips.yaml", "task: robot-grips\nsteps:\n  - command: close-gripper\n"
+                                  "    bind: {gripper: robot}\n    params: {grip_force: 30}\n"))
+    together, alone = _together_and_alone(the_task, [Configuration("with", ("gripper", "robot")),
+                                                     Configuration("without", ("gripper",))])
+    assert together == alone
+    assert [r.purchase.impossible if r.purchase else None for r in together] == [
+        "step 1 of robot-grips: device robot named for role gripper cannot play it; adding devices cannot cure it",
+        "no set of catalogue devices makes every task plausible; e.g. adding robot: step 1 of robot-grips: device "
+        "robot named for role gripper cannot play it"]
+
+
+def test_a_lone_first_device_and_several_players_of_a_role_are_answered_apart_in_one_batch(tmp_path: Path) -> None:
+    """The bin-picking PC alone localizes; beside the UPnP one the role is ambiguous, in one batch as alone."""
+    together, alone = _together_and_alone(service.task(write(tmp_path, "localize.yaml", LOCALIZE_ANY)),
+                                          [Configuration("lone", ("binpicking-pc", "sensor3d")),
+                                           Configuration("two", ("binpicking-pc", "binpicking-pc-ua", "sensor3d"))])
+    assert together == alone
+    assert together[0].plausible == ("localize",) and together[1].plausible == ()
+    assert together[1].purchase is not None and (together[1].purchase.ambiguous or "").startswith(
+        "step 1 of localize: several devices can play role localizer")
