@@ -743,3 +743,21 @@ def test_a_lone_first_device_and_several_players_of_a_role_are_answered_apart_in
     assert together[0].plausible == ("localize",) and together[1].plausible == ()
     assert together[1].purchase is not None and (together[1].purchase.ambiguous or "").startswith(
         "step 1 of localize: several devices can play role localizer")
+
+
+def test_a_step_whose_command_names_no_process_is_named_as_check_names_it(tmp_path: Path) -> None:
+    the_task = service.task(write(tmp_path, "wave.yaml", "task: wave\nsteps:\n  - command: wave-hello\n"
+                                  "  - command: close-gripper\n    params: {grip_force: 30}\n"))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "unknown_command")]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of wave: no process has this name; adding devices cannot cure it")
+
+
+def test_a_value_outside_the_process_range_is_named_as_not_fitting_its_declaration(tmp_path: Path) -> None:
+    fast = service.task(write(tmp_path, "fast.yaml", WITHIN_EVERY_ROBOT.replace("grip_force: 30", "grip_force: 30\n"
+                                                                                 "      speed: 101")))
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [fast], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of pick-and-place: a parameter value does not fit its declaration; adding devices cannot cure it")
