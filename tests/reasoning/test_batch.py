@@ -761,3 +761,14 @@ def test_a_value_outside_the_process_range_is_named_as_not_fitting_its_declarati
     (row,) = service.batch([Configuration("paper", PAPER)], None, [fast], workers=1)
     assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
         "step 1 of pick-and-place: a parameter value does not fit its declaration; adding devices cannot cure it")
+
+
+def test_a_role_the_process_does_not_have_is_named_as_check_names_it(tmp_path: Path) -> None:
+    the_task = service.task(write(tmp_path, "hand.yaml", "task: hand\nsteps:\n  - command: close-gripper\n"
+                                  "    bind: {hand: gripper}\n    params: {grip_force: 30}\n"))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "unknown_role")]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of hand: the process has no role hand; adding devices cannot cure it")
+
