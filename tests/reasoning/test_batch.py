@@ -772,3 +772,30 @@ def test_a_role_the_process_does_not_have_is_named_as_check_names_it(tmp_path: P
     assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
         "step 1 of hand: the process has no role hand; adding devices cannot cure it")
 
+
+
+def test_the_states_are_followed_once_a_purchase_fills_every_role(tmp_path: Path) -> None:
+    """No robot for the first step's move: the batch looks for one to buy before it follows the gripper's states,
+    and then finds that the second close finds the gripper closed, which no purchase cures."""
+    text = ("task: move-then-close-twice\nsteps:\n  - command: move-to\n    params: {target_pose: [0.30, 0.00, 0.40, 0, "
+            "180, 0], speed: 50}\n" + CLOSE_TWICE.split("steps:\n", 1)[1])
+    the_task = service.task(write(tmp_path, "task.yaml", text))
+    cell = Cell("gripper-only", tuple(d for d in service.catalogue() if d.id == "gripper"))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "no_device"), (3, "wrong_state")]
+    (row,) = service.batch([Configuration("gripper-only", ("gripper",))], None, [the_task], workers=1)
+    assert row.purchase is not None and row.purchase.impossible == (
+        "no set of catalogue devices makes every task plausible; e.g. adding scara: step 3 of move-then-close-twice: "
+        "device gripper is not in the state role gripper starts from")
+
+
+def test_findings_are_named_in_step_order(tmp_path: Path) -> None:
+    """The move's pose is beyond the robot's reach (step 1, role robot) and the close's force beyond its process's
+    range (step 2, no role): the first named is the first step's, as check names it first."""
+    text = ("task: far-then-hard\nsteps:\n  - command: move-to\n    params: {target_pose: [1.48, 0.00, 0.40, 0, 180, 0], "
+            "speed: 50}\n  - command: close-gripper\n    params: {grip_force: 150}\n")
+    the_task = service.task(write(tmp_path, "task.yaml", text))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "device_limit"), (2, "too_high")]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.purchase is not None and (row.purchase.impossible or "").startswith(
+        "step 1 of far-then-hard: device robot (role robot) refuses a value sent to it by its own limits")
