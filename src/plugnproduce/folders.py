@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import hashlib
 import os
 import pickle
 import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
+
+from plugnproduce.digests import sha256
 
 T = TypeVar("T")
 
@@ -73,7 +74,7 @@ def code_digest() -> str:
     """The package's code and the interpreter's version, by each module's name, size and time of change (reading
     it all would cost more than it saves); looked at once per process. What is kept from the code's work is named
     by it, so another version of the code never reads it."""
-    h = hashlib.sha256(f"{sys.version}\0".encode())
+    h = sha256(f"{sys.version}\0".encode())
     here = os.path.dirname(__file__)
     for folder, dirs, names in os.walk(here):
         dirs[:] = sorted(d for d in dirs if d != "__pycache__")
@@ -99,7 +100,7 @@ def kept(kind: str, source: Path, parse: Callable[[Path], T], fits: Callable[[ob
         data = source.read_bytes()
     except OSError:
         return parse(source)
-    h = hashlib.sha256(f"{kind}\0{code_digest()}\0{source}\0{source.resolve()}\0".encode())  # as named, and where
+    h = sha256(f"{kind}\0{code_digest()}\0{source}\0{source.resolve()}\0".encode())  # as named, and where
     # it is: what a file names relative to itself or the working folder is read back as that file meant it
     h.update(data)
     path = (folder or cache_folder()) / f"{kind}-{h.hexdigest()[:32]}.pickle"
@@ -112,3 +113,19 @@ def kept(kind: str, source: Path, parse: Callable[[Path], T], fits: Callable[[ob
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
         keep_newest(path, pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL), KEEP_PARSED)
     return value
+
+
+def made_once(path: Path, make: Callable[[], str], keep: int) -> str:
+    """``make()``, read back from ``path`` when kept there, else made and kept there (with the newest ``keep`` of
+    its kind, :func:`keep_newest`). ``path`` is named by the digest of everything ``make`` depends on; a kept file
+    that cannot be read or is not what was kept is made again, and a folder that cannot be written costs only the
+    making. The folder is the user's own, so the pickle is as trusted as the user's files."""
+    with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError,
+                             ValueError, IndexError):
+        name, text = pickle.loads(path.read_bytes())  # noqa: S301 - the user's own cache folder, by content
+        if name == path.name and isinstance(text, str):
+            return text
+    text = make()
+    with contextlib.suppress(OSError, pickle.PicklingError):
+        keep_newest(path, pickle.dumps((path.name, text), protocol=pickle.HIGHEST_PROTOCOL), keep)
+    return text

@@ -10,10 +10,11 @@ stale file is written again the next time the command line prints its help.
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import io
 import os
 import sys
+
+from plugnproduce.digests import sha256
 
 TYPE_CHECKING = False  # typing itself is not imported: it costs a fifth of the start-up this module saves
 if TYPE_CHECKING:
@@ -54,7 +55,7 @@ def help_file(folder: str | None = None) -> str:
     """The file of the help text for this command line's code, version, width and environment."""
     here = os.path.dirname(__file__)
     cli = os.path.join(here, "cli")
-    h = hashlib.sha256(f"{sys.version}\0{_width()}\0{sys.argv[0]}\0".encode())
+    h = sha256(f"{sys.version}\0{_width()}\0{sys.argv[0]}\0".encode())
     for name in ("NO_COLOR", "FORCE_COLOR", "TERM", "_TYPER_FORCE_DISABLE_TERMINAL", "LANG", "LC_ALL"):
         h.update(f"{name}={os.environ.get(name)}\0".encode())
     files = [os.path.join(cli, f) for f in os.listdir(cli) if f.endswith(".py")] + [os.path.join(here, "__init__.py")]

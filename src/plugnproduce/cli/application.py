@@ -158,9 +158,9 @@ def boundary(func: F) -> F:
 
 
 def emit_json(data: object) -> None:
-    """Write a JSON document to stdout."""
-    json.dump(data, sys.stdout, indent=2, sort_keys=False, default=str)
-    sys.stdout.write("\n")
+    """Write a JSON document to stdout, in one write (``json.dump`` writes each of its pieces: the repairs of a
+    10,000-step task are some 400,000 writes through the quiet pipe)."""
+    sys.stdout.write(json.dumps(data, indent=2, sort_keys=False, default=str) + "\n")
 
 
 def _command_named(args: list[str]) -> str | None:

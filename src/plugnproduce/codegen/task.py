@@ -179,19 +179,20 @@ def generate_task(
     chart; nothing is unrolled.
     """
     consumed = consumed_outputs(task)
-    keys, values, end = _plan(task, cell, bindings, processes, taxonomy, consumed)
-    groups: dict[_Key, list[dict[str, object]]] = {}
-    for key, row in zip(keys, values, strict=True):
-        groups.setdefault(key, []).append(row)
-    varying = {key: _varying(rows) for key, rows in groups.items()}
-    charts: dict[_Key, StepChart] = {}
+    kinds, keys, values, end = _plan(task, cell, bindings, processes, taxonomy, consumed)
+    groups: list[list[dict[str, object]]] = [[] for _ in keys]
+    for kind, row in zip(kinds, values, strict=True):
+        groups[kind].append(row)
+    varying = [_varying(rows) for rows in groups]
+    charts: list[StepChart | None] = [None] * len(keys)
     steps: list[StepChart] = []
     for i, (step, binding) in enumerate(zip(task.steps, bindings, strict=True)):
-        key, process = keys[i], processes[step.command]
-        vary, first = varying[key], charts.get(key)  # a key is a deep tuple: hashed once a step
+        kind, process = kinds[i], processes[step.command]
+        vary, first = varying[kind], charts[kind]
         if first is None:  # from the device states the plan found this key's first step to start in
+            key = keys[kind]
             bound = {n: Varying(n) if n in vary else v for n, v in values[i].items()}
-            first = charts[key] = _step(step, process, binding, cell, dict(key[2]), taxonomy, bound, key[4])
+            first = charts[kind] = _step(step, process, binding, cell, dict(key[2]), taxonomy, bound, key[4])
         row = {n: v for n, v in values[i].items() if n in vary}
         steps.append(StepChart(step, process, binding, first.regions, first.element, first.body, row, first.produces))
     return GeneratedTask(task, steps, _task_chart(task, steps, outcome_names(task, processes, taxonomy)), end)
@@ -214,14 +215,16 @@ def _plan(
     processes: Mapping[str, ProcessDescription],
     taxonomy: Taxonomy,
     consumed: dict[str, set[str]],
-) -> tuple[list[_Key], list[dict[str, object]], dict[str, str]]:
-    """Each step's key (what its chart depends on: process, bindings, device states, parameters) and values, and
-    the device states the task ends in."""
+) -> tuple[list[int], list[_Key], list[dict[str, object]], dict[str, str]]:
+    """Each step's kind (a number: the steps of one kind share a chart), the key of each kind (what its chart
+    depends on: process, bindings, device states, parameters), each step's values, and the device states the
+    task ends in. A key is a deep tuple, hashed once a step: the steps' kinds are numbers."""
     current = {d.id: d.initial for d in cell.devices}
     states = tuple(sorted(current.items()))
+    kinds: list[int] = []
     keys: list[_Key] = []
     values: list[dict[str, object]] = []
-    after: dict[_Key, tuple[dict[str, str], tuple[tuple[str, str], ...]]] = {}
+    after: dict[_Key, tuple[dict[str, str], tuple[tuple[str, str], ...], int]] = {}
     left: dict[int, dict[str, str]] = {}
     firsts = _branch_firsts(task)
     for step, binding in zip(task.steps, bindings, strict=True):
@@ -237,11 +240,12 @@ def _plan(
             placeholders: dict[str, object] = {n: Varying(n) for n in values[-1]}
             ended = dict(current)
             _step(step, process, binding, cell, ended, taxonomy, placeholders, produces)
-            ends = after[key] = ended, tuple(sorted(ended.items()))
-        keys.append(key)
-        current, states = ends  # never changed in place: a branch's start copies it
+            ends = after[key] = ended, tuple(sorted(ended.items())), len(keys)
+            keys.append(key)
+        current, states, kind = ends  # never changed in place: a branch's start copies it
+        kinds.append(kind)
         left[step.index] = current
-    return keys, values, dict(current)
+    return kinds, keys, values, dict(current)
 
 
 def _varying(rows: list[dict[str, object]]) -> set[str]:

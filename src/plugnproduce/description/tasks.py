@@ -60,6 +60,14 @@ class Step:
     name: str | None = None
     """The step's name (``name:``), by which later steps take its outputs."""
 
+    def at(self, index: int) -> Step:
+        """This step at position ``index`` of a task: itself when it is there already, else a copy (the same
+        values, bindings and lines; a plain copy costs a fraction of ``dataclasses.replace``, which the
+        repairs of a 10,000-step task would pay for every step after their first insertion)."""
+        if index == self.index:
+            return self
+        return Step(index, self.command, self.bind, self.params, self.line, self.param_lines, self.name)
+
     def links(self) -> dict[str, Link]:
         """The parameters whose values come from earlier steps' outputs."""
         return {n: v for n, v in self.params.items() if isinstance(v, Link)}

@@ -14,12 +14,12 @@ as the user's files.
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import pickle
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 from plugnproduce import folders
+from plugnproduce.digests import sha256
 from plugnproduce.folders import code_digest as code_digest
 from plugnproduce.knowledge.libraries import Knowledge, Library
 from plugnproduce.ontology.taxonomy import ontology_files
@@ -43,7 +43,7 @@ def _files(root: Path) -> list[Path]:
 def digest(libraries: Sequence[Library]) -> str | None:
     """The digest of what the knowledge of ``libraries`` is loaded from; None when a file cannot be read (it is
     then loaded, and what is wrong said, as without a cache)."""
-    h = hashlib.sha256(f"{FORMAT}\0{code_digest()}\0".encode())
+    h = sha256(f"{FORMAT}\0{code_digest()}\0".encode())
     try:
         # the pnp ontology, then every file of every library: the TBox files a library imports lie inside it, so
         # they are among its files without resolving its imports (which would mean reading RDF)
@@ -80,12 +80,48 @@ def cached_knowledge(libraries: Sequence[Library], load: Callable[[], Knowledge]
                              ValueError, IndexError):
         kept, outside = pickle.loads(path.read_bytes())  # noqa: S301 - the user's own cache folder, by content
         if isinstance(kept, Knowledge) and _unchanged(outside):
-            return kept
+            return _keyed(kept, _own_key(key, outside), path.parent)
     knowledge = load()
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
-        data = pickle.dumps((knowledge, _outside(knowledge)), protocol=pickle.HIGHEST_PROTOCOL)
+        outside = _outside(knowledge)
+        _keyed(knowledge, _own_key(key, outside), path.parent)
+        data = pickle.dumps((knowledge, outside), protocol=pickle.HIGHEST_PROTOCOL)
         folders.keep_newest(path, data, KEEP)
     return knowledge
+
+
+_FOLDERS: dict[str, Path] = {}
+"""The cache folder of each knowledge key this process read or kept, where what is made of it is kept too."""
+
+
+def _keyed(knowledge: Knowledge, key: str, folder: Path) -> Knowledge:
+    object.__setattr__(knowledge, "key", key)  # set once, as it is read: the knowledge is frozen for everyone else
+    _FOLDERS[key] = folder
+    return knowledge
+
+
+KEEP_MADE = 64
+"""Texts made of knowledge alone (:func:`kept_for`) kept in the cache folder."""
+
+
+def kept_for(knowledge: Knowledge, what: str, make: Callable[[], str]) -> str:
+    """``make()``: a text made of ``knowledge``'s taxonomy and processes alone, which ``what`` names (the processes'
+    ASP facts), read back from the cache folder under the knowledge's key when kept there, else made and kept.
+    Made, and not kept, for knowledge without a key (:attr:`~.libraries.Knowledge.key`)."""
+    folder = _FOLDERS.get(knowledge.key) if knowledge.key is not None else None
+    if folder is None:
+        return make()
+    name = sha256(f"{FORMAT}\0{knowledge.key}\0{what}".encode()).hexdigest()[:32]
+    return folders.made_once(folder / f"made-{name}.pickle", make, KEEP_MADE)
+
+
+def _own_key(key: str, outside: dict[str, bytes]) -> str:
+    """The knowledge's own key (:attr:`~.libraries.Knowledge.key`): the digest of its libraries and of the content
+    of each chart it read outside them (which the digest alone does not name)."""
+    h = sha256(key.encode())
+    for f, data in sorted(outside.items()):
+        h.update(f"\0{f}\0{len(data)}\0".encode() + data)
+    return h.hexdigest()[:32]
 
 
 def kept_files(folder: Path | None = None) -> Iterable[Path]:

@@ -13,14 +13,15 @@ The folder is the user's own, so the pickle is as trusted as the user's files.
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import pickle
+import weakref
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from plugnproduce import folders
 from plugnproduce.description.model import DeviceDescription
+from plugnproduce.digests import sha256
 from plugnproduce.knowledge.cache import cache_folder, code_digest
 
 if TYPE_CHECKING:
@@ -41,7 +42,7 @@ def _read(path: Path) -> bytes | None:
 
 def _chart_digest(device: DeviceDescription) -> str | None:
     data = _read(Path(device.chart_file))
-    return None if data is None else hashlib.sha256(data).hexdigest()
+    return None if data is None else sha256(data).hexdigest()
 
 
 def _load_device(path: Path, taxonomy: Taxonomy) -> DeviceDescription:
@@ -61,19 +62,46 @@ def cached_device(path: str | Path, taxonomy: Taxonomy, folder: Path | None = No
     data = _read(p)
     if data is None:
         return read(p, taxonomy)
-    h = hashlib.sha256(f"{FORMAT}\0{code_digest()}\0{taxonomy.digest}\0{p}\0".encode())
+    h = sha256(f"{FORMAT}\0{code_digest()}\0{taxonomy.digest}\0{p}\0".encode())
     h.update(data)
     kept = (folder or cache_folder()) / f"device-{h.hexdigest()[:32]}.pickle"
     with contextlib.suppress(OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError,
                              ValueError, IndexError):
         device, chart = pickle.loads(kept.read_bytes())  # noqa: S301 - the user's own cache folder, by content
         if isinstance(device, DeviceDescription) and chart is not None and chart == _chart_digest(device):
-            return device
+            return _served(device, f"{h.hexdigest()}\0{chart}", kept.parent)
     device = read(p, taxonomy)
+    chart = _chart_digest(device)
     with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
-        folders.keep_newest(kept, pickle.dumps((device, _chart_digest(device)), protocol=pickle.HIGHEST_PROTOCOL),
-                            KEEP)
+        folders.keep_newest(kept, pickle.dumps((device, chart), protocol=pickle.HIGHEST_PROTOCOL), KEEP)
+    return device if chart is None else _served(device, f"{h.hexdigest()}\0{chart}", kept.parent)
+
+
+_SERVED: dict[int, tuple[weakref.ref[DeviceDescription], str, Path]] = {}
+"""The devices :func:`cached_device` gave in this process and still alive, by identity: each with the digest of
+what it was read from (the code, taxonomy, description and chart) and its cache folder, for what is made of it to
+be kept (:func:`kept_facts`). By identity, not equality: a copy made by :func:`dataclasses.replace` is not among
+them. Not held: a device's entry goes when the device does (before its id can name another object), so a
+long-running process that reads devices again and again keeps none of them."""
+
+
+def _served(device: DeviceDescription, key: str, folder: Path) -> DeviceDescription:
+    at, served = id(device), _SERVED  # the dict itself, not the module's name for it: gone at interpreter exit
+    served[at] = (weakref.ref(device, lambda _: served.pop(at, None)), key, folder)
     return device
+
+
+def kept_facts(device: DeviceDescription, knowledge: str | None, make: Callable[[], str]) -> str:
+    """``make()``: the ASP facts of ``device`` with the knowledge whose key (:attr:`~.libraries.Knowledge.key`) is
+    ``knowledge``, read back from the cache folder when kept there for the same device (as :func:`cached_device`
+    read it) and knowledge, else made, then kept. Made, and not kept, for a device :func:`cached_device` did not
+    give or knowledge without a key: what it was made from is not known by name."""
+    served = _SERVED.get(id(device))
+    if served is None or served[0]() is not device or knowledge is None:
+        return make()
+    _, key, folder = served
+    name = sha256(f"{FORMAT}\0{key}\0{knowledge}".encode()).hexdigest()[:32]
+    return folders.made_once(folder / f"facts-{name}.pickle", make, KEEP)
 
 
 def device_reader(taxonomy: Taxonomy, folder: Path | None = None) -> Callable[[Path], DeviceDescription]:

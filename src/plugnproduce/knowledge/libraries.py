@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import field
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -99,6 +100,11 @@ class Knowledge:
     """TBox files given beside the libraries (an extension being tried out)."""
     left_out: tuple[Path, ...] = ()
     """TBox files of the libraries left out (the state before an extension, for ``pnp impact``)."""
+    key: str | None = field(default=None, init=False, compare=False, repr=False)
+    """The digest of everything the knowledge was loaded from, when it was read through the cache folder
+    (:func:`~plugnproduce.knowledge.cache.cached_knowledge`): two with the same key have the same taxonomy and
+    processes, so what is made of them may be kept under it. None for knowledge made otherwise; a copy made by
+    :func:`dataclasses.replace` has none."""
 
     @cached_property
     def processes_by_id(self) -> Mapping[str, ProcessDescription]:

@@ -14,7 +14,6 @@ ontology IRI. The file must lie inside the library folder. Anything else is bad 
 
 from __future__ import annotations
 
-import hashlib
 import io
 import warnings
 from collections.abc import Iterable
@@ -23,6 +22,7 @@ from typing import TYPE_CHECKING
 from urllib.parse import unquote, urljoin, urlparse
 
 from plugnproduce.deferred import dataclass
+from plugnproduce.digests import sha256
 from plugnproduce.errors import DescriptionError, HostileInputError, UnreadableError, tidy
 
 if TYPE_CHECKING:  # the parsers are imported when a file is read: listing the files needs none of them
@@ -65,7 +65,7 @@ def read_tbox_file(path: Path) -> TBoxFile:
 
     p = Path(path)
     data = read_bytes(p)
-    key = (str(p), hashlib.sha256(data).hexdigest())
+    key = (str(p), sha256(data).hexdigest())
     if key not in _READ:
         if len(_READ) >= _READ_MOST:
             _READ.clear()

@@ -7,7 +7,6 @@ code generation) asks this object, never the reasoner.
 
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 from collections.abc import Iterable
@@ -16,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from plugnproduce.deferred import dataclass
+from plugnproduce.digests import sha256
 from plugnproduce.errors import OntologyError
 from plugnproduce.ontology.iris import PNP_IRI, local_name
 from plugnproduce.ontology.sources import folder_files
@@ -132,7 +132,7 @@ def _digest(files: Iterable[Path]) -> str:
     keys; imported files are among ``files`` (the libraries list them), so editing one reclassifies."""
     from plugnproduce.safeio import read_bytes
 
-    h = hashlib.sha256()
+    h = sha256()
     for p in files:
         h.update(p.name.encode() + b"\0" + read_bytes(p) + b"\0")
     return h.hexdigest()

@@ -84,14 +84,17 @@ def assessed_repairs(
     worst side effect, then by cost (:func:`plugnproduce.reasoning.repairs.sideeffects.ranking`). When the check refuses
     some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds. ``checked``: the
     task's :func:`check` in that cell, when the caller has it (it is not checked again)."""
+    from plugnproduce.statechart import gcpause
+
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     the_task = as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
     asked = top
-    for _ in range(MORE_REPAIRS):
-        repairs = repair(the_task, the_cell, devices, asked, knowledge=k)
-        assessed = reasoning.assess(repairs, the_task, the_cell, k, devices or (), checked)
-        if len(assessed) >= top or len(repairs) < asked:
-            break
-        asked += top
+    with gcpause.paused():  # repairs of a long task make long-lived results, not cyclic garbage: see gcpause
+        for _ in range(MORE_REPAIRS):
+            repairs = repair(the_task, the_cell, devices, asked, knowledge=k)
+            assessed = reasoning.assess(repairs, the_task, the_cell, k, devices or (), checked)
+            if len(assessed) >= top or len(repairs) < asked:
+                break
+            asked += top
     return assessed[:top]

@@ -13,12 +13,12 @@ estimate. The folder is the user's own, so the pickle is as trusted as the user'
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import pickle
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from plugnproduce import folders
+from plugnproduce.digests import sha256
 from plugnproduce.knowledge.cache import cache_folder, code_digest
 from plugnproduce.timing.cycle import CycleTime
 
@@ -37,7 +37,7 @@ _NONE = "no estimate"
 
 def _key(task: Task, cell: Cell, knowledge: Knowledge, result: CheckResult) -> str | None:
     """The digest of everything the estimate follows from; None when a chart cannot be read."""
-    h = hashlib.sha256(f"{FORMAT}\0{code_digest()}\0{knowledge.taxonomy.digest}\0{task!r}\0".encode())
+    h = sha256(f"{FORMAT}\0{code_digest()}\0{knowledge.taxonomy.digest}\0{task!r}\0".encode())
     processes = [knowledge.processes_by_id.get(s.command) for s in task.steps]
     every: list[DeviceDescription | ProcessDescription] = [*cell.devices]
     every += dict.fromkeys(p for p in processes if p is not None)

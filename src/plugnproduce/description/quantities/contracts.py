@@ -19,16 +19,11 @@ from collections.abc import Mapping
 from typing import Any
 
 from plugnproduce.description.model import Argument
+from plugnproduce.description.quantities.kinds import KINDS as KINDS
+from plugnproduce.description.quantities.kinds import XSD as XSD
+from plugnproduce.description.quantities.kinds import kind_of as kind_of
 from plugnproduce.description.quantities.units import UnitError, convert, convert_pose, pose_units
-from plugnproduce.ontology.iris import PNP_IRI, local_name
-
-XSD = "http://www.w3.org/2001/XMLSchema#"
-KINDS = {
-    XSD + "decimal": "decimal", XSD + "double": "decimal", XSD + "float": "decimal",
-    XSD + "integer": "integer", XSD + "int": "integer", XSD + "long": "integer",
-    XSD + "boolean": "boolean", XSD + "string": "string", PNP_IRI + "Pose": "pose",
-}
-"""Declared datatypes → the kind of value they take."""
+from plugnproduce.ontology.iris import local_name
 
 MAX_STRING = 1024
 """The longest text a request argument may carry (a part type, a program name)."""
@@ -36,11 +31,6 @@ MAX_ITEMS = 64
 """The most items a list argument may carry."""
 POSE_SIZE = 6
 """A pose is x, y, z (m) and rx, ry, rz (deg)."""
-
-
-def kind_of(datatype: str) -> str:
-    """The kind of value a declared datatype takes (``""``: any)."""
-    return KINDS.get(datatype, "")
 
 
 def breach(value: object, unit: str, contract: Argument, *, types: bool = True) -> str | None:

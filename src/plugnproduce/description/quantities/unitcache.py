@@ -16,7 +16,6 @@ the same float); a conversion involving an offset unit (``degC``) always goes to
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import importlib.machinery
 import json
 import os
@@ -24,6 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from plugnproduce import folders
+from plugnproduce.digests import sha256
 from plugnproduce.errors import PlugNProduceError
 
 if TYPE_CHECKING:
@@ -157,4 +157,4 @@ def table_file(folder: Path | None = None) -> Path | None:
     if spec is None or spec.origin is None:
         return None
     stamp = f"{spec.origin}\0{os.stat(spec.origin).st_mtime_ns}"
-    return (folder or cache_folder()) / f"units-{hashlib.sha256(stamp.encode()).hexdigest()[:16]}.json"
+    return (folder or cache_folder()) / f"units-{sha256(stamp.encode()).hexdigest()[:16]}.json"

@@ -5,7 +5,7 @@ are turned into facts once and reused for every configuration they appear in. Ch
 reachability (``reach/3``) is left to ASP, as the transitive closure of ``edge/3``; the
 one thing computed here is where a role's region *leaves* a device (``leaves/5``),
 because that is code generation's own shortest-path choice
-(:func:`plugnproduce.description.paths.find_path`, networkx) and the plausibility check must
+(:func:`plugnproduce.description.paths.find_path`) and the plausibility check must
 agree with the code that will run.
 """
 
@@ -13,20 +13,27 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import field
-from decimal import Decimal, InvalidOperation
 from typing import TYPE_CHECKING
 
 from plugnproduce.deferred import dataclass
 from plugnproduce.description.model import DeviceDescription, ProcessDescription, Role, Task
-from plugnproduce.description.paths import NoPath, find_path, in_concept
-from plugnproduce.description.quantities.contracts import KINDS
+from plugnproduce.description.quantities.kinds import KINDS
 from plugnproduce.errors import UnknownName
+from plugnproduce.knowledge.cache import kept_for
+from plugnproduce.knowledge.devicecache import kept_facts
+from plugnproduce.lazy import lazy_module
 from plugnproduce.ontology.taxonomy import Taxonomy
 from plugnproduce.reasoning.asp import schema as s
 from plugnproduce.reasoning.asp.terms import Atom, program
 
 if TYPE_CHECKING:
+    import decimal
+
+    from plugnproduce.description import paths
     from plugnproduce.knowledge import Knowledge
+else:  # what makes facts: a command whose facts are all kept in the cache folder reads them without either
+    decimal = lazy_module("decimal")
+    paths = lazy_module("plugnproduce.description.paths")
 
 DATATYPES = KINDS
 """Declared parameter datatypes → the short names the encodings compare (the contracts' kinds of value)."""
@@ -47,8 +54,8 @@ def milli(value: object) -> int | None:
     if not text.isascii():
         return None
     try:
-        number = Decimal(text)
-    except (InvalidOperation, ValueError):
+        number = decimal.Decimal(text)
+    except (decimal.InvalidOperation, ValueError):
         return None
     if not number.is_finite():
         return None
@@ -63,7 +70,7 @@ def value_kinds(value: object) -> tuple[str, ...]:
         return ("boolean",)
     if isinstance(value, int):
         return ("integer",)
-    if isinstance(value, float | Decimal):
+    if isinstance(value, float | decimal.Decimal):
         return ("decimal", "integer") if float(value).is_integer() else ("decimal",)
     if isinstance(value, str):
         return ("string", "pose") if _pose(value.split()) else ("string",)
@@ -87,8 +94,8 @@ def region_walk(device: DeviceDescription, process: ProcessDescription, role: Ro
     for general in role.region[1:]:
         try:
             given = frozenset(process.parameter(p).quantity for p in general.params)
-            path = find_path(device, current, general.concept, taxonomy, given)
-        except (NoPath, KeyError):
+            path = paths.find_path(device, current, general.concept, taxonomy, given)
+        except (paths.NoPath, KeyError):
             return None
         current = path.target
         missing |= {(t.request.name, q) for t in path.steps if t.request for q in t.accepts
@@ -116,7 +123,7 @@ def effects(device: DeviceDescription, process: ProcessDescription, taxonomy: Ta
         first: str | None = None
         missing: set[tuple[str, str]] = set()
         for state in device.states:
-            if not in_concept(state, role.start_concept, taxonomy):
+            if not paths.in_concept(state, role.start_concept, taxonomy):
                 continue
             walked = region_walk(device, process, role, state.id, taxonomy)
             if walked is not None:
@@ -213,14 +220,16 @@ class FactBook:
     def process_text(self) -> str:
         """ASP facts of every process."""
         if not self._processes:
-            self._processes = program(a for p in self.processes for a in process_facts(p))
+            self._processes = kept_for(self.knowledge, "processes",
+                                       lambda: program(a for p in self.processes for a in process_facts(p)))
         return self._processes
 
     def device_text(self, device: DeviceDescription) -> str:
         """ASP facts of one device (cached)."""
         text = self._devices.get(device)
         if text is None:
-            text = program(device_facts(device, self.taxonomy, self.processes))
+            text = kept_facts(device, self.knowledge.key,
+                              lambda: program(device_facts(device, self.taxonomy, self.processes)))
             self._devices[device] = text
         return text
 

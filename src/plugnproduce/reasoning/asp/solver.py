@@ -20,6 +20,7 @@ from functools import cache, lru_cache
 from typing import TypeVar
 
 import clingo
+import clingo.ast
 
 from plugnproduce.errors import EncodingError
 from plugnproduce.reasoning.asp.terms import Model, decode
@@ -71,6 +72,26 @@ def encoding(name: str) -> str:
         raise EncodingError(f"encoding {name} not found in {rules_path()}") from exc
 
 
+@lru_cache(maxsize=16)
+def _parsed(texts: tuple[str, ...]) -> tuple[clingo.ast.AST, ...]:
+    """The statements of encodings, each text parsed once a process (a long task's repair makes a ``Control`` per
+    window: added as parsed statements, the program is the one their text gives, without parsing it again). Keyed
+    by the texts themselves, so an encoding read again with other text is parsed again. A text clingo refuses
+    raises RuntimeError with clingo's error messages."""
+    statements: list[clingo.ast.AST] = []
+    messages: list[str] = []
+
+    def log(code: clingo.MessageCode, message: str) -> None:
+        messages.append(message.strip())
+
+    try:
+        for text in texts:
+            clingo.ast.parse_string(text, statements.append, logger=log, message_limit=50)
+    except RuntimeError as exc:
+        raise RuntimeError("; ".join(m for m in messages if "error" in m) or str(exc)) from exc
+    return tuple(statements)
+
+
 def _control(arguments: Sequence[str]) -> tuple[clingo.Control, list[str]]:
     messages: list[str] = []
 
@@ -82,8 +103,9 @@ def _control(arguments: Sequence[str]) -> tuple[clingo.Control, list[str]]:
 
 def _ground(ctl: clingo.Control, messages: list[str], rules: Sequence[str], facts: str) -> None:
     try:
-        for name in rules:
-            ctl.add("base", [], encoding(name))
+        with clingo.ast.ProgramBuilder(ctl) as builder:
+            for statement in _parsed(tuple(encoding(name) for name in rules)):
+                builder.add(statement)
         ctl.add("base", [], facts)
         ctl.ground([("base", [])])
     except RuntimeError as exc:

@@ -231,19 +231,24 @@ def _holding(k: _Cell, result: CheckResult, cell: Cell, fresh: set[int], task: T
     concepts: dict[tuple[str, str | None], str | None] = {}  # _concept, indexed: the first device and state
     for dev in reversed(cell.devices):
         concepts.update({(dev.id, st.id): st.concept for st in reversed(dev.states)})
+    kinds: dict[tuple[str, str | None], tuple[bool, bool, bool]] = {}  # a state left in: open, holding, closed
     for i, step in enumerate(result.steps, start=1):
+        left = _after(result, i)
         for d in step.bindings.values():
-            after = concepts.get((d, _after(result, i).get(d)))
-            if d in held and k.is_a(after, "Open") and not k.process_is(step.command, "PlaceProcess"):
+            kind = kinds.get(key := (d, left.get(d)))
+            if kind is None:
+                after = concepts.get(key)
+                kind = kinds[key] = (k.is_a(after, "Open"), k.is_a(after, "HoldingPart"), k.is_a(after, "Closed"))
+            opened, holding, closed = kind
+            if d in held and opened and not k.process_is(step.command, "PlaceProcess"):
                 picker = f"step {held[d]} ({result.steps[held[d] - 1].command})"
                 out.append(SideEffect("drops_part", f"step {i} ({step.command}) opens device '{d}', which holds the "
                                                     f"part {picker} picked: the part would be released "
                                                     f"{_mover(k, result, i, cell)}, not placed", i, d,
                                       _drop_evidence(k, result, cell, held[d], i, d)))
-            if k.is_a(after, "Open"):
+            if opened:
                 held.pop(d, None)
-            elif k.is_a(after, "HoldingPart") or (k.process_is(step.command, "PickProcess")
-                                                  and k.is_a(after, "Closed")):
+            elif holding or (closed and k.process_is(step.command, "PickProcess")):
                 held[d] = i
         if i in fresh:
             if len(origins) == len(task.steps) and origins:

@@ -402,7 +402,7 @@ class _Solver:
             start = p.window.last + 1
         steps += task.steps[start - 1:]
         origins += range(start, len(task.steps) + 1)
-        steps = [replace(st, index=k) for k, st in enumerate(steps, start=1)]
+        steps = [st.at(k) for k, st in enumerate(steps, start=1)]
         repaired = Task(task.name, tuple(steps), task.file, task.description,
                         repairs.folded_repeat(steps, task.repeat))
         return Repair(rank, cost / 100, tuple(read), repaired, added, tuple(origins))
