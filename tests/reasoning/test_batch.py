@@ -799,3 +799,17 @@ def test_findings_are_named_in_step_order(tmp_path: Path) -> None:
     (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
     assert row.purchase is not None and (row.purchase.impossible or "").startswith(
         "step 1 of far-then-hard: device robot (role robot) refuses a value sent to it by its own limits")
+
+
+def test_a_value_no_command_of_the_bound_device_accepts_is_named_as_check_names_it(
+        tmp_path: Path, vacuum_with_default: DeviceDescription) -> None:
+    """The vacuum gripper (with a default vacuum, so that it can close) has no command that takes a grip force."""
+    the_task = service.task(write(tmp_path, "t.yaml", "task: t\nsteps:\n  - command: close-gripper\n"
+                                  "    params: {grip_force: 50}\n"))
+    catalogue = [d for d in service.catalogue() if d.id != "vacuum-gripper"] + [vacuum_with_default]
+    cell = Cell("vacuum", tuple(d for d in catalogue if d.id in ("robot", "vacuum-gripper")))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "not_accepted")]
+    (row,) = service.batch([Configuration("vacuum", ("robot", "vacuum-gripper"))], catalogue, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of t: device vacuum-gripper (role gripper) accepts no command for a parameter value given; adding "
+        "devices cannot cure it")
