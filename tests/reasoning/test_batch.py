@@ -524,7 +524,8 @@ def test_the_lone_player_of_a_role_is_bound_when_it_is_the_catalogues_first_devi
 def test_a_configuration_offers_the_processes_the_reasoner_says_it_offers() -> None:
     """Each configuration's offered processes are those ``pnp capabilities`` lists for it as a cell."""
     configs = [Configuration("gripper", ("gripper",)), Configuration("sensing", ("binpicking-pc", "sensor3d")),
-               Configuration("arm", ("robot", "screwdriver")), Configuration("paper", PAPER)]
+               Configuration("arm", ("robot", "screwdriver")), Configuration("paper", PAPER),
+               Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d"))]  # no bin-pick: it needs a gripper
     found = rows(configs)
     k = service.knowledge()
     assert [r.offered for r in found] == [o for o, _ in _reasoner(configs, tasks(), k)]
