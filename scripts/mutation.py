@@ -170,9 +170,9 @@ CORE = (
     Guard("executor-links", (_S + "executor/links.py",), ("tests/executor/test_links.py",)),
     Guard("executor-values", (_S + "executor/values.py",), ("tests/executor/test_values.py",)),
     *(Guard(f"verification-{name}", (_S + f"verification/{name}.py",),
-            ("tests/verification/test_answers.py", "tests/verification/test_verify.py",
-             "tests/verification/test_branch_verify.py", "tests/verification/test_nested_verify.py",
-             "tests/verification/test_hierarchical_verify.py"),
+            ("tests/verification/test_answers.py", "tests/verification/test_device_ends.py",  # the fast ones first
+             "tests/verification/test_verify.py", "tests/verification/test_branch_verify.py",
+             "tests/verification/test_nested_verify.py", "tests/verification/test_hierarchical_verify.py"),
             deselect=(  # a run on the simulated cell (the executor's work) and pnp verify in a child process
                 "tests/verification/test_verify.py::test_the_seeded_deadlock_is_not_hit_by_a_simulated_run",
                 "tests/verification/test_nested_verify.py::"

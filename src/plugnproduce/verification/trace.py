@@ -11,7 +11,7 @@ from plugnproduce.description.model import Step
 from plugnproduce.statechart.model import Transition
 from plugnproduce.statechart.runtime.events import TRANSITION_TAKEN, MetaEvent
 from plugnproduce.verification.results import TraceStep
-from plugnproduce.verification.world import CONTROLLER, ClosedWorld, Move, Violation, World
+from plugnproduce.verification.world import CONTROLLER, ClosedWorld, Move, Violation, World, states_of
 
 
 def explain(world: ClosedWorld, moves: list[Move], violation: Violation) -> list[TraceStep]:
@@ -43,20 +43,19 @@ def explain(world: ClosedWorld, moves: list[Move], violation: Violation) -> list
 def _step(world: ClosedWorld, before: World, after: World, move: Move, taken: list[Transition]) -> TraceStep:
     if move.session == CONTROLLER:
         sent = _sent(world, before, after)
-        what = f"takes {move.name}" if move.kind == "own" else f"receives {move.name}"
-        what += f" reporting {move.outcome}" if move.outcome else ""
+        what = f"receives {move.name}" + (f" reporting {move.outcome}" if move.outcome else "")
         text = f"controller {what}" + (f"; sends {', '.join(sent)}" if sent else "")
         return TraceStep(text, _task_where(world, before))
     i = world.devices_index(move.session)
     device = world.devices[i]
     arrives = {"request": f"receives {move.name}", "timer": f"delay of {move.name} passes",
                "own": f"takes {move.name}"}[move.kind]
-    states_before = "/".join(before.devices[i].states)
+    states_before = states_of(before.devices[i])
     if taken:
         line = taken[0].line
-        text = f"{device.id} {arrives}: {states_before} -> {'/'.join(after.devices[i].states)}"
+        text = f"{device.id} {arrives}: {states_before} -> {states_of(after.devices[i])}"
     else:
-        state = before.devices[i].states[-1] if before.devices[i].states else device.initial
+        state = states_before.split("/")[-1]
         line = device.state(state).line if any(s.id == state for s in device.states) else None
         text = f"{device.id} {arrives} in state {states_before}, which has no transition for it"
     return TraceStep(text, f"{device.chart_file}:{line}" if line else device.chart_file)

@@ -9,7 +9,7 @@ open, as the devices' delays are unknown:
 - ``request``: a device receives the next request the controller sent it;
 - ``event``: the controller receives the next event a device sent;
 - ``timer``: one of a device's delayed sends arrives (its own motion ending, say);
-- ``own``: a session takes an event it sent itself without delay (these come first).
+- ``own``: a device takes an event it sent itself without delay (these come first).
 
 An event that reports the step's ``outcome`` may report any outcome the step's process declares
 (which one a device finds is not in its chart): each is a move of its own, so every branch and
@@ -17,6 +17,8 @@ every way out of a loop is explored.
 
 The controller's own timers (a device's command timeout) never fire: the devices are taken to
 behave as their charts say, so a controller that would wait for ever is a deadlock, not a timeout.
+The controller sends itself nothing else (the Task State Chart sends only requests and its timers), so
+it only ever moves on an event of a device.
 """
 
 from __future__ import annotations
@@ -73,7 +75,7 @@ class Move:
     session: str
     """The session that acts: ``controller`` or a device id."""
     device: str = ""
-    """The device the message comes from or goes to."""
+    """The device the event comes from (``event`` moves)."""
     name: str = ""
     """The event that arrives."""
     timer: int = -1
@@ -88,6 +90,11 @@ class Violation:
 
     kind: Literal["refused", "argument", "unexpected", "failed", "error", "deadlock"]
     message: str
+
+
+def states_of(session: Snapshot) -> str:
+    """Where a session is: its active states, outermost first, or the final state its chart ended in."""
+    return "/".join(s for s in (*session.states, session.final_state) if s)
 
 
 class _Outbox:
@@ -122,11 +129,10 @@ class ClosedWorld:
         """The initial world: every session started."""
         self.controller.start()
         requests = self._requests([[] for _ in self.devices])
-        for session in self.sessions:
-            session.start()
         events: list[list[Message]] = [[] for _ in self.devices]
-        for i, _ in enumerate(self.sessions):
-            self._device_events(i, events)
+        for i, session in enumerate(self.sessions):
+            session.start()
+            self._device_events(i, events)  # what it sent as it started, on its own channel
         world = self._world(take(self.controller, self._vars),
                             tuple(take(s, v) for s, v in zip(self.sessions, self._device_vars, strict=True)),
                             requests, events)
@@ -136,19 +142,17 @@ class ClosedWorld:
         """Every move possible in ``world``, in a fixed order."""
         if world.controller.final_state is not None:
             return
-        if world.controller.external:
-            yield Move("own", CONTROLLER, name=world.controller.external[0].name)
         for i, device in enumerate(self.devices):
             snap = world.devices[i]
             if snap.external:
-                yield Move("own", device.id, device.id, snap.external[0].name)
+                yield Move("own", device.id, name=snap.external[0].name)
                 continue
             if world.requests[i]:
-                yield Move("request", device.id, device.id, world.requests[i][0].name)
+                yield Move("request", device.id, name=world.requests[i][0].name)
             for n, pending in enumerate(snap.delayed):
-                yield Move("timer", device.id, device.id, pending.event.name, n)
+                yield Move("timer", device.id, name=pending.event.name, timer=n)
         for i, device in enumerate(self.devices):
-            if world.events[i] and not world.controller.external:  # what a session sent itself comes first
+            if world.events[i]:
                 name = f"{device.id}.{world.events[i][0].name}"
                 data = world.events[i][0].data
                 if isinstance(data, EventData) and "outcome" in data and self._outcomes(world):
@@ -193,12 +197,11 @@ class ClosedWorld:
         restore(self.controller, world.controller, self._vars)
         violation = None
         try:
-            if move.kind == "event":
-                message = events[self._index[move.device]].pop(0)
-                data = EventData({**message.data, "outcome": move.outcome}) if move.outcome else message.data
-                self.controller.external.append(Event(move.name, data))
+            message = events[self._index[move.device]].pop(0)
+            data = EventData({**message.data, "outcome": move.outcome}) if move.outcome else message.data
+            self.controller.external.append(Event(move.name, data))
             step = self.controller.execute_once()
-            if move.kind == "event" and step is not None and not step.transitions:
+            if step is not None and not step.transitions:
                 violation = Violation("unexpected", f"the controller does not wait for {move.name} "
                                                     "where it is: the run would stop with a fault")
         except ExecutionError as exc:
@@ -210,8 +213,7 @@ class ClosedWorld:
         """A request refused where the device is, or one missing an argument the transition takes."""
         device = self.devices[i]
         if step is None or not step.transitions:
-            where = ", ".join(before.states) or "no state"
-            return Violation("refused", f"device {device.id} in state {where} refuses {message.name}: "
+            return Violation("refused", f"device {device.id} in state {states_of(before)} refuses {message.name}: "
                                         "its chart has no transition for it there")
         taken = step.transitions[0]
         transition: ChartTransition | None = self._transitions[i].get((taken.source, message.name))
@@ -253,16 +255,12 @@ class ClosedWorld:
 
     def steps_ended(self, world: World) -> int:
         """How many steps of the task the controller has ended in ``world``."""
-        if STEP not in self._vars:
-            return 0
-        value = world.controller.data[self._vars.index(STEP)]
-        return value if isinstance(value, int) else 0
+        return int(world.controller.data[self._vars.index(STEP)])  # every Task State Chart counts its steps
 
     def deadlock(self, world: World) -> Violation:
         """Why nothing can happen in ``world``: what the controller waits for and where the devices are."""
-        devices = ", ".join(f"{d.id} in {'/'.join(s.states) or '-'}"
-                            for d, s in zip(self.devices, world.devices, strict=True))
-        waits = sorted({e for s in world.controller.config if s.is_atomic for t in s.evented
-                        for e in (t.events or "").split() if not e.startswith(("timeout", "error"))})
+        devices = ", ".join(f"{d.id} in {states_of(s)}" for d, s in zip(self.devices, world.devices, strict=True))
+        # the controller's own timeout and error transitions are on the task's outer state, never on an atomic one
+        waits = sorted({e for s in world.controller.config if s.is_atomic for t in s.evented for e in t.node.events})
         return Violation("deadlock", f"deadlock: the controller waits for {' or '.join(waits) or 'nothing'} "
                                      f"and no device will send it ({devices})")
