@@ -341,3 +341,45 @@ def test_the_next_best_repairs_with_a_catalogue_are_distinct_bought_or_not(cell:
     assert [(r.cost, r.added_devices) for r in found] == [(6.14, ("screwdriver",)), (9.0, ()),
                                                           (11.14, ("screwdriver",))]
     assert len({tuple(e.text for e in r.edits) for r in found}) == 3
+
+
+def test_a_problem_at_a_devices_first_use_is_repaired_in_a_long_task(cell: Cell) -> None:
+    """The gripper's first use is a place (nothing picked): its problem's span starts at that step."""
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    place = Step(0, "place")
+    steps = [move] * 20 + [place] + [move] * 25
+    task = Task("first-use", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "first-use.yaml")
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    found = service.repair(task, cell, top=2)
+    assert _answers(found) == [(2.0, ["insert close-gripper before step 21 (place)"]),
+                               (2.0, ["insert close-gripper before step 20 (move-to)"])]
+    assert all(service.check(r.task, cell).plausible for r in found)
+
+
+def test_a_purchase_paying_for_itself_only_over_two_windows_by_one_hundredth_is_made(
+        cell: Cell, devices: list[DeviceDescription]) -> None:
+    """Removing a screw step costs 1, a (dear) screwdriver 1.99 in all: worth buying for the two screw steps far apart,
+    though in each window alone removing is cheaper."""
+    screwdriver = replace(_by_id(devices, "screwdriver"), cost=15000)
+    costs = RepairCosts(insert=0.5, insert_per_role=0.5, remove=1, swap=1, rebind=1, add_device=0.49)
+    task = _screws(faulty_task(25, 0, 5), (6, 42))
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, [screwdriver], top=3, costs=costs)
+    assert _answers(found) == [(1.99, ["add device 'screwdriver' (Electric screwdriver, price 15000) to the cell"]),
+                               (2.0, ["remove step 7 (screw)", "remove step 44 (screw)"])]
+    # the best alone: removing both screw steps (2) is dearer than the screwdriver (1.99) by one hundredth
+    assert _answers(windows.windowed_repair(task, cell, KNOWLEDGE, [screwdriver], top=1, costs=costs)) == [
+        (1.99, ["add device 'screwdriver' (Electric screwdriver, price 15000) to the cell"])]
+
+
+def test_two_windows_buying_two_devices_buy_both(cell: Cell, devices: list[DeviceDescription]) -> None:
+    """A screw step and, far from it, a machine-part step: each window buys its own device, the best repair both."""
+    costs = RepairCosts(add_device=1, add_device_per_price=0)
+    steps = list(faulty_task(25, 0, 5).steps)
+    steps.insert(6, Step(0, "screw"))
+    steps.insert(42, Step(0, "machine-part"))
+    task = Task("two", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "two.yaml")
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, devices, top=3, costs=costs)
+    assert [(r.cost, r.added_devices) for r in found] == [(2.0, ("cnc", "screwdriver")), (5.0, ("screwdriver",)),
+                                                          (5.0, ("cnc",))]
+    assert [e.text for e in found[1].edits] == [
+        "add device 'screwdriver' (Electric screwdriver, price 1400) to the cell", "remove step 43 (machine-part)"]
