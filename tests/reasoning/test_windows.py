@@ -383,3 +383,32 @@ def test_two_windows_buying_two_devices_buy_both(cell: Cell, devices: list[Devic
                                                           (5.0, ("cnc",))]
     assert [e.text for e in found[1].edits] == [
         "add device 'screwdriver' (Electric screwdriver, price 1400) to the cell", "remove step 43 (machine-part)"]
+
+
+@pytest.mark.parametrize("add_device, tried, bought", [
+    (2.0, False, False),  # the device costs what the repair without it costs: not even priced window by window
+    (1.01, True, False),  # with the force's reset (1) no purchase can cost less than 2: priced, not tried
+    (0.99, True, True),  # 0.99 + 1 is cheaper than 2: tried and bought
+])
+def test_a_purchase_is_tried_only_when_it_can_pay_for_itself(cell: Cell, devices: list[DeviceDescription],
+                                                             add_device: float, tried: bool, bought: bool,
+                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    """A grip force out of range (reset: 1) and, later, a screw step (remove: 1, or buy a screwdriver): the windows
+    are solved with the screwdriver added only when the cheapest purchase plus what the windows cost with it nearly
+    free is below the repair without it."""
+    costs = RepairCosts(insert=0.5, insert_per_role=0.5, remove=1, swap=1, rebind=1, add_device=add_device,
+                        add_device_per_price=0)
+    steps = list(faulty_task(25, 1, 0, kinds=("force",)).steps)
+    steps.insert(44, Step(0, "screw"))
+    task = Task("force-screw", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "fs.yaml")
+    priced: list[int] = []
+    added: list[tuple[str, ...]] = []
+    purchases, combined = windows._Solver.purchases, windows._Solver.combined
+    monkeypatch.setattr(windows._Solver, "purchases", lambda self, *a: priced.append(1) or purchases(self, *a))
+    monkeypatch.setattr(windows._Solver, "combined",
+                        lambda self, w, a: added.append(tuple(d.id for d in a)) or combined(self, w, a))
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, [_by_id(devices, "screwdriver")], top=1, costs=costs)
+    assert (bool(priced), [a for a in added if a]) == (tried, [("screwdriver",)] if bought else [])
+    reset = "step 27 (bin-pick): reset parameter grip_force to its default 40"
+    assert _answers(found) == ([(1.99, ["add device 'screwdriver' (Electric screwdriver, price 1400) to the cell", reset])]
+                               if bought else [(2.0, [reset, "remove step 45 (screw)"])])
