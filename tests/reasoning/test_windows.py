@@ -412,3 +412,18 @@ def test_a_purchase_is_tried_only_when_it_can_pay_for_itself(cell: Cell, devices
     reset = "step 27 (bin-pick): reset parameter grip_force to its default 40"
     assert _answers(found) == ([(1.99, ["add device 'screwdriver' (Electric screwdriver, price 1400) to the cell", reset])]
                                if bought else [(2.0, [reset, "remove step 45 (screw)"])])
+
+
+def test_a_device_priced_nearly_free_enters_the_next_window_as_the_first_left_it(
+        cell: Cell, devices: list[DeviceDescription]) -> None:
+    """No gripper, a pick and 25 moves later a place, removing a step costs 3: the gripper (5.18) is cheaper than
+    removing both (6) only if, pricing the windows with the gripper nearly free, the place's window finds the gripper
+    holding the part the pick's window left it with (else it would need a close-gripper too, and the purchase would
+    seem unable to pay for itself)."""
+    pick, place = (replace(st, bind={}) for st in service.task(service.builtin("tasks", "bin-picking.yaml")).steps[:2])
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    steps = [move] * 10 + [pick] + [move] * 25 + [place] + [move] * 10
+    task = Task("far", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "far.yaml")
+    found = windows.windowed_repair(task, cell.without("gripper"), KNOWLEDGE, [_by_id(devices, "gripper")], top=1,
+                                    costs=RepairCosts(remove=3))
+    assert _answers(found) == [(5.18, ["add device 'gripper' (Parallel gripper, price 1800) to the cell"])]
