@@ -16,7 +16,7 @@ from plugnproduce.description.model import Cell, DeviceDescription, Step, Task
 from plugnproduce.description.taskfile import parse_task
 from plugnproduce.reasoning import Repair, RepairCosts
 from plugnproduce.reasoning import repair as user_repair
-from plugnproduce.reasoning.repairs import repairs, windows
+from plugnproduce.reasoning.repairs import repairs, sideeffects, windows
 from plugnproduce.reasoning.repairs.windows import Window
 from tests.reasoning.faulty_tasks import faulty_task
 
@@ -427,3 +427,12 @@ def test_a_device_priced_nearly_free_enters_the_next_window_as_the_first_left_it
     found = windows.windowed_repair(task, cell.without("gripper"), KNOWLEDGE, [_by_id(devices, "gripper")], top=1,
                                     costs=RepairCosts(remove=3))
     assert _answers(found) == [(5.18, ["add device 'gripper' (Parallel gripper, price 1800) to the cell"])]
+
+
+def test_a_step_inserted_in_a_window_is_the_only_new_step_of_the_repaired_task(cell: Cell) -> None:
+    """The repaired task's steps keep their original positions (what the side effects of a repair are judged by),
+    the open-gripper inserted before step 19 none."""
+    [best] = windows.windowed_repair(LONG_INSERT, cell, KNOWLEDGE, top=1)
+    assert _answers([best]) == [(2.0, ["insert open-gripper before step 19 (bin-pick)"])]
+    assert best.origins == (*range(1, 19), 0, *range(19, 49))
+    assert sideeffects.new_steps(LONG_INSERT, best.task, best.origins) == {19}
