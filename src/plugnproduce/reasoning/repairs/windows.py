@@ -95,13 +95,12 @@ class Window:
 
 @dataclass(frozen=True)
 class _Part:
-    """One repair of one window: its cost (hundredths), edits (original step numbers), steps, end states."""
+    """One repair of one window: its cost (hundredths), edits (original step numbers), steps."""
 
     window: Window
     cost: int
     edits: tuple[edits.EditTerm, ...]
     steps: tuple[Step, ...]
-    left_in: tuple[tuple[str, str], ...]
     origins: tuple[int, ...] = ()
     """The original (whole-task) step position each of :attr:`steps` keeps, 0 if inserted."""
     reset_bound: tuple[tuple[int, tuple[tuple[str, str], ...]], ...] = ()
@@ -370,12 +369,11 @@ class _Solver:
         sub = Task(self.chain.task.name, tuple(replace(st, index=k) for k, st in enumerate(steps, start=1)),
                    self.chain.task.file)
         moved = tuple(e.e.shifted(w.first - 1) for e in model[s.Edit])
-        left = tuple(sorted((a.d, a.x) for a in model[s.LeftIn]))
         runs = repairs.repaired_runs(model, sub)
         origins = tuple(i + w.first - 1 if i else 0 for i, _ in runs)
         resets = sorted({e.e.i for e in model[s.Edit] if isinstance(e.e, edits.Reset)})
         bound = tuple((i + w.first - 1, tuple(sorted(repairs.bound_at(model, i).items()))) for i in resets)
-        return _Part(w, model.cost[0] if model.cost else 0, moved, tuple(st for _, st in runs), left, origins,
+        return _Part(w, model.cost[0] if model.cost else 0, moved, tuple(st for _, st in runs), origins,
                      bound)
 
     def read(self, rank: int, combo: tuple[int, tuple[_Part, ...], tuple[str, ...]],
