@@ -32,7 +32,7 @@ LAYERS = {
     "description": 2,
     "ontology": 1, "statechart": 1, "protocols": 1,
     "chartnames": 0.5,  # the generated task chart's variable names: codegen writes them, the executor reads them
-    "resources": 0, "safeio": 0, "folders": 0, "lazy": 0, "deferred": 0, "helpcache": 0,
+    "resources": 0, "safeio": 0, "folders": 0, "lazy": 0, "deferred": 0, "helpcache": 0, "collector": 0,
     "errors": -1, "digests": -1,
 }
 """Rank of each subpackage or top-level module: a module imports only from lower ranks or its own part."""

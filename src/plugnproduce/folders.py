@@ -1,7 +1,8 @@
 """The user's folders the controller writes to, where the platform keeps them (platformdirs).
 
 - the **cache folder** (``~/.cache/plugnproduce`` on Linux, or ``$XDG_CACHE_HOME/plugnproduce``): the
-  taxonomy's closures, the unit table, the batch engines, the simulated cell's control file, the kept help;
+  taxonomy's closures, the unit table, the batch engines, the simulated cell's control file, the kept help,
+  OPC UA's standard address space;
   the parsed knowledge, devices, cell and task files and cycle time estimates (:func:`kept`);
 - the **runs folder** (``~/.local/state/plugnproduce/runs`` on Linux, or under ``$XDG_STATE_HOME``): the
   run journals, unless ``PNP_RUNS`` names another folder.

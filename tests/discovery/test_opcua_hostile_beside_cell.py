@@ -18,6 +18,7 @@ from plugnproduce.description.loader import load_device
 from plugnproduce.discovery.opcua import discover_on_lds
 from plugnproduce.ontology.taxonomy import load_taxonomy
 from plugnproduce.protocols.opcua.discovery import LocalDiscoveryServer
+from plugnproduce.protocols.opcua.space import new_server
 from plugnproduce.protocols.opcua.spec import MAX_ARRAY, application_uri_for, format_endpoint, namespace_for
 from plugnproduce.sim.device import SimulatedDevice
 
@@ -64,8 +65,7 @@ HOSTILE: dict[str, Build] = {"huge-array": _huge_array, "far-too-large": _far_to
 
 
 async def _hostile(name: str, build: Build, lds: str) -> Server:
-    server = Server()
-    await server.init()
+    server = await new_server()  # the standard address space as every server of the package gets it
     server.set_endpoint(format_endpoint("127.0.0.1", 0, f"/pnp/{name}"))
     server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
     await server.set_application_uri(application_uri_for(name))

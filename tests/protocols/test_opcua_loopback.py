@@ -16,6 +16,7 @@ from plugnproduce.description.model import DeviceDescription
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError, ProtocolTimeout, RemoteError
 from plugnproduce.ontology.taxonomy import load_taxonomy
 from plugnproduce.protocols.opcua import MAX_ARRAY, OpcUaDeviceClient, namespace_for
+from plugnproduce.protocols.opcua.space import new_server
 from plugnproduce.sim.device import SimulatedDevice
 from tests.lines import WAIT
 
@@ -119,8 +120,7 @@ async def test_output_arguments_carry_the_answer_with_opc_ua_types() -> None:
 @pytest.fixture
 async def hostile() -> AsyncIterator[tuple[Server, str]]:
     """A server with the device's namespace and object whose methods misbehave."""
-    server = Server()
-    await server.init()
+    server = await new_server()  # the standard address space as every server of the package gets it
     server.set_endpoint("opc.tcp://127.0.0.1:0/hostile")
     server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
     idx = await server.register_namespace(namespace_for("hostile"))

@@ -13,6 +13,7 @@ from plugnproduce import service
 from plugnproduce.batch import BatchRow, Configuration, batches, engine, generate, purchases, read_configurations
 from plugnproduce.description.model import Cell, DeviceDescription, Task
 from plugnproduce.errors import DescriptionError
+from plugnproduce.reasoning import CheckResult
 from tests.reasoning.conftest import DESCRIPTIONS, task, write
 
 PAPER = ("binpicking-pc", "gripper", "robot", "sensor3d")
@@ -480,3 +481,351 @@ def test_a_device_the_task_names_that_no_catalogue_holds_cannot_be_bought(tmp_pa
     assert row.to_json()["purchase"] == {"options": [], "impossible": "step 1 of own-gripper: device my-gripper named "
                                                                       "for role gripper is not in the cell; it is not "
                                                                       "in the catalogue"}
+
+
+# ---- the batch binds each step's roles as check binds them
+
+PICK_WITH_THE_GRIPPER = ("task: pick-with-the-gripper\nsteps:\n  - command: pick\n    bind: {gripper: gripper}\n"
+                         "    params: {pick_pose: [0.35, 0.15, 0.04, 0, 180, 0], grip_force: 30}\n")
+LOCALIZE_ANY = "task: localize\nsteps:\n  - command: localize-part\n    params: {exposure: 25, part_type: bracket}\n"
+
+
+def _check_and_batch(tmp_path: Path, text: str, devices: tuple[str, ...]) -> tuple[CheckResult, BatchRow]:
+    the_task = service.task(write(tmp_path, "task.yaml", text))
+    cell = Cell("c", tuple(d for d in service.catalogue() if d.id in devices))
+    (row,) = service.batch([Configuration("c", devices)], None, [the_task], workers=1)
+    return service.check(the_task, cell), row
+
+
+def test_a_role_left_to_the_configuration_after_a_named_one_is_bound_as_check_binds_it(tmp_path: Path) -> None:
+    """The pick names its gripper (its first role: roles go in name order) and leaves its robot to the
+    configuration: without a robot, or with two, the batch says what check says."""
+    checked, row = _check_and_batch(tmp_path, PICK_WITH_THE_GRIPPER, ("gripper",))
+    assert [(p.step, p.kind) for p in checked.problems] == [(1, "no_device")]
+    assert row.plausible == () and row.purchase is not None and row.purchase.options[0][0] == ("scara",)
+    checked, row = _check_and_batch(tmp_path, PICK_WITH_THE_GRIPPER, ("cobot", "gripper", "robot"))
+    assert [(p.step, p.kind) for p in checked.problems] == [(1, "ambiguous")]
+    assert row.plausible == () and row.purchase is not None and row.purchase.ambiguous == (
+        "step 1 of pick-with-the-gripper: several devices can play role robot; bind step 1's role robot to one of "
+        "them")
+    checked, row = _check_and_batch(tmp_path, PICK_WITH_THE_GRIPPER, ("gripper", "robot"))
+    assert checked.plausible and row.plausible == ("pick-with-the-gripper",) and row.purchase is None
+
+
+def test_the_lone_player_of_a_role_is_bound_when_it_is_the_catalogues_first_device(tmp_path: Path) -> None:
+    """The bin-picking PC comes first in the catalogue (its lowest bit): as the one localizer of the configuration
+    it plays the role, as check says; it is not taken for several."""
+    assert min(d.id for d in service.catalogue()) == "binpicking-pc"
+    checked, row = _check_and_batch(tmp_path, LOCALIZE_ANY, ("binpicking-pc", "sensor3d"))
+    assert checked.plausible and checked.steps[0].bindings == {"localizer": "binpicking-pc", "sensor": "sensor3d"}
+    assert row.plausible == ("localize",) and row.purchase is None
+
+
+def test_a_configuration_offers_the_processes_the_reasoner_says_it_offers() -> None:
+    """Each configuration's offered processes are those ``pnp capabilities`` lists for it as a cell."""
+    configs = [Configuration("gripper", ("gripper",)), Configuration("sensing", ("binpicking-pc", "sensor3d")),
+               Configuration("arm", ("robot", "screwdriver")), Configuration("paper", PAPER),
+               Configuration("no-gripper", ("binpicking-pc", "robot", "sensor3d"))]  # no bin-pick: it needs a gripper
+    found = rows(configs)
+    k = service.knowledge()
+    assert [r.offered for r in found] == [o for o, _ in _reasoner(configs, tasks(), k)]
+    assert found[0].offered == ("close-gripper", "open-gripper")
+    f = engine(service.catalogue(), tasks(), k).feasibility  # asked without the roles filled: it finds them itself
+    assert [f.offered(sum(f.abilities.bit(d) for d in c.devices)) for c in configs] == [
+        r.offered for r in found]
+
+
+# ---- a device that plays two roles of one step plays them in role order, the second from where the first left it
+
+GRIP_AND_GO = """<?xml version="1.0" encoding="UTF-8"?>
+<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:pnp="http://plugnproduce.org/ontology#"
+       version="1.0" name="grip-and-go" initial="grip-and-go">
+  <parallel id="grip-and-go">
+    <state id="gripper" pnp:role="gripper" initial="gripper_open">
+      <final id="gripper_open" pnp:concept="Open"/>
+    </state>
+    <state id="robot" pnp:role="robot" initial="robot_holding">
+      <state id="robot_holding" pnp:concept="GripperState">
+        <transition cond="In('gripper_open')" target="robot_moving"/>
+      </state>
+      <final id="robot_moving" pnp:concept="Moving"/>
+    </state>
+  </parallel>
+</scxml>
+"""
+GRIP_AND_GO_TTL = """@prefix pnp:  <http://plugnproduce.org/ontology#> .
+@prefix proc: <http://plugnproduce.org/processes/> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+
+proc:grip-and-go a pnp:MotionProcess ;
+    rdfs:label "grip and go" ;
+    pnp:generalChart <grip-and-go.scxml> ;
+    pnp:hasRole proc:grip-and-go-robot , proc:grip-and-go-gripper .
+
+proc:grip-and-go-robot a pnp:Role ; pnp:roleName "robot" ; pnp:requiresSkill pnp:CanMove .
+proc:grip-and-go-gripper a pnp:Role ; pnp:roleName "gripper" ; pnp:requiresSkill pnp:CanGrip .
+"""
+
+
+def _grip_arm(name: str, initial: str) -> tuple[str, str]:
+    """A device that grips and moves: from ``open`` it goes nowhere, from ``ajar`` (also open) it closes, and only
+    closed it moves."""
+    ttl = (f"@prefix pnp: <http://plugnproduce.org/ontology#> .\n@prefix dev: <http://plugnproduce.org/devices/> .\n"
+           f"dev:{name} a pnp:Robot ; pnp:hasSkill pnp:CanGrip , pnp:CanMove ; pnp:protocol pnp:XIRP ;\n"
+           f"    pnp:endpoint \"xirp://127.0.0.1:0\" ; pnp:stateChart <{name}.scxml> ; pnp:commandTimeout 2.0 ;\n"
+           f"    pnp:cost 5000 .\n")
+    chart = f"""<?xml version="1.0" encoding="UTF-8"?>
+<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:pnp="http://plugnproduce.org/ontology#"
+       version="1.0" name="{name}" initial="{initial}">
+  <state id="idle" pnp:concept="Idle">
+    <transition event="xirp.request.Open" target="open"/>
+  </state>
+  <state id="open" pnp:concept="Open"/>
+  <state id="ajar" pnp:concept="Open">
+    <transition event="xirp.request.Close" target="closed"/>
+  </state>
+  <state id="closed" pnp:concept="Closed">
+    <transition event="xirp.request.Move" target="moving"/>
+  </state>
+  <state id="moving" pnp:concept="Moving">
+    <onentry><send event="motion.done" delay="100ms"/></onentry>
+    <transition event="motion.done" target="at_pose"/>
+  </state>
+  <state id="at_pose" pnp:concept="AtPose">
+    <transition event="xirp.request.Home" target="idle"/>
+  </state>
+</scxml>
+"""
+    return ttl, chart
+
+
+def _grip_arms(library: Path) -> service.Knowledge:
+    (library / "processes").mkdir(parents=True)
+    (library / "processes" / "grip-and-go.scxml").write_text(GRIP_AND_GO, encoding="utf-8")
+    (library / "processes" / "grip-and-go.ttl").write_text(GRIP_AND_GO_TTL, encoding="utf-8")
+    (library / "devices").mkdir()
+    for name, initial in (("idle-arm", "idle"), ("ajar-arm", "ajar")):
+        ttl, chart = _grip_arm(name, initial)
+        (library / "devices" / f"{name}.ttl").write_text(ttl, encoding="utf-8")
+        (library / "devices" / f"{name}.scxml").write_text(chart, encoding="utf-8")
+    return service.knowledge((library,))
+
+
+def _both_roles(tmp_path: Path, device: str) -> tuple[CheckResult, BatchRow]:
+    k = _grip_arms(tmp_path / "library")
+    the_task = service.task(write(tmp_path, "task.yaml", "task: grip-and-go\nsteps:\n  - command: grip-and-go\n"
+                                                         f"    bind: {{gripper: {device}, robot: {device}}}\n"))
+    cell = Cell("c", tuple(d for d in k.devices if d.id == device))
+    (row,) = service.batch([Configuration("c", (device,))], [d for d in k.devices if d.id == device], [the_task],
+                           workers=1, knowledge=k)
+    return service.check(the_task, cell, k), row
+
+
+def test_a_device_whose_first_role_starts_wrong_plays_its_second_from_where_the_first_recovers(tmp_path: Path) -> None:
+    """The idle arm is not open for the gripper role (its first, in name order), which leaves it where the role ends
+    from an open state (``open``); from there the robot role has no way on. Check names the stuck robot role first;
+    so does the batch, and no purchase cures it."""
+    checked, row = _both_roles(tmp_path, "idle-arm")
+    assert [(p.step, p.kind, p.role) for p in checked.problems] == [(1, "stuck", "robot"), (1, "wrong_state", "gripper")]
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of grip-and-go: device idle-arm cannot play role robot from the state it is in; adding devices "
+        "cannot cure it")
+
+
+def test_a_device_plays_its_second_role_from_where_its_first_left_it(tmp_path: Path) -> None:
+    """The ajar arm plays the gripper role where it is (``ajar``, not the other open state), and from there the robot
+    role closes and moves it: plausible in check and in the batch."""
+    checked, row = _both_roles(tmp_path, "ajar-arm")
+    assert checked.plausible and checked.problems == ()
+    assert row.plausible == ("grip-and-go",) and row.purchase is None
+
+
+# ---- an odd cycle of roles: three roles, each playable by two of three devices, and no set fills each once
+
+TRIO = """<?xml version="1.0" encoding="UTF-8"?>
+<scxml xmlns="http://www.w3.org/2005/07/scxml" xmlns:pnp="http://plugnproduce.org/ontology#"
+       version="1.0" name="trio" initial="trio">
+  <parallel id="trio">
+    <state id="grip" pnp:role="grip" initial="grip_any"><final id="grip_any" pnp:concept="StateConcept"/></state>
+    <state id="move" pnp:role="move" initial="move_any"><final id="move_any" pnp:concept="StateConcept"/></state>
+    <state id="sense" pnp:role="sense" initial="sense_any"><final id="sense_any" pnp:concept="StateConcept"/></state>
+  </parallel>
+</scxml>
+"""
+TRIO_TTL = """@prefix pnp:  <http://plugnproduce.org/ontology#> .
+@prefix proc: <http://plugnproduce.org/processes/> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+
+proc:trio a pnp:MotionProcess ;
+    rdfs:label "trio" ;
+    pnp:generalChart <trio.scxml> ;
+    pnp:hasRole proc:trio-grip , proc:trio-move , proc:trio-sense .
+
+proc:trio-grip a pnp:Role ; pnp:roleName "grip" ; pnp:requiresSkill pnp:CanGrip .
+proc:trio-move a pnp:Role ; pnp:roleName "move" ; pnp:requiresSkill pnp:CanMove .
+proc:trio-sense a pnp:Role ; pnp:roleName "sense" ; pnp:requiresSkill pnp:CanSense3D .
+"""
+STATES = {"CanGrip": (("open", "Open"), ("closed", "Closed")), "CanMove": (("idle", "Idle"), ("at_pose", "AtPose")),
+          "CanSense3D": (("ready", "SensorReady"), ("captured", "Captured"))}
+
+
+def _two_skills(library: Path, name: str, skills: tuple[str, str], cost: int) -> None:
+    """A device of two skills whose chart goes round the states each skill needs, by a request each."""
+    states = [s for skill in skills for s in STATES[skill]]
+    body = "".join(f'  <state id="{x}" pnp:concept="{c}">\n    <transition event="xirp.request.Next" '
+                   f'target="{states[(n + 1) % len(states)][0]}"/>\n  </state>\n' for n, (x, c) in enumerate(states))
+    (library / "devices" / f"{name}.scxml").write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n<scxml xmlns="http://www.w3.org/2005/07/scxml" '
+        f'xmlns:pnp="http://plugnproduce.org/ontology#"\n       version="1.0" name="{name}" initial="{states[0][0]}">\n'
+        f"{body}</scxml>\n", encoding="utf-8")
+    (library / "devices" / f"{name}.ttl").write_text(
+        f"@prefix pnp: <http://plugnproduce.org/ontology#> .\n@prefix dev: <http://plugnproduce.org/devices/> .\n"
+        f"dev:{name} a pnp:Robot ; pnp:hasSkill pnp:{skills[0]} , pnp:{skills[1]} ; pnp:protocol pnp:XIRP ;\n"
+        f'    pnp:endpoint "xirp://127.0.0.1:0" ; pnp:stateChart <{name}.scxml> ; pnp:commandTimeout 2.0 ;\n'
+        f"    pnp:cost {cost} .\n", encoding="utf-8")
+
+
+def test_an_odd_cycle_of_roles_has_no_purchase_and_the_search_says_so_when_it_runs_out(tmp_path: Path) -> None:
+    """Each pair of the three devices shares a role, so every set fills some role twice or leaves one empty: check
+    finds every set of them wanting, and the batch, having looked at each, says that no set makes the task
+    plausible (with no example: no set fills each role once)."""
+    library = tmp_path / "library"
+    (library / "processes").mkdir(parents=True)
+    (library / "processes" / "trio.scxml").write_text(TRIO, encoding="utf-8")
+    (library / "processes" / "trio.ttl").write_text(TRIO_TTL, encoding="utf-8")
+    (library / "devices").mkdir()
+    for name, skills, price in (("grip-move", ("CanGrip", "CanMove"), 100), ("move-sense", ("CanMove", "CanSense3D"),
+                                                                              200),
+                                ("sense-grip", ("CanSense3D", "CanGrip"), 300)):
+        _two_skills(library, name, skills, price)
+    k = service.knowledge((library,))
+    own = [d for d in k.devices if d.id in ("grip-move", "move-sense", "sense-grip")]
+    the_task = service.task(write(tmp_path, "trio.yaml", "task: trio\nsteps:\n  - command: trio\n"))
+    for size in range(4):
+        for chosen in itertools.combinations(own, size):
+            assert not service.check(the_task, Cell("c", chosen), k).plausible, chosen
+    (row,) = service.batch([Configuration("empty", ())], own, [the_task], workers=1, knowledge=k)
+    assert row.outcome == "impossible" and row.purchase is not None
+    assert row.purchase.impossible == "no set of catalogue devices makes every task plausible"
+    (row,) = service.batch([Configuration("one", ("grip-move",))], own, [the_task], workers=1, knowledge=k)
+    assert row.purchase is not None and row.purchase.impossible == (  # the search fills the sense role only
+        "no set of catalogue devices makes every task plausible; e.g. adding move-sense: step 1 of trio: several "
+        "devices can play role move")
+
+
+# ---- answers are remembered by what they depend on, and only by that
+
+def _together_and_alone(the_task: Task, configs: list[Configuration]) -> tuple[list[BatchRow], list[BatchRow]]:
+    together = list(service.batch(configs, None, [the_task], workers=1))
+    alone = [row for c in configs for row in service.batch([c], None, [the_task], workers=1)]
+    return together, alone
+
+
+def test_a_configuration_is_answered_in_a_batch_as_alone_whether_the_device_a_task_names_is_there(
+        tmp_path: Path) -> None:
+    """The task names the robot for the gripper role: with the robot, it cannot play it; without, it is absent."""
+    the_task = service.task(write(tmp_path, "robot-grips.yaml", "task: robot-grips\nsteps:\n  - command: close-gripper\n"
+                                  "    bind: {gripper: robot}\n    params: {grip_force: 30}\n"))
+    together, alone = _together_and_alone(the_task, [Configuration("with", ("gripper", "robot")),
+                                                     Configuration("without", ("gripper",))])
+    assert together == alone
+    assert [r.purchase.impossible if r.purchase else None for r in together] == [
+        "step 1 of robot-grips: device robot named for role gripper cannot play it; adding devices cannot cure it",
+        "no set of catalogue devices makes every task plausible; e.g. adding robot: step 1 of robot-grips: device "
+        "robot named for role gripper cannot play it"]
+
+
+def test_a_lone_first_device_and_several_players_of_a_role_are_answered_apart_in_one_batch(tmp_path: Path) -> None:
+    """The bin-picking PC alone localizes; beside the UPnP one the role is ambiguous, in one batch as alone."""
+    together, alone = _together_and_alone(service.task(write(tmp_path, "localize.yaml", LOCALIZE_ANY)),
+                                          [Configuration("lone", ("binpicking-pc", "sensor3d")),
+                                           Configuration("two", ("binpicking-pc", "binpicking-pc-ua", "sensor3d"))])
+    assert together == alone
+    assert together[0].plausible == ("localize",) and together[1].plausible == ()
+    assert together[1].purchase is not None and (together[1].purchase.ambiguous or "").startswith(
+        "step 1 of localize: several devices can play role localizer")
+
+
+def test_a_step_whose_command_names_no_process_is_named_as_check_names_it(tmp_path: Path) -> None:
+    the_task = service.task(write(tmp_path, "wave.yaml", "task: wave\nsteps:\n  - command: wave-hello\n"
+                                  "  - command: close-gripper\n    params: {grip_force: 30}\n"))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "unknown_command")]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of wave: no process has this name; adding devices cannot cure it")
+
+
+def test_a_value_outside_the_process_range_is_named_as_not_fitting_its_declaration(tmp_path: Path) -> None:
+    fast = service.task(write(tmp_path, "fast.yaml", WITHIN_EVERY_ROBOT.replace("grip_force: 30", "grip_force: 30\n"
+                                                                                 "      speed: 101")))
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [fast], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of pick-and-place: a parameter value does not fit its declaration; adding devices cannot cure it")
+
+
+def test_a_role_the_process_does_not_have_is_named_as_check_names_it(tmp_path: Path) -> None:
+    the_task = service.task(write(tmp_path, "hand.yaml", "task: hand\nsteps:\n  - command: close-gripper\n"
+                                  "    bind: {hand: gripper}\n    params: {grip_force: 30}\n"))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "unknown_role")]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of hand: the process has no role hand; adding devices cannot cure it")
+
+
+
+@pytest.mark.parametrize("last", ["  - command: wave-hello\n",
+                                  "  - command: open-gripper\n    bind: {hand: gripper}\n"], ids=["command", "role"])
+def test_the_states_are_followed_past_an_unknown_command_or_role_as_check_follows_them(tmp_path: Path,
+                                                                                        last: str) -> None:
+    """Close, close, then a step check cannot bind as written: check names the second close first (the gripper is
+    closed already), and the batch names it too, not the later step."""
+    the_task = service.task(write(tmp_path, "task.yaml", CLOSE_TWICE + last))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [p.step for p in service.check(the_task, cell).problems][:2] == [2, 3]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 2 of close-twice: device gripper is not in the state role gripper starts from; adding devices cannot "
+        "cure it")
+
+
+def test_the_states_are_followed_once_a_purchase_fills_every_role(tmp_path: Path) -> None:
+    """No robot for the first step's move: the batch looks for one to buy before it follows the gripper's states,
+    and then finds that the second close finds the gripper closed, which no purchase cures."""
+    text = ("task: move-then-close-twice\nsteps:\n  - command: move-to\n    params: {target_pose: [0.30, 0.00, 0.40, 0, "
+            "180, 0], speed: 50}\n" + CLOSE_TWICE.split("steps:\n", 1)[1])
+    the_task = service.task(write(tmp_path, "task.yaml", text))
+    cell = Cell("gripper-only", tuple(d for d in service.catalogue() if d.id == "gripper"))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "no_device"), (3, "wrong_state")]
+    (row,) = service.batch([Configuration("gripper-only", ("gripper",))], None, [the_task], workers=1)
+    assert row.purchase is not None and row.purchase.impossible == (
+        "no set of catalogue devices makes every task plausible; e.g. adding scara: step 3 of move-then-close-twice: "
+        "device gripper is not in the state role gripper starts from")
+
+
+def test_findings_are_named_in_step_order(tmp_path: Path) -> None:
+    """The move's pose is beyond the robot's reach (step 1, role robot) and the close's force beyond its process's
+    range (step 2, no role): the first named is the first step's, as check names it first."""
+    text = ("task: far-then-hard\nsteps:\n  - command: move-to\n    params: {target_pose: [1.48, 0.00, 0.40, 0, 180, 0], "
+            "speed: 50}\n  - command: close-gripper\n    params: {grip_force: 150}\n")
+    the_task = service.task(write(tmp_path, "task.yaml", text))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "device_limit"), (2, "too_high")]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.purchase is not None and (row.purchase.impossible or "").startswith(
+        "step 1 of far-then-hard: device robot (role robot) refuses a value sent to it by its own limits")
+
+
+def test_a_value_no_command_of_the_bound_device_accepts_is_named_as_check_names_it(
+        tmp_path: Path, vacuum_with_default: DeviceDescription) -> None:
+    """The vacuum gripper (with a default vacuum, so that it can close) has no command that takes a grip force."""
+    the_task = service.task(write(tmp_path, "t.yaml", "task: t\nsteps:\n  - command: close-gripper\n"
+                                  "    params: {grip_force: 50}\n"))
+    catalogue = [d for d in service.catalogue() if d.id != "vacuum-gripper"] + [vacuum_with_default]
+    cell = Cell("vacuum", tuple(d for d in catalogue if d.id in ("robot", "vacuum-gripper")))
+    assert [(p.step, p.kind) for p in service.check(the_task, cell).problems] == [(1, "not_accepted")]
+    (row,) = service.batch([Configuration("vacuum", ("robot", "vacuum-gripper"))], catalogue, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 1 of t: device vacuum-gripper (role gripper) accepts no command for a parameter value given; adding "
+        "devices cannot cure it")

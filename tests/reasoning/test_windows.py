@@ -1,4 +1,7 @@
-"""Repair window by window: the same optimal cost as repairing the whole task at once, on random tasks."""
+"""Repair window by window: the same optimal cost as repairing the whole task at once, on random tasks; and the repair
+users get (``pnp repair``, :func:`plugnproduce.reasoning.repair`): a task of at most ``WHOLE_UP_TO`` steps repaired
+whole, a longer one window by window, every setting of the call (catalogue, costs, insertion slots, most insertions,
+how many repairs) honoured both ways."""
 
 from __future__ import annotations
 
@@ -10,7 +13,9 @@ from hypothesis import strategies as st
 
 from plugnproduce import service
 from plugnproduce.description.model import Cell, DeviceDescription, Step, Task
-from plugnproduce.reasoning import RepairCosts
+from plugnproduce.description.taskfile import parse_task
+from plugnproduce.reasoning import Repair, RepairCosts
+from plugnproduce.reasoning import repair as user_repair
 from plugnproduce.reasoning.repairs import repairs, windows
 from plugnproduce.reasoning.repairs.windows import Window
 from tests.reasoning.faulty_tasks import faulty_task
@@ -51,6 +56,20 @@ def test_when_swapping_is_cheaper_than_inserting_the_windows_widen_until_the_cos
 
 def test_the_default_costs_keep_edits_local() -> None:
     assert windows.edits_stay_local(RepairCosts(), KNOWLEDGE.processes)
+
+
+@pytest.mark.parametrize("costs, local", [
+    (RepairCosts(remove=2, swap=2, rebind=2), True),  # as dear as the cheapest insertion (open-gripper: 1 + 1 role)
+    (RepairCosts(remove=1.9), False),
+    (RepairCosts(swap=1.9), False),
+    (RepairCosts(rebind=1.9), False),
+])
+def test_edits_stay_local_while_no_edit_is_cheaper_than_the_cheapest_insertion(costs: RepairCosts, local: bool) -> None:
+    assert windows.edits_stay_local(costs, KNOWLEDGE.processes) is local
+
+
+def test_with_no_process_to_insert_every_edit_stays_local() -> None:
+    assert windows.edits_stay_local(RepairCosts(remove=0.5), ()) is True
 
 
 def test_a_long_task_keeps_its_unbroken_steps_and_is_plausible_after(cell: Cell) -> None:
@@ -161,4 +180,164 @@ def test_a_windows_further_repairs_solved_when_wanted_are_those_solved_at_once(
     monkeypatch.setattr(windows, "FIRST", top)
     at_once = windowed(task, cell, top=top)
     assert [(r.cost, r.edits, r.task) for r in later] == [(r.cost, r.edits, r.task) for r in at_once]
-    assert len(later) == top
+    assert len({tuple(e.text for e in r.edits) for r in later}) == top  # distinct
+
+NOT_DROPPED = ("move-to", "swap", "force", "absent", "unknown")
+SHORT = faulty_task(20, 2, 0, kinds=NOT_DROPPED)
+"""40 steps: the third-best repair of the whole task (insert a place) is not the windows' (remove the bin-pick)."""
+LONG = faulty_task(24, 2, 3, kinds=NOT_DROPPED)
+"""48 steps: the third-best repair of the windows (insert a pick) is not the whole task's (insert a place)."""
+LONG_INSERT = faulty_task(24, 1, 3, kinds=("move-to",))
+"""48 steps: best repaired by inserting an open-gripper, else by removing a bin-pick."""
+
+
+def _answers(found: list[Repair]) -> list[tuple[float, list[str]]]:
+    return [(r.cost, [e.text for e in r.edits]) for r in found]
+
+
+def _inserts(found: list[Repair]) -> list[str]:
+    return [e.text for r in found for e in r.edits if e.kind == "insert"]
+
+
+def test_a_task_of_exactly_the_whole_limit_is_repaired_whole(cell: Cell) -> None:
+    assert len(SHORT.steps) == windows.WHOLE_UP_TO
+    got = _answers(service.repair(SHORT, cell, top=3))
+    assert got == _answers(repairs.repair(SHORT, cell, KNOWLEDGE, top=3))
+    assert got[2] == (4.0, ["insert place before step 28 (move-to)",
+                            "step 29 (bin-pick): reset parameter grip_force to its default 40"])
+    assert got != _answers(windows.windowed_repair(SHORT, cell, KNOWLEDGE, top=3))  # the two ways differ here
+
+
+def test_a_longer_task_is_repaired_window_by_window(cell: Cell) -> None:
+    assert len(LONG.steps) > windows.WHOLE_UP_TO
+    got = _answers(service.repair(LONG, cell, top=3))
+    assert got == _answers(windows.windowed_repair(LONG, cell, KNOWLEDGE, top=3))
+    dropped = "step 18 (place): drop parameter grip_force (not declared)"
+    assert got == [(4.0, [dropped, "swap step 40 (bin-pick) with step 41 (place)"]),
+                   (5.0, [dropped, "insert open-gripper before step 40 (bin-pick)",
+                          "insert close-gripper before step 42 (place)"]),
+                   (6.0, [dropped, "insert open-gripper before step 40 (bin-pick)",
+                          "insert pick before step 42 (place)"])]
+    assert got != _answers(repairs.repair(LONG, cell, KNOWLEDGE, top=3))  # the two ways differ here
+
+
+def test_three_repairs_unless_asked_for_another_number(cell: Cell) -> None:
+    assert [r.rank for r in user_repair(SHORT, cell, KNOWLEDGE)] == [1, 2, 3]
+    assert [r.rank for r in user_repair(LONG, cell, KNOWLEDGE)] == [1, 2, 3]
+    assert [r.rank for r in windows.windowed_repair(LONG, cell, KNOWLEDGE)] == [1, 2, 3]
+
+
+def test_no_insertion_when_none_is_allowed_short_or_long(cell: Cell) -> None:
+    for task in (SHORT, LONG_INSERT):
+        assert _inserts(windows.repair(task, cell, KNOWLEDGE, top=1))  # the best repair inserts a step
+        found = windows.repair(task, cell, KNOWLEDGE, top=1, max_inserts=0)
+        assert _inserts(found) == [] and found[0].cost == 4.0
+        assert service.check(found[0].task, cell).plausible
+
+
+def test_no_insertion_without_insertion_slots_short_or_long(cell: Cell) -> None:
+    for task, removed in ((SHORT, "remove step 29 (bin-pick)"), (LONG_INSERT, "remove step 17 (bin-pick)")):
+        found = windows.repair(task, cell, KNOWLEDGE, top=1, per_gap=0)
+        assert _answers(found) == [(4.0, [removed])]
+
+
+def test_the_users_costs_price_the_repair_short_or_long(cell: Cell) -> None:
+    costs = RepairCosts(insert=7, reset=3)
+    assert _answers(windows.repair(SHORT, cell, KNOWLEDGE, top=1, costs=costs)) == [
+        (4.0, ["remove step 29 (bin-pick)"])]
+    assert _answers(windows.repair(LONG, cell, KNOWLEDGE, top=1, costs=costs)) == [
+        (6.0, ["step 18 (place): drop parameter grip_force (not declared)",
+               "swap step 40 (bin-pick) with step 41 (place)"])]
+
+
+def _with_screw(task: Task) -> Task:
+    screws = "  - command: screw\n" * 2
+    return parse_task(f"task: screwed\nsteps:\n{_steps(task)}{screws}".encode(), "screwed.yaml")
+
+
+def _steps(task: Task) -> str:
+    return "".join(f"  - command: {st.command}\n" for st in task.steps)
+
+
+def test_a_device_of_the_catalogue_is_bought_short_or_long(cell: Cell, devices: list[DeviceDescription]) -> None:
+    """No screwdriver in the cell: two screw steps at the end of a short and of a long plausible task (buying a
+    screwdriver costs less than removing both)."""
+    for pairs in (10, 24):
+        task = _with_screw(faulty_task(pairs, 0, 1))
+        [best] = service.repair(task, cell, devices, top=1)
+        assert best.added_devices == ("screwdriver",) and best.cost == 5.14
+
+
+LOOP = """  - loop:
+      until: BinEmpty
+      max: 100
+      steps:
+        - name: localize
+          command: localize-part
+          params: {exposure: 25}
+        - command: pick
+          params:
+            pick_pose: {from: localize, output: part_pose}
+            grip_force: 45
+        - command: place
+        - command: screw
+"""
+
+
+def test_a_long_task_keeps_its_loop_with_the_device_bought_for_it(cell: Cell, devices: list[DeviceDescription]
+                                                                 ) -> None:
+    """42 bin-pick and place steps, then a loop that screws: the screwdriver bought, the loop written as it was."""
+    text = f"task: long-loop\nsteps:\n{_steps(faulty_task(21, 0, 1))}{LOOP}"
+    task = parse_task(text.encode(), "long-loop.yaml")
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    [best] = service.repair(task, cell, devices, top=1)
+    assert best.added_devices == ("screwdriver",) and best.unrolls is None
+    assert [(lp.entry, lp.first, lp.last) for lp in best.task.loops] == [(43, 47, 50)]
+    assert service.check(best.task, cell.with_device(next(d for d in devices if d.id == "screwdriver"))).plausible
+
+
+def test_a_window_with_a_single_repair_gives_that_one_however_many_are_asked(cell: Cell) -> None:
+    """A grip force out of range, no insertion slots, the window the bin-pick alone: removing the bin-pick would
+    leave the gripper open for the place after the window, so resetting the force is the only repair."""
+    task = faulty_task(25, 1, 0, kinds=("force",))
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=3, per_gap=0, margin=0)
+    assert _answers(found) == [(1.0, ["step 27 (bin-pick): reset parameter grip_force to its default 40"])]
+
+
+def test_every_combination_of_the_windows_repairs_when_fewer_than_asked(cell: Cell) -> None:
+    """Two places bound to a SCARA the cell lacks, no insertion slots: each window is repaired by rebinding its place
+    or removing it with its bin-pick, so there are four repairs, whatever the number asked."""
+    task = faulty_task(25, 2, 5, kinds=("absent",))
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=10, per_gap=0)
+    assert [r.cost for r in found] == [4.0, 10.0, 10.0, 16.0]
+    assert len({tuple(e.text for e in r.edits) for r in found}) == 4
+
+
+def test_a_window_leaves_the_devices_as_the_steps_after_it_expect(cell: Cell, device) -> None:
+    """Resetting the grip force dear, the window the bin-pick alone: removing the bin-pick (4) would leave the gripper
+    open for the place after the window; the repair closes it as well (6), and the task is plausible (in a cell with
+    a conveyor no step uses)."""
+    with_conveyor = cell.with_device(device("conveyor"))
+    task = faulty_task(25, 1, 0, kinds=("force",))
+    costs = RepairCosts(reset=10)
+    [best] = windows.windowed_repair(task, with_conveyor, KNOWLEDGE, top=1, costs=costs, margin=0)
+    assert _answers([best]) == [(6.0, ["insert close-gripper before step 27 (bin-pick)", "remove step 27 (bin-pick)"])]
+    assert service.check(best.task, with_conveyor).plausible
+
+
+def test_a_long_task_plausible_as_written_needs_no_repair(cell: Cell) -> None:
+    task = faulty_task(25, 0, 1)
+    assert service.check(task, cell).plausible
+    assert service.repair(task, cell, top=3) == []
+    assert windows.windowed_repair(task, cell, KNOWLEDGE, top=3) == []
+
+
+def test_the_next_best_repairs_with_a_catalogue_are_distinct_bought_or_not(cell: Cell,
+                                                                         devices: list[DeviceDescription]) -> None:
+    """Two screw steps far apart and a grip force out of range: buy a screwdriver, or remove both screws, or buy it
+    and repair the force otherwise; each once."""
+    task = _screws(faulty_task(25, 1, 5), (6, 42))
+    found = windowed(task, cell, devices, top=3)
+    assert [(r.cost, r.added_devices) for r in found] == [(6.14, ("screwdriver",)), (9.0, ()),
+                                                          (11.14, ("screwdriver",))]
+    assert len({tuple(e.text for e in r.edits) for r in found}) == 3

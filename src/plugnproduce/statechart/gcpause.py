@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import gc
 import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
+
+from plugnproduce.collector import paused
+
+__all__ = ["LARGE_CHART", "hold", "holders", "paused", "release"]
 
 LARGE_CHART = 200
 """Compiled states and transitions from which a session freezes the collector's view.
@@ -53,15 +55,3 @@ def release() -> None:
 def holders() -> int:
     """How many sessions hold the collector's view frozen now."""
     return _holders
-
-
-@contextmanager
-def paused() -> Iterator[None]:
-    """No automatic collection inside the block (it was on: it is on again after)."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()

@@ -21,6 +21,7 @@ from typing import Any
 from asyncua import Client, Server, ua
 
 from plugnproduce.errors import ProtocolConnectionError, ProtocolError
+from plugnproduce.protocols.opcua.space import new_server
 from plugnproduce.protocols.opcua.spec import APPLICATION_URI_PREFIX, REGISTRATION_PERIOD, format_endpoint
 from plugnproduce.protocols.opcua.transport import LIMIT, bound_transport
 
@@ -63,8 +64,7 @@ class LocalDiscoveryServer:
 
     async def start(self) -> None:
         """Listen (security mode None)."""
-        server = Server()
-        await server.init()
+        server = await new_server()  # the standard address space as kept, not built again
         server.set_server_name("Plug'n'Produce Local Discovery Server")
         server.set_endpoint(format_endpoint(self._host, self._port))
         server.set_security_policy([ua.SecurityPolicyType.NoSecurity])

@@ -20,6 +20,7 @@ from asyncua import Node, Server, ua
 from plugnproduce.errors import PlugNProduceError, ProtocolError
 from plugnproduce.protocols.files import DeviceFiles
 from plugnproduce.protocols.opcua.security import Security, secure_server
+from plugnproduce.protocols.opcua.space import new_server
 from plugnproduce.protocols.opcua.spec import (
     DESCRIPTION_OBJECT,
     DESCRIPTION_VARIABLES,
@@ -88,8 +89,7 @@ class OpcUaDeviceServer:
 
     async def start(self) -> None:
         """Build the address space and listen."""
-        server = Server()
-        await server.init()
+        server = await new_server()  # the standard address space as kept, not built again
         server.set_server_name(f"Plug'n'Produce {self.spec.device}")
         server.set_endpoint(format_endpoint(self._host, self._port, f"/pnp/{self.spec.device}"))
         await secure_server(server, self.security, self.spec.device)

@@ -126,14 +126,10 @@ class _Parts:
         return self.parts[i]
 
 
-def k_best(options: Sequence[Sequence[_Part] | _Parts], k: int) -> list[tuple[_Part, ...]]:
+def k_best(options: Sequence[_Parts], k: int) -> list[tuple[_Part, ...]]:
     """The ``k`` cheapest ways to pick one part per window (each window's parts sorted by cost)."""
     def total(ix: tuple[int, ...]) -> int:
         return sum(options[w][i].cost for w, i in enumerate(ix))
-
-    def has(w: int, i: int) -> bool:
-        parts = options[w]
-        return parts.has(i) if isinstance(parts, _Parts) else i < len(parts)
 
     first = (0,) * len(options)
     heap, seen = [(total(first), first)], {first}
@@ -143,7 +139,7 @@ def k_best(options: Sequence[Sequence[_Part] | _Parts], k: int) -> list[tuple[_P
         out.append(tuple(options[w][i] for w, i in enumerate(ix)))
         for w in range(len(ix)):
             nxt = ix[:w] + (ix[w] + 1,) + ix[w + 1:]
-            if nxt not in seen and has(w, nxt[w]):
+            if nxt not in seen and options[w].has(nxt[w]):
                 seen.add(nxt)
                 heapq.heappush(heap, (total(nxt), nxt))
     return out
