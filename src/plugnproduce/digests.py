@@ -11,9 +11,6 @@ if TYPE_CHECKING:
     from hashlib import sha256
 else:
     try:
-        from _sha256 import sha256  # CPython 3.11
+        from _sha256 import sha256  # CPython 3.11 (3.12 renamed it: hashlib's is used there)
     except ImportError:
-        try:
-            from _sha2 import sha256  # CPython 3.12 and later
-        except ImportError:
-            from hashlib import sha256
+        from hashlib import sha256

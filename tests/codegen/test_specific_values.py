@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -12,6 +13,7 @@ from statemachine.io.scxml.processor import SCXMLProcessor
 
 from plugnproduce import service
 from plugnproduce.description.loader import load_device
+from plugnproduce.drawing import chart_to_dot
 from plugnproduce.executor.chartmap import StateInfo, chart_map
 from plugnproduce.statechart import parse_chart
 from tests.conftest import edit
@@ -128,9 +130,11 @@ def test_a_force_for_a_device_that_declares_no_unit_is_sent_as_written(tmp_path:
     assert [(p.get("name"), p.get("expr")) for p in chart.iterfind(".//s:send/s:param", NS)] == [("GripForce", "45")]
 
 
-def test_the_cycle_time_follows_each_regions_path_and_its_synchronisation() -> None:
+def test_the_cycle_time_follows_each_regions_path_and_its_synchronisation(tmp_path: Path,
+                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
     # the localizer waits for the sensor's capture (180 ms) before localizing (150 ms); a pick moves the robot
     # (250 ms), closes the gripper (120 ms) once there, and lifts (250 ms)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))  # estimated from the charts, not read back as kept
     estimate = service.cycle_time(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
     assert estimate is not None
     assert [(s.step, s.command, round(s.seconds, 6)) for s in estimate.steps[:3]] == [
@@ -173,3 +177,24 @@ def test_the_generated_program_lists_each_devices_requests_and_events_in_order()
                      ("robot", "request", "MoveTo"), ("robot", "event", "motion_done"),
                      ("robot", "request", "MoveTo"), ("robot", "event", "motion_done")]
     assert len(commands) == 48
+
+
+def test_the_picture_of_a_steps_chart_names_each_controller_states_concept() -> None:
+    # pnp draw of the pick step: each state of a region shows the general state's concept it stands for
+    generation = service.generation(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
+    chart = parse_chart(next(c.data for c in generation.charts if c.name == "step02-pick.scxml"), "pick.scxml")
+    labels = re.findall(r'label="(s2_\w+)\\n«(\w+)»"', chart_to_dot(chart).source)
+    assert labels == [("s2_gripper_open", "Open"), ("s2_gripper_closed", "Closed"), ("s2_robot_idle", "Idle"),
+                      ("s2_robot_approach", "Moving"), ("s2_robot_at_part", "AtPose"), ("s2_robot_lift", "Moving"),
+                      ("s2_robot_lifted", "AtPose")]
+
+
+def test_a_region_that_waits_for_another_sends_its_first_request_only_once_the_other_is_there() -> None:
+    # the pick: the gripper closes only once the robot is at the part, then waits for the event that it closed
+    generation = service.generation(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
+    chart = etree.fromstring(next(c.data for c in generation.charts if c.kind == "task"))
+    moves = [(t.get("cond"), t.get("event"), [s.get("event") for s in t.iterfind("s:send", NS)], t.get("target"))
+             for state in ("s2_gripper_open", "s2_gripper_closed_1a")
+             for t in chart.iterfind(f".//s:state[@id='{state}']/s:transition", NS)]
+    assert moves == [("In('s2_robot_at_part')", None, ["xirp.request.Close"], "s2_gripper_closed_1a"),
+                     (None, "gripper.xirp.event.gripper_closed", [], "s2_gripper_closed")]

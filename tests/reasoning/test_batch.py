@@ -775,6 +775,21 @@ def test_a_role_the_process_does_not_have_is_named_as_check_names_it(tmp_path: P
 
 
 
+@pytest.mark.parametrize("last", ["  - command: wave-hello\n",
+                                  "  - command: open-gripper\n    bind: {hand: gripper}\n"], ids=["command", "role"])
+def test_the_states_are_followed_past_an_unknown_command_or_role_as_check_follows_them(tmp_path: Path,
+                                                                                        last: str) -> None:
+    """Close, close, then a step check cannot bind as written: check names the second close first (the gripper is
+    closed already), and the batch names it too, not the later step."""
+    the_task = service.task(write(tmp_path, "task.yaml", CLOSE_TWICE + last))
+    cell = Cell("paper", tuple(d for d in service.catalogue() if d.id in PAPER))
+    assert [p.step for p in service.check(the_task, cell).problems][:2] == [2, 3]
+    (row,) = service.batch([Configuration("paper", PAPER)], None, [the_task], workers=1)
+    assert row.plausible == () and row.purchase is not None and row.purchase.impossible == (
+        "step 2 of close-twice: device gripper is not in the state role gripper starts from; adding devices cannot "
+        "cure it")
+
+
 def test_the_states_are_followed_once_a_purchase_fills_every_role(tmp_path: Path) -> None:
     """No robot for the first step's move: the batch looks for one to buy before it follows the gripper's states,
     and then finds that the second close finds the gripper closed, which no purchase cures."""

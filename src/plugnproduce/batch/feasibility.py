@@ -7,7 +7,8 @@ those of ``offered.lp``, ``resolve.lp`` and ``chain.lp``, applied to the per-dev
 - a role a step names a device for is played by that device (``absent`` if it is not plugged in,
   ``cannot_play`` if it cannot); another role is played by the one device that can play it
   (``no_device`` when there is none, ``ambiguous`` when there are several);
-- when every role of every step is bound, the chain runs: each device starts in its initial
+- when every role of every process a step names is bound, the chain runs (past a step of no process, which
+  moves no device, and a role the process does not have, as check's chain does): each device starts in its initial
   states, a step needs each bound device in a state its role's start concept subsumes
   (``wrong_state``) from which the role can be played (``stuck``), and leaves it where the role
   ends; a device filling several roles of a step plays them in role order;
@@ -131,13 +132,11 @@ def _findings(ab: Abilities, task: TaskSpec, mask: int) -> tuple[Finding, ...]:
     for step in task.steps:
         if step.bad_value:
             out.append(("bad_value", step.index, "", ""))
-        if step.process is None:
+        if step.process is None:  # a step of no process moves no device: the chain goes on past it, as check's
             out.append(("unknown_command", step.index, "", ""))
-            unbound = True
             bindings.append(())
             continue
         out += [("unknown_role", step.index, r, "") for r in step.unknown_roles]
-        unbound |= bool(step.unknown_roles)
         bound, problems = _bind(ab, step.process, step.roles, step.index, mask)
         out += problems
         unbound |= bool(problems)

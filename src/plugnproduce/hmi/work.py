@@ -21,15 +21,12 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
-import contextlib
 import logging
 import multiprocessing
-import os
 import signal
 import threading
 import time
 from collections.abc import Callable
-from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from multiprocessing import forkserver
 from typing import Any, TypeVar
@@ -119,35 +116,20 @@ class Work:
         """The pool, its workers started (in this thread, not with the first request)."""
         pool = ProcessPool(self.limits.workers, initializer=jobs.start_worker,
                            initargs=(self._knowledge, self._catalogue, self.limits.memory), context=_context())
-        try:
-            pool.schedule(jobs.ready)
-        except BaseException:  # its fork server ended (the application stops): close what it opened
-            pool.stop()  # type: ignore[no-untyped-call]
-            pool.join()
-            raise
+        pool.schedule(jobs.ready)
         return pool
 
     async def _pool(self) -> ProcessPool:
         return await asyncio.shield(self.start())
 
     async def stop(self) -> None:
-        """Stop every job and the worker processes, also while they are still starting: the fork server is then
-        still importing :data:`PRELOAD` (seconds of CPU, far more on a busy machine) and is ended there, so that
-        stopping never waits for it."""
+        """Stop every job and the worker processes."""
         self.cancel_all()
         starting, self._starting = self._starting, None
-        if starting is None:
-            return
-        while not starting.done():  # the pool's start then fails at once, its workers unborn; a fork server it
-            _end_forkserver()  # starts again meanwhile (it asks for one before each worker) is ended too
-            await asyncio.wait({starting}, timeout=0.05)
-        try:
+        if starting is not None:
             pool = await starting
-        except (BrokenProcessPool, OSError, EOFError) as exc:
-            log.info("the worker processes were stopped while they were starting (%s)", type(exc).__name__)
-            return
-        pool.stop()  # type: ignore[no-untyped-call]  # pebble leaves it unannotated
-        await asyncio.to_thread(pool.join)
+            pool.stop()  # type: ignore[no-untyped-call]  # pebble leaves it unannotated
+            await asyncio.to_thread(pool.join)
 
     def cancel_all(self) -> None:
         """Stop every job in progress; each of their requests ends with 503 (the server is stopping)."""
@@ -254,19 +236,6 @@ def _start_forkserver() -> None:
         forkserver.ensure_running()
     finally:
         signal.signal(signal.SIGINT, previous)
-
-
-def _end_forkserver() -> None:
-    """End this process's fork server now, even in the middle of its preload (it forks no worker before the
-    preload is done, so none is left behind); the next pool starts a new one. multiprocessing only asks a fork
-    server to stop, which it notices once its preload is done, so it is killed first."""
-    server: Any = forkserver._forkserver  # the process's one fork server (multiprocessing keeps it private)
-    pid = server._forkserver_pid
-    if pid is None:
-        return
-    with contextlib.suppress(ProcessLookupError):
-        os.kill(pid, signal.SIGKILL)
-    server._stop()  # reaps it and forgets its socket
 
 
 async def _disconnected(request: Request) -> None:
