@@ -436,3 +436,6 @@ def test_a_step_inserted_in_a_window_is_the_only_new_step_of_the_repaired_task(c
     assert _answers([best]) == [(2.0, ["insert open-gripper before step 19 (bin-pick)"])]
     assert best.origins == (*range(1, 19), 0, *range(19, 49))
     assert sideeffects.new_steps(LONG_INSERT, best.task, best.origins) == {19}
+    written = [st.command for st in LONG_INSERT.steps]
+    assert [st.command for st in best.task.steps] == [*written[:18], "open-gripper", *written[18:]]  # all kept
+    assert [st.index for st in best.task.steps] == list(range(1, 50)) and best.task.name == LONG_INSERT.name
