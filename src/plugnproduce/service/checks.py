@@ -84,13 +84,13 @@ def assessed_repairs(
     worst side effect, then by cost (:func:`plugnproduce.reasoning.repairs.sideeffects.ranking`). When the check refuses
     some of the solver's repairs, the solver is asked for more, up to :data:`MORE_REPAIRS` rounds. ``checked``: the
     task's :func:`check` in that cell, when the caller has it (it is not checked again)."""
-    from plugnproduce.statechart import gcpause
+    from plugnproduce import collector
 
     the_cell, k = cell_and_knowledge(cell_or_path, knowledge)
     the_task = as_task(task_or_path)
     devices = None if catalogue_or_folder is None else _devices(catalogue_or_folder, k)
     asked = top
-    with gcpause.paused():  # repairs of a long task make long-lived results, not cyclic garbage: see gcpause
+    with collector.paused():  # repairs of a long task make long-lived results, not cyclic garbage
         for _ in range(MORE_REPAIRS):
             repairs = repair(the_task, the_cell, devices, asked, knowledge=k)
             assessed = reasoning.assess(repairs, the_task, the_cell, k, devices or (), checked)

@@ -114,10 +114,10 @@ def task_from_text(data: bytes | str, name: str) -> Task:
 
 def task_text(the_task: Task, block: bool = False) -> str:
     """A task as a YAML task file (``block``: every value on a line of its own)."""
+    from plugnproduce import collector
     from plugnproduce.description.taskfile import task_to_yaml
-    from plugnproduce.statechart import gcpause
 
-    with gcpause.paused():  # its only garbage is acyclic temporaries: a long task's text pays for no collection
+    with collector.paused():  # its only garbage is acyclic temporaries: a long task's text pays for no collection
         return task_to_yaml(the_task, block)
 
 

@@ -153,7 +153,7 @@ def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path
     """Each repaired task's estimated cycle time in the cell with the devices its repair buys (None: no estimate).
     Every repair starts from the same task, so their order by it is their order by the time they add; the
     steps they share are estimated once."""
-    from plugnproduce.statechart import gcpause
+    from plugnproduce import collector
     from plugnproduce.timing.estimate import StepMemo
     from plugnproduce.timing.tasks import task_cycle_time
 
@@ -163,7 +163,7 @@ def repair_cycle_times(repairs: Sequence[reasoning.AssessedRepair], cell_or_path
         bought = {d.id: d for d in (k.devices if catalogue_or_folder is None else _devices(catalogue_or_folder, k))}
     out: list[CycleTime | None] = []
     memo = StepMemo()
-    with gcpause.paused():  # the repaired tasks' programs are long-lived while estimated, not cyclic garbage
+    with collector.paused():  # the repaired tasks' programs are long-lived while estimated, not cyclic garbage
         for r in repairs:
             cell = the_cell
             for device in r.repair.added_devices:

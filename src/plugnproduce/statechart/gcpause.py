@@ -16,10 +16,6 @@ from __future__ import annotations
 import gc
 import threading
 
-from plugnproduce.collector import paused
-
-__all__ = ["LARGE_CHART", "hold", "holders", "paused", "release"]
-
 LARGE_CHART = 200
 """Compiled states and transitions from which a session freezes the collector's view.
 

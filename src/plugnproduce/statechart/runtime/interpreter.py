@@ -55,6 +55,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from plugnproduce import collector
 from plugnproduce.errors import ExecutionError
 from plugnproduce.safeio import read_bytes
 from plugnproduce.statechart import gcpause
@@ -112,7 +113,7 @@ class Interpreter(Datamodel, Dispatcher, Invoker, Microstep):
         self.io_processors = io_processors
         self.base_dir = base_dir
         self.session_id = session_id
-        with gcpause.paused():  # a large chart would otherwise pay for collections that find nothing
+        with collector.paused():  # a large chart would otherwise pay for collections that find nothing
             self.compiled = CompiledChart(chart, Evaluator(trusted), chart.name or "chart")
         self._holds_gc = False
         self.running = False
