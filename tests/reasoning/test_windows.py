@@ -439,3 +439,21 @@ def test_a_step_inserted_in_a_window_is_the_only_new_step_of_the_repaired_task(c
     written = [st.command for st in LONG_INSERT.steps]
     assert [st.command for st in best.task.steps] == [*written[:18], "open-gripper", *written[18:]]  # all kept
     assert [st.index for st in best.task.steps] == list(range(1, 50)) and best.task.name == LONG_INSERT.name
+
+
+def test_a_value_beyond_the_devices_limit_far_from_other_problems_is_reset_saying_which_limit(cell: Cell) -> None:
+    """48 steps: the bin-pick at 11 sends the gripper 10 N (within the process's range, below the 20 N the gripper
+    takes: a problem of the device's limits, not of the encodings' check), the bin-pick at 41 a force beyond the
+    process's own range. Both are reset, the first saying which limit of which device it broke; the repaired task is
+    plausible."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[10] = replace(steps[10], params={"grip_force": 10})
+    steps[40] = replace(steps[40], params={"grip_force": 150})
+    task = Task("limits", tuple(steps), "limits.yaml")
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("device_limit", 11), ("too_high", 41)]
+    found = service.repair(task, cell, top=1)
+    assert _answers(found) == [(2.0, [
+        "step 11 (bin-pick): reset parameter grip_force to its default 40 (device 'gripper' takes at least 20 N; "
+        "the value is 10 N)", "step 41 (bin-pick): reset parameter grip_force to its default 40"])]
+    assert service.check(found[0].task, cell).plausible
