@@ -457,3 +457,21 @@ def test_a_value_beyond_the_devices_limit_far_from_other_problems_is_reset_sayin
         "step 11 (bin-pick): reset parameter grip_force to its default 40 (device 'gripper' takes at least 20 N; "
         "the value is 10 N)", "step 41 (bin-pick): reset parameter grip_force to its default 40"])]
     assert service.check(found[0].task, cell).plausible
+
+
+def test_windows_alike_but_for_a_pose_are_repaired_each_with_its_own_steps(cell: Cell) -> None:
+    """A place done twice after one bin-pick, early in the task to the same pose, late to two poses; no insertion
+    slots. Removing either of the first two places leads to the same task (one repair); removing either of the last
+    two does not (two repairs), though both windows make the same facts (a pose is no number of the encodings)."""
+    here, there = {"place_pose": [0.5, 0.1, 0.2, 0, 180, 0]}, {"place_pose": [0.5, -0.1, 0.2, 0, 180, 0]}
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[11] = replace(steps[11], params=here)
+    steps.insert(12, steps[11])  # step 13: the same place again
+    steps[38] = replace(steps[38], params=here)
+    steps.insert(39, replace(steps[38], params=there))  # step 40: a place elsewhere
+    task = Task("twice", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "twice.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("wrong_state", 13), ("wrong_state", 40)]
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=2, per_gap=0)
+    assert _answers(found) == [(8.0, ["remove step 12 (place)", "remove step 39 (place)"]),
+                               (8.0, ["remove step 12 (place)", "remove step 40 (place)"])]
+    assert [st.params for st in found[1].task.steps[36:39]] == [{}, here, {}]  # the place to the pose there removed
