@@ -475,3 +475,20 @@ def test_windows_alike_but_for_a_pose_are_repaired_each_with_its_own_steps(cell:
     assert _answers(found) == [(8.0, ["remove step 12 (place)", "remove step 39 (place)"]),
                                (8.0, ["remove step 12 (place)", "remove step 40 (place)"])]
     assert [st.params for st in found[1].task.steps[36:39]] == [{}, here, {}]  # the place to the pose there removed
+
+
+def test_a_device_a_window_last_uses_enters_a_later_window_as_the_repair_left_it(cell: Cell) -> None:
+    """A close-gripper with a force out of range (its reset dear: removed instead, the gripper left open) and, 20 moves
+    later, a close-gripper bound to a gripper the cell lacks. The gripper's last use is the first window's last step;
+    the second window rebinds its close-gripper to the gripper, open as the first window left it (not closed, as the
+    task as written would have left it), so nothing more is needed."""
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    steps = [move] * 20 + [Step(0, "close-gripper", {}, {"grip_force": 500})] + [move] * 20 + [
+        Step(0, "close-gripper", {"gripper": "gripper2"}, {"grip_force": 40})] + [move] * 5
+    task = Task("two-closes", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "two-closes.yaml")
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=2, costs=RepairCosts(reset=10), margin=0)
+    assert _answers(found) == [
+        (6.0, ["remove step 21 (close-gripper)",
+               "step 42 (close-gripper): bind role 'gripper' to device 'gripper' instead of 'gripper2'"]),
+        (8.0, ["remove step 21 (close-gripper)", "remove step 42 (close-gripper)"])]
+    assert all(service.check(r.task, cell).plausible for r in found)

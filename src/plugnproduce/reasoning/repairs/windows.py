@@ -185,7 +185,7 @@ class _Chain:
 
     def states(self, i: int) -> dict[str, str]:
         """Every device's state before original step ``i`` (``n + 1``: after the task)."""
-        return dict(self.at.get(i, {}))
+        return dict(self.at[i])  # {} where no device has a state (each lost where it got stuck: no recovers/4)
 
     def exits(self, w: Window) -> dict[str, str]:
         """The states the steps after ``w`` expect: of each device one of them uses."""
