@@ -492,3 +492,17 @@ def test_a_device_a_window_last_uses_enters_a_later_window_as_the_repair_left_it
                "step 42 (close-gripper): bind role 'gripper' to device 'gripper' instead of 'gripper2'"]),
         (8.0, ["remove step 21 (close-gripper)", "remove step 42 (close-gripper)"])]
     assert all(service.check(r.task, cell).plausible for r in found)
+
+
+def test_a_long_task_whose_only_problem_is_a_devices_limit_is_repaired_window_by_window(cell: Cell) -> None:
+    """48 steps, the bin-pick at 11 sending the gripper 10 N (it takes at least 20 N): no problem of the encodings'
+    check, so it is the device's limit alone that makes the task one to repair window by window."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[10] = replace(steps[10], params={"grip_force": 10})
+    task = Task("limit", tuple(steps), "limit.yaml")
+    got = _answers(service.repair(task, cell, top=3))
+    assert got == [(1.0, ["step 11 (bin-pick): reset parameter grip_force to its default 40 (device 'gripper' takes "
+                          "at least 20 N; the value is 10 N)"]),
+                   (6.0, ["remove step 11 (bin-pick)", "insert close-gripper before step 12 (place)"]),
+                   (7.0, ["remove step 11 (bin-pick)", "insert pick before step 12 (place)"])]
+    assert got != _answers(repairs.repair(task, cell, KNOWLEDGE, top=3))  # the whole task's third: the pick before 11
