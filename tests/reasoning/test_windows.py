@@ -506,3 +506,17 @@ def test_a_long_task_whose_only_problem_is_a_devices_limit_is_repaired_window_by
                    (6.0, ["remove step 11 (bin-pick)", "insert close-gripper before step 12 (place)"]),
                    (7.0, ["remove step 11 (bin-pick)", "insert pick before step 12 (place)"])]
     assert got != _answers(repairs.repair(task, cell, KNOWLEDGE, top=3))  # the whole task's third: the pick before 11
+
+
+def test_a_value_in_a_unit_of_another_quantity_far_from_other_problems_is_reset(cell: Cell) -> None:
+    """48 steps: the bin-pick at 11 grips with "40 kg" (no force), the bin-pick at 41 with a force beyond the process's
+    range. The windows see the value as written, so both are reset and the repaired task is plausible."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[10] = replace(steps[10], params={"grip_force": "40 kg"})
+    steps[40] = replace(steps[40], params={"grip_force": 150})
+    task = Task("kilograms", tuple(steps), "kilograms.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("bad_unit", 11), ("too_high", 41)]
+    found = service.repair(task, cell, top=1)
+    assert _answers(found) == [(2.0, ["step 11 (bin-pick): reset parameter grip_force to its default 40",
+                                      "step 41 (bin-pick): reset parameter grip_force to its default 40"])]
+    assert service.check(found[0].task, cell).plausible
