@@ -520,3 +520,18 @@ def test_a_value_in_a_unit_of_another_quantity_far_from_other_problems_is_reset(
     assert _answers(found) == [(2.0, ["step 11 (bin-pick): reset parameter grip_force to its default 40",
                                       "step 41 (bin-pick): reset parameter grip_force to its default 40"])]
     assert service.check(found[0].task, cell).plausible
+
+
+def test_a_problem_spans_back_to_the_devices_previous_use(cell: Cell) -> None:
+    """A bin-pick and, six moves later, another (the gripper still closed): the open-gripper may go anywhere after the
+    first bin-pick, so the window reaches back to it and every such place is a repair of its own."""
+    pick = replace(service.task(service.builtin("tasks", "bin-picking.yaml")).steps[0], bind={})
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    steps = [move] * 15 + [pick] + [move] * 6 + [pick] + [move] * 20
+    task = Task("again", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "again.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("wrong_state", 23)]
+    found = _answers(service.repair(task, cell, top=8))
+    assert found[0] == (2.0, ["insert open-gripper before step 23 (bin-pick)"])
+    assert sorted(found[:7]) == [(2.0, [f"insert open-gripper before step {i} ({'move-to' if i < 23 else 'bin-pick'})"])
+                                 for i in range(17, 24)]
+    assert found[7] == (3.0, ["insert place before step 23 (bin-pick)"])
