@@ -404,6 +404,16 @@ async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its
             await asyncio.wait_for(query_report(silent, WAIT), WAIT)
 
 
+@pytest.mark.parametrize("endpoint", ["http:/device.xml", "http:///device.xml", "binpicking-pc.local"])
+async def test_a_upnp_endpoint_that_names_no_host_is_refused_naming_the_device_and_the_endpoint(endpoint: str) -> None:
+    hostless = dataclasses.replace(device(BIN_PICKING, "binpicking-pc"), endpoint=endpoint)
+    said = f"^device binpicking-pc: endpoint '{endpoint}' names no host; expected http://HOST:PORT/PATH$"
+    for opening in (lambda: Heard().open(hostless), lambda: query_report(hostless, WAIT),
+                    lambda: query_state(hostless, WAIT)):
+        with pytest.raises(ProtocolError, match=said):
+            await opening()
+
+
 async def test_query_report_over_upnp_refuses_an_answer_without_a_state_or_with_a_value_that_is_no_json() -> None:
     answers = [{upnp.STATE_ARGUMENT: "", "TargetPose": "[]"}, {upnp.STATE_ARGUMENT: "home", "TargetPose": "a pose"}]
 
