@@ -70,8 +70,9 @@ def _fixpoint(task: Task, loop: Loop, result: CheckResult) -> Iterator[Problem]:
             text = (f"loop iteration: device {device} ends an iteration in state '{after[device]}', but the "
                     f"iteration before left it in '{before[device]}'; each iteration must leave every device "
                     "as it found it")
-            where = Where(task.file, loop.line)
-            yield Problem(loop.first, first.command, "loop_fixpoint", Reason("loop_fixpoint", text, (), (where,)),
+            where = Where(task.file, first.line)  # the iteration's first step, as for the step's other findings
+            rests_on = (where, Where(task.file, loop.line))
+            yield Problem(loop.first, first.command, "loop_fixpoint", Reason("loop_fixpoint", text, (), rests_on),
                           where, device=device, state=after[device])
 
 
