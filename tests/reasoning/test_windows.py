@@ -535,3 +535,14 @@ def test_a_problem_spans_back_to_the_devices_previous_use(cell: Cell) -> None:
     assert sorted(found[:7]) == [(2.0, [f"insert open-gripper before step {i} ({'move-to' if i < 23 else 'bin-pick'})"])
                                  for i in range(17, 24)]
     assert found[7] == (3.0, ["insert place before step 23 (bin-pick)"])
+
+
+def test_a_long_task_whose_only_problem_no_edit_cures_gets_the_whole_tasks_answer(cell: Cell) -> None:
+    """49 steps, the last taking its pose from a step no step is named: the encodings find nothing to repair, so the
+    answer is the whole-task repair's, however many repairs are asked for."""
+    body = "".join(f"  - command: {st.command}\n" for st in faulty_task(24, 0, 1).steps)
+    text = f"task: linked\nsteps:\n{body}  - command: pick\n    params:\n      pick_pose: {{from: nowhere, output: part_pose}}\n"
+    task = parse_task(text.encode(), "linked.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("bad_link", 49)]
+    for top in (1, 3):
+        assert _answers(service.repair(task, cell, top=top)) == _answers(repairs.repair(task, cell, KNOWLEDGE, top=top))
