@@ -546,3 +546,19 @@ def test_a_long_task_whose_only_problem_no_edit_cures_gets_the_whole_tasks_answe
     assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("bad_link", 49)]
     for top in (1, 3):
         assert _answers(service.repair(task, cell, top=top)) == _answers(repairs.repair(task, cell, KNOWLEDGE, top=top))
+
+
+def test_a_long_task_done_in_rounds_keeps_its_rounds_description_and_file_where_the_repair_keeps_them_alike(
+        cell: Cell) -> None:
+    """Twelve bin-picks and places done twice (48 steps), the third bin-pick of a round gripping too hard: the best
+    repair resets it in both rounds, so its task is still one round done twice; the next repairs a round otherwise."""
+    one_round = "".join("  - command: bin-pick\n" + ("    params: {grip_force: 150}\n" if i == 2 else "")
+                        + "  - command: place\n" for i in range(12))
+    text = f"task: rounds\ndescription: Twelve parts, twice\nrepeat: 2\nsteps:\n{one_round}"
+    task = parse_task(text.encode(), "rounds.yaml")
+    assert len(task.steps) == 48 and task.repeat == 2
+    found = service.repair(task, cell, top=2)
+    assert [(r.cost, r.task.repeat, r.task.description, r.task.file, len(r.task.steps)) for r in found] == [
+        (2.0, 2, "Twelve parts, twice", "rounds.yaml", 48), (7.0, 1, "Twelve parts, twice", "rounds.yaml", 48)]
+    assert found[0].task.one_round() == tuple(replace(st, params={}) if st.index == 5 else st
+                                              for st in task.one_round())
