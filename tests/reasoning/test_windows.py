@@ -562,3 +562,17 @@ def test_a_long_task_done_in_rounds_keeps_its_rounds_description_and_file_where_
         (2.0, 2, "Twelve parts, twice", "rounds.yaml", 48), (7.0, 1, "Twelve parts, twice", "rounds.yaml", 48)]
     assert found[0].task.one_round() == tuple(replace(st, params={}) if st.index == 5 else st
                                               for st in task.one_round())
+
+
+def test_without_margin_a_problem_at_the_first_step_is_repaired_in_a_window_of_that_step_alone(cell: Cell) -> None:
+    """The first bin-pick grips too hard, no margin: the window is step 1 alone, so besides the reset the only repair
+    removes it and, before it, makes the gripper hold a located part for the place after it (the place is outside)."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[0] = replace(steps[0], params={"grip_force": 150})
+    task = Task("first", tuple(steps), "first.yaml")
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=3, margin=0)
+    assert _answers(found) == [
+        (1.0, ["step 1 (bin-pick): reset parameter grip_force to its default 40"]),
+        (10.0, ["insert localize-part before step 1 (bin-pick)", "insert pick before step 1 (bin-pick)",
+                "remove step 1 (bin-pick)"])]
+    assert all(service.check(r.task, cell).plausible for r in found)
