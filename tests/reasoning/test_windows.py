@@ -576,3 +576,19 @@ def test_without_margin_a_problem_at_the_first_step_is_repaired_in_a_window_of_t
         (10.0, ["insert localize-part before step 1 (bin-pick)", "insert pick before step 1 (bin-pick)",
                 "remove step 1 (bin-pick)"])]
     assert all(service.check(r.task, cell).plausible for r in found)
+
+
+@pytest.mark.parametrize("first, margins, answer", [
+    (2, [2, 4, 8], (2.0, ["swap step 45 (bin-pick) with step 46 (place)",
+                          "swap step 47 (bin-pick) with step 48 (place)"])),
+    (0, [0, 1], (8.0, ["remove step 43 (bin-pick)"])),  # no margin: one step more, then the cost settles
+])
+def test_when_edits_do_not_stay_local_the_margins_double_until_the_cost_settles(
+        cell: Cell, first: int, margins: list[int], answer: tuple[float, list[str]],
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    costs = RepairCosts(insert=10, insert_per_role=1, remove=8, swap=1, rebind=1, reset=5)
+    seen: list[int] = []
+    widen = windows.windows
+    monkeypatch.setattr(windows, "windows", lambda spans, n, margin: seen.append(margin) or widen(spans, n, margin))
+    found = windows.windowed_repair(faulty_task(24, 1, 113371), cell, KNOWLEDGE, costs=costs, top=1, margin=first)
+    assert (seen, _answers(found)) == (margins, [answer])
