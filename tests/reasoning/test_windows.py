@@ -592,3 +592,16 @@ def test_when_edits_do_not_stay_local_the_margins_double_until_the_cost_settles(
     monkeypatch.setattr(windows, "windows", lambda spans, n, margin: seen.append(margin) or widen(spans, n, margin))
     found = windows.windowed_repair(faulty_task(24, 1, 113371), cell, KNOWLEDGE, costs=costs, top=1, margin=first)
     assert (seen, _answers(found)) == (margins, [answer])
+
+
+def test_a_long_task_whose_windows_cover_it_is_repaired_whole(cell: Cell, monkeypatch: pytest.MonkeyPatch) -> None:
+    """42 steps with a fault in every pair but the first and the last: the windows merge into the whole task, which is
+    then repaired as a short task is (one whole-task repair), not as one window."""
+    task = faulty_task(21, 19, 0, kinds=NOT_DROPPED)
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    expected = _answers(repairs.repair(task, cell, KNOWLEDGE, top=2))
+    wholes: list[int] = []
+    whole_repair = repairs.repair
+    monkeypatch.setattr(repairs, "repair", lambda *a, **k: wholes.append(1) or whole_repair(*a, **k))
+    monkeypatch.setattr(windows._Solver, "best", lambda *a: pytest.fail("solved window by window"))
+    assert _answers(windows.windowed_repair(task, cell, KNOWLEDGE, top=2)) == expected and wholes == [1]
