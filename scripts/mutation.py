@@ -169,7 +169,8 @@ CORE = (
           deselect=(*_BATCH_WORKERS,  # they reach no line or branch of the module the other tests do not reach
                     "tests/reasoning/test_batch.py::test_answers_agree_with_the_full_reasoner_on_random_configurations")),
     Guard("reasoning-purchases", (_S + "batch/purchases.py",),
-          ("tests/reasoning/test_batch.py", *_DEAD_END_BATCH, _LOOP_FIXPOINT),
+          ("tests/reasoning/test_batch.py", "tests/reasoning/test_batch_purchase_order.py", *_DEAD_END_BATCH,
+           _LOOP_FIXPOINT),
           deselect=(*_BATCH_WORKERS,  # they compare offered and plausible only, never a purchase
                     "tests/reasoning/test_batch.py::test_answers_agree_with_the_full_reasoner_on_random_configurations")),
     Guard("reasoning-windows", (_S + "reasoning/repairs/windows.py",), ("tests/reasoning/test_windows.py",)),

@@ -14,7 +14,7 @@ from plugnproduce import service
 from plugnproduce.cli import app
 from plugnproduce.description.model import Task
 from plugnproduce.description.taskfile import parse_task
-from plugnproduce.reasoning import Repair
+from plugnproduce.reasoning import AssessedRepair, Repair
 from plugnproduce.reasoning.repairs.lifting import UNROLLS
 from tests.reasoning.conftest import BIN_PICKING, DESCRIPTIONS, TASKS
 from tests.reasoning.test_nested_loop_check import REGRIP
@@ -333,3 +333,27 @@ def test_a_task_without_loops_or_branches_keeps_its_repeat(tmp_path: Path) -> No
                            "  - command: open-gripper\n")
     r = _with(service.repair(path, BIN_PICKING), ("reset", 1, None), ("reset", 3, None))
     assert r.unrolls is None and r.task.repeat == 2 and r.task.steps[0].params == {}
+
+
+# ---- the side effects of a repair kept in the loop are those of its written steps
+
+def _effects(a: AssessedRepair) -> list[tuple[str, int | None, str]]:
+    return [(e.kind, e.step, e.text) for e in a.side_effects]
+
+
+def test_the_side_effects_of_a_repair_kept_in_the_loop_are_those_of_the_steps_it_changes(tmp_path: Path) -> None:
+    """Rebinding the pick's gripper in the loop body changes no step's values, as in the same task without the loop:
+    no side effect. A close-gripper written into the body instead of the pick is a new step in every iteration,
+    and runs with its default grip force in each."""
+    path = _file(tmp_path, UNTIL_EMPTY.replace("gripper: gripper}", "gripper: sensor3d}"))
+    assessed = service.assessed_repairs(path, BIN_PICKING, top=8)
+    rebound = next(a for a in assessed if [(e.kind, e.step) for e in a.repair.edits] == [("rebind", 2), ("rebind", 5)])
+    assert rebound.repair.unrolls is None and rebound.repair.task.loops and _effects(rebound) == []
+    closed = next(a for a in assessed if [(e.kind, e.step) for e in a.repair.edits] == [
+        ("rebind", 2), ("remove", 5), ("insert", 6)])
+    assert closed.repair.unrolls is None and _written(closed.repair) == (
+        ["localize-part", "close-gripper", "place"] * 2, [(1, 4, 6)])
+    assert _effects(closed) == [
+        ("default_values", 2, "step 2 (close-gripper) runs with default values: grip_force = 40"),
+        ("default_values", 5, "step 5 (close-gripper) runs with default values: grip_force = 40")]
+    assert rebound.rank < closed.rank

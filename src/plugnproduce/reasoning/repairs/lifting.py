@@ -201,6 +201,8 @@ class _Flat:
     steps: list[Step] = field(default_factory=list)
     loops: list[Loop] = field(default_factory=list)
     branches: list[Branch] = field(default_factory=list)
+    origins: list[int] = field(default_factory=list)
+    """Each step's flat position in the written task (0: inserted), as :attr:`Repair.origins` says."""
 
     def add(self, items: list[_Node]) -> None:
         """Flatten items onto the steps (a loop's body twice, a branch's steps after its step)."""
@@ -211,6 +213,8 @@ class _Flat:
                 first = len(self.steps) + 1
                 n = first - entry
                 self.steps += [dataclasses.replace(s, index=s.index + n) for s in self.steps[entry - 1:]]
+                shift = node.loop.first - node.loop.entry  # where the written task's second copy of its body is
+                self.origins += [q + shift if q else 0 for q in self.origins[entry - 1:]]
                 self.branches += [dataclasses.replace(b, step=b.step + n, first=b.first + n, last=b.last + n)
                                   for b in self.branches[known:]]
                 self.loops.append(dataclasses.replace(node.loop, entry=entry, first=first, last=len(self.steps)))
@@ -219,18 +223,20 @@ class _Flat:
                 continue
             index = len(self.steps) + 1
             self.steps.append(dataclasses.replace(node.step, index=index))
+            self.origins.append(int(str(node.key[1])) if node.key[0] == "step" else 0)
             for b, body in node.branches:
                 first = len(self.steps) + 1
                 self.add(body)
                 self.branches.append(dataclasses.replace(b, step=index, first=first, last=len(self.steps)))
 
 
-def _placements(w: _Written, repair: Repair) -> list[Task]:
-    """The written tasks the repair may stand for, the flat order's own placement first."""
+def _placements(w: _Written, repair: Repair) -> list[tuple[Task, tuple[int, ...]]]:
+    """The written tasks the repair may stand for, the flat order's own placement first, each with the written
+    task's flat position of each of its steps (0: inserted)."""
     steps = _written_steps(w, {q: s for q, s in zip(repair.origins, repair.task.steps, strict=True) if q})
     items = _swapped(w, repair)
     groups = _insert_groups(w, repair)
-    out: list[Task] = []
+    out: list[tuple[Task, tuple[int, ...]]] = []
     for choice in itertools.islice(itertools.product(*(gaps for gaps, _ in groups)), MAX_PLACEMENTS):
         inserts: dict[Gap, list[_Node]] = {}
         for gap, (_, run) in zip(choice, groups, strict=True):
@@ -242,8 +248,8 @@ def _placements(w: _Written, repair: Repair) -> list[Task]:
             flat = _Flat()
             flat.add(_rebuild(items, ("top",), steps, inserts))
             t = w.task
-            out.append(Task(t.name, tuple(flat.steps), t.file, t.description, 1, tuple(flat.loops),
-                            tuple(flat.branches)))
+            out.append((Task(t.name, tuple(flat.steps), t.file, t.description, 1, tuple(flat.loops),
+                             tuple(flat.branches)), tuple(flat.origins)))
     return out
 
 
@@ -261,10 +267,10 @@ def lift(repair: Repair, task: Task, cell: Cell, knowledge: Knowledge) -> Repair
     except _Unliftable as e:
         return dataclasses.replace(repair, task=flat, unrolls=UNROLLS + str(e))
     first_problem = ""
-    for written in candidates:
+    for written, origins in candidates:
         result = check(written, cell, knowledge)
-        if result.plausible:
-            return dataclasses.replace(repair, task=written, origins=())
+        if result.plausible:  # its side effects are those of the written steps it inserts or changes
+            return dataclasses.replace(repair, task=written, origins=origins)
         first_problem = first_problem or (result.problems[0].text if result.problems else "")
     why = (f"kept in the loop or branch it is not plausible ({first_problem})" if candidates
            else "the loop's iterations repair it differently")
