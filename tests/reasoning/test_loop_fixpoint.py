@@ -5,7 +5,8 @@ The library is written here, outside the package: a three-station turntable whos
 station. Each step of a loop of ``index-table`` finds the table at a station, as the role needs; but a loop of one
 ``index-table`` leaves it a station further each iteration, so the generated chart's one copy of the later
 iterations could not serve them all. Check and batch must both refuse it, and both let through a loop of three
-``index-table``, which brings the table back round to where it began.
+``index-table``, which brings the table back round to where it began, and a loop of one ``index-table`` that runs
+at most twice (no iteration starts from where the second left the table).
 """
 
 from __future__ import annotations
@@ -93,7 +94,7 @@ TASK = """task: {name}
 steps:
   - command: index-table
   - loop:
-      max: 10
+      max: {most}
       steps:
 {body}"""
 FILES = {
@@ -105,9 +106,11 @@ FILES = {
     "processes/index-table.scxml": SCXML.format(name="index-table", initial="index-table", body=REGION),
     "cells/turntable-cell.yaml": "cell: turntable-cell\nlibraries:\n  - ..\ndevices:\n  - turntable\n",
     # one station on per iteration: A to B before the loop, B to C in the first iteration, C to A in the second
-    "tasks/index-once.yaml": TASK.format(name="index-once", body="        - command: index-table\n"),
+    "tasks/index-once.yaml": TASK.format(name="index-once", most=10, body="        - command: index-table\n"),
     # a whole round per iteration: every iteration starts and ends at station B
-    "tasks/index-round.yaml": TASK.format(name="index-round", body="        - command: index-table\n" * 3),
+    "tasks/index-round.yaml": TASK.format(name="index-round", most=10, body="        - command: index-table\n" * 3),
+    # at most two iterations: the generated chart's copy of the later ones runs once, from where the first left
+    "tasks/index-twice.yaml": TASK.format(name="index-twice", most=2, body="        - command: index-table\n"),
     "configs.jsonl": '{"config": "table", "devices": ["turntable"]}\n',
 }
 FIRST_STEP_OF_THE_LOOP = 7
@@ -184,3 +187,12 @@ def test_a_loop_that_brings_the_table_back_round_is_plausible_in_check_and_batch
     assert out.splitlines()[0] == "task index-round in cell turntable-cell: plausible"
     row = batch(library, "index-round.yaml")
     assert row["plausible"] == ["index-round"] and row["purchase"] is None
+
+
+def test_a_loop_of_at_most_two_iterations_need_not_bring_the_table_back(library: Path) -> None:
+    """No iteration starts from where the second left the table: each starts where the step before it leaves it."""
+    code, out = check(library, "index-twice.yaml")
+    assert code == 0, out
+    assert out.splitlines()[0] == "task index-twice in cell turntable-cell: plausible"
+    row = batch(library, "index-twice.yaml")
+    assert row["plausible"] == ["index-twice"] and row["purchase"] is None
