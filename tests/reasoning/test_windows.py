@@ -605,3 +605,13 @@ def test_a_long_task_whose_windows_cover_it_is_repaired_whole(cell: Cell, monkey
     monkeypatch.setattr(repairs, "repair", lambda *a, **k: wholes.append(1) or whole_repair(*a, **k))
     monkeypatch.setattr(windows._Solver, "best", lambda *a: pytest.fail("solved window by window"))
     assert _answers(windows.windowed_repair(task, cell, KNOWLEDGE, top=2)) == expected and wholes == [1]
+
+
+def test_a_long_task_covered_by_its_windows_is_repaired_whole_with_the_users_catalogue_and_costs(
+        cell: Cell, devices: list[DeviceDescription]) -> None:
+    """42 steps in a cell without a gripper, which every step needs: the windows cover the task, and the whole-task
+    repair buys a gripper at the user's prices (2 per device and a thousandth of its price)."""
+    found = windows.windowed_repair(faulty_task(21, 0, 1), cell.without("gripper"), KNOWLEDGE, devices, top=2,
+                                    costs=RepairCosts(add_device=2, add_device_per_price=0.001))
+    assert _answers(found) == [(2.7, ["add device 'magnetic-gripper' (Magnetic gripper, price 700) to the cell"]),
+                               (3.8, ["add device 'gripper' (Parallel gripper, price 1800) to the cell"])]
