@@ -605,6 +605,8 @@ def test_a_long_task_whose_windows_cover_it_is_repaired_whole(cell: Cell, monkey
     monkeypatch.setattr(repairs, "repair", lambda *a, **k: wholes.append(1) or whole_repair(*a, **k))
     monkeypatch.setattr(windows._Solver, "best", lambda *a: pytest.fail("solved window by window"))
     assert _answers(windows.windowed_repair(task, cell, KNOWLEDGE, top=2)) == expected and wholes == [1]
+    no_slots = _answers(whole_repair(task, cell, KNOWLEDGE, top=1, per_gap=0))  # no step inserted
+    assert _answers(windows.windowed_repair(task, cell, KNOWLEDGE, top=1, per_gap=0)) == no_slots != expected[:1]
 
 
 def test_a_long_task_covered_by_its_windows_is_repaired_whole_with_the_users_catalogue_and_costs(
