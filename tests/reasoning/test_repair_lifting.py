@@ -373,3 +373,14 @@ def test_a_repair_kept_in_the_loop_moves_no_device_the_step_after_the_loop_relie
         ([("rebind", 2), ("remove", 5), ("insert", 6)], defaults),
         ([("remove", 2), ("insert", 3), ("rebind", 5)], defaults)]
     assert all(a.repair.unrolls is None and _written(a.repair)[1] == [(1, 4, 6)] for a in assessed)
+
+
+def test_a_repair_of_a_loop_in_a_loop_that_keeps_every_step_is_written_out_step_by_step(tmp_path: Path) -> None:
+    """Resetting the exposure keeps every flat step where it was; the note says the loops are written out, and
+    the resulting task is: its steps one by one, with no loop left to run them again."""
+    text = (TASKS / "bin-picking-in-rounds.yaml").read_text(encoding="utf-8").replace("exposure: 25", "exposure: 5000")
+    r = _with(service.repair(_file(tmp_path, text), BIN_PICKING, top=1), *(("reset", n, None) for n in (1, 4, 8, 11)))
+    assert r.unrolls == UNROLLS + "the task has a loop inside a loop"
+    assert r.task.loops == () and r.task.branches == ()
+    assert [s.command for s in r.task.steps] == (THREE * 2 + ["move-to"]) * 2
+    assert all("exposure" not in s.params for s in r.task.steps)
