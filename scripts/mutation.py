@@ -27,7 +27,11 @@ the mutants clingo refuses counted apart. Their equivalents are listed under the
 (and not run).
 
 Each module runs in its own work folder (``--work``, default ``build/mutation/NAME``) that
-holds a copy of the checkout, so the checkout is never changed. mutmut only changes code
+holds a copy of the checkout, so the checkout is never changed. Every pytest session there (the clean run,
+mutmut's stats run, each mutant's run) keeps its results in an empty cache folder of its own (``caches/`` of the
+work folder, removed when the session ends), its child processes too: all mutants share one mutated source, so
+one digest, and the user's cache folder would give each the knowledge, devices, task files and cycle time
+estimates the unmutated code kept there, without running the mutated function. mutmut only changes code
 inside functions: a guard must live in a function to be tested here (module-level tables
 such as allow-lists are exercised by the tests of the functions that read them).
 """
@@ -100,7 +104,8 @@ GUARDS = (
           ("x__escaped", "x__attr", "x__checked", "x__name", "x__decimal", "x__write_pose", "x__value", "x__positive",
            "x_encode", "x_decode", "x__decode_document", "x__number", "x__integer", "x__pose", "x__decode_event")),
     Guard("executor-faults", ("src/plugnproduce/executor/run.py", "src/plugnproduce/executor/safestop.py"),
-          ("tests/executor/test_faults.py", "tests/executor/test_run.py", "tests/executor/test_unanswered.py"),
+          ("tests/executor/test_faults.py", "tests/executor/test_run.py", "tests/executor/test_unanswered.py",
+           "tests/executor/test_spinning_chart.py"),
           ("xǁTaskRunǁstop", "xǁTaskRunǁdevice_lost", "xǁTaskRunǁsend", "xǁTaskRunǁ_request",
            "x_stop_safely", "x__stop_device", "xǁTaskRunǁ_on_event", "xǁTaskRunǁ_on_lost",
            "xǁTaskRunǁ_on_anomaly", "xǁTaskRunǁ_on_step", "xǁTaskRunǁ_fault", "xǁTaskRunǁ_fail",
@@ -117,6 +122,8 @@ _S = "src/plugnproduce/"
 _DEAD_END_BATCH = tuple(f"tests/reasoning/test_dead_end.py::{t}" for t in (
     "test_the_batch_says_what_check_says_for_every_configuration_with_or_without_the_dead_end",
     "test_the_batch_names_the_dead_end_as_the_reason_and_buys_a_gripper_that_can_close"))
+# a loop whose steps are plausible but whose iteration moves its device on (loop_fixpoint), in check and batch
+_LOOP_FIXPOINT = "tests/reasoning/test_loop_fixpoint.py"
 _BATCH_WORKERS = tuple(f"tests/reasoning/test_batch.py::{t}" for t in (  # how the work is shared, not the answers
     "test_two_workers_give_the_same_rows_as_one", "test_workers_start_only_for_work_large_enough_to_repay_them"))
 CORE = (
@@ -137,7 +144,8 @@ CORE = (
            "tests/reasoning/test_why.py", "tests/reasoning/test_link_findings.py",
            # a device that cannot leave its start state (stuck), in a library written outside the package
            "tests/reasoning/test_dead_end.py::test_check_says_a_device_that_cannot_leave_its_start_state_is_stuck_at_the_steps_line",
-           "tests/reasoning/test_dead_end.py::test_the_problem_names_the_device_its_state_and_the_role")),
+           "tests/reasoning/test_dead_end.py::test_the_problem_names_the_device_its_state_and_the_role",
+           _LOOP_FIXPOINT)),
     Guard("codegen-specific", (_S + "codegen/specific.py",),
           ("tests/codegen/test_specific_values.py", "tests/codegen/test_task_chart.py",
            "tests/codegen/test_closed_world.py"),
@@ -157,11 +165,12 @@ CORE = (
           ("tests/reasoning/test_link_findings.py", "tests/reasoning/test_flow_check.py",
            "tests/reasoning/test_plausibility.py", "tests/reasoning/test_branch_check.py")),
     Guard("reasoning-feasibility", (_S + "batch/feasibility.py",),
-          ("tests/reasoning/test_batch.py", *_DEAD_END_BATCH),
+          ("tests/reasoning/test_batch.py", *_DEAD_END_BATCH, _LOOP_FIXPOINT),
           deselect=(*_BATCH_WORKERS,  # they reach no line or branch of the module the other tests do not reach
                     "tests/reasoning/test_batch.py::test_answers_agree_with_the_full_reasoner_on_random_configurations")),
     Guard("reasoning-purchases", (_S + "batch/purchases.py",),
-          ("tests/reasoning/test_batch.py", "tests/reasoning/test_batch_purchase_order.py", *_DEAD_END_BATCH),
+          ("tests/reasoning/test_batch.py", "tests/reasoning/test_batch_purchase_order.py", *_DEAD_END_BATCH,
+           _LOOP_FIXPOINT),
           deselect=(*_BATCH_WORKERS,  # they compare offered and plausible only, never a purchase
                     "tests/reasoning/test_batch.py::test_answers_agree_with_the_full_reasoner_on_random_configurations")),
     Guard("reasoning-windows", (_S + "reasoning/repairs/windows.py",), ("tests/reasoning/test_windows.py",)),
@@ -209,9 +218,43 @@ ENCODINGS = tuple(Target(f"rules-{name}", f"rules/{name}.lp", tests) for name, t
 first failure)."""
 
 PLUGIN = "mutation_fresh_caches"
-PLUGIN_TEXT = '''"""Empties the caches of the guard modules before each test (mutation runs only)."""
+PLUGIN_TEXT = '''"""Mutation runs only: each pytest session gets a cache folder of its own, and the guard modules'
+caches are emptied before each test."""
+
+import os
+import shutil
+import tempfile
 
 import pytest
+
+_FOLDERS = []
+
+
+def pytest_configure(config):
+    """The session (the clean run, the stats run, one mutant's run) keeps its results in an empty cache folder of its
+    own, which its child processes inherit: all mutants share one mutated source, so one digest, and a result kept
+    by another session (made by the unmutated code or another mutant) would answer for this one's code."""
+    folder = tempfile.mkdtemp(prefix="cache-", dir=os.environ.get("PNP_MUTATION_CACHES") or None)
+    seed = os.environ.get("PNP_MUTATION_SEED")
+    if seed and os.path.isdir(seed):  # what no mutated function makes (the taxonomy closures, the unit table)
+        shutil.copytree(seed, folder, dirs_exist_ok=True)
+    _FOLDERS.append((folder, os.environ.get("XDG_CACHE_HOME")))
+    os.environ["XDG_CACHE_HOME"] = folder
+    from plugnproduce.knowledge import cache, devicecache
+    from plugnproduce.service import descriptions
+
+    cache._FOLDERS.clear()  # what the process read while the tests were collected names another folder
+    devicecache._SERVED.clear()
+    descriptions._loaded.cache_clear()
+
+
+def pytest_unconfigure(config):
+    folder, before = _FOLDERS.pop()
+    if before is None:
+        os.environ.pop("XDG_CACHE_HOME", None)
+    else:
+        os.environ["XDG_CACHE_HOME"] = before
+    shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.fixture(autouse=True)
@@ -223,8 +266,18 @@ def _fresh_caches():
     codec._NAMES.clear()
     yield
 '''
-"""A pytest plugin of the work folder: a cache filled while the tests were collected (by the unmutated
-code) would otherwise answer for the mutated function."""
+"""A pytest plugin of the work folder: a cache filled by the unmutated code (in memory while the tests were
+collected, or in the user's cache folder: the kept knowledge, devices, task files, cycle time estimates, taxonomy
+closures) would otherwise answer for the mutated function."""
+
+SEEDS = {"taxonomy": ("src/plugnproduce/ontology/taxonomy.py", "src/plugnproduce/ontology/sources.py",
+                      "src/plugnproduce/safeio.py"),
+         "units": ("src/plugnproduce/description/quantities/unitcache.py",
+                   "src/plugnproduce/description/quantities/units.py")}
+"""What each session's cache folder starts with, copied from the user's cache folder when the work folder is
+prepared (``KIND-*.json``): HermiT's taxonomy closures (about 1.5 s of CPU each, most of what an empty cache folder
+costs a session) and pint's unit table, with the files whose functions run while they are made: a module among
+those starts without them."""
 
 COPIED = ("src", "tests", "ontology", "rules", "descriptions", "pyproject.toml")
 _KILLED = {1: "killed", 3: "killed"}
@@ -293,6 +346,24 @@ def _prepare(guard: Guard, work: Path) -> None:
     (work / "pyproject.toml").write_text(text + "\n[tool.mutmut]\n" + "\n".join(lines) + "\n", encoding="utf-8")
     (work / "mutants" / "src").mkdir(parents=True)  # on sys.path of the tests' child processes from the start
     (work / "src" / f"{PLUGIN}.py").write_text(PLUGIN_TEXT, encoding="utf-8")
+    _seed(guard, work)
+
+
+def _user_cache() -> Path:
+    """The user's cache folder, as plugnproduce names it on Linux (``$XDG_CACHE_HOME`` when absolute)."""
+    xdg = os.environ.get("XDG_CACHE_HOME", "")
+    return Path(xdg if os.path.isabs(xdg) else os.path.expanduser("~/.cache")) / "plugnproduce"
+
+
+def _seed(guard: Guard, work: Path) -> None:
+    """The kept results of :data:`SEEDS` no function of ``guard`` makes, from the user's cache folder, into the
+    work folder's ``seed/`` (where each session's cache folder starts from)."""
+    seed = work / "seed" / "plugnproduce"
+    seed.mkdir(parents=True)
+    for kind, makers in SEEDS.items():
+        if not set(guard.files) & set(makers):
+            for kept in sorted(_user_cache().glob(f"{kind}-*.json")):
+                shutil.copy2(kept, seed)
 
 
 def _selected_tests(work: Path) -> list[str]:
@@ -307,8 +378,16 @@ def _refresh_tests(work: Path) -> None:
         shutil.copytree(ROOT / "tests", where, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__"))
 
 
+def _caches(work: Path) -> Path:
+    """Where each pytest session of a work folder makes its own cache folder (removed when it ends)."""
+    folder = work / "caches"
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
 def _run_mutmut(guard: Guard, work: Path, jobs: int, names: list[str] | None = None) -> None:
-    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
+    env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1",
+           "PNP_MUTATION_CACHES": str(_caches(work)), "PNP_MUTATION_SEED": str(work / "seed")}
     patterns = names or [f"*.{f}__mutmut_*" for f in guard.functions]
     command = [sys.executable, "-m", "mutmut", "run", "--max-children", str(jobs), *patterns]
     done = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True)
@@ -378,7 +457,7 @@ def _survivor(key: str, file: str, work: Path, functions: dict[str, str]) -> Sur
 def _pytest_mutant(guard: Guard, work: Path, key: str, timeout: float | None) -> str:
     """Run the module's whole test selection against one mutant (``""`` for none): killed, survived or timeout."""
     env = {**os.environ, "PYTHONPATH": str(work / "mutants" / "src"), "PYTHONDONTWRITEBYTECODE": "1",
-           "MUTANT_UNDER_TEST": key}
+           "MUTANT_UNDER_TEST": key, "PNP_MUTATION_CACHES": str(_caches(work)), "PNP_MUTATION_SEED": str(work / "seed")}
     command = [sys.executable, "-m", "pytest", "-x", "-q", "-n", "0", "-p", "no:cacheprovider", "-p", PLUGIN,
                *guard.selection]
     try:

@@ -1,4 +1,4 @@
-"""The folders the controller writes to come from platformdirs: the cache folder (units, engines, the simulated
+"""The folders the controller writes to come from platformdirs: the cache folder (units, engines, taxonomy closures, the simulated
 cell's control file, the kept help) and the runs folder, with ``PNP_RUNS`` still naming another runs folder."""
 
 from __future__ import annotations
@@ -11,6 +11,8 @@ import pytest
 from plugnproduce import folders, helpcache, service
 from plugnproduce.batch import enginecache
 from plugnproduce.description.quantities import unitcache
+from plugnproduce.knowledge.libraries import Library, tbox_files
+from plugnproduce.ontology.taxonomy import load_taxonomy
 from plugnproduce.sim import control
 
 
@@ -51,3 +53,15 @@ def test_runs_go_to_the_platforms_state_folder_unless_pnp_runs_names_one(home: P
     assert service.runs_folder() == home / "state" / "plugnproduce" / "runs"
     monkeypatch.setenv("PNP_RUNS", str(home / "my-runs"))
     assert service.runs_folder() == home / "my-runs"
+
+
+def test_xdg_cache_home_moves_the_closure_of_a_librarys_taxonomy_too(home: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The closure HermiT computes for a user's library is kept where every other cache is, not in ~/.cache."""
+    elsewhere = home / "elsewhere"
+    monkeypatch.setenv("XDG_CACHE_HOME", str(elsewhere))
+    library = Path(__file__).parent / "data" / "libraries" / "transport-lock"
+    taxonomy = load_taxonomy(tbox_files([Library(library)]))
+    assert "http://example.org/transport-lock#TransportLocked" in taxonomy.superclasses
+    assert [p.name for p in (elsewhere / "plugnproduce").glob("taxonomy-*.json")] == [
+        f"taxonomy-{taxonomy.digest[:32]}.json"]
+    assert not (home / ".cache").exists()

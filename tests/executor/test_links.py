@@ -351,6 +351,21 @@ async def test_a_device_that_never_greets_is_given_up_after_its_command_timeout_
             await asyncio.wait_for(query_report(silent, SHORT), WAIT)
 
 
+@pytest.mark.parametrize(("floor", "command_timeout", "given_up"), [(SHORT, 2 * SHORT, 2 * SHORT),
+                                                                     (2 * SHORT, SHORT, 2 * SHORT)])
+async def test_an_opc_ua_server_that_never_answers_the_hello_is_given_up_after_the_command_timeout_or_the_floor(
+        monkeypatch: pytest.MonkeyPatch, floor: float, command_timeout: float, given_up: float) -> None:
+    monkeypatch.setattr(links, "CONNECT_TIMEOUT", floor)  # 10 s in earnest: a test need not wait that long
+    async with silent_server() as port:
+        silent = dataclasses.replace(device(MIXED, "screwdriver-ua"), endpoint=f"opc.tcp://127.0.0.1:{port}/pnp/x",
+                                     command_timeout=command_timeout)
+        said = f"^device screwdriver-ua: {silent.endpoint} did not open a session within {given_up:g} s$"
+        with pytest.raises(ProtocolTimeout, match=said):
+            await asyncio.wait_for(Heard().open(silent), WAIT)
+        with pytest.raises(ProtocolTimeout, match=said):
+            await asyncio.wait_for(query_report(silent, WAIT), WAIT)
+
+
 async def test_a_upnp_link_waits_for_an_answer_as_long_as_it_is_told_not_as_the_device_says() -> None:
     release = asyncio.Event()
 
@@ -387,6 +402,16 @@ async def test_a_upnp_device_whose_description_never_comes_is_given_up_after_its
             await asyncio.wait_for(Heard().open(silent), WAIT)
         with pytest.raises(ProtocolTimeout, match=said):
             await asyncio.wait_for(query_report(silent, WAIT), WAIT)
+
+
+@pytest.mark.parametrize("endpoint", ["http:/device.xml", "http:///device.xml", "binpicking-pc.local"])
+async def test_a_upnp_endpoint_that_names_no_host_is_refused_naming_the_device_and_the_endpoint(endpoint: str) -> None:
+    hostless = dataclasses.replace(device(BIN_PICKING, "binpicking-pc"), endpoint=endpoint)
+    said = f"^device binpicking-pc: endpoint '{endpoint}' names no host; expected http://HOST:PORT/PATH$"
+    for opening in (lambda: Heard().open(hostless), lambda: query_report(hostless, WAIT),
+                    lambda: query_state(hostless, WAIT)):
+        with pytest.raises(ProtocolError, match=said):
+            await opening()
 
 
 async def test_query_report_over_upnp_refuses_an_answer_without_a_state_or_with_a_value_that_is_no_json() -> None:

@@ -439,3 +439,84 @@ def test_a_step_inserted_in_a_window_is_the_only_new_step_of_the_repaired_task(c
     written = [st.command for st in LONG_INSERT.steps]
     assert [st.command for st in best.task.steps] == [*written[:18], "open-gripper", *written[18:]]  # all kept
     assert [st.index for st in best.task.steps] == list(range(1, 50)) and best.task.name == LONG_INSERT.name
+
+
+def test_a_value_beyond_the_devices_limit_far_from_other_problems_is_reset_saying_which_limit(cell: Cell) -> None:
+    """48 steps: the bin-pick at 11 sends the gripper 10 N (within the process's range, below the 20 N the gripper
+    takes: a problem of the device's limits, not of the encodings' check), the bin-pick at 41 a force beyond the
+    process's own range. Both are reset, the first saying which limit of which device it broke; the repaired task is
+    plausible."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[10] = replace(steps[10], params={"grip_force": 10})
+    steps[40] = replace(steps[40], params={"grip_force": 150})
+    task = Task("limits", tuple(steps), "limits.yaml")
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("device_limit", 11), ("too_high", 41)]
+    found = service.repair(task, cell, top=1)
+    assert _answers(found) == [(2.0, [
+        "step 11 (bin-pick): reset parameter grip_force to its default 40 (device 'gripper' takes at least 20 N; "
+        "the value is 10 N)", "step 41 (bin-pick): reset parameter grip_force to its default 40"])]
+    assert service.check(found[0].task, cell).plausible
+
+
+def test_windows_alike_but_for_a_pose_are_repaired_each_with_its_own_steps(cell: Cell) -> None:
+    """A place done twice after one bin-pick, early in the task to the same pose, late to two poses; no insertion
+    slots. Removing either of the first two places leads to the same task (one repair); removing either of the last
+    two does not (two repairs), though both windows make the same facts (a pose is no number of the encodings)."""
+    here, there = {"place_pose": [0.5, 0.1, 0.2, 0, 180, 0]}, {"place_pose": [0.5, -0.1, 0.2, 0, 180, 0]}
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[11] = replace(steps[11], params=here)
+    steps.insert(12, steps[11])  # step 13: the same place again
+    steps[38] = replace(steps[38], params=here)
+    steps.insert(39, replace(steps[38], params=there))  # step 40: a place elsewhere
+    task = Task("twice", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "twice.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("wrong_state", 13), ("wrong_state", 40)]
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=2, per_gap=0)
+    assert _answers(found) == [(8.0, ["remove step 12 (place)", "remove step 39 (place)"]),
+                               (8.0, ["remove step 12 (place)", "remove step 40 (place)"])]
+    assert [st.params for st in found[1].task.steps[36:39]] == [{}, here, {}]  # the place to the pose there removed
+
+
+def test_a_device_a_window_last_uses_enters_a_later_window_as_the_repair_left_it(cell: Cell) -> None:
+    """A close-gripper with a force out of range (its reset dear: removed instead, the gripper left open) and, 20 moves
+    later, a close-gripper bound to a gripper the cell lacks. The gripper's last use is the first window's last step;
+    the second window rebinds its close-gripper to the gripper, open as the first window left it (not closed, as the
+    task as written would have left it), so nothing more is needed."""
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    steps = [move] * 20 + [Step(0, "close-gripper", {}, {"grip_force": 500})] + [move] * 20 + [
+        Step(0, "close-gripper", {"gripper": "gripper2"}, {"grip_force": 40})] + [move] * 5
+    task = Task("two-closes", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "two-closes.yaml")
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=2, costs=RepairCosts(reset=10), margin=0)
+    assert _answers(found) == [
+        (6.0, ["remove step 21 (close-gripper)",
+               "step 42 (close-gripper): bind role 'gripper' to device 'gripper' instead of 'gripper2'"]),
+        (8.0, ["remove step 21 (close-gripper)", "remove step 42 (close-gripper)"])]
+    assert all(service.check(r.task, cell).plausible for r in found)
+
+
+def test_a_long_task_whose_only_problem_is_a_devices_limit_is_repaired_window_by_window(cell: Cell) -> None:
+    """48 steps, the bin-pick at 11 sending the gripper 10 N (it takes at least 20 N): no problem of the encodings'
+    check, so it is the device's limit alone that makes the task one to repair window by window."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[10] = replace(steps[10], params={"grip_force": 10})
+    task = Task("limit", tuple(steps), "limit.yaml")
+    got = _answers(service.repair(task, cell, top=3))
+    assert got == [(1.0, ["step 11 (bin-pick): reset parameter grip_force to its default 40 (device 'gripper' takes "
+                          "at least 20 N; the value is 10 N)"]),
+                   (6.0, ["remove step 11 (bin-pick)", "insert close-gripper before step 12 (place)"]),
+                   (7.0, ["remove step 11 (bin-pick)", "insert pick before step 12 (place)"])]
+    assert got != _answers(repairs.repair(task, cell, KNOWLEDGE, top=3))  # the whole task's third: the pick before 11
+
+
+def test_a_value_in_a_unit_of_another_quantity_far_from_other_problems_is_reset(cell: Cell) -> None:
+    """48 steps: the bin-pick at 11 grips with "40 kg" (no force), the bin-pick at 41 with a force beyond the process's
+    range. The windows see the value as written, so both are reset and the repaired task is plausible."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[10] = replace(steps[10], params={"grip_force": "40 kg"})
+    steps[40] = replace(steps[40], params={"grip_force": 150})
+    task = Task("kilograms", tuple(steps), "kilograms.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("bad_unit", 11), ("too_high", 41)]
+    found = service.repair(task, cell, top=1)
+    assert _answers(found) == [(2.0, ["step 11 (bin-pick): reset parameter grip_force to its default 40",
+                                      "step 41 (bin-pick): reset parameter grip_force to its default 40"])]
+    assert service.check(found[0].task, cell).plausible

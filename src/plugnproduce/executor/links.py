@@ -83,6 +83,15 @@ class XirpLink:
         await self._client.close()
 
 
+def _upnp_host(device: DeviceDescription) -> str:
+    """The host a UPnP device's endpoint names: the only host its description and services are trusted on."""
+    host = urlparse(device.endpoint).hostname
+    if not host:
+        raise ProtocolError(f"device {device.id}: endpoint {device.endpoint!r} names no host; "
+                            "expected http://HOST:PORT/PATH")
+    return host
+
+
 class UpnpLink:
     """A device driven over UPnP: requests are SOAP actions, events are changes of evented counters.
 
@@ -97,8 +106,8 @@ class UpnpLink:
     async def open(cls, device: DeviceDescription, on_event: EventCallback, on_lost: ProblemCallback,
                    on_anomaly: ProblemCallback) -> UpnpLink:
         """Read the device's UPnP description (where it was discovered) and subscribe to its events."""
-        host = urlparse(device.endpoint).hostname or ""
-        client = await upnp.UpnpDeviceClient.connect(device.endpoint, host, timeout=connect_timeout(device))
+        client = await upnp.UpnpDeviceClient.connect(device.endpoint, _upnp_host(device),
+                                                     timeout=connect_timeout(device))
         def changed(variable: str, _value: Any) -> None:
             if not upnp.is_payload_variable(variable):  # a value an event carries comes with its counter
                 on_event(device.id, variable, upnp.payload_of(client.values, variable))
@@ -186,8 +195,7 @@ async def _xirp_report(device: DeviceDescription, _names: list[str], timeout: fl
 
 
 async def _upnp_report(device: DeviceDescription, names: list[str], timeout: float) -> tuple[str, dict[str, Any]]:
-    client = await upnp.UpnpDeviceClient.connect(device.endpoint, urlparse(device.endpoint).hostname or "",
-                                                 timeout=connect_timeout(device))
+    client = await upnp.UpnpDeviceClient.connect(device.endpoint, _upnp_host(device), timeout=connect_timeout(device))
     try:
         results = await client.invoke(upnp.STATE_ACTION, {}, timeout=timeout)
     finally:

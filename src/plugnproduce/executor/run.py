@@ -52,6 +52,11 @@ RecordObserver = Callable[[dict[str, Any]], None]
 """Called with each journal record as soon as it is written."""
 
 FAULT_EVENT = "error.fault"
+MAX_UNANSWERED = 1000
+"""Requests to one device not yet answered (sent, or held back behind earlier ones) that a task chart may queue. A
+chart waits for its device's event after each request, so it has one or two; more means that eventless
+transitions send in a cycle (the chart never settles): a fault of the chart, before the interpreter's own
+microstep bound, and nothing more is queued."""
 
 
 class TaskRun:
@@ -81,6 +86,8 @@ class TaskRun:
         self._journal_failed = False
         self._links: dict[str, DeviceLink] = {}
         self._commands: set[asyncio.Task[None]] = set()
+        self._last: asyncio.Task[None] | None = None
+        """The command sent last: the next one goes out once it is answered."""
         self._monitor = Monitor(generated, cell)
         self._prefixes = dict(prefixes or outcomes.DEFAULT_PREFIXES)
         self._unanswered: dict[str, int] = {}
@@ -171,24 +178,32 @@ class TaskRun:
         given = dict(event.data or {})
         # Whatever becomes of the command is told of the step that sent it and the state its device was in then.
         sent = Fault("", "", self.step, self.command, target, self.device_states.get(target), command.name)
+        if self._unanswered.get(target, 0) >= MAX_UNANSWERED:
+            self._fail(replace(sent, kind="chart", message=f"{self.interpreter.chart.name or 'the task chart'} queued "
+                               f"{MAX_UNANSWERED} requests to {target} without waiting for one to be answered: its "
+                               "eventless transitions send in a cycle"))
+            return
         checked = self._monitor.check(self.step, target, command.name, given, self.interpreter.dm)
         if isinstance(checked, Breach):
             self._fail(replace(sent, kind="contract", message=checked.message(target, command.name),
                                argument=checked.argument))
             return
         used = values.used(self.generated, self.step, target, given, self.interpreter.dm)
-        earlier = tuple(self._commands)
         self._unanswered[target] = self._unanswered.get(target, 0) + 1
-        task = asyncio.get_running_loop().create_task(self._request(sent, checked, used, earlier))
+        task = asyncio.get_running_loop().create_task(self._request(sent, checked, used, self._last))
+        self._last = task
         self._commands.add(task)
         task.add_done_callback(self._commands.discard)
 
     async def _request(self, sent: Fault, params: dict[str, Any], used: list[dict[str, Any]],
-                       earlier: tuple[asyncio.Task[None], ...]) -> None:
+                       earlier: asyncio.Task[None] | None) -> None:
         device, name = sent.device or "", sent.request or ""
         try:
-            if earlier:  # each bounded by its device's timeout; a fault among them holds this one back for good
-                await asyncio.wait(earlier)
+            # the command sent before this one, itself sent after the one before it (each bounded by its device's
+            # timeout; a fault among them holds this one back for good): a wait of its own, not of all of them,
+            # so that many commands queued at once cost each the same
+            if earlier is not None:
+                await asyncio.wait((earlier,))
             if self.fault is not None:
                 return
             self._record("command", step=sent.step, device=device, command=name, params=params)

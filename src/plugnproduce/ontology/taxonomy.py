@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from plugnproduce.deferred import dataclass
 from plugnproduce.digests import sha256
 from plugnproduce.errors import OntologyError
+from plugnproduce.folders import cache_folder
 from plugnproduce.ontology.iris import PNP_IRI, local_name
 from plugnproduce.ontology.sources import folder_files
 from plugnproduce.resources import ontology_path
@@ -139,8 +140,9 @@ def _digest(files: Iterable[Path]) -> str:
 
 
 def default_cache_dir() -> Path:
-    """Where closures are cached: the user's cache folder."""
-    return Path.home() / ".cache" / "plugnproduce"
+    """Where closures are cached: the user's cache folder (``$XDG_CACHE_HOME/plugnproduce`` when set), as every
+    other kept result (:func:`plugnproduce.folders.cache_folder`)."""
+    return cache_folder()
 
 
 def load_taxonomy(

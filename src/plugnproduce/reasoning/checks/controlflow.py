@@ -5,7 +5,8 @@ it), so the chained check already covers iteration 1, iteration 2 and the steps 
 the loop. This module adds what a straight line cannot show:
 
 - the **fixpoint**: an iteration must leave every device in the state the iteration
-  before it left it in, so that every later iteration starts as the second one did;
+  before it left it in, so that every later iteration starts as the second one did (a loop
+  of at most two iterations has no later one);
 - the **exits**: a loop ends as soon as a step of its body ends with the loop's
   ``until`` outcome, so the steps after the loop must also be plausible from the states
   that step leaves, in the first iteration and in the later ones.
@@ -52,7 +53,8 @@ def loop_problems(task: Task, result: CheckResult, knowledge: Knowledge,
     """
     every = paths or [Path(None, tuple(range(1, len(task.steps) + 1)))]
     for loop in task.loops:
-        yield from _fixpoint(task, loop, result)
+        if loop.max is None or loop.max > 2:  # a third iteration would start where the second left the devices
+            yield from _fixpoint(task, loop, result)
         if loop.until is not None:
             yield from _exits(task, loop, knowledge, check, every)
 
@@ -70,8 +72,9 @@ def _fixpoint(task: Task, loop: Loop, result: CheckResult) -> Iterator[Problem]:
             text = (f"loop iteration: device {device} ends an iteration in state '{after[device]}', but the "
                     f"iteration before left it in '{before[device]}'; each iteration must leave every device "
                     "as it found it")
-            where = Where(task.file, loop.line)
-            yield Problem(loop.first, first.command, "loop_fixpoint", Reason("loop_fixpoint", text, (), (where,)),
+            where = Where(task.file, first.line)  # the iteration's first step, as for the step's other findings
+            rests_on = (where, Where(task.file, loop.line))
+            yield Problem(loop.first, first.command, "loop_fixpoint", Reason("loop_fixpoint", text, (), rests_on),
                           where, device=device, state=after[device])
 
 

@@ -2,9 +2,11 @@
 
 The plausibility check gives, for every step of the task as written, the chart state of every
 device when the step starts (a broken step leaves its devices where it would have left them,
-``recovers/4``). Each problem spans the steps from the one that last used its device to the
-step that fails; a *window* is such a span widened by ``margin`` unbroken steps on each side,
-overlapping windows merged. Each window is repaired on its own by repair.lp, with
+``recovers/4``); a value the device bound to a step refuses by its own limits is a problem of that
+step too (the check finds it outside the encodings, repair.lp resets it). Each problem spans the
+steps from the one that last used its device to the step that fails; a *window* is such a span
+widened by ``margin`` unbroken steps on each side, overlapping windows merged. Each window is
+repaired on its own by repair.lp, with
 
 - the devices *entering* the window in the states the check found there (the steps before it
   are unbroken, or earlier windows left every device a later step uses in its original state), and
@@ -68,7 +70,7 @@ from plugnproduce.reasoning.asp.terms import Model, program
 from plugnproduce.reasoning.checks.contracts import normalised
 from plugnproduce.reasoning.checks.offers import CELL, cell_program
 from plugnproduce.reasoning.checks.plausibility import TASK
-from plugnproduce.reasoning.checks.refusals import Refusals
+from plugnproduce.reasoning.checks.refusals import Refusals, refusal_facts
 from plugnproduce.reasoning.repairs import lifting, repairs
 
 if TYPE_CHECKING:
@@ -147,8 +149,8 @@ def k_best(options: Sequence[_Parts], k: int) -> list[tuple[_Part, ...]]:
 class _Chain:
     """The task as checked (check.lp): device states before each step, its problems, each device's uses."""
 
-    def __init__(self, task: Task, model: Model):
-        self.task, self.n, self.plausible = task, len(task.steps), bool(model[s.Plausible])
+    def __init__(self, task: Task, model: Model, refused: Iterable[s.ValueRefused] = ()):
+        self.task, self.n = task, len(task.steps)
         self.at: dict[int, dict[str, str]] = defaultdict(dict)
         for a in model[s.At]:
             self.at[a.i][a.d] = a.x
@@ -160,7 +162,11 @@ class _Chain:
                       | s.BadType | s.TooLow | s.TooHigh | s.UnknownParam] = [
             *model[s.NoDevice], *model[s.Ambiguous], *model[s.Absent], *model[s.CannotPlay], *model[s.UnknownRole],
             *model[s.UnknownCommand], *model[s.BadType], *model[s.TooLow], *model[s.TooHigh], *model[s.UnknownParam]]
-        self.problems: list[tuple[int, str | None]] = [(a.i, a.d) for a in at_device] + [(a.i, None) for a in at_step]
+        # a value the device bound to the step refuses by its own limits: found by the check outside the encodings
+        beyond = {a.i for a in refused if a.d in users[a.i]}
+        self.plausible = bool(model[s.Plausible]) and not beyond
+        self.problems: list[tuple[int, str | None]] = [(a.i, a.d) for a in at_device] + [
+            (i, None) for i in [*(a.i for a in at_step), *beyond]]
         self.last_use: dict[str, int] = {}
         self.used_before: dict[tuple[int, str], int] = {}
         for i in sorted(users):
@@ -179,7 +185,7 @@ class _Chain:
 
     def states(self, i: int) -> dict[str, str]:
         """Every device's state before original step ``i`` (``n + 1``: after the task)."""
-        return dict(self.at.get(i, {}))
+        return dict(self.at[i])  # {} where no device has a state (each lost where it got stuck: no recovers/4)
 
     def exits(self, w: Window) -> dict[str, str]:
         """The states the steps after ``w`` expect: of each device one of them uses."""
@@ -240,7 +246,8 @@ def windowed_repair(
     book = fact_book(knowledge)
     readable, _ = normalised(task, knowledge.processes, keep_unreadable=True)  # "40 %" is 40, as the check reads it
     facts = cell_program(book, cell) + program(task_facts(readable, TASK)) + program([s.Check(CELL, TASK)])
-    chain = _Chain(task, solver.solve(solver.CHECK, facts))  # the check's own model when it checked this task
+    refused = [a for a in refusal_facts(readable, TASK, cell.devices, knowledge) if isinstance(a, s.ValueRefused)]
+    chain = _Chain(task, solver.solve(solver.CHECK, facts), refused)  # the check's own model of this task
     if top < 1 or chain.plausible:  # plausible to the encodings: whatever else check() finds, repair.lp cannot fix
         return repairs.repair(task, cell, knowledge, catalogue, top, costs, per_gap) if top >= 1 else []
     present = {d.id for d in cell.devices}
