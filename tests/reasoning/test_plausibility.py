@@ -84,6 +84,14 @@ def test_an_unknown_command_is_a_problem_not_an_error(cell: Cell) -> None:
     assert p.kind == "unknown_command"
 
 
+def test_the_parameters_of_an_unknown_command_are_not_called_unknown_too(cell: Cell) -> None:
+    # rules/params.lp: a parameter is unknown only to a process; a command that is none is one problem, once
+    t = task("pick-and-place")
+    odd = replace(t, steps=(Step(1, "fly", params={"speed": 10, "height": 2}, line=3),))
+    (p,) = service.check(odd, cell).problems
+    assert (p.kind, p.step) == ("unknown_command", 1)
+
+
 def test_check_and_code_generation_agree_on_where_devices_are_left(cell: Cell) -> None:
     k = service.knowledge()
     t = task("bin-picking")
