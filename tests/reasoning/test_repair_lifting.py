@@ -357,3 +357,30 @@ def test_the_side_effects_of_a_repair_kept_in_the_loop_are_those_of_the_steps_it
         ("default_values", 2, "step 2 (close-gripper) runs with default values: grip_force = 40"),
         ("default_values", 5, "step 5 (close-gripper) runs with default values: grip_force = 40")]
     assert rebound.rank < closed.rank
+
+
+def test_a_repair_kept_in_the_loop_moves_no_device_the_step_after_the_loop_relies_on(tmp_path: Path) -> None:
+    """A library step after the loop holds the robot where the loop's last place left it. Rebinding the pick's
+    gripper in the body leaves every step where it was, so no step moves the robot anew: each repair's side effects
+    are those of its written steps only, and the rebinding, with none, comes first."""
+    path = _file(tmp_path, UNTIL_EMPTY.replace("gripper: gripper}", "gripper: sensor3d}") + "  - command: hold\n")
+    knowledge = service.knowledge((Path(__file__).parents[1] / "data" / "libraries" / "holding",))
+    assessed = service.assessed_repairs(path, BIN_PICKING, top=3, knowledge=knowledge)
+    defaults = [("default_values", n, f"step {n} (close-gripper) runs with default values: grip_force = 40")
+                for n in (2, 5)]
+    assert [([(e.kind, e.step) for e in a.repair.edits], _effects(a)) for a in assessed] == [
+        ([("rebind", 2), ("rebind", 5)], []),
+        ([("rebind", 2), ("remove", 5), ("insert", 6)], defaults),
+        ([("remove", 2), ("insert", 3), ("rebind", 5)], defaults)]
+    assert all(a.repair.unrolls is None and _written(a.repair)[1] == [(1, 4, 6)] for a in assessed)
+
+
+def test_a_repair_of_a_loop_in_a_loop_that_keeps_every_step_is_written_out_step_by_step(tmp_path: Path) -> None:
+    """Resetting the exposure keeps every flat step where it was; the note says the loops are written out, and
+    the resulting task is: its steps one by one, with no loop left to run them again."""
+    text = (TASKS / "bin-picking-in-rounds.yaml").read_text(encoding="utf-8").replace("exposure: 25", "exposure: 5000")
+    r = _with(service.repair(_file(tmp_path, text), BIN_PICKING, top=1), *(("reset", n, None) for n in (1, 4, 8, 11)))
+    assert r.unrolls == UNROLLS + "the task has a loop inside a loop"
+    assert r.task.loops == () and r.task.branches == ()
+    assert [s.command for s in r.task.steps] == (THREE * 2 + ["move-to"]) * 2
+    assert all("exposure" not in s.params for s in r.task.steps)
