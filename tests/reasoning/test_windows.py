@@ -520,3 +520,100 @@ def test_a_value_in_a_unit_of_another_quantity_far_from_other_problems_is_reset(
     assert _answers(found) == [(2.0, ["step 11 (bin-pick): reset parameter grip_force to its default 40",
                                       "step 41 (bin-pick): reset parameter grip_force to its default 40"])]
     assert service.check(found[0].task, cell).plausible
+
+
+def test_a_problem_spans_back_to_the_devices_previous_use(cell: Cell) -> None:
+    """A bin-pick and, six moves later, another (the gripper still closed): the open-gripper may go anywhere after the
+    first bin-pick, so the window reaches back to it and every such place is a repair of its own."""
+    pick = replace(service.task(service.builtin("tasks", "bin-picking.yaml")).steps[0], bind={})
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    steps = [move] * 15 + [pick] + [move] * 6 + [pick] + [move] * 20
+    task = Task("again", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "again.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("wrong_state", 23)]
+    found = _answers(service.repair(task, cell, top=8))
+    assert found[0] == (2.0, ["insert open-gripper before step 23 (bin-pick)"])
+    assert sorted(found[:7]) == [(2.0, [f"insert open-gripper before step {i} ({'move-to' if i < 23 else 'bin-pick'})"])
+                                 for i in range(17, 24)]
+    assert found[7] == (3.0, ["insert place before step 23 (bin-pick)"])
+
+
+def test_a_long_task_whose_only_problem_no_edit_cures_gets_the_whole_tasks_answer(cell: Cell) -> None:
+    """49 steps, the last taking its pose from a step no step is named: the encodings find nothing to repair, so the
+    answer is the whole-task repair's, however many repairs are asked for."""
+    body = "".join(f"  - command: {st.command}\n" for st in faulty_task(24, 0, 1).steps)
+    text = f"task: linked\nsteps:\n{body}  - command: pick\n    params:\n      pick_pose: {{from: nowhere, output: part_pose}}\n"
+    task = parse_task(text.encode(), "linked.yaml")
+    assert [(p.kind, p.step) for p in service.check(task, cell).problems] == [("bad_link", 49)]
+    for top in (1, 3):
+        assert _answers(service.repair(task, cell, top=top)) == _answers(repairs.repair(task, cell, KNOWLEDGE, top=top))
+
+
+def test_a_long_task_done_in_rounds_keeps_its_rounds_description_and_file_where_the_repair_keeps_them_alike(
+        cell: Cell) -> None:
+    """Twelve bin-picks and places done twice (48 steps), the third bin-pick of a round gripping too hard: the best
+    repair resets it in both rounds, so its task is still one round done twice; the next repairs a round otherwise."""
+    one_round = "".join("  - command: bin-pick\n" + ("    params: {grip_force: 150}\n" if i == 2 else "")
+                        + "  - command: place\n" for i in range(12))
+    text = f"task: rounds\ndescription: Twelve parts, twice\nrepeat: 2\nsteps:\n{one_round}"
+    task = parse_task(text.encode(), "rounds.yaml")
+    assert len(task.steps) == 48 and task.repeat == 2
+    found = service.repair(task, cell, top=2)
+    assert [(r.cost, r.task.repeat, r.task.description, r.task.file, len(r.task.steps)) for r in found] == [
+        (2.0, 2, "Twelve parts, twice", "rounds.yaml", 48), (7.0, 1, "Twelve parts, twice", "rounds.yaml", 48)]
+    assert found[0].task.one_round() == tuple(replace(st, params={}) if st.index == 5 else st
+                                              for st in task.one_round())
+
+
+def test_without_margin_a_problem_at_the_first_step_is_repaired_in_a_window_of_that_step_alone(cell: Cell) -> None:
+    """The first bin-pick grips too hard, no margin: the window is step 1 alone, so besides the reset the only repair
+    removes it and, before it, makes the gripper hold a located part for the place after it (the place is outside)."""
+    steps = list(faulty_task(24, 0, 1).steps)
+    steps[0] = replace(steps[0], params={"grip_force": 150})
+    task = Task("first", tuple(steps), "first.yaml")
+    found = windows.windowed_repair(task, cell, KNOWLEDGE, top=3, margin=0)
+    assert _answers(found) == [
+        (1.0, ["step 1 (bin-pick): reset parameter grip_force to its default 40"]),
+        (10.0, ["insert localize-part before step 1 (bin-pick)", "insert pick before step 1 (bin-pick)",
+                "remove step 1 (bin-pick)"])]
+    assert all(service.check(r.task, cell).plausible for r in found)
+
+
+@pytest.mark.parametrize("first, margins, answer", [
+    (2, [2, 4, 8], (2.0, ["swap step 45 (bin-pick) with step 46 (place)",
+                          "swap step 47 (bin-pick) with step 48 (place)"])),
+    (0, [0, 1], (8.0, ["remove step 43 (bin-pick)"])),  # no margin: one step more, then the cost settles
+])
+def test_when_edits_do_not_stay_local_the_margins_double_until_the_cost_settles(
+        cell: Cell, first: int, margins: list[int], answer: tuple[float, list[str]],
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    costs = RepairCosts(insert=10, insert_per_role=1, remove=8, swap=1, rebind=1, reset=5)
+    seen: list[int] = []
+    widen = windows.windows
+    monkeypatch.setattr(windows, "windows", lambda spans, n, margin: seen.append(margin) or widen(spans, n, margin))
+    found = windows.windowed_repair(faulty_task(24, 1, 113371), cell, KNOWLEDGE, costs=costs, top=1, margin=first)
+    assert (seen, _answers(found)) == (margins, [answer])
+
+
+def test_a_long_task_whose_windows_cover_it_is_repaired_whole(cell: Cell, monkeypatch: pytest.MonkeyPatch) -> None:
+    """42 steps with a fault in every pair but the first and the last: the windows merge into the whole task, which is
+    then repaired as a short task is (one whole-task repair), not as one window."""
+    task = faulty_task(21, 19, 0, kinds=NOT_DROPPED)
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    expected = _answers(repairs.repair(task, cell, KNOWLEDGE, top=2))
+    wholes: list[int] = []
+    whole_repair = repairs.repair
+    monkeypatch.setattr(repairs, "repair", lambda *a, **k: wholes.append(1) or whole_repair(*a, **k))
+    monkeypatch.setattr(windows._Solver, "best", lambda *a: pytest.fail("solved window by window"))
+    assert _answers(windows.windowed_repair(task, cell, KNOWLEDGE, top=2)) == expected and wholes == [1]
+    no_slots = _answers(whole_repair(task, cell, KNOWLEDGE, top=1, per_gap=0))  # no step inserted
+    assert _answers(windows.windowed_repair(task, cell, KNOWLEDGE, top=1, per_gap=0)) == no_slots != expected[:1]
+
+
+def test_a_long_task_covered_by_its_windows_is_repaired_whole_with_the_users_catalogue_and_costs(
+        cell: Cell, devices: list[DeviceDescription]) -> None:
+    """42 steps in a cell without a gripper, which every step needs: the windows cover the task, and the whole-task
+    repair buys a gripper at the user's prices (2 per device and a thousandth of its price)."""
+    found = windows.windowed_repair(faulty_task(21, 0, 1), cell.without("gripper"), KNOWLEDGE, devices, top=2,
+                                    costs=RepairCosts(add_device=2, add_device_per_price=0.001))
+    assert _answers(found) == [(2.7, ["add device 'magnetic-gripper' (Magnetic gripper, price 700) to the cell"]),
+                               (3.8, ["add device 'gripper' (Parallel gripper, price 1800) to the cell"])]
