@@ -6,6 +6,8 @@
     python scripts/mutation.py --jobs 2 --work build/mutation
     python scripts/mutation.py --again evaluator  # only the last run's survivors, with the tests as they are now
                                                   # (a whole run again if the module's list of tests changed)
+    python scripts/mutation.py --only 'xǁFeasibilityǁ__init__' --only x__key_masks reasoning-feasibility
+                                                  # only the mutants of some functions (mutmut's keys, * allowed)
 
 For each guard module, mutmut (3.x, the ``test`` extra) makes small changes to its guard
 functions, one at a time (``<`` for ``<=``, ``and`` for ``or``, a string or number changed,
@@ -51,7 +53,7 @@ import time
 import tomllib
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import mutation_asp
@@ -595,6 +597,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jobs", type=int, default=2, help="mutants tested at once (default 2)")
     parser.add_argument("--again", action="store_true",
                         help="test only the survivors of the last run again, with the tests as they are now")
+    parser.add_argument("--only", action="append", default=[], metavar="FUNCTION",
+                        help="mutate only this function of the modules named (mutmut's key: x_name, xǁClassǁmethod; "
+                             "* matches any text; may be given several times)")
     parser.add_argument("--work", type=Path, default=ROOT / "build" / "mutation",
                         help="folder for the per-module copies (default build/mutation)")
     args = parser.parse_args(argv)
@@ -607,11 +612,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"scripts/mutation.py: unknown module {unknown[0]!r}; expected one of {', '.join(by_name)}",
               file=sys.stderr)
         return 2
+    if args.only and (not args.modules or any(not isinstance(by_name[m], Guard) for m in args.modules)):
+        print("scripts/mutation.py: --only names functions of Python modules: name those modules, no encoding",
+              file=sys.stderr)
+        return 2
     known = equivalents()
     total: Counter[str] = Counter()
     try:
         for name in args.modules or list(by_name):
             unit = by_name[name]
+            if args.only and isinstance(unit, Guard):
+                unit = replace(unit, functions=tuple(args.only))
             run = run_guard if isinstance(unit, Guard) else run_encoding
             total.update(run(unit, args.work.resolve() / name, args.jobs, known, args.again))  # type: ignore[arg-type]
     except RuntimeError as exc:

@@ -117,6 +117,19 @@ def test_the_journal_reads_each_state_of_a_region_as_its_devices_state() -> None
     assert (region.get(pnp + "role"), region.get(pnp + "device")) == ("localizer", "binpicking-pc")
 
 
+def test_each_mirrored_move_of_a_region_leads_to_its_next_state() -> None:
+    # the pick's gripper, once the robot is at the part: send Close and go to the state of a closing gripper, then
+    # wait there for the event that it closed and go on to the region's final state
+    generation = service.generation(service.builtin("tasks", "bin-picking-localized.yaml"), CELL)
+    chart = etree.fromstring(next(c.data for c in generation.charts if c.kind == "task"))
+    region = chart.find(".//s:state[@id='s2_gripper']", NS)
+    assert [(s.get("id"), [(t.get("event"), t.get("cond"), [a.get("event") for a in t], t.get("target"))
+                           for t in s.iterfind("s:transition", NS)]) for s in region] == [
+        ("s2_gripper_open", [(None, "In('s2_robot_at_part')", ["xirp.request.Close"], "s2_gripper_closed_1a")]),
+        ("s2_gripper_closed_1a", [("gripper.xirp.event.gripper_closed", None, [], "s2_gripper_closed")]),
+        ("s2_gripper_closed", [])]
+
+
 def test_a_force_for_a_device_that_declares_no_unit_is_sent_as_written(tmp_path: Path) -> None:
     # the gripper's Close takes a plain number: the 45 N of the task go out as 45, not converted to a float
     for f in ("gripper.ttl", "gripper.scxml"):
