@@ -6,6 +6,7 @@ how many repairs) honoured both ways."""
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
@@ -617,3 +618,22 @@ def test_a_long_task_covered_by_its_windows_is_repaired_whole_with_the_users_cat
                                     costs=RepairCosts(add_device=2, add_device_per_price=0.001))
     assert _answers(found) == [(2.7, ["add device 'magnetic-gripper' (Magnetic gripper, price 700) to the cell"]),
                                (3.8, ["add device 'gripper' (Parallel gripper, price 1800) to the cell"])]
+
+
+def test_a_long_task_whose_only_problem_is_a_stuck_device_is_repaired_window_by_window(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """45 moves and, at 31, a close-gripper in a cell whose gripper is delivered locked open (the transport-lock
+    library, written outside the package): its stuck start state is a problem of the encodings' own check, so the
+    task is repaired window by window, not handed whole to the whole-task repair."""
+    library = Path(__file__).parent.parent / "data" / "libraries" / "transport-lock"
+    k = service.knowledge((library,))
+    cell = service.cell(library / "cells" / "bin-picking-locked.yaml", k)
+    move = Step(0, "move-to", {}, {"target_pose": [0.4, 0, 0.3, 0, 180, 0], "speed": 50})
+    steps = [move] * 30 + list(service.task(library / "tasks" / "close-gripper.yaml").steps) + [move] * 14
+    task = Task("locked", tuple(replace(st, index=n) for n, st in enumerate(steps, start=1)), "locked.yaml")
+    assert len(task.steps) > windows.WHOLE_UP_TO
+    assert [(p.kind, p.step) for p in service.check(task, cell, k).problems] == [("stuck", 31)]
+    monkeypatch.setattr(repairs, "repair", lambda *a, **kw: pytest.fail("repaired whole, not window by window"))
+    found = service.repair(task, cell, top=3, knowledge=k)
+    assert _answers(found) == [(4.0, ["remove step 31 (close-gripper)"])]
+    assert service.check(found[0].task, cell, k).plausible
