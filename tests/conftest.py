@@ -18,6 +18,15 @@ from tests.processes import ours, running_descendants
 DESCRIPTIONS = descriptions_path()
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    """The tests stop the ``pnp`` processes they start with Ctrl-C (SIGINT), as a user would. A suite started in the
+    background by a shell (``python -m pytest &``) inherits SIGINT ignored, and an ignored signal stays ignored in
+    every process it starts, so none of them would stop: give the suite Python's own handler, which a started
+    process does not inherit."""
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 @pytest.fixture(scope="session", autouse=True)
 def no_process_outlives_the_suite() -> Iterator[None]:
     """At the end of the session (of each worker), no ``pnp``/``python -m plugnproduce`` process a test started is
