@@ -85,9 +85,8 @@ class HostileDevice:
 
     def _answer(self, conn: socket.socket) -> None:
         with conn, contextlib.suppress(OSError):
-            conn.settimeout(1.0)
+            conn.settimeout(WAIT)  # a controller busy elsewhere for a second must find the request read, the body whole
             conn.recv(4096)
-            conn.settimeout(WAIT)  # a reader busy elsewhere for a second must not find the description cut short
             if self.kind == "huge":
                 conn.sendall(f"HTTP/1.1 200 OK\r\nContent-Type: text/xml\r\nContent-Length: {HUGE}\r\n\r\n".encode())
                 chunk, sent = b"<" * 65536, 0
