@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 import yaml
-from playwright.sync_api import Page, Route, expect
+from playwright.sync_api import APIResponse, Page, Route, expect
 from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
 from plugnproduce import service
@@ -190,6 +190,21 @@ def test_a_check_still_running_when_an_import_fails_does_not_hide_the_import_s_e
     expect(page.locator("#verdict .error")).to_have_text(refused)
     expect(page.locator("#verdict .ok")).to_have_count(0)
     expect(page.locator("#steps li.step")).to_have_count(steps)  # the task as it was
+
+
+@pytest.mark.parametrize("served", [SLOW_GRIPPER], indirect=True)
+def test_a_run_the_event_stream_tells_before_its_start_is_answered_still_says_its_devices_are_simulated(
+        page: Page) -> None:
+    """The page learns of a run from the event stream and from the answer to its start, in either order."""
+    page.locator("#import").set_input_files(str(service.builtin("tasks", "pick-and-place.yaml")))
+    expect(page.locator("#verdict .ok")).to_be_visible()
+    held: list[tuple[Route, APIResponse]] = []
+    page.route("**/api/runs", lambda route: held.append((route, route.fetch())))  # started; its answer held back
+    page.get_by_role("button", name="Start run").click()
+    expect(page.locator("#run-states tr[data-device='gripper'] .badge")).to_have_text("closing")  # from the stream
+    assert len(held) == 1
+    held[0][0].fulfill(response=held[0][1])
+    expect(page.locator("#run-status")).to_contain_text("on simulated devices at speed 1")
 
 
 @pytest.mark.parametrize("served", [SLOW_GRIPPER], indirect=True)

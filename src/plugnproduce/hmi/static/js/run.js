@@ -180,7 +180,8 @@ export function takeRecord({ run: id, record, text }) {
   run.lines.push(text);
   switch (record.kind) {
     case "start":
-      Object.assign(run, { task: record.task, steps: record.steps, states: { ...(record.states || {}) } });
+      Object.assign(run, { task: record.task, cell: record.cell, speed: record.speed ?? null, steps: record.steps,
+        states: { ...(record.states || {}) } });
       break;
     case "step":
       run.step = record;
